@@ -1,0 +1,212 @@
+"""Ball and bat properties (Tables I and II of Kensrud et al. 2017) and recoil factors.
+
+The property tables live in CSV files in the paper's units (``config/balls.csv`` and
+``config/bats.csv``); :func:`load_balls` and :func:`load_bats` read them, check every row
+and return SI dataclasses. :func:`recoil_normal` and :func:`recoil_tangential` are the
+kinematic recoil factors r_y (Eq. ry) and r_x (Eq. rx).
+
+References
+----------
+.. [1] J. R. Kensrud, A. M. Nathan and L. V. Smith, "Oblique collisions of baseballs and
+   softballs with a bat", Am. J. Phys. 85, 503 (2017).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+from .units import INCH, OUNCE, OZ_IN2
+
+
+class InputError(ValueError):
+    """Bad user input; the message names the file, the row, the column and the problem.
+
+    ``problems`` holds every problem found (a file is checked whole, not up to the first
+    problem).
+    """
+
+    def __init__(self, problems: list[str]):
+        self.problems = list(problems)
+        super().__init__("\n".join(self.problems))
+
+
+@dataclass(frozen=True)
+class Ball:
+    """A ball type, SI units. ``alpha`` is I_ball / (m r^2) (Eq. iball)."""
+
+    ball: str
+    name: str
+    m: float  # kg
+    r: float  # m
+    alpha: float = 0.4
+    psi_max: float = math.nan  # rad, Table I (experiment's range, not a property)
+    D_max: float = math.nan  # m, Table I
+
+
+@dataclass(frozen=True)
+class Bat:
+    """A bat at its impact location, SI units (Table II)."""
+
+    bat: str
+    name: str
+    M: float  # kg
+    I0: float  # kg m^2, about the centre of mass, perpendicular to the axis
+    Iz: float  # kg m^2, about the long axis
+    b: float  # m, impact location from the centre of mass
+    R: float  # m, bat radius at the impact location
+
+
+#: Columns of the ball table: name -> (unit factor to SI, required, must be positive).
+BALL_COLUMNS = {
+    "ball": (None, True, False),
+    "name": (None, False, False),
+    "m_oz": (OUNCE, True, True),
+    "m_oz_sd": (OUNCE, False, False),
+    "r_in": (INCH, True, True),
+    "r_in_sd": (INCH, False, False),
+    "alpha": (1.0, False, True),
+    "psi_max_deg": (math.pi / 180, False, True),
+    "D_max_in": (INCH, False, True),
+}
+
+#: Columns of the bat table: name -> (unit factor to SI, required, must be positive).
+BAT_COLUMNS = {
+    "bat": (None, True, False),
+    "name": (None, False, False),
+    "M_oz": (OUNCE, True, True),
+    "I0_oz_in2": (OZ_IN2, True, True),
+    "Iz_oz_in2": (OZ_IN2, True, True),
+    "b_in": (INCH, True, False),
+    "R_in": (INCH, True, True),
+}
+
+
+def _read_table(path: Path, columns: dict, key: str) -> list[dict]:
+    """Read a property CSV, checking every row; raise one InputError listing all problems."""
+    path = Path(path)
+    problems: list[str] = []
+    try:
+        with open(path, newline="") as fh:
+            reader = csv.DictReader(fh)
+            header = [h.strip() for h in (reader.fieldnames or [])]
+            rows = [{(k or "").strip(): (v or "").strip() for k, v in row.items()} for row in reader]
+    except FileNotFoundError:
+        raise InputError([f"{path}: file not found"]) from None
+    missing = [c for c, (_, req, _) in columns.items() if req and c not in header]
+    unknown = [c for c in header if c not in columns]
+    if missing:
+        problems.append(f"{path}: missing column(s) {', '.join(missing)}")
+    if unknown:
+        problems.append(f"{path}: unknown column(s) {', '.join(unknown)}; expected {', '.join(columns)}")
+    if missing:
+        raise InputError(problems)
+    out, seen = [], {}
+    for i, row in enumerate(rows, start=2):  # row 1 is the header
+        rec = {}
+        for col, (factor, req, positive) in columns.items():
+            raw = row.get(col, "")
+            if factor is None:
+                if req and not raw:
+                    problems.append(f"{path}: row {i}, column {col}: empty")
+                rec[col] = raw
+                continue
+            if raw == "":
+                if req:
+                    problems.append(f"{path}: row {i}, column {col}: empty")
+                rec[col] = None
+                continue
+            try:
+                val = float(raw)
+            except ValueError:
+                problems.append(f"{path}: row {i}, column {col}: {raw!r} is not a number")
+                continue
+            if not math.isfinite(val):
+                problems.append(f"{path}: row {i}, column {col}: {raw!r} is not finite")
+            elif positive and val <= 0:
+                problems.append(f"{path}: row {i}, column {col}: {raw} must be positive")
+            rec[col] = val * factor
+        k = rec.get(key)
+        if k:
+            if k in seen:
+                problems.append(f"{path}: row {i}, column {key}: {k!r} duplicates row {seen[k]}")
+            seen[k] = i
+        out.append(rec)
+    if not rows:
+        problems.append(f"{path}: no rows")
+    if problems:
+        raise InputError(problems)
+    return out
+
+
+def load_balls(path) -> dict[str, Ball]:
+    """Read a ball table (Table I layout, paper units) into SI :class:`Ball` records."""
+    balls = {}
+    for rec in _read_table(path, BALL_COLUMNS, "ball"):
+        balls[rec["ball"]] = Ball(
+            ball=rec["ball"],
+            name=rec["name"] or rec["ball"],
+            m=rec["m_oz"],
+            r=rec["r_in"],
+            alpha=rec["alpha"] if rec["alpha"] is not None else 0.4,
+            psi_max=rec["psi_max_deg"] if rec["psi_max_deg"] is not None else math.nan,
+            D_max=rec["D_max_in"] if rec["D_max_in"] is not None else math.nan,
+        )
+    return balls
+
+
+def load_bats(path) -> dict[str, Bat]:
+    """Read a bat table (Table II layout, paper units) into SI :class:`Bat` records."""
+    return {
+        rec["bat"]: Bat(
+            bat=rec["bat"],
+            name=rec["name"] or rec["bat"],
+            M=rec["M_oz"],
+            I0=rec["I0_oz_in2"],
+            Iz=rec["Iz_oz_in2"],
+            b=rec["b_in"],
+            R=rec["R_in"],
+        )
+        for rec in _read_table(path, BAT_COLUMNS, "bat")
+    }
+
+
+def as_dict(record) -> dict:
+    """A property record as a plain dict (for provenance)."""
+    return asdict(record)
+
+
+def recoil_normal(m, M, I0, b):
+    """Normal recoil factor r_y of the bat (Eq. ry of Kensrud et al. 2017).
+
+    Parameters
+    ----------
+    m : ball mass, kg.   M : bat mass, kg.
+    I0 : bat moment of inertia about its centre of mass, kg m^2.
+    b : impact location measured from the bat's centre of mass, m.
+
+    Notes
+    -----
+    r_y = m (1/M + b^2/I0).
+    """
+    return m * (1.0 / M + b**2 / I0)
+
+
+def recoil_tangential(m, M, I0, Iz, b, R, alpha=0.4):
+    """Tangential recoil factor r_x of the bat (Eq. rx of Kensrud et al. 2017).
+
+    Notes
+    -----
+    r_x = m alpha/(1 + alpha) (1/M + b^2/I0 + R^2/Iz), with R the bat radius at impact
+    and Iz the bat's moment of inertia about its long axis.
+    """
+    return m * alpha / (1.0 + alpha) * (1.0 / M + b**2 / I0 + R**2 / Iz)
+
+
+def recoil_factors(ball: Ball, bat: Bat) -> tuple[float, float]:
+    """(r_x, r_y) for a ball hitting a bat."""
+    r_x = recoil_tangential(ball.m, bat.M, bat.I0, bat.Iz, bat.b, bat.R, ball.alpha)
+    r_y = recoil_normal(ball.m, bat.M, bat.I0, bat.b)
+    return r_x, r_y
