@@ -1,0 +1,23 @@
+# ballbat: oblique ball-bat collisions, end to end (Kensrud, Nathan & Smith 2017).
+# A table of contents: config, validation, one file of rules per stage, and the targets.
+from snakemake.utils import min_version
+
+min_version("9.0")
+
+
+configfile: "config/config.yaml"
+
+
+include: "workflow/rules/common.smk"
+include: "workflow/rules/source.smk"
+include: "workflow/rules/normalize.smk"
+include: "workflow/rules/reconstruct.smk"
+include: "workflow/rules/fit_ex.smk"
+include: "workflow/rules/compare.smk"
+
+
+rule all:
+    """Every dataset's paper comparison (and all that it needs)."""
+    input:
+        all_targets(),
+    default_target: True

@@ -1,0 +1,185 @@
+"""The paper-comparison table: every published number beside ours (and the truth).
+
+Columns: ``quantity, ball, bat, paper, paper_uncertainty, value, uncertainty, truth, unit``,
+in the paper's units. One row per published number (``ballbat.published``) and one per
+result of ours that the paper does not publish (e.g. e_x of a bat not in the paper, or
+e_y implied by Eq. ratio). Cells that do not apply are empty.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+
+import numpy as np
+
+from .published import PUBLISHED, UNPUBLISHED
+from .units import from_si
+
+COLUMNS = ("quantity", "ball", "bat", "paper", "paper_uncertainty", "value", "uncertainty", "truth", "unit")
+
+#: quantity -> (variable in fit_ex.nc, unit of the table); value's error is ``<var>_err``.
+FIT_QUANTITIES = {
+    "e_x": ("e_x", "1"),
+    "e_x_pooled": ("e_x_pooled", "1"),
+    "spin_theta_slope": ("spin_theta_slope", "rpm/deg"),
+    "speed_theta_slope": ("speed_theta_slope", "mph/deg"),
+    "tan_ratio_slope": ("tan_ratio_slope", "1"),
+    "e_y_implied": ("e_y_implied", "1"),
+    "mu_k_lower_bound": ("mu_k_lower_bound", "1"),
+    "gross_slip_psi": ("gross_slip_psi", "deg"),
+    "gross_slip_theta": ("gross_slip_theta", "deg"),
+    "gross_slip_omega": ("gross_slip_omega", "rpm"),
+}
+
+
+def _num(x) -> str:
+    if x is None:
+        return ""
+    x = float(x)
+    return "" if not math.isfinite(x) else f"{x:.6g}"
+
+
+def _pick(ds, var, ball, bat):
+    if var not in ds:
+        return None
+    v = ds[var]
+    if "ball" in v.dims:
+        if ball not in ds["ball"].values:
+            return None
+        v = v.sel(ball=ball)
+    if "bat" in v.dims:
+        if bat not in ds["bat"].values:
+            return None
+        v = v.sel(bat=bat)
+    return float(v.values)
+
+
+def fit_rows(fit) -> list[dict]:
+    """Rows for the quantities of ``fit_ex.nc`` (values in SI converted to the table's units)."""
+    rows = []
+    balls = [str(b) for b in fit["ball"].values]
+    bats = [str(b) for b in fit["bat"].values]
+    for q, (var, unit) in FIT_QUANTITIES.items():
+        per_bat = "bat" in fit[var].dims
+        for ball in balls:
+            for bat in bats if per_bat else [""]:
+                val = _pick(fit, var, ball, bat or None)
+                if val is None or (per_bat and not np.isfinite(val) and _pick(fit, f"{var}_n", ball, bat) == 0):
+                    continue
+                err = _pick(fit, f"{var}_err", ball, bat or None)
+                tru = _pick(fit, f"truth_{var}", ball, bat or None)
+                conv = (lambda x, unit=unit: None if x is None else from_si(x, unit)) if unit != "1" else (lambda x: x)
+                rows.append(
+                    {
+                        "quantity": q,
+                        "ball": ball,
+                        "bat": bat,
+                        "value": conv(val),
+                        "uncertainty": conv(err),
+                        "truth": conv(tru),
+                        "unit": unit,
+                    }
+                )
+    return rows
+
+
+def impact_rows(rec) -> list[dict]:
+    """Rows from the reconstructed impacts: psi_max, D_max and n_impacts per ball (Table I)."""
+    rows = []
+    ok = rec["flag"].values == 0
+    ball = rec["ball"].values.astype(str)
+    has_truth = "truth_psi" in rec
+    for b in sorted(set(ball)):
+        sel = ok & (ball == b)
+        psi = rec["psi"].values[sel]
+        D = rec["D"].values[sel]
+        tpsi = rec["truth_psi"].values[ball == b] if has_truth else None
+        tD = (rec["r"].values + rec["R"].values)[ball == b] * np.sin(tpsi) if has_truth else None
+        rows += [
+            {
+                "quantity": "psi_max",
+                "ball": b,
+                "bat": "",
+                "value": from_si(psi.max(), "deg") if psi.size else None,
+                "truth": from_si(tpsi.max(), "deg") if has_truth else None,
+                "unit": "deg",
+            },
+            {
+                "quantity": "D_max",
+                "ball": b,
+                "bat": "",
+                "value": from_si(D.max(), "in") if D.size else None,
+                "truth": from_si(tD.max(), "in") if has_truth else None,
+                "unit": "in",
+            },
+            {
+                "quantity": "n_impacts",
+                "ball": b,
+                "bat": "",
+                "value": int(sel.sum()),
+                "truth": int((ball == b).sum()) if has_truth else None,
+                "unit": "1",
+            },
+        ]
+    return rows
+
+
+def comparison_table(rows: list[dict]) -> list[dict]:
+    """Merge our rows with the published values: one row per published number, plus ours."""
+    ours = {(r["quantity"], r["ball"], r["bat"]): r for r in rows}
+    table = []
+    for p in PUBLISHED:
+        key = (p.quantity, p.ball, p.bat)
+        r = ours.pop(key, {})
+        table.append(
+            {
+                **{c: None for c in COLUMNS},
+                **r,
+                "quantity": p.quantity,
+                "ball": p.ball,
+                "bat": p.bat,
+                "paper": p.value,
+                "paper_uncertainty": p.uncertainty,
+                "unit": p.unit,
+            }
+        )
+    for key, r in ours.items():  # results with no published counterpart
+        unit = r.get("unit") or UNPUBLISHED.get(key[0], "")
+        table.append({**{c: None for c in COLUMNS}, **r, "unit": unit})
+    return table
+
+
+def to_csv(table: list[dict]) -> str:
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(COLUMNS)
+    for r in table:
+        w.writerow([r[c] if c in ("quantity", "ball", "bat", "unit") else _num(r[c]) for c in COLUMNS])
+    return buf.getvalue()
+
+
+def to_markdown(table: list[dict], title: str) -> str:
+    lines = [f"# {title}", "", "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    for r in table:
+        cells = [r[c] or "" if c in ("quantity", "ball", "bat", "unit") else _num(r[c]) for c in COLUMNS]
+        lines.append("| " + " | ".join(cells) + " |")
+    return "\n".join(lines) + "\n"
+
+
+def read_csv(path) -> list[dict]:
+    """Read a comparison CSV back (strings)."""
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def write_comparison(fit, impacts, csv_path, md_path, title, extra_rows=()) -> list[dict]:
+    """Build the comparison from ``fit_ex.nc`` and ``reconstruct.nc``; write CSV and Markdown."""
+    from .ncio import atomic_write_text, read_dataset
+
+    rows = fit_rows(read_dataset(fit)) + impact_rows(read_dataset(impacts)) + list(extra_rows)
+    table = comparison_table(rows)
+    atomic_write_text(csv_path, to_csv(table))
+    atomic_write_text(md_path, to_markdown(table, title))
+    return table

@@ -1,0 +1,163 @@
+"""Kinematics of a bat hitting a ball at rest (Sec. III of Kensrud et al. 2017).
+
+Forward model (used to make synthetic experiments) and its inverse (the reconstruction of
+the impact geometry psi from measured exit speed, angle and spin). All inputs and outputs
+are SI: m, m s-1, rad, rad s-1. Functions broadcast over numpy arrays of impacts.
+
+Conventions (PHYSICS.md): n-hat points from the bat's centre to the ball's centre; the bat
+velocity is v_bat (cos psi n-hat + sin psi t-hat); omega > 0 is the spin of the paper's
+Fig. 2 (backspin when the bat undercuts the ball); theta is the ball's angle from the bat's
+direction of travel.
+
+References
+----------
+.. [1] J. R. Kensrud, A. M. Nathan and L. V. Smith, Am. J. Phys. 85, 503 (2017).
+.. [2] R. Cross and A. M. Nathan, "Scattering of a baseball by a bat",
+   Am. J. Phys. 74, 896 (2006).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Reference bat speed of the paper's normalisation, m/s (77 mph, Sec. II).
+V_BAT_REF = 77.0 * 0.44704
+
+
+def offset_from_psi(psi, r, R):
+    """Ball-bat offset D from the impact angle psi (Eq. D): D = (r + R) sin psi."""
+    return (r + R) * np.sin(psi)
+
+
+def psi_from_offset(D, r, R):
+    """Inverse of Eq. D: psi = asin(D / (r + R))."""
+    return np.arcsin(np.asarray(D, dtype=float) / (r + R))
+
+
+def spin_bracket(v_bat, psi, r, r_x, alpha=0.4):
+    """The bracket of Eq. omega: v_bat sin psi / (r (1 + r_x)(1 + alpha)), rad s-1.
+
+    The measured spin is (1 + e_x) times this term; Fig. 5 plots omega against it.
+    """
+    return v_bat * np.sin(psi) / (r * (1.0 + r_x) * (1.0 + alpha))
+
+
+def vtf_bracket(psi, r_x):
+    """The bracket of Eq. vtf: tan psi / (1 + r_x) (dimensionless, Fig. 9 abscissa)."""
+    return np.tan(psi) / (1.0 + r_x)
+
+
+def vtf_ordinate(v_ball, theta, omega, v_bat, psi, r):
+    """The left side of Eq. vtf: (v_ball,t + r omega) / v_bat,n (Fig. 9 ordinate).
+
+    v_ball,t = v_ball sin(psi - theta) and v_bat,n = v_bat cos psi.
+    """
+    return (v_ball * np.sin(psi - theta) + r * omega) / (v_bat * np.cos(psi))
+
+
+@dataclass(frozen=True)
+class Outgoing:
+    """Outgoing ball of a ball-at-rest collision (SI)."""
+
+    v_n: np.ndarray  # m s-1, normal component
+    v_t: np.ndarray  # m s-1, tangential component
+    omega: np.ndarray  # rad s-1
+    v_ball: np.ndarray  # m s-1, speed
+    theta: np.ndarray  # rad, angle from the bat's direction of travel
+
+
+def ball_at_rest_collision(v_bat, psi, e_x, e_y, r, r_x, r_y, alpha=0.4) -> Outgoing:
+    """Outgoing ball after a bat at speed ``v_bat`` and angle ``psi`` hits a ball at rest.
+
+    Parameters
+    ----------
+    v_bat : bat speed at the impact point, m s-1.
+    psi : angle of the bat velocity to the normal n-hat, rad.
+    e_x, e_y : tangential and normal coefficients of restitution.
+    r : ball radius, m.   r_x, r_y : recoil factors (Eqs. rx, ry).
+    alpha : I_ball / (m r^2) (Eq. iball).
+
+    Notes
+    -----
+    v_n = (1 + e_y)/(1 + r_y) v_bat cos psi                    (Eq. vballn)
+    v_t = (1 + e_x) alpha v_bat sin psi / ((1 + r_x)(1 + alpha)) (Eq. vxf)
+    omega = (1 + e_x) v_bat sin psi / (r (1 + r_x)(1 + alpha))  (Eq. omega)
+    theta = psi - atan(v_t / v_n)                               (Fig. 2 geometry)
+    """
+    v_n = (1.0 + e_y) / (1.0 + r_y) * v_bat * np.cos(psi)
+    v_t = (1.0 + e_x) * alpha * v_bat * np.sin(psi) / ((1.0 + r_x) * (1.0 + alpha))
+    omega = (1.0 + e_x) * spin_bracket(v_bat, psi, r, r_x, alpha)
+    return Outgoing(
+        v_n=v_n,
+        v_t=v_t,
+        omega=omega,
+        v_ball=np.hypot(v_n, v_t),
+        theta=psi - np.arctan2(v_t, v_n),
+    )
+
+
+#: Reasons a measured impact cannot be reconstructed (value of the ``flag`` variable).
+RECONSTRUCT_FLAGS = {
+    0: "ok",
+    1: "alpha r omega / v_ball outside [-1, 1]: psi undefined (Eq. angmom)",
+    2: "non-finite or non-positive measured speed",
+    3: "reconstructed |psi| >= 90 deg: the bat cannot reach the ball there",
+}
+
+
+def reconstruct_psi(v_ball, theta, omega, r, alpha=0.4):
+    """Impact angle psi from measured exit speed, angle and spin (Eq. angmom).
+
+    Returns ``(psi, flag)``. Angular momentum of the ball about the contact point
+    vanishes (Eq. angmom): alpha m r^2 omega = m v_ball r sin(psi - theta), so
+    psi = theta + asin(alpha r omega / v_ball). Where the argument lies outside [-1, 1]
+    psi is NaN and ``flag`` is 1 (see :data:`RECONSTRUCT_FLAGS`): never clipped. A small
+    negative psi (bat over the ball's centre, or noise near head-on impacts) is valid.
+    """
+    v_ball = np.asarray(v_ball, dtype=float)
+    arg = alpha * r * np.asarray(omega, dtype=float) / np.where(v_ball > 0, v_ball, np.nan)
+    bad_speed = ~np.isfinite(v_ball) | (v_ball <= 0)
+    out_of_range = ~bad_speed & (np.abs(arg) > 1.0)
+    with np.errstate(invalid="ignore"):
+        psi = np.where(bad_speed | out_of_range, np.nan, theta + np.arcsin(np.clip(arg, -1, 1)))
+    flag = np.zeros(np.shape(psi), dtype=np.int8)
+    flag[out_of_range] = 1
+    flag[bad_speed] = 2
+    with np.errstate(invalid="ignore"):
+        flag[(flag == 0) & ~(np.abs(psi) < np.pi / 2)] = 3
+    return psi, flag
+
+
+def normalize_to_bat_speed(value, v_bat, v_ref=V_BAT_REF):
+    """Scale a measured spin or exit speed to the reference bat speed (Sec. II).
+
+    Both scale linearly with bat speed (Eqs. vballn, vxf, omega), so the normalised value
+    is value * v_ref / v_bat. The paper's text prints the ratio upside down; only
+    v_ref / v_bat normalises (PHYSICS.md).
+    """
+    return np.asarray(value, dtype=float) * (v_ref / np.asarray(v_bat, dtype=float))
+
+
+def tan_ratio_slope_model(e_x, e_y, r_x, r_y, alpha=0.4):
+    """Slope of tan(psi - theta) against tan psi predicted by Eq. ratio."""
+    return alpha / (1.0 + alpha) * (1.0 + e_x) / (1.0 + r_x) * (1.0 + r_y) / (1.0 + e_y)
+
+
+def e_y_from_tan_ratio_slope(slope, e_x, r_x, r_y, alpha=0.4):
+    """Invert Eq. ratio for the normal COR e_y that a measured slope implies."""
+    return alpha / (1.0 + alpha) * (1.0 + e_x) / (1.0 + r_x) * (1.0 + r_y) / slope - 1.0
+
+
+def gross_slip_onset(mu_k, tan_slope, v_bat, e_x, r, r_x, alpha=0.4):
+    """Largest psi before gross slip for friction ``mu_k`` (Sec. IV example).
+
+    Gross slip sets in where tan(psi - theta) reaches mu_k (Eq. muk); with the measured
+    slope of Eq. ratio, tan psi = mu_k / slope. Returns ``(psi, theta, omega)`` at that
+    point, omega from Eq. omega at bat speed ``v_bat``.
+    """
+    psi = np.arctan(mu_k / tan_slope)
+    theta = psi - np.arctan(mu_k)
+    omega = (1.0 + e_x) * spin_bracket(v_bat, psi, r, r_x, alpha)
+    return psi, theta, omega

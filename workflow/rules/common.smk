@@ -1,0 +1,50 @@
+# Config validation, input functions and code dependencies shared by all rules.
+from pathlib import Path
+
+import yaml
+
+from ballbat.codedeps import module_files
+from ballbat.config import validate_config
+
+SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
+with open(SCHEMA) as _fh:
+    validate_config(config, yaml.safe_load(_fh), source="config (config/config.yaml and --configfile/--config overrides)")
+
+DATASETS = sorted(config["datasets"])
+SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
+
+
+wildcard_constraints:
+    dataset="|".join(DATASETS),
+
+
+def code(script):
+    """The package modules a script imports (so editing them reruns the rule)."""
+    here = Path.cwd()
+    files = module_files(str(SCRIPTS / script))
+    return [str(Path(f).relative_to(here)) if Path(f).is_relative_to(here) else f for f in files]
+
+
+def dataset_config(wildcards):
+    return config["datasets"][wildcards.dataset]
+
+
+def get_synthetic_settings(wildcards):
+    return dataset_config(wildcards)["synthetic"]
+
+
+def get_balls_table(wildcards):
+    return dataset_config(wildcards).get("balls", config["tables"]["balls"])
+
+
+def get_bats_table(wildcards):
+    return dataset_config(wildcards).get("bats", config["tables"]["bats"])
+
+
+def get_source(wildcards):
+    """The first stage of a dataset: its synthetic experiment."""
+    return f"results/{wildcards.dataset}/simulate.nc"
+
+
+def all_targets():
+    return expand("results/{dataset}/paper_comparison.csv", dataset=DATASETS)

@@ -1,0 +1,13 @@
+rule compare:
+    """Tabulate every published number of Secs. II-IV beside ours and the truth."""
+    input:
+        fit=rules.fit_ex.output.fit,
+        impacts=rules.reconstruct.output.impacts,
+        code=code("compare.py"),
+    output:
+        csv="results/{dataset}/paper_comparison.csv",
+        md="results/{dataset}/paper_comparison.md",
+    log:
+        "results/{dataset}/logs/compare.log",
+    script:
+        "../scripts/compare.py"

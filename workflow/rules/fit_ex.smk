@@ -1,0 +1,16 @@
+rule fit_ex:
+    """Fit e_x per bat and ball and pooled (Eq. omega), Eq. ratio, and the Figs. 3-4 slopes."""
+    input:
+        impacts=rules.reconstruct.output.impacts,
+        code=code("fit_ex.py"),
+    output:
+        fit="results/{dataset}/fit_ex.nc",
+    params:
+        v_ref_mph=config["normalize"]["v_ref_mph"],
+        mu_k_example=config["analysis"]["mu_k_example"],
+    log:
+        "results/{dataset}/logs/fit_ex.log",
+    benchmark:
+        "results/{dataset}/benchmarks/fit_ex.tsv"
+    script:
+        "../scripts/fit_ex.py"

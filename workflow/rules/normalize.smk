@@ -1,0 +1,15 @@
+rule normalize:
+    """Scale measured spin and exit speed to the reference bat speed of 77 mph (Sec. II)."""
+    input:
+        impacts=get_source,
+        code=code("normalize.py"),
+    output:
+        impacts="results/{dataset}/normalize.nc",
+    params:
+        v_ref_mph=config["normalize"]["v_ref_mph"],
+    log:
+        "results/{dataset}/logs/normalize.log",
+    benchmark:
+        "results/{dataset}/benchmarks/normalize.tsv"
+    script:
+        "../scripts/normalize.py"

@@ -1,0 +1,15 @@
+rule reconstruct:
+    """Reconstruct psi (Eq. angmom), D and the bracket terms of Eqs. omega and vtf per impact."""
+    input:
+        impacts=rules.normalize.output.impacts,
+        balls=get_balls_table,
+        bats=get_bats_table,
+        code=code("reconstruct.py"),
+    output:
+        impacts="results/{dataset}/reconstruct.nc",
+    log:
+        "results/{dataset}/logs/reconstruct.log",
+    benchmark:
+        "results/{dataset}/benchmarks/reconstruct.tsv"
+    script:
+        "../scripts/reconstruct.py"

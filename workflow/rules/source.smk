@@ -1,0 +1,16 @@
+rule simulate:
+    """Draw a synthetic experiment that mirrors the paper's (Sec. II, Tables I-II)."""
+    input:
+        balls=get_balls_table,
+        bats=get_bats_table,
+        code=code("simulate.py"),
+    output:
+        impacts="results/{dataset}/simulate.nc",
+    params:
+        settings=get_synthetic_settings,
+    log:
+        "results/{dataset}/logs/simulate.log",
+    benchmark:
+        "results/{dataset}/benchmarks/simulate.tsv"
+    script:
+        "../scripts/simulate.py"

@@ -1,0 +1,13 @@
+"""Rule compare: adapter around ballbat.compare."""
+
+from ballbat.compare import write_comparison
+from ballbat.runlog import logged
+
+with logged(snakemake.log[0], snakemake.rule):
+    write_comparison(
+        fit=snakemake.input.fit,
+        impacts=snakemake.input.impacts,
+        csv_path=snakemake.output.csv,
+        md_path=snakemake.output.md,
+        title=f"Dataset {snakemake.wildcards.dataset}: the paper's numbers beside ours",
+    )

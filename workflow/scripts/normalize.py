@@ -1,0 +1,18 @@
+"""Rule normalize: adapter around ballbat.analysis.normalize."""
+
+from ballbat.analysis import normalize
+from ballbat.ncio import read_dataset, write_dataset
+from ballbat.provenance import data_inputs
+from ballbat.runlog import logged
+from ballbat.units import MPH
+
+with logged(snakemake.log[0], snakemake.rule):
+    ds = normalize(read_dataset(snakemake.input.impacts), v_ref=snakemake.params.v_ref_mph * MPH)
+    write_dataset(
+        ds,
+        snakemake.output.impacts,
+        title=f"Impacts of dataset {snakemake.wildcards.dataset}, spin and exit speed normalised to the reference bat speed",
+        rule=snakemake.rule,
+        inputs=data_inputs(snakemake.input),
+        config=dict(snakemake.params),
+    )

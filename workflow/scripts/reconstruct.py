@@ -1,0 +1,24 @@
+"""Rule reconstruct: adapter around ballbat.analysis.reconstruct."""
+
+from ballbat.analysis import reconstruct
+from ballbat.ncio import read_dataset, write_dataset
+from ballbat.properties import load_balls, load_bats
+from ballbat.provenance import data_inputs
+from ballbat.runlog import logged
+
+with logged(snakemake.log[0], snakemake.rule) as log:
+    ds = reconstruct(
+        read_dataset(snakemake.input.impacts),
+        balls=load_balls(snakemake.input.balls),
+        bats=load_bats(snakemake.input.bats),
+    )
+    bad = int((ds["flag"] != 0).sum())
+    log.info("%d of %d impacts cannot be reconstructed (flagged, kept in the file)", bad, ds.sizes["impact"])
+    write_dataset(
+        ds,
+        snakemake.output.impacts,
+        title=f"Impacts of dataset {snakemake.wildcards.dataset} with the reconstructed geometry (Sec. III)",
+        rule=snakemake.rule,
+        inputs=data_inputs(snakemake.input),
+        config={},
+    )
