@@ -1,0 +1,40 @@
+# Two commands do all the set-up: `make run` and `make test` (see README.md).
+PYTHON ?= python3
+VENV ?= .venv
+BIN := $(VENV)/bin
+STAMP := $(VENV)/.ballbat-installed
+CORES ?= 2
+
+.PHONY: install run test report bench lint lock clean
+
+# Create the virtual environment and install the pinned stack plus ballbat (editable).
+$(STAMP): pyproject.toml requirements.lock
+	test -x $(BIN)/python || $(PYTHON) -m venv $(VENV)
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check -r requirements.lock
+	$(BIN)/python -m pip install --quiet --disable-pip-version-check --no-deps -e .
+	touch $(STAMP)
+
+install: $(STAMP)
+
+run: install
+	$(BIN)/snakemake -c$(CORES)
+
+test: install
+	$(BIN)/python -m pytest
+
+report: run
+	$(BIN)/snakemake -c$(CORES) --report results/report.html
+
+bench: install
+	$(BIN)/python bench/bench_workflow.py
+
+lint: install
+	$(BIN)/ruff check .
+	$(BIN)/snakemake --lint
+
+# Re-pin the stack after changing pyproject.toml's dependencies.
+lock: install
+	$(BIN)/python -m pip freeze --exclude-editable | grep -v '^ballbat' > requirements.lock
+
+clean:
+	rm -rf results .snakemake

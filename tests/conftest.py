@@ -1,0 +1,24 @@
+"""Shared fixtures: the repository's property tables (Tables I and II of the paper)."""
+
+from pathlib import Path
+
+import pytest
+
+from ballbat.properties import load_balls, load_bats
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="session")
+def root():
+    return ROOT
+
+
+@pytest.fixture(scope="session")
+def balls():
+    return load_balls(ROOT / "config" / "balls.csv")
+
+
+@pytest.fixture(scope="session")
+def bats():
+    return load_bats(ROOT / "config" / "bats.csv")

@@ -1,0 +1,107 @@
+"""Sec. IV fits: e_x recovery from synthetic data, honest standard errors, line fits."""
+
+import numpy as np
+import pytest
+import yaml
+
+from ballbat.analysis import normalize, reconstruct
+from ballbat.fitting import LineFit, fit_dataset, fit_line, wls_slope
+from ballbat.synthetic import SyntheticSettings, simulate_experiment
+
+
+@pytest.fixture(scope="module")
+def default_settings(root):
+    cfg = yaml.safe_load((root / "config" / "config.yaml").read_text())
+    return cfg["datasets"]["synthetic"]["synthetic"]
+
+
+def run(settings, balls, bats, **over):
+    s = SyntheticSettings(**{**settings, **over})
+    return fit_dataset(reconstruct(normalize(simulate_experiment(s, balls, bats)), balls, bats))
+
+
+def test_fit_line_matches_closed_form():
+    rng = np.random.default_rng(1)
+    x = rng.uniform(0, 10, 200)
+    y = 1.4 * x + rng.normal(0, 0.3, 200)
+    fit = fit_line(x, y)
+    s = np.dot(x, y) / np.dot(x, x)
+    resid = y - s * x
+    se = np.sqrt(np.sum(resid**2) / (x.size - 1) / np.dot(x, x))
+    assert fit.slope == pytest.approx(s, rel=1e-9)
+    assert fit.slope_err == pytest.approx(se, rel=1e-6)
+    assert np.isnan(fit.redchi)  # no uncertainties given: chi-square undefined, not faked
+    line = fit_line(x, y + 2.0, through_origin=False)
+    assert line.intercept == pytest.approx(np.polyfit(x, y + 2.0, 1)[1], rel=1e-8)
+
+
+def test_fit_line_too_few_points():
+    assert not fit_line(np.array([1.0]), np.array([2.0])).success
+    assert isinstance(fit_line(np.array([1.0]), np.array([2.0])), LineFit)
+
+
+def test_effective_variance_chi2_is_one_for_pure_noise():
+    # y = 2x, noise only in y with known sigma: reduced chi-square near 1.
+    rng = np.random.default_rng(7)
+    n = 4000
+    x = rng.uniform(1, 5, n)
+    sig = np.full((n, 1), 0.2)
+    y = 2 * x + rng.normal(0, 0.2, n)
+    fit = fit_line(x, y, jx=np.zeros((n, 1)), jy=np.ones((n, 1)), sigma=sig)
+    assert fit.redchi == pytest.approx(1.0, abs=0.08)
+    assert abs(fit.slope - 2) < 3 * fit.slope_err
+
+
+def test_recovery_default_config(default_settings, balls, bats):
+    """Issue 2: pooled e_x within 2 SE of the truth, each bat x ball within 3 SE."""
+    fit = run(default_settings, balls, bats)
+    for ball in fit.ball.values:
+        f = fit.sel(ball=ball)
+        assert abs(f.e_x_pooled - f.truth_e_x_pooled) < 2 * f.e_x_pooled_err, ball
+        for bat in fit.bat.values:
+            g = f.sel(bat=bat)
+            if int(g.e_x_n) == 0:
+                continue
+            assert abs(g.e_x - g.truth_e_x) < 3 * g.e_x_err, (ball, bat)
+            assert g.e_x_ci_low < g.e_x < g.e_x_ci_high
+    # Per-bat truth is exactly the configured Table II value (no intrinsic scatter).
+    assert float(fit.truth_e_x.sel(ball="baseball", bat="wood")) == pytest.approx(0.464, rel=1e-12)
+    assert int(fit.e_x_n.sel(ball="baseball", bat="softball_composite")) == 0  # no baseball on it
+
+
+def test_standard_errors_are_honest(default_settings, balls, bats):
+    """Coverage: over 60 seeds the pooled e_x lies within 2 SE of the truth ~95 % of the time."""
+    hits, pulls = 0, []
+    for seed in range(60):
+        fit = run(default_settings, balls, bats, seed=1000 + seed)
+        f = fit.sel(ball="baseball")
+        pull = float((f.e_x_pooled - f.truth_e_x_pooled) / f.e_x_pooled_err)
+        pulls.append(pull)
+        hits += abs(pull) < 2
+    assert hits / 60 >= 0.85  # binomial: 95 % expected, 0.85 is ~3.5 sigma below
+    assert abs(np.mean(pulls)) < 0.5  # no bias larger than half a standard error
+    assert 0.7 < np.std(pulls) < 1.4
+
+
+def test_synthetic_is_seeded(default_settings, balls, bats):
+    a = simulate_experiment(SyntheticSettings(**default_settings), balls, bats)
+    b = simulate_experiment(SyntheticSettings(**default_settings), balls, bats)
+    np.testing.assert_array_equal(a.omega.values, b.omega.values)
+    c = simulate_experiment(SyntheticSettings(**{**default_settings, "seed": 1}), balls, bats)
+    assert not np.array_equal(a.omega.values, c.omega.values)
+    assert a.sizes["impact"] == 108 and int((a.ball == "baseball").sum()) == 58  # Table I counts
+
+
+def test_truth_of_ratio_and_e_y(default_settings, balls, bats):
+    fit = run(default_settings, balls, bats)
+    for ball, e_y in (("baseball", 0.45), ("softball", 0.32)):
+        f = fit.sel(ball=ball)
+        assert float(f.truth_e_y_implied) == pytest.approx(e_y)
+        assert abs(f.e_y_implied - e_y) < 3 * f.e_y_implied_err
+        assert abs(f.tan_ratio_slope - f.truth_tan_ratio_slope) < 3 * f.tan_ratio_slope_err
+
+
+def test_wls_slope():
+    x = np.array([1.0, 2.0, 3.0])
+    assert wls_slope(x, 2 * x)[0] == pytest.approx(2.0)
+    assert wls_slope(x, 2 * x + 1, through_origin=False) == pytest.approx((2.0, 1.0))

@@ -1,0 +1,79 @@
+"""NetCDF writing: metadata checks, provenance records, atomic and reproducible writes."""
+
+import json
+
+import numpy as np
+import pytest
+import xarray as xr
+
+from ballbat.config import ConfigError, validate_config
+from ballbat.ncio import MetadataError, read_dataset, write_dataset
+from ballbat.provenance import package_source_hash, sha256_file
+
+
+def _ds():
+    return xr.Dataset(
+        {"v": ("impact", np.arange(3.0), {"units": "m s-1", "long_name": "speed"})},
+        coords={"impact": ("impact", np.arange(3), {"units": "1", "long_name": "impact number"})},
+    )
+
+
+def test_write_records_provenance_and_is_reproducible(tmp_path):
+    src = tmp_path / "in.csv"
+    src.write_text("a\n1\n")
+    kw = {"title": "t", "rule": "r", "inputs": {"table": str(src)}, "config": {"k": 1, "flag": True, "none": None}}
+    a = write_dataset(_ds(), tmp_path / "a.nc", **kw)
+    b = write_dataset(_ds(), tmp_path / "b.nc", **kw)
+    assert sha256_file(a) == sha256_file(b)  # no clock in the file
+    ds = read_dataset(a, require=("v",))
+    assert json.loads(ds.attrs["provenance_inputs"]) == [
+        {"name": "table", "path": str(src), "sha256": sha256_file(src)}
+    ]
+    assert json.loads(ds.attrs["provenance_config"]) == {"flag": True, "k": 1, "none": None}
+    assert json.loads(ds.attrs["provenance_software"])["ballbat_source_sha256"] == package_source_hash()
+    assert ds.v.attrs["units"] == "m s-1"
+
+
+def test_missing_metadata_is_refused(tmp_path):
+    ds = _ds()
+    ds["w"] = ("impact", np.zeros(3), {"long_name": "no units"})
+    with pytest.raises(MetadataError, match="w: units"):
+        write_dataset(ds, tmp_path / "x.nc", title="t", rule="r", inputs={}, config={})
+    assert not list(tmp_path.iterdir())  # nothing half-written
+
+
+def test_failed_write_keeps_old_file(tmp_path, monkeypatch):
+    path = write_dataset(_ds(), tmp_path / "a.nc", title="t", rule="r", inputs={}, config={})
+    before = sha256_file(path)
+
+    def boom(*a, **k):
+        raise OSError("disk full")
+
+    monkeypatch.setattr(xr.Dataset, "to_netcdf", boom)
+    with pytest.raises(OSError, match="disk full"):
+        write_dataset(_ds(), path, title="t2", rule="r", inputs={}, config={})
+    assert sha256_file(path) == before
+    assert [p.name for p in tmp_path.iterdir()] == ["a.nc"]  # no temporary left behind
+
+
+def test_read_requires_variables(tmp_path):
+    path = write_dataset(_ds(), tmp_path / "a.nc", title="t", rule="r", inputs={}, config={})
+    with pytest.raises(MetadataError, match="missing variable\\(s\\) psi"):
+        read_dataset(path, require=("psi",))
+
+
+def test_config_validation_lists_all_problems(root):
+    import yaml
+
+    schema = yaml.safe_load((root / "workflow" / "schemas" / "config.schema.yaml").read_text())
+    good = yaml.safe_load((root / "config" / "config.yaml").read_text())
+    assert validate_config(good, schema)["normalize"]["v_ref_mph"] == 77.0
+    minimal = {"datasets": {"d": {"synthetic": {"impacts": {}, "e_x": {}, "e_y": {}}}}}
+    filled = validate_config(minimal, schema)
+    assert filled["tables"]["balls"] == "config/balls.csv"  # defaults filled
+    assert filled["datasets"]["d"]["synthetic"]["noise"]["omega_rpm"] == 75.0
+    bad = {"datasets": {"d": {"synthetic": {"impacts": {}, "e_x": {}, "e_y": {}, "sed": 1}}}, "extra": 1}
+    with pytest.raises(ConfigError) as exc:
+        validate_config(bad, schema)
+    assert "datasets.d.synthetic.sed: unknown key" in str(exc.value)
+    assert "extra: unknown key" in str(exc.value)

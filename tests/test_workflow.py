@@ -1,0 +1,156 @@
+"""End to end: the real workflow on a small config in a temporary directory."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+import xarray as xr
+import yaml
+
+from ballbat.compare import read_csv
+from ballbat.provenance import sha256_file
+from workflow_helpers import ROOT, make_workdir, planned_jobs, snakemake
+
+pytestmark = pytest.mark.slow
+
+SMALL = {
+    "datasets": {
+        "small": {
+            "synthetic": {
+                "seed": 7,
+                "impacts": {"baseball": {"wood": 12, "metal_rough": 12}, "softball": {"softball_composite": 12}},
+                "e_x": {"baseball": {"wood": 0.464, "metal_rough": 0.356}, "softball": {"softball_composite": 0.128}},
+                "e_y": {"baseball": 0.45, "softball": 0.32},
+            }
+        }
+    }
+}
+
+
+@pytest.fixture(scope="module")
+def run_dir(tmp_path_factory):
+    wd = make_workdir(tmp_path_factory.mktemp("wf"), copy_package=True)
+    cfg = yaml.safe_load((wd / "config" / "config.yaml").read_text())
+    cfg["datasets"] = SMALL["datasets"]
+    (wd / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
+    snakemake(wd, "-c2")
+    return wd
+
+
+def test_outputs_content(run_dir):
+    res = run_dir / "results" / "small"
+    for stage in ("simulate", "normalize", "reconstruct", "fit_ex"):
+        ds = xr.open_dataset(res / f"{stage}.nc")
+        for name, var in {**ds.data_vars, **ds.coords}.items():
+            assert "long_name" in var.attrs, (stage, name)
+            if var.dtype.kind not in "OSU":
+                assert "units" in var.attrs, (stage, name)
+        for attr in ("Conventions", "title", "source", "history", "references"):
+            assert ds.attrs[attr], (stage, attr)
+        # Provenance: rule, inputs with their sha256, config, software, git.
+        assert ds.attrs["provenance_rule"] == stage
+        for rec in json.loads(ds.attrs["provenance_inputs"]):
+            assert rec["sha256"] == sha256_file(run_dir / rec["path"]), rec
+        soft = json.loads(ds.attrs["provenance_software"])
+        assert {"ballbat", "ballbat_source_sha256", "python", "numpy", "xarray", "scipy"} <= set(soft)
+        assert set(json.loads(ds.attrs["provenance_git"])) == {"commit", "dirty"}
+        ds.close()
+    sim = xr.open_dataset(res / "simulate.nc")
+    assert sim.sizes["impact"] == 36
+    assert json.loads(sim.attrs["provenance_config"])["settings"]["seed"] == 7
+    rec = xr.open_dataset(res / "reconstruct.nc")
+    # psi reconstructed from noisy data tracks the truth to within a degree or so.
+    ok = rec.flag.values == 0
+    assert np.nanmax(np.abs(rec.psi.values[ok] - rec.truth_psi.values[ok])) < np.radians(3)
+    fit = xr.open_dataset(res / "fit_ex.nc")
+    assert int(fit.e_x_n.sel(ball="baseball", bat="wood")) == 12
+    table = read_csv(res / "paper_comparison.csv")
+    assert list(table[0]) == [
+        "quantity",
+        "ball",
+        "bat",
+        "paper",
+        "paper_uncertainty",
+        "value",
+        "uncertainty",
+        "truth",
+        "unit",
+    ]
+    rows = {(r["quantity"], r["ball"], r["bat"]): r for r in table}
+    wood = rows[("e_x", "baseball", "wood")]
+    assert float(wood["paper"]) == 0.464 and float(wood["truth"]) == 0.464
+    assert abs(float(wood["value"]) - 0.464) < 3 * float(wood["uncertainty"])
+    assert rows[("e_x", "softball", "wood")]["value"] == ""  # not in this dataset: empty, not invented
+    for q in (
+        "e_x_pooled",
+        "spin_theta_slope",
+        "speed_theta_slope",
+        "tan_ratio_slope",
+        "e_y_implied",
+        "mu_k_lower_bound",
+    ):
+        assert rows[(q, "baseball", "")]["value"] != "", q
+    assert (res / "paper_comparison.md").read_text().startswith("# Dataset small")
+
+
+def test_rerun_is_noop_and_byte_identical(run_dir):
+    res = run_dir / "results" / "small"
+    assert planned_jobs(run_dir) == {}
+    before = {p.name: sha256_file(p) for p in res.glob("*.nc")}
+    snakemake(run_dir, "-c2", "--forceall")
+    after = {p.name: sha256_file(p) for p in res.glob("*.nc")}
+    assert before == after
+
+
+def test_code_edit_reruns_only_dependents(run_dir):
+    """Editing a package module marks the outputs that import it out of date; README does not."""
+    mod = run_dir / "src" / "ballbat" / "fitting.py"
+    text = mod.read_text()
+    try:
+        mod.write_text(text + "\n# an edit\n")
+        assert planned_jobs(run_dir) == {"fit_ex": 1, "compare": 1}
+    finally:
+        mod.write_text(text)
+    kin = run_dir / "src" / "ballbat" / "kinematics.py"
+    text = kin.read_text()
+    try:
+        kin.write_text(text + "\n# an edit\n")
+        assert planned_jobs(run_dir) == {"simulate": 1, "normalize": 1, "reconstruct": 1, "fit_ex": 1, "compare": 1}
+    finally:
+        kin.write_text(text)
+    (run_dir / "README.md").write_text("an unrelated edit\n")
+    assert planned_jobs(run_dir) == {}
+
+
+def test_config_error_names_the_key(tmp_path):
+    wd = make_workdir(tmp_path)
+    bad = tmp_path / "bad.yaml"
+    bad.write_text("normalize:\n  v_ref_mph: fast\n  colour: red\n")
+    out = snakemake(wd, "-n", "--configfile", str(bad), check=False)
+    assert out.returncode != 0
+    text = out.stdout + out.stderr
+    assert "normalize.colour: unknown key" in text
+    assert "normalize.v_ref_mph: 'fast' is not of type 'number'" in text
+
+
+@pytest.mark.parametrize("script", ["simulate", "normalize", "reconstruct", "fit_ex", "compare"])
+def test_jobs_import_only_what_they_use(script):
+    """No job imports lmfit or matplotlib unless it fits or draws (issue 2, speed)."""
+    from ballbat.codedeps import module_files
+
+    mods = [
+        f"ballbat.{p.rsplit('/', 1)[-1][:-3]}"
+        for p in module_files(str(ROOT / "workflow" / "scripts" / f"{script}.py"))
+    ]
+    mods = [m.replace(".__init__", "") for m in mods]
+    code = (
+        "import sys\n"
+        + "".join(f"import {m}\n" for m in mods)
+        + "print(sorted(m for m in ('lmfit', 'matplotlib') if m in sys.modules))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "[]", (script, out.stdout)

@@ -1,0 +1,57 @@
+"""Helpers to run the real workflow in a temporary copy of the repository."""
+
+from __future__ import annotations
+
+import os
+import re
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def make_workdir(tmp: Path, copy_package: bool = False) -> Path:
+    """Copy Snakefile, workflow/ and config/ (and optionally src/) into ``tmp``."""
+    shutil.copy(ROOT / "Snakefile", tmp / "Snakefile")
+    shutil.copytree(ROOT / "workflow", tmp / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(ROOT / "config", tmp / "config")
+    (tmp / "README.md").write_text("copy\n")
+    if copy_package:
+        shutil.copytree(ROOT / "src", tmp / "src", ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+    return tmp
+
+
+def snakemake(workdir: Path, *args: str, check: bool = True, timeout: int = 600) -> subprocess.CompletedProcess:
+    """Run ``python -m snakemake`` in ``workdir`` (with workdir/src first on the path if present)."""
+    env = dict(os.environ)
+    if (workdir / "src").is_dir():
+        env["PYTHONPATH"] = os.pathsep.join([str(workdir / "src"), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    proc = subprocess.run(
+        [sys.executable, "-m", "snakemake", *args],
+        cwd=workdir,
+        env=env,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+    )
+    if check and proc.returncode != 0:
+        raise AssertionError(f"snakemake {' '.join(args)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
+    return proc
+
+
+def planned_jobs(workdir: Path, *args: str) -> dict[str, int]:
+    """Rule -> job count of a dry run (empty when nothing is to be done)."""
+    out = snakemake(workdir, "-n", *args)
+    text = out.stdout + out.stderr
+    if "Nothing to be done" in text:
+        return {}
+    m = re.search(r"Job stats:\n.*?\n-+\s+-+\n(.*?)\ntotal", text, re.S)
+    assert m, text[-3000:]
+    jobs = {}
+    for line in m.group(1).strip().splitlines():
+        name, count = line.split()
+        jobs[name] = int(count)
+    jobs.pop("all", None)
+    return jobs
