@@ -36,23 +36,33 @@ def _message(error) -> str:
     return f"{_path(error)}: {error.message}"
 
 
-def fill_defaults(instance, schema):
+def _resolve(schema, root):
+    """Follow a local ``$ref`` (``#/$defs/name``)."""
+    while "$ref" in schema and schema["$ref"].startswith("#/"):
+        target = root
+        for part in schema["$ref"][2:].split("/"):
+            target = target[part]
+        schema = {**target, **{k: v for k, v in schema.items() if k != "$ref"}}
+    return schema
+
+
+def fill_defaults(instance, schema, root=None):
     """Fill missing keys that have a ``default`` in ``schema`` (recursively, in place)."""
+    root = schema if root is None else root
+    schema = _resolve(schema, root)
     if not isinstance(instance, dict) or schema.get("type") != "object":
         return instance
-    for key, sub in schema.get("properties", {}).items():
+    props = schema.get("properties", {})
+    for key, sub in props.items():
+        sub = _resolve(sub, root)
         if key not in instance and "default" in sub:
             instance[key] = copy.deepcopy(sub["default"])
         if key in instance:
-            fill_defaults(instance[key], sub)
-    for sub in schema.get("patternProperties", {}).values():
-        for key, val in instance.items():
-            if key not in schema.get("properties", {}):
-                fill_defaults(val, sub)
+            fill_defaults(instance[key], sub, root)
     if isinstance(schema.get("additionalProperties"), dict):
         for key, val in instance.items():
-            if key not in schema.get("properties", {}):
-                fill_defaults(val, schema["additionalProperties"])
+            if key not in props:
+                fill_defaults(val, schema["additionalProperties"], root)
     return instance
 
 

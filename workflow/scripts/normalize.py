@@ -11,7 +11,7 @@ with logged(snakemake.log[0], snakemake.rule):
     write_dataset(
         ds,
         snakemake.output.impacts,
-        title=f"Impacts of dataset {snakemake.wildcards.dataset}, spin and exit speed normalised to the reference bat speed",
+        title=f"Impacts of dataset {snakemake.wildcards.dataset}, spin and exit speed normalised to {snakemake.params.v_ref_mph:g} mph",
         rule=snakemake.rule,
         inputs=data_inputs(snakemake.input),
         config=dict(snakemake.params),
