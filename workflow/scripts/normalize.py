@@ -11,7 +11,10 @@ with logged(snakemake.log[0], snakemake.rule):
     write_dataset(
         ds,
         snakemake.output.impacts,
-        title=f"Impacts of dataset {snakemake.wildcards.dataset}, spin and exit speed normalised to {snakemake.params.v_ref_mph:g} mph",
+        title=(
+            f"Impacts of dataset {snakemake.wildcards.dataset}, "
+            f"spin and exit speed normalised to {snakemake.params.v_ref_mph:g} mph"
+        ),
         rule=snakemake.rule,
         inputs=data_inputs(snakemake.input),
         config=dict(snakemake.params),
