@@ -1,0 +1,89 @@
+"""Benchmarks of the workflow backbone (issue 2).
+
+1. Cold ``snakemake -c2`` of the default workflow in a fresh copy of the repository.
+2. A no-op rerun, against Snakemake's own no-op on a one-rule workflow (target: within 1.5x).
+3. The fit stage alone (``ballbat.fitting.fit_dataset``) at 10^3 .. 10^5 impacts
+   (targets: linear in the number of impacts, 10^5 impacts in under 5 s).
+
+Run: ``.venv/bin/python bench/bench_workflow.py`` (or ``make bench``). Prints a table.
+"""
+
+from __future__ import annotations
+
+import shutil
+import statistics
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+import yaml
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def timed(cmd, cwd) -> float:
+    t0 = time.perf_counter()
+    subprocess.run(cmd, cwd=cwd, check=True, capture_output=True)
+    return time.perf_counter() - t0
+
+
+def snakemake_times(repeats: int = 5) -> dict:
+    sm = [sys.executable, "-m", "snakemake", "-c2"]
+    with tempfile.TemporaryDirectory() as tmp:
+        wd = Path(tmp) / "wf"
+        wd.mkdir()
+        shutil.copy(ROOT / "Snakefile", wd)
+        shutil.copytree(ROOT / "workflow", wd / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
+        shutil.copytree(ROOT / "config", wd / "config")
+        cold = timed(sm, wd)
+        noop = statistics.median(timed(sm, wd) for _ in range(repeats))
+        one = Path(tmp) / "one"
+        one.mkdir()
+        (one / "Snakefile").write_text('rule a:\n    output:\n        "a.txt"\n    shell:\n        "touch {output}"\n')
+        timed(sm, one)
+        base = statistics.median(timed(sm, one) for _ in range(repeats))
+    return {"cold": cold, "noop": noop, "noop_one_rule": base}
+
+
+def fit_times(sizes=(1_000, 10_000, 100_000)) -> list[tuple[int, float]]:
+    from ballbat.analysis import normalize, reconstruct
+    from ballbat.fitting import fit_dataset
+    from ballbat.properties import load_balls, load_bats
+    from ballbat.synthetic import SyntheticSettings, simulate_experiment
+
+    balls = load_balls(ROOT / "config" / "balls.csv")
+    bats = load_bats(ROOT / "config" / "bats.csv")
+    base = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["datasets"]["synthetic"]["synthetic"]
+    total = sum(sum(v.values()) for v in base["impacts"].values())
+    fit_dataset(reconstruct(normalize(simulate_experiment(SyntheticSettings(**base), balls, bats)), balls, bats))
+    out = []
+    for n in sizes:
+        scale = n / total
+        impacts = {b: {t: max(3, round(k * scale)) for t, k in v.items()} for b, v in base["impacts"].items()}
+        ds = reconstruct(
+            normalize(simulate_experiment(SyntheticSettings(**{**base, "impacts": impacts}), balls, bats)), balls, bats
+        )
+        t0 = time.perf_counter()
+        fit_dataset(ds)
+        out.append((ds.sizes["impact"], time.perf_counter() - t0))
+    return out
+
+
+def main() -> None:
+    sm = snakemake_times()
+    print("workflow (default config, snakemake -c2)")
+    print(f"  cold run                       {sm['cold']:7.2f} s")
+    print(f"  no-op rerun (median of 5)      {sm['noop']:7.2f} s")
+    print(f"  one-rule workflow no-op        {sm['noop_one_rule']:7.2f} s")
+    print(f"  ratio (target <= 1.5)          {sm['noop'] / sm['noop_one_rule']:7.2f}")
+    print("fit stage alone (fit_dataset, all fits of Sec. IV)")
+    fits = fit_times()
+    for n, t in fits:
+        print(f"  {n:>7d} impacts                {t:7.3f} s   {1e6 * t / n:8.2f} us/impact")
+    print(f"  10^5 impacts under 5 s: {'yes' if fits[-1][1] < 5 else 'NO'}")
+
+
+if __name__ == "__main__":
+    main()
