@@ -111,7 +111,8 @@ def pitched_ball_collision(
         tangential velocity of the contact points (ball minus bat).
     e_y : normal coefficient of restitution (ratio of the normal relative velocities).
     ball, bat : properties (SI); the bat enters through its recoil factors r_x and r_y.
-    mu : friction coefficient used for the ``exceeds_mu`` flag, or None (no check).
+    mu : friction coefficient for the ``exceeds_mu`` flag (scalar or broadcastable to the
+        result), or None (no check).
 
     Returns
     -------

@@ -474,8 +474,8 @@ def fly(
         perpendicular to the launch direction, pointing to the batted ball's right.
     sidespin : sidespin, rad/s, about the axis perpendicular to the launch velocity in the
         vertical plane that contains it (the calculator's convention). Positive sidespin
-        points the spin axis up-ish (counterclockwise seen from above) and curves the ball
-        towards -x (to the left, a "hook" for a right-handed batter's pull side).
+        tilts the spin axis towards +z (counter-clockwise seen from above) and curves the
+        ball towards -x (to the left as seen from home plate); negative to the right.
     ball_mass : kg (default 5.125 oz).
     ball_circumference, ball_radius : give one; radius wins when both are given
         (default circumference 9.125 in).
