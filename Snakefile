@@ -14,6 +14,7 @@ include: "workflow/rules/normalize.smk"
 include: "workflow/rules/reconstruct.smk"
 include: "workflow/rules/fit_ex.smk"
 include: "workflow/rules/compare.smk"
+include: "workflow/rules/implications.smk"
 
 
 rule all:

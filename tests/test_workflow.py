@@ -36,6 +36,14 @@ def run_dir(tmp_path_factory):
     wd = make_workdir(tmp_path_factory.mktemp("wf"), copy_package=True)
     cfg = yaml.safe_load((wd / "config" / "config.yaml").read_text())
     cfg["datasets"] = SMALL["datasets"]
+    paper = cfg["implications"]["scenarios"]["paper"]
+    paper["sweep"]["D_in"]["num"] = 26
+    paper["e_x_from_dataset"] = "small"
+    cfg["implications"]["scenarios"]["flyballs"] = {
+        "ball": "baseball",
+        "launch": {"exit_speed_mph": [95, 105], "launch_deg": [15, 25, 35], "backspin_rpm": 2200},
+        "flight": {"n_points": 11},
+    }
     (wd / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
     snakemake(wd, "-c2")
     return wd
@@ -97,31 +105,64 @@ def test_outputs_content(run_dir):
     assert (res / "paper_comparison.md").read_text().startswith("# Dataset small")
 
 
+def test_implications_outputs(run_dir):
+    imp = run_dir / "results" / "implications"
+    paper = xr.open_dataset(imp / "paper.nc")
+    fit = xr.open_dataset(run_dir / "results" / "small" / "fit_ex.nc")
+    # e_x taken from the dataset's pooled baseball fit, recorded in the file and its inputs
+    assert paper.attrs["e_x"] == pytest.approx(float(fit.e_x_pooled.sel(ball="baseball")), rel=1e-12)
+    assert any(r["name"] == "fit" for r in json.loads(paper.attrs["provenance_inputs"]))
+    assert paper.sizes["case"] == 26 and paper.D.attrs["units"] == "m"
+    assert set(np.unique(paper.exceeds_mu.values)) <= {0, 1}
+    fly = xr.open_dataset(imp / "flyballs.nc")
+    assert fly.sizes == {"case": 6, "point": 11}
+    assert np.all(fly.carry.values > 50) and "D" not in fly
+    rows = {r["quantity"]: r for r in read_csv(imp / "paper_comparison.csv")}
+    assert rows["carry_max"]["paper"] == "400" and 350 < float(rows["carry_max"]["value"]) < 450
+    assert rows["carry_max"]["unit"] == "ft" and rows["D_at_carry_max"]["unit"] == "in"
+
+
 def test_rerun_is_noop_and_byte_identical(run_dir):
     res = run_dir / "results" / "small"
     assert planned_jobs(run_dir) == {}
-    before = {p.name: sha256_file(p) for p in res.glob("*.nc")}
+    files = sorted(res.glob("*.nc")) + sorted((run_dir / "results" / "implications").glob("*.nc"))
+    before = {p: sha256_file(p) for p in files}
     snakemake(run_dir, "-c2", "--forceall")
-    after = {p.name: sha256_file(p) for p in res.glob("*.nc")}
+    after = {p: sha256_file(p) for p in files}
     assert before == after
+
+
+def _jobs_after_edit(run_dir, path):
+    """Dry-run job counts after appending a comment to ``path`` (restored afterwards)."""
+    text = path.read_text()
+    try:
+        path.write_text(text + "\n# an edit\n")
+        return planned_jobs(run_dir)
+    finally:
+        path.write_text(text)
 
 
 def test_code_edit_reruns_only_dependents(run_dir):
     """Editing a package module marks the outputs that import it out of date; README does not."""
-    mod = run_dir / "src" / "ballbat" / "fitting.py"
-    text = mod.read_text()
-    try:
-        mod.write_text(text + "\n# an edit\n")
-        assert planned_jobs(run_dir) == {"fit_ex": 1, "compare": 1}
-    finally:
-        mod.write_text(text)
-    kin = run_dir / "src" / "ballbat" / "kinematics.py"
-    text = kin.read_text()
-    try:
-        kin.write_text(text + "\n# an edit\n")
-        assert planned_jobs(run_dir) == {"simulate": 1, "normalize": 1, "reconstruct": 1, "fit_ex": 1, "compare": 1}
-    finally:
-        kin.write_text(text)
+    pkg = run_dir / "src" / "ballbat"
+    # implications use this dataset's pooled e_x, so they follow the fit
+    assert _jobs_after_edit(run_dir, pkg / "fitting.py") == {
+        "fit_ex": 1,
+        "compare": 1,
+        "implications": 1,
+        "implications_compare": 1,
+    }
+    assert _jobs_after_edit(run_dir, pkg / "kinematics.py") == {
+        "simulate": 1,
+        "normalize": 1,
+        "reconstruct": 1,
+        "fit_ex": 1,
+        "compare": 1,
+        "implications": 1,
+        "implications_compare": 1,
+    }
+    assert _jobs_after_edit(run_dir, pkg / "flight.py") == {"implications": 2, "implications_compare": 1}
+    assert planned_jobs(run_dir) == {}  # restoring the text restores the state
     (run_dir / "README.md").write_text("an unrelated edit\n")
     assert planned_jobs(run_dir) == {}
 

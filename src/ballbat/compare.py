@@ -126,11 +126,11 @@ def impact_rows(rec) -> list[dict]:
     return rows
 
 
-def comparison_table(rows: list[dict]) -> list[dict]:
+def comparison_table(rows: list[dict], published=PUBLISHED) -> list[dict]:
     """Merge our rows with the published values: one row per published number, plus ours."""
     ours = {(r["quantity"], r["ball"], r["bat"]): r for r in rows}
     table = []
-    for p in PUBLISHED:
+    for p in published:
         key = (p.quantity, p.ball, p.bat)
         r = ours.pop(key, {})
         table.append(
@@ -176,10 +176,17 @@ def read_csv(path) -> list[dict]:
 
 def write_comparison(fit, impacts, csv_path, md_path, title, extra_rows=()) -> list[dict]:
     """Build the comparison from ``fit_ex.nc`` and ``reconstruct.nc``; write CSV and Markdown."""
-    from .ncio import atomic_write_text, read_dataset
+    from .ncio import read_dataset
 
     rows = fit_rows(read_dataset(fit)) + impact_rows(read_dataset(impacts)) + list(extra_rows)
-    table = comparison_table(rows)
+    return write_table(rows, csv_path, md_path, title)
+
+
+def write_table(rows, csv_path, md_path, title, published=PUBLISHED) -> list[dict]:
+    """Merge ``rows`` with the published values; write the CSV and its Markdown rendering."""
+    from .ncio import atomic_write_text
+
+    table = comparison_table(rows, published)
     atomic_write_text(csv_path, to_csv(table))
     atomic_write_text(md_path, to_markdown(table, title))
     return table

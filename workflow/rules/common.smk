@@ -47,4 +47,34 @@ def get_source(wildcards):
 
 
 def all_targets():
-    return expand("results/{dataset}/paper_comparison.csv", dataset=DATASETS)
+    return expand("results/{dataset}/paper_comparison.csv", dataset=DATASETS) + implications_targets()
+
+
+SCENARIOS = sorted(config.get("implications", {}).get("scenarios", {}))
+for _name, _sc in config.get("implications", {}).get("scenarios", {}).items():
+    if "e_x_from_dataset" in _sc and _sc["e_x_from_dataset"] not in DATASETS:
+        raise ValueError(
+            f"config: implications.scenarios.{_name}.e_x_from_dataset: "
+            f"{_sc['e_x_from_dataset']!r} is not a dataset ({', '.join(DATASETS)})"
+        )
+
+
+wildcard_constraints:
+    scenario="|".join(SCENARIOS) or "^$",
+
+
+def get_scenario(wildcards):
+    return config["implications"]["scenarios"][wildcards.scenario]
+
+
+def get_scenario_fit(wildcards):
+    """fit_ex.nc of the dataset whose pooled e_x the scenario uses (none by default)."""
+    name = get_scenario(wildcards).get("e_x_from_dataset")
+    return {"fit": f"results/{name}/fit_ex.nc"} if name else {}
+
+
+def implications_targets():
+    out = expand("results/implications/{scenario}.nc", scenario=SCENARIOS)
+    if "paper" in SCENARIOS and "sweep" in config["implications"]["scenarios"]["paper"]:
+        out.append("results/implications/paper_comparison.csv")
+    return out

@@ -1,0 +1,88 @@
+"""Sec. V.B scenarios: the paper's D sweep shows what the paper reports; launch scenarios."""
+
+import numpy as np
+import pytest
+import yaml
+
+from ballbat.implications import comparison_rows, density_from_conditions, launch_conditions, run_scenario
+from ballbat.units import DEGREE, FOOT, INCH, MPH, RPM
+
+
+@pytest.fixture(scope="module")
+def cfg(root):
+    return yaml.safe_load((root / "config" / "config.yaml").read_text())["implications"]
+
+
+@pytest.fixture(scope="module")
+def paper(cfg, balls, bats):
+    return run_scenario(cfg["scenarios"]["paper"], balls, bats, cfg["air"])
+
+
+def test_default_air_density(cfg):
+    # PHYSICS.md: 70 F, 15 ft, 50 %, 29.92 inHg give rho ~ 1.1938 kg/m^3.
+    assert density_from_conditions(cfg["air"]) == pytest.approx(1.1938, abs=5e-4)
+
+
+def test_paper_sweep_matches_sec_VB(paper):
+    """Sec. V.B / Fig. 11: what the paper reports, each as a testable statement."""
+    D = paper.D.values / INCH
+    v = paper.exit_speed.values / MPH
+    spin = paper.backspin.values / RPM
+    launch = paper.launch_angle.values / DEGREE
+    carry = paper.carry.values / FOOT
+    # Exit speed peaks near D = 0 and drops off with D.
+    assert D[np.argmax(v)] <= 0.1
+    assert np.all(np.diff(v) < 0)
+    # Topspin at D = 0 (the pitch's backspin).
+    assert spin[0] < 0
+    # Backspin roughly linear in D: a straight line explains > 99.9 % of its variance.
+    r = np.corrcoef(D, spin)[0, 1]
+    assert r**2 > 0.999
+    # A line drive at small D, a ~400 ft home run at intermediate D, a popup at larger D.
+    i = np.argmax(np.where(launch < 90, carry, -np.inf))
+    assert 0.3 < D[i] < 1.2
+    assert carry[i] == pytest.approx(400, abs=25)  # "a 400-ft home run"; the model gives ~393 ft
+    small = np.argmin(np.abs(D - 0.25))
+    assert 5 < launch[small] < 20 and carry[small] < 350  # line drive
+    big = np.argmin(np.abs(D - 1.8))
+    assert launch[big] > 55 and carry[big] < 200  # popup
+    # The friction flag: needed |J_t/J_n| grows with D and exceeds mu = 0.5 only at large D.
+    assert paper.exceeds_mu.values[0] == 0 and paper.exceeds_mu.values[-1] == 1
+    assert np.all(np.diff(paper.friction_ratio.values) > 0)
+
+
+def test_comparison_rows(paper):
+    rows = {r["quantity"]: r for r in comparison_rows(paper)}
+    assert rows["carry_max"]["unit"] == "ft" and 375 < rows["carry_max"]["value"] < 425
+    assert rows["D_at_exit_speed_max"]["value"] == pytest.approx(0.0, abs=0.1)
+    assert rows["backspin_at_D0"]["value"] < 0
+
+
+def test_launch_conditions_grid_and_list():
+    grid = launch_conditions({"exit_speed_mph": [90, 100], "launch_deg": [20, 25, 30], "combine": "grid"})
+    assert grid["exit_speed"].size == 6
+    lst = launch_conditions(
+        {"exit_speed_mph": [90, 100], "launch_deg": [20, 25], "backspin_rpm": 2000, "combine": "list"}
+    )
+    np.testing.assert_allclose(lst["launch_angle"], np.radians([20, 25]))
+    np.testing.assert_allclose(lst["backspin"], 2000 * RPM)
+    with pytest.raises(ValueError, match="the lists must have one length.*exit_speed_mph has 2, launch_deg has 3"):
+        launch_conditions({"exit_speed_mph": [90, 100], "launch_deg": [20, 25, 30], "combine": "list"})
+
+
+def test_launch_scenario_flies_calculator_case(cfg, balls, bats):
+    # The calculator's published case with our baseball (5.04 oz, r = 1.42 in), not its 5.125 oz:
+    # a lighter, smaller ball; only check it flies to the right neighbourhood and is sane.
+    sc = {"ball": "baseball", "launch": {"exit_speed_mph": 103, "launch_deg": 27.5, "backspin_rpm": 2500}}
+    ds = run_scenario(sc, balls, bats, cfg["air"])
+    assert ds.sizes["case"] == 1
+    assert 400 < float(ds.carry[0]) / FOOT < 440
+    assert float(ds.trajectory_z[0, -1]) == pytest.approx(0.0, abs=1e-6)
+
+
+def test_unknown_ball_or_bat(cfg, balls, bats):
+    with pytest.raises(ValueError, match="scenario ball 'cricket' is not in the ball table"):
+        run_scenario({"ball": "cricket", "launch": {"exit_speed_mph": 90, "launch_deg": 20}}, balls, bats, cfg["air"])
+    sc = {**cfg["scenarios"]["paper"], "bat": "oak"}
+    with pytest.raises(ValueError, match="scenario bat 'oak' is not in the bat table"):
+        run_scenario(sc, balls, bats, cfg["air"])

@@ -1,0 +1,32 @@
+rule implications:
+    """Collide a pitched ball with a bat and fly it, or fly given launch conditions (Sec. V.B)."""
+    input:
+        unpack(get_scenario_fit),
+        balls=config["tables"]["balls"],
+        bats=config["tables"]["bats"],
+        code=code("implications.py"),
+    output:
+        scenario="results/implications/{scenario}.nc",
+    params:
+        scenario=get_scenario,
+        air=config["implications"]["air"],
+    log:
+        "results/implications/logs/{scenario}.log",
+    benchmark:
+        "results/implications/benchmarks/{scenario}.tsv"
+    script:
+        "../scripts/implications.py"
+
+
+rule implications_compare:
+    """Compare the paper scenario's carry and exit speed with Sec. V.B's statements."""
+    input:
+        scenario="results/implications/paper.nc",
+        code=code("implications_compare.py"),
+    output:
+        csv="results/implications/paper_comparison.csv",
+        md="results/implications/paper_comparison.md",
+    log:
+        "results/implications/logs/paper_comparison.log",
+    script:
+        "../scripts/implications_compare.py"

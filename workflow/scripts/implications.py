@@ -1,0 +1,25 @@
+"""Rule implications: adapter around ballbat.implications.run_scenario."""
+
+from ballbat.implications import pooled_e_x, run_scenario
+from ballbat.ncio import write_dataset
+from ballbat.properties import load_balls, load_bats
+from ballbat.provenance import data_inputs
+from ballbat.runlog import logged
+
+with logged(snakemake.log[0], snakemake.rule):
+    scenario = snakemake.params.scenario
+    ds = run_scenario(
+        scenario,
+        balls=load_balls(snakemake.input.balls),
+        bats=load_bats(snakemake.input.bats),
+        air=snakemake.params.air,
+        e_x=pooled_e_x(snakemake.input.fit, scenario["ball"]) if "fit" in snakemake.input.keys() else None,
+    )
+    write_dataset(
+        ds,
+        snakemake.output.scenario,
+        title=f"Batted-ball scenario {snakemake.wildcards.scenario}: collision and flight (Sec. V.B)",
+        rule=snakemake.rule,
+        inputs=data_inputs(snakemake.input),
+        config=dict(snakemake.params),
+    )

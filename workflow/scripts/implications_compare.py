@@ -1,0 +1,16 @@
+"""Rule implications_compare: adapter around ballbat.compare for the paper scenario."""
+
+from ballbat.compare import write_table
+from ballbat.implications import comparison_rows
+from ballbat.ncio import read_dataset
+from ballbat.published import PUBLISHED_IMPLICATIONS
+from ballbat.runlog import logged
+
+with logged(snakemake.log[0], snakemake.rule):
+    write_table(
+        comparison_rows(read_dataset(snakemake.input.scenario)),
+        csv_path=snakemake.output.csv,
+        md_path=snakemake.output.md,
+        title="Sec. V.B, scenario paper: the paper's statements beside ours",
+        published=PUBLISHED_IMPLICATIONS,
+    )
