@@ -146,8 +146,16 @@ def pitched_ball_collision(
         np.asarray(a, dtype=float)
         for a in np.broadcast_arrays(D, v_pitch, pitch_descent, pitch_spin, v_bat, attack_angle, e_x, e_y)
     )
-    for name, arr in (("D", D), ("v_pitch", v_pitch), ("pitch_descent", descent), ("pitch_spin", spin_i),
-                      ("v_bat", v_bat), ("attack_angle", attack), ("e_x", e_x), ("e_y", e_y)):
+    for name, arr in (
+        ("D", D),
+        ("v_pitch", v_pitch),
+        ("pitch_descent", descent),
+        ("pitch_spin", spin_i),
+        ("v_bat", v_bat),
+        ("attack_angle", attack),
+        ("e_x", e_x),
+        ("e_y", e_y),
+    ):
         if not np.all(np.isfinite(arr)):
             raise ValueError(f"pitched_ball_collision: {name} has non-finite values")
     m, r, alpha = ball.m, ball.r, ball.alpha

@@ -322,8 +322,7 @@ def _fly_accurate(model, X0, V0, rtol, atol, t_max, keep_history):
                 g = acc[top]
                 has_top[g] = True
                 top_t0[g], top_h[g] = ti[top], hi[top]
-                top_z[g] = np.stack([Xi[top, 2], Vi[top, 2], Ai[top, 2], X1[top, 2], V1[top, 2],
-                                     A1[top, 2]], axis=1)
+                top_z[g] = np.stack([Xi[top, 2], Vi[top, 2], Ai[top, 2], X1[top, 2], V1[top, 2], A1[top, 2]], axis=1)
             down = (Xi[:, 2] > 0) & (X1[:, 2] <= 0)
             if down.any():
                 g = acc[down]
@@ -373,8 +372,7 @@ def _resample_accurate(history, hang, n_points):
     t0, t1 = tH[rows, j], tH[rows, j + 1]
     h = np.maximum(t1 - t0, np.finfo(float).tiny)[..., None]
     s = np.clip((T - t0)[..., None] / h, 0.0, 1.0)
-    P = _hermite5(s, h, XH[rows, j], VH[rows, j], AH[rows, j], XH[rows, j + 1], VH[rows, j + 1],
-                  AH[rows, j + 1])[0]
+    P = _hermite5(s, h, XH[rows, j], VH[rows, j], AH[rows, j], XH[rows, j + 1], VH[rows, j + 1], AH[rows, j + 1])[0]
     P[:, -1, 2] = 0.0
     return T, P
 
@@ -550,8 +548,13 @@ def fly(
     if wind_arr.shape[-1:] != (2,):
         raise ValueError(f"fly: wind must be (w_x, w_y), got shape {wind_arr.shape}")
     shape = np.broadcast_shapes(
-        np.shape(v0), np.shape(launch_angle), np.shape(spray_angle), np.shape(backspin),
-        np.shape(sidespin), start.shape[:-1], wind_arr.shape[:-1],
+        np.shape(v0),
+        np.shape(launch_angle),
+        np.shape(spray_angle),
+        np.shape(backspin),
+        np.shape(sidespin),
+        start.shape[:-1],
+        wind_arr.shape[:-1],
     )
     N = int(np.prod(shape))
 
@@ -562,8 +565,15 @@ def fly(
     X0 = np.broadcast_to(start, (*shape, 3)).reshape(N, 3).astype(float)
     W = np.zeros((N, 3))
     W[:, :2] = np.broadcast_to(wind_arr, (*shape, 2)).reshape(N, 2)
-    for name, arr in (("v0", v0_), ("launch_angle", th), ("spray_angle", ph), ("backspin", wb),
-                      ("sidespin", ws), ("start", X0), ("wind", W)):
+    for name, arr in (
+        ("v0", v0_),
+        ("launch_angle", th),
+        ("spray_angle", ph),
+        ("backspin", wb),
+        ("sidespin", ws),
+        ("start", X0),
+        ("wind", W),
+    ):
         if not np.all(np.isfinite(arr)):
             raise ValueError(f"fly: {name} has non-finite values")
     bad = (X0[:, 2] < 0) | ((X0[:, 2] == 0) & (np.sin(th) <= 0))
