@@ -20,5 +20,5 @@ include: "workflow/rules/implications.smk"
 rule all:
     """Every dataset's paper comparison (and all that it needs)."""
     input:
-        all_targets(),
+        TARGETS,
     default_target: True

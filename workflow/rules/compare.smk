@@ -1,3 +1,6 @@
+TARGETS += expand("results/{dataset}/paper_comparison.csv", dataset=DATASETS)
+
+
 rule compare:
     """Tabulate every published number of Secs. II-IV beside ours and the truth."""
     input:

@@ -1,3 +1,8 @@
+TARGETS += expand("results/implications/{scenario}.nc", scenario=SCENARIOS)
+if "paper" in SCENARIOS and "sweep" in config["implications"]["scenarios"]["paper"]:
+    TARGETS.append("results/implications/paper_comparison.csv")
+
+
 rule implications:
     """Collide a pitched ball with a bat and fly it, or fly given launch conditions (Sec. V.B)."""
     input:
