@@ -105,3 +105,32 @@ def test_wls_slope():
     x = np.array([1.0, 2.0, 3.0])
     assert wls_slope(x, 2 * x)[0] == pytest.approx(2.0)
     assert wls_slope(x, 2 * x + 1, through_origin=False) == pytest.approx((2.0, 1.0))
+
+
+@pytest.mark.parametrize("design", ["spin", "tan_ratio", "vtf", "theta_spin", "theta_speed"])
+def test_design_jacobians_match_finite_differences(design):
+    """The effective-variance weights rest on these derivatives: check them numerically."""
+    from ballbat import fitting as f
+
+    rng = np.random.default_rng(3)
+    n = 5
+    meas = [rng.uniform(28, 39, n), rng.uniform(30, 45, n), rng.uniform(0.0, 0.4, n), rng.uniform(50, 350, n)]
+    r, r_x, alpha = 0.036, 0.25, 0.4
+    fun = {
+        "spin": lambda m: f.spin_design(*m, r, r_x, alpha),
+        "tan_ratio": lambda m: f.tan_ratio_design(*m, r, alpha),
+        "vtf": lambda m: f.vtf_design(*m, r, r_x, alpha),
+        "theta_spin": lambda m: f.normalized_theta_design(m[0], m[3], m[2], "omega"),
+        "theta_speed": lambda m: f.normalized_theta_design(m[0], m[1], m[2], "v_ball"),
+    }[design]
+    x, y, jx, jy = fun(meas)
+    for k in range(4):
+        h = 1e-6 * max(1.0, float(np.mean(np.abs(meas[k]))))
+        up = [m.copy() for m in meas]
+        dn = [m.copy() for m in meas]
+        up[k] += h
+        dn[k] -= h
+        xu, yu, _, _ = fun(up)
+        xd, yd, _, _ = fun(dn)
+        np.testing.assert_allclose(jx[:, k], (xu - xd) / (2 * h), rtol=1e-5, atol=1e-8)
+        np.testing.assert_allclose(jy[:, k], (yu - yd) / (2 * h), rtol=1e-5, atol=1e-8)

@@ -172,6 +172,28 @@ def tan_ratio_design(v_bat, v_ball, theta, omega, r, alpha):
     return x, y, jx, jy
 
 
+def vtf_design(v_bat, v_ball, theta, omega, r, r_x, alpha):
+    """Eq. vtf: x = tan psi / (1 + r_x), y = (v_ball,t + r omega) / v_bat,n.
+
+    With Eq. angmom, v_ball,t = alpha r omega, so y = (1 + alpha) r omega / (v_bat cos psi).
+    """
+    psi, dpsi = _psi_and_partials(v_ball, theta, omega, r, alpha)
+    x = np.tan(psi) / (1.0 + r_x)
+    y = (1.0 + alpha) * r * omega / (v_bat * np.cos(psi))
+    jx = (1.0 / (np.cos(psi) ** 2 * (1.0 + r_x)))[:, None] * dpsi
+    jy = (y * np.tan(psi))[:, None] * dpsi
+    jy[:, 0] += -y / v_bat
+    jy[:, 3] += (1.0 + alpha) * r / (v_bat * np.cos(psi))
+    return x, y, jx, jy
+
+
+def effective_sigma(jx, jy, sigma, slope):
+    """Standard deviation of y - slope x from the measurement uncertainties (effective variance)."""
+    if sigma is None:
+        return None
+    return np.sqrt(np.sum((jy - slope * jx) ** 2 * sigma**2, axis=1))
+
+
 def normalized_theta_design(v_bat, value, theta, which, v_ref=V_BAT_REF):
     """Figs. 3-4: x = theta, y = value v_ref / v_bat, value = omega or v_ball."""
     n = np.size(theta)
