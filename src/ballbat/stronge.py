@@ -834,117 +834,118 @@ def stronge_reference(
     integrating with unit tangential speed and no friction limit (stick throughout), which
     is the limit of the model as tan(psi)/(mu eta2) -> 0.
     """
-    from scipy.integrate import solve_ivp
-
     arrs = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (psi, eta2, e_y, mu, r_x, r_y, alpha)))
     shape = arrs[0].shape
-    flat = [a.ravel() for a in arrs]
-    ex = np.empty(flat[0].size)
-    regimes, events, tcs = [], [], []
-    for i, (ps, h2, e, m_u, rx, ry, al) in enumerate(zip(*flat, strict=True)):
-        m_n = 1.0 / (1.0 + ry)
-        m_t = al / ((1.0 + al) * (1.0 + rx))
-        k_n = 1.0
-        k_t = k_n / h2
-        v_n = np.cos(ps)
-        u0 = abs(np.sin(ps))
-        fric = m_u
-        if u0 == 0.0:
-            u0, fric = 1.0, np.inf
-        state = {"unloading": False, "d_m": np.nan}
-
-        def normal_force(d, st=state, e=e):
-            if st["unloading"]:
-                return (k_n / e**2) * (d - st["d_m"] * (1.0 - e**2))
-            return k_n * d
-
-        def dN_dt(d, v, st=state, e=e):
-            return (k_n / e**2 if st["unloading"] else k_n) * v
-
-        def rhs(t, y, mode, normal_force=normal_force, dN_dt=dN_dt, m_t=m_t, m_n=m_n, fric=fric):
-            d, v, u, s = y
-            N = normal_force(d)
-            if mode == 0:
-                return [v, -N / m_n, -k_t * s / m_t, u]
-            return [v, -N / m_n, -mode * fric * N / m_t, mode * fric * dN_dt(d, v) / k_t]
-
-        y = np.array([0.0, v_n, u0, 0.0])
-        t = 0.0
-        mode = 0 if (np.isinf(fric) or k_t * u0 < fric * k_n * v_n) else 1
-        seq = ["stick" if mode == 0 else "slip"]
-        evs = []
-        t_c = np.nan
-        for _ in range(200):
-            if not state["unloading"]:
-
-                def ev_normal(t, y):
-                    return y[1]
-
-            else:
-
-                def ev_normal(t, y, normal_force=normal_force):
-                    return normal_force(y[0])
-
-            ev_normal.terminal, ev_normal.direction = True, -1
-            evl = [ev_normal]
-            if mode == 0 and np.isfinite(fric):
-                for sg in (1.0, -1.0):
-
-                    def ev_stick(t, y, sg=sg, normal_force=normal_force, fric=fric):
-                        return sg * k_t * y[3] - fric * normal_force(y[0])
-
-                    ev_stick.terminal, ev_stick.direction = True, 1
-                    evl.append(ev_stick)
-            elif mode != 0:
-
-                def ev_slip(t, y, mode=mode, dN_dt=dN_dt, fric=fric):
-                    return y[2] - mode * fric * dN_dt(y[0], y[1]) / k_t
-
-                ev_slip.terminal, ev_slip.direction = True, -mode
-                evl.append(ev_slip)
-            sol = solve_ivp(
-                lambda t, y, mode=mode, rhs=rhs: rhs(t, y, mode),
-                (t, t + 10.0),
-                y,
-                method="DOP853",
-                rtol=rtol,
-                atol=atol,
-                events=evl,
-            )
-            if sol.status != 1:
-                raise RuntimeError(f"stronge_reference: integration failed ({sol.message}) at impact {i}")
-            hit = [(te[0], k) for k, te in enumerate(sol.t_events) if te.size]
-            t_hit, k_hit = min(hit)
-            y = sol.y_events[k_hit][0].copy()
-            t = t_hit
-            if k_hit == 0:
-                if not state["unloading"]:
-                    state["unloading"] = True
-                    state["d_m"] = y[0]
-                    t_c = t
-                    continue
-                break  # separation
-            if mode == 0:
-                mode = 1 if k_hit == 1 else -1
-                y[3] = mode * fric * normal_force(y[0]) / k_t
-                seq.append("slip")
-            else:
-                mode = 0
-                seq.append("stick")
-            evs.append((t, seq[-1]))
-        else:
-            raise RuntimeError(f"stronge_reference: too many phase changes at impact {i}")
-        ex[i] = -y[2] / u0
-        merged = [seq[0]] + [b for a, b in zip(seq, seq[1:], strict=False) if a != b]
-        regimes.append("gross-slip" if merged == ["slip"] else "-".join(merged))
-        events.append([(te / t_c, ph) for te, ph in evs])
-        tcs.append(t_c)
+    out = [_reference_one(*args, rtol=rtol, atol=atol) for args in zip(*(a.ravel() for a in arrs), strict=True)]
+    ex = np.array([o[0] for o in out])
     return {
         "e_x": ex.reshape(shape) if shape else float(ex[0]),
-        "regime": np.array(regimes).reshape(shape),
-        "t_c": np.array(tcs).reshape(shape),
-        "events": events,
+        "regime": np.array([o[1] for o in out]).reshape(shape),
+        "t_c": np.array([o[2] for o in out]).reshape(shape),
+        "events": [o[3] for o in out],
     }
+
+
+def _reference_one(psi, eta2, e, mu, r_x, r_y, alpha, rtol, atol):
+    """One impact of :func:`stronge_reference`: (e_x, regime, t_c, events)."""
+    from scipy.integrate import solve_ivp
+
+    m_n = 1.0 / (1.0 + r_y)
+    m_t = alpha / ((1.0 + alpha) * (1.0 + r_x))
+    k_n = 1.0
+    k_t = k_n / eta2
+    v_n = np.cos(psi)
+    u0 = abs(np.sin(psi))
+    fric = mu
+    if u0 == 0.0:
+        u0, fric = 1.0, np.inf
+    st = {"unloading": False, "d_m": np.nan}
+
+    def normal_force(d):
+        if st["unloading"]:
+            return (k_n / e**2) * (d - st["d_m"] * (1.0 - e**2))
+        return k_n * d
+
+    def dN_dt(d, v):
+        return (k_n / e**2 if st["unloading"] else k_n) * v
+
+    def rhs(t, y, mode):
+        d, v, u, s = y
+        N = normal_force(d)
+        if mode == 0:
+            return [v, -N / m_n, -k_t * s / m_t, u]
+        return [v, -N / m_n, -mode * fric * N / m_t, mode * fric * dN_dt(d, v) / k_t]
+
+    def ev_compression(t, y):
+        return y[1]
+
+    def ev_separation(t, y):
+        return normal_force(y[0])
+
+    def ev_stick_pos(t, y):
+        return k_t * y[3] - fric * normal_force(y[0])
+
+    def ev_stick_neg(t, y):
+        return -k_t * y[3] - fric * normal_force(y[0])
+
+    def ev_slip(t, y, mode):
+        return y[2] - mode * fric * dN_dt(y[0], y[1]) / k_t
+
+    for f, d in ((ev_compression, -1), (ev_separation, -1), (ev_stick_pos, 1), (ev_stick_neg, 1)):
+        f.terminal, f.direction = True, d
+
+    y = np.array([0.0, v_n, u0, 0.0])
+    t = 0.0
+    mode = 0 if (np.isinf(fric) or k_t * u0 < fric * k_n * v_n) else 1
+    seq = ["stick" if mode == 0 else "slip"]
+    evs = []
+    t_c = np.nan
+    for _ in range(200):
+        evl = [ev_separation if st["unloading"] else ev_compression]
+        if mode == 0 and np.isfinite(fric):
+            evl += [ev_stick_pos, ev_stick_neg]
+        elif mode != 0:
+
+            def ev(t, y, mode=mode):
+                return ev_slip(t, y, mode)
+
+            ev.terminal, ev.direction = True, -mode
+            evl.append(ev)
+        sol = solve_ivp(
+            lambda t, y, mode=mode: rhs(t, y, mode),
+            (t, t + 10.0),
+            y,
+            method="DOP853",
+            rtol=rtol,
+            atol=atol,
+            events=evl,
+        )
+        if sol.status != 1:
+            raise RuntimeError(
+                f"stronge_reference: integration failed ({sol.message}) for psi={psi:g}, eta2={eta2:g},"
+                f" e_y={e:g}, mu={mu:g}, r_x={r_x:g}, r_y={r_y:g}"
+            )
+        t, k_hit = min((te[0], k) for k, te in enumerate(sol.t_events) if te.size)
+        y = sol.y_events[k_hit][0].copy()
+        if k_hit == 0:
+            if st["unloading"]:
+                break  # separation
+            st["unloading"], st["d_m"] = True, y[0]
+            t_c = t
+            continue
+        if mode == 0:
+            mode = 1 if k_hit == 1 else -1
+            y[3] = mode * fric * normal_force(y[0]) / k_t
+            seq.append("slip")
+        else:
+            mode = 0
+            seq.append("stick")
+        evs.append((t, seq[-1]))
+    else:
+        raise RuntimeError(f"stronge_reference: too many phase changes for psi={psi:g}, eta2={eta2:g}")
+    merged = [seq[0]] + [b for a, b in zip(seq, seq[1:], strict=False) if a != b]
+    regime = "gross-slip" if merged == ["slip"] else "-".join(merged)
+    return -y[2] / u0, regime, t_c, [(te / t_c, ph) for te, ph in evs]
 
 
 # --------------------------------------------------------------------------------------
