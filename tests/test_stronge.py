@@ -264,6 +264,14 @@ def test_regimes_slip_stick_slip_needs_omega_t_above_omega_n():
     assert rb.psi[0] == pytest.approx(rb.psi_stick_paper, abs=1e-10)
     assert rb.psi[1] == pytest.approx(np.arctan(3.5 * 0.5), abs=1e-9)  # 60.26 deg
     assert np.rad2deg(rb.psi_gross_paper) == pytest.approx(69.15, abs=0.01)
+    # the model's gross-slip onset in closed form, for Omega_t > Omega_n, both frames
+    for args in ((2.0, 0.9, 0.3), (2.0, 1.0, 0.5), (3.0, 0.5, 0.5), (1.0, 0.7, 0.4), (2.5, 0.8, 0.5, 0.29, 0.27)):
+        rb = regime_boundaries(*args)
+        assert rb.above[-1] == "gross-slip"
+        # abs 1e-8: within ~3e-9 rad below the boundary the final slip starts less than
+        # SEPARATION_TOL before separation and the solver labels the impact "slip-stick"
+        assert rb.psi[-1] == pytest.approx(rb.psi_gross_model, abs=1e-8)
+        assert rb.psi_gross_model < rb.psi_gross_paper
     # superball: stick right up to tan psi = mu eta2, then gross slip
     rb = regime_boundaries(3.5, 1.0, 0.5)
     assert rb.below == ("stick",) and rb.above == ("gross-slip",)

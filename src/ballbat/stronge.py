@@ -394,10 +394,12 @@ def _slip_step(th0, u0, sig, rho, Lam, e, thf):
     # W at the segment end: loading end z = pi/2 (cos 0); unloading end z = 0 (cos 1)
     w_end = np.where(unl, A + B, A)
     dec = np.where(unl, rho * e > 1.0, rho > 1.0)  # sigma W decreasing in this segment
+    # root of A + B cos z = 0: z = arccos(-A/B), written as 2 asin(sqrt((A + B)/(2B))) so
+    # that it stays accurate for small z (re-stick just before separation or near t = 0)
     with np.errstate(divide="ignore", invalid="ignore"):
-        cz = np.clip(-A / B, -1.0, 1.0)
-    ev = dec & (sig * w_end < -ROUND_TOL * (np.abs(A) + np.abs(B))) & np.isfinite(cz)
-    z = np.arccos(cz)
+        h = np.clip((A + B) / (2.0 * B), 0.0, 1.0)
+    ev = dec & (sig * w_end < -ROUND_TOL * (np.abs(A) + np.abs(B))) & np.isfinite(h)
+    z = 2.0 * np.arcsin(np.sqrt(np.where(np.isfinite(h), h, 0.0)))
     th_ev = np.where(unl, thf - e * z, z)
     ev &= th_ev < thf - SEPARATION_TOL
     th_end = np.where(unl, thf, HALF_PI)
@@ -964,6 +966,10 @@ class RegimeBoundaries:
     psi_rigid_reversal : atan(rho^2 mu eta2 (1 + e_y)): where gross slip of the model gives
         u_f = 0 (e_x = 0); equals the paper's 3.5 mu (1 + e_y) in the rigid frame. It is the
         rigid-body (Coulomb, no tangential compliance) onset of gross slip.
+    psi_gross_model : the model's onset of gross slip in closed form (docs/stronge.md):
+        atan(mu eta2) when Omega_t <= Omega_n, otherwise
+        atan(rho^2 mu eta2 max(1, 1 + e_y - 1/(rho^2 e_y))) (C's slip velocity at t_c, or at
+        separation, reaching zero). It tends to the paper's 3.5 mu (1 + e_y) as eta2 -> 0.
     """
 
     psi: NDArray
@@ -972,6 +978,7 @@ class RegimeBoundaries:
     psi_stick_paper: float
     psi_gross_paper: float
     psi_rigid_reversal: float
+    psi_gross_model: float
 
 
 def regime_boundaries(
@@ -1028,4 +1035,7 @@ def regime_boundaries(
         psi_stick_paper=float(np.arctan(mu * eta2)),
         psi_gross_paper=float(np.arctan(3.5 * mu * (1.0 + e_y))),
         psi_rigid_reversal=float(np.arctan(rho**2 * mu * eta2 * (1.0 + e_y))),
+        psi_gross_model=float(
+            np.arctan(mu * eta2 * (1.0 if rho <= 1 else rho**2 * max(1.0, 1.0 + e_y - 1.0 / (rho**2 * e_y))))
+        ),
     )
