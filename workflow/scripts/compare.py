@@ -1,6 +1,7 @@
 """Rule compare: adapter around ballbat.compare."""
 
-from ballbat.compare import write_comparison
+from ballbat.compare import stronge_rows, write_comparison
+from ballbat.ncio import read_dataset
 from ballbat.runlog import logged
 
 with logged(snakemake.log[0], snakemake.rule):
@@ -10,4 +11,5 @@ with logged(snakemake.log[0], snakemake.rule):
         csv_path=snakemake.output.csv,
         md_path=snakemake.output.md,
         title=f"Dataset {snakemake.wildcards.dataset}: the paper's numbers beside ours",
+        extra_rows=stronge_rows(read_dataset(snakemake.input.stronge)),
     )

@@ -1,0 +1,293 @@
+"""Stronge's contact model applied to a dataset (Sec. V.A): the eta^2 fit and Figs. 9-10.
+
+For each ball the Eq. vtf data of the usable impacts (``flag == 0``) are fitted with
+Stronge's lumped-parameter model in the bat frame, each impact with its own recoil
+factors (:func:`ballbat.stronge_fit.fit_eta2`). The result holds the fitted parameters and
+intervals, the model curves on a psi grid (Fig. 9a and its extrapolation, Fig. 9b) for the
+fitted and for the published eta^2, the time histories at psi = 30 deg (Fig. 10) and the
+regime boundaries in psi.
+
+References
+----------
+.. [1] J. R. Kensrud, A. M. Nathan and L. V. Smith, Am. J. Phys. 85, 503 (2017), Sec. V.A.
+.. [2] W. J. Stronge, Impact Mechanics (Cambridge University Press, 2000).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from .fitting import MEASURED, effective_sigma, vtf_design, wls_slope
+from .stronge import omega_ratio, regime_boundaries, stronge_ex, stronge_solve
+from .stronge_fit import fit_eta2
+
+#: eta^2 published in Sec. V.A (with e_y = mu = 0.5), drawn beside the fits.
+PUBLISHED_ETA2 = {"baseball": 4.75, "softball": 6.30}
+
+
+def _attrs(units, long_name, **extra):
+    return {"units": units, "long_name": long_name, **extra}
+
+
+def _fit_inputs(rec, sel):
+    meas = [np.asarray(rec[k].values[sel], dtype=float) for k in MEASURED]
+    r, r_x, alpha = (rec[k].values[sel] for k in ("r", "r_x", "alpha"))
+    x, y, jx, jy = vtf_design(*meas, r, r_x, alpha)
+    sigma = None
+    if all(f"{k}_err" in rec for k in MEASURED):
+        sig = np.stack([rec[f"{k}_err"].values[sel] for k in MEASURED], axis=1).astype(float)
+        # Effective variance of y - (1 + e_x) x with the local slope of the data (the model's
+        # slope varies slowly with psi over the experiment's range).
+        sigma = effective_sigma(jx, jy, sig, wls_slope(x, y)[0])
+    return x, y, sigma
+
+
+def stronge_dataset(
+    rec: xr.Dataset,
+    e_y: float = 0.5,
+    mu: float = 0.5,
+    vary_e_y: bool = False,
+    vary_mu: bool = False,
+    psi_grid_deg: tuple = (0.0, 85.0, 171),
+    psi_history_deg: float = 30.0,
+    n_time: int = 301,
+) -> xr.Dataset:
+    """Fit eta^2 per ball and build the Figs. 9-10 products (see module docstring).
+
+    Parameters
+    ----------
+    rec : reconstructed impacts (``results/{dataset}/reconstruct.nc``).
+    e_y, mu : fixed values, or starting values when ``vary_e_y``/``vary_mu``.
+    psi_grid_deg : (start, stop, num) of the psi grid of the model curves, deg.
+    psi_history_deg : psi of the time histories (Fig. 10), deg.
+    n_time : points of the time histories.
+    """
+    usable = rec["flag"].values == 0
+    ball_ids = rec["ball"].values.astype(str)
+    balls = sorted(set(ball_ids[usable]))
+    psi_grid = np.deg2rad(np.linspace(*psi_grid_deg[:2], int(psi_grid_deg[2])))
+    psi_h = np.deg2rad(psi_history_deg)
+    nb, ng = len(balls), psi_grid.size
+
+    scal = {
+        k: np.full(nb, np.nan)
+        for k in (
+            "eta2",
+            "eta2_err",
+            "eta2_ci_low",
+            "eta2_ci_high",
+            "e_y",
+            "e_y_err",
+            "mu",
+            "mu_err",
+            "redchi",
+            "omega_ratio",
+            "omega_ratio_bat",
+            "r_x_mean",
+            "r_y_mean",
+            "psi_stick_boundary",
+            "psi_gross_slip_boundary",
+            "psi_stick_paper",
+            "psi_gross_slip_paper",
+            "t_stick_end",
+            "t_separation",
+            "t_stretch_max",
+            "eta2_published",
+        )
+    }
+    n_fit = np.zeros(nb, dtype=np.int64)
+    curves = {
+        k: np.full((nb, ng), np.nan)
+        for k in ("vtf_x_model", "vtf_y_model", "e_x_model", "vtf_y_published", "e_x_published")
+    }
+    hist = None
+    regimes_h = []
+    data_ball, data_x, data_y, data_err = [], [], [], []
+
+    for i, ball in enumerate(balls):
+        sel = usable & (ball_ids == ball)
+        x, y, sigma = _fit_inputs(rec, sel)
+        psi = rec["psi"].values[sel]
+        r_x, r_y, alpha = (rec[k].values[sel] for k in ("r_x", "r_y", "alpha"))
+        fit = fit_eta2(
+            psi, x, y, r_x, r_y, sigma=sigma, e_y=e_y, mu=mu, alpha=alpha, vary_e_y=vary_e_y, vary_mu=vary_mu
+        )
+        for k in ("eta2", "eta2_err", "eta2_ci_low", "eta2_ci_high", "e_y", "e_y_err", "mu", "mu_err", "redchi"):
+            scal[k][i] = getattr(fit, k)
+        n_fit[i] = fit.n
+        a = float(np.mean(alpha))
+        rxm, rym = float(np.mean(r_x)), float(np.mean(r_y))
+        scal["r_x_mean"][i], scal["r_y_mean"][i] = rxm, rym
+        scal["omega_ratio"][i] = float(omega_ratio(fit.eta2, 0.0, 0.0, a))
+        scal["omega_ratio_bat"][i] = float(omega_ratio(fit.eta2, rxm, rym, a))
+        # Model curves on the grid (bat frame, mean recoil factors of the ball's impacts).
+        xg = np.tan(psi_grid) / (1.0 + rxm)
+        ex = stronge_ex(psi_grid, fit.eta2, fit.e_y, fit.mu, rxm, rym, a)
+        curves["vtf_x_model"][i] = xg
+        curves["e_x_model"][i] = ex
+        curves["vtf_y_model"][i] = (1.0 + ex) * xg
+        pub = PUBLISHED_ETA2.get(ball)
+        if pub is not None:
+            scal["eta2_published"][i] = pub
+            exp = stronge_ex(psi_grid, pub, 0.5, 0.5, rxm, rym, a)
+            curves["e_x_published"][i] = exp
+            curves["vtf_y_published"][i] = (1.0 + exp) * xg
+        rb = regime_boundaries(fit.eta2, fit.e_y, fit.mu, rxm, rym, a)
+        stick = [p for p, b in zip(rb.psi, rb.below, strict=True) if str(b).startswith("stick")]
+        gross = [p for p, ab in zip(rb.psi, rb.above, strict=True) if ab == "gross-slip"]
+        scal["psi_stick_boundary"][i] = stick[0] if stick else np.nan
+        scal["psi_gross_slip_boundary"][i] = gross[0] if gross else np.nan
+        scal["psi_stick_paper"][i] = rb.psi_stick_paper
+        scal["psi_gross_slip_paper"][i] = rb.psi_gross_paper
+        # Fig. 10: time histories at psi_history for the fitted eta^2.
+        sol = stronge_solve(psi_h, fit.eta2, fit.e_y, fit.mu, rxm, rym, a, histories=True, n_time=n_time)
+        if hist is None:
+            hist = {
+                k: np.full((nb, sol.t.size), np.nan)
+                for k in ("normal_force", "tangential_force", "tangential_velocity", "spring_stretch", "stick")
+            }
+            t_grid = sol.t
+        hist["normal_force"][i] = sol.normal_force
+        hist["tangential_force"][i] = sol.tangential_force
+        hist["tangential_velocity"][i] = sol.u
+        hist["spring_stretch"][i] = sol.stretch
+        stuck = np.where(np.isfinite(sol.normal_force), (np.abs(sol.c_velocity) < 1e-12).astype(float), np.nan)
+        hist["stick"][i] = stuck
+        scal["t_stick_end"][i] = float(sol.t_stick_end)
+        scal["t_separation"][i] = float(sol.t_separation)
+        scal["t_stretch_max"][i] = float(sol.t_stretch_max)
+        regimes_h.append(str(sol.regime))
+        data_ball += [ball] * x.size
+        data_x.append(x)
+        data_y.append(y)
+        data_err.append(sigma if sigma is not None else np.full(x.size, np.nan))
+
+    if hist is None:
+        raise ValueError("fit_stronge: no usable impacts in the dataset")
+    u = "1"
+    data = {
+        "eta2": (("ball",), scal["eta2"], _attrs(u, "eta^2 = k_n/k_t fitted to Eq. vtf (Sec. V.A)")),
+        "eta2_err": (
+            ("ball",),
+            scal["eta2_err"],
+            _attrs(u, "standard error of eta^2 (covariance scaled by reduced chi^2)"),
+        ),
+        "eta2_ci_low": (
+            ("ball",),
+            scal["eta2_ci_low"],
+            _attrs(u, "lower end of the 95 % profile-likelihood interval of eta^2"),
+        ),
+        "eta2_ci_high": (
+            ("ball",),
+            scal["eta2_ci_high"],
+            _attrs(u, "upper end of the 95 % profile-likelihood interval of eta^2"),
+        ),
+        "eta2_published": (("ball",), scal["eta2_published"], _attrs(u, "eta^2 published in Sec. V.A")),
+        "eta2_n": (("ball",), n_fit, _attrs(u, "number of impacts in the eta^2 fit")),
+        "eta2_redchi": (("ball",), scal["redchi"], _attrs(u, "reduced chi-square of the eta^2 fit")),
+        "e_y": (
+            ("ball",),
+            scal["e_y"],
+            _attrs(u, "normal COR e_y of the model (fixed unless fitted)", vary=int(vary_e_y)),
+        ),
+        "e_y_err": (("ball",), scal["e_y_err"], _attrs(u, "standard error of e_y (NaN when fixed)")),
+        "mu": (
+            ("ball",),
+            scal["mu"],
+            _attrs(u, "friction coefficient mu of the model (fixed unless fitted)", vary=int(vary_mu)),
+        ),
+        "mu_err": (("ball",), scal["mu_err"], _attrs(u, "standard error of mu (NaN when fixed)")),
+        "omega_ratio": (
+            ("ball",),
+            scal["omega_ratio"],
+            _attrs(u, "Omega_t/Omega_n in the bat frame at the fitted eta^2"),
+        ),
+        "r_x_mean": (("ball",), scal["r_x_mean"], _attrs(u, "mean r_x of the ball's impacts (model curves)")),
+        "r_y_mean": (("ball",), scal["r_y_mean"], _attrs(u, "mean r_y of the ball's impacts (model curves)")),
+        "psi_stick_boundary": (
+            ("ball",),
+            scal["psi_stick_boundary"],
+            _attrs("rad", "psi where initial stick ends (solver)"),
+        ),
+        "psi_gross_slip_boundary": (
+            ("ball",),
+            scal["psi_gross_slip_boundary"],
+            _attrs("rad", "psi where gross slip begins (solver)"),
+        ),
+        "psi_stick_paper": (
+            ("ball",),
+            scal["psi_stick_paper"],
+            _attrs("rad", "atan(mu eta^2): end of initial stick as the paper states"),
+        ),
+        "psi_gross_slip_paper": (
+            ("ball",),
+            scal["psi_gross_slip_paper"],
+            _attrs("rad", "atan(3.5 mu (1 + e_y)): onset of gross slip as the paper states"),
+        ),
+        "t_stick_end": (
+            ("ball",),
+            scal["t_stick_end"],
+            _attrs(u, "end of initial stick at psi_history, in units of t_c"),
+        ),
+        "t_separation": (("ball",), scal["t_separation"], _attrs(u, "separation at psi_history, in units of t_c")),
+        "t_stretch_max": (
+            ("ball",),
+            scal["t_stretch_max"],
+            _attrs(u, "time of largest spring stretch at psi_history, in units of t_c"),
+        ),
+        "regime_history": (("ball",), np.array(regimes_h, dtype=str), {"long_name": "phase sequence at psi_history"}),
+        "vtf_x_model": (
+            ("ball", "psi_grid"),
+            curves["vtf_x_model"],
+            _attrs(u, "tan psi / (1 + mean r_x) (Fig. 9 abscissa)"),
+        ),
+        "vtf_y_model": (
+            ("ball", "psi_grid"),
+            curves["vtf_y_model"],
+            _attrs(u, "(1 + e_x) tan psi / (1 + mean r_x), fitted eta^2"),
+        ),
+        "e_x_model": (("ball", "psi_grid"), curves["e_x_model"], _attrs(u, "e_x of the model at the fitted eta^2")),
+        "vtf_y_published": (
+            ("ball", "psi_grid"),
+            curves["vtf_y_published"],
+            _attrs(u, "(1 + e_x) tan psi / (1 + mean r_x), published eta^2, e_y = mu = 0.5"),
+        ),
+        "e_x_published": (
+            ("ball", "psi_grid"),
+            curves["e_x_published"],
+            _attrs(u, "e_x of the model at the published eta^2, e_y = mu = 0.5"),
+        ),
+        "data_ball": (("impact_fit",), np.array(data_ball, dtype=str), {"long_name": "ball of each fitted impact"}),
+        "data_vtf_x": (("impact_fit",), np.concatenate(data_x), _attrs(u, "tan psi / (1 + r_x) of each fitted impact")),
+        "data_vtf_y": (
+            ("impact_fit",),
+            np.concatenate(data_y),
+            _attrs(u, "(v_ball,t + r omega)/v_bat,n of each fitted impact"),
+        ),
+        "data_vtf_y_err": (
+            ("impact_fit",),
+            np.concatenate(data_err),
+            _attrs(u, "effective standard uncertainty of data_vtf_y (NaN: none given)"),
+        ),
+    }
+    for k, what in (
+        ("normal_force", "normal force / peak normal force"),
+        ("tangential_force", "tangential spring force / peak normal force"),
+        ("tangential_velocity", "tangential velocity of the ball's contact point / initial normal speed"),
+        ("spring_stretch", "tangential spring stretch / (v_n / Omega_n)"),
+        ("stick", "1 while the contact point sticks, 0 while it slips (NaN after separation)"),
+    ):
+        data[k] = (("ball", "time"), hist[k], _attrs(u, f"{what} at psi_history"))
+    ds = xr.Dataset(
+        data,
+        coords={
+            "ball": ("ball", np.array(balls, dtype=str), {"long_name": "ball type"}),
+            "psi_grid": ("psi_grid", psi_grid, _attrs("rad", "incidence angle psi of the model curves")),
+            "time": ("time", np.arange(t_grid.size, dtype=np.int64), _attrs(u, "time sample")),
+            "t_over_tc": ("time", t_grid, _attrs(u, "time / t_c, t_c = (pi/2)/Omega_n")),
+            "impact_fit": ("impact_fit", np.arange(len(data_ball), dtype=np.int64), _attrs(u, "fitted impact number")),
+        },
+    )
+    ds.attrs.update({"psi_history_deg": float(psi_history_deg), "frame": "bat (recoil factors r_x, r_y)"})
+    return ds

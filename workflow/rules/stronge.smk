@@ -1,0 +1,15 @@
+rule fit_stronge:
+    """Fit eta^2 of Stronge's contact model per ball; model curves and Fig. 10 histories (Sec. V.A)."""
+    input:
+        impacts=rules.reconstruct.output.impacts,
+        code=code("fit_stronge.py"),
+    output:
+        stronge="results/{dataset}/stronge.nc",
+    params:
+        stronge=config["stronge"],
+    log:
+        "results/{dataset}/logs/fit_stronge.log",
+    benchmark:
+        "results/{dataset}/benchmarks/fit_stronge.tsv"
+    script:
+        "../scripts/fit_stronge.py"

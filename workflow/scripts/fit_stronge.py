@@ -1,0 +1,30 @@
+"""Rule fit_stronge: adapter around ballbat.stronge_analysis.stronge_dataset."""
+
+from ballbat.ncio import read_dataset, write_dataset
+from ballbat.provenance import data_inputs
+from ballbat.runlog import logged
+from ballbat.stronge_analysis import stronge_dataset
+
+with logged(snakemake.log[0], snakemake.rule) as log:
+    s = snakemake.params.stronge
+    ds = stronge_dataset(
+        read_dataset(snakemake.input.impacts),
+        e_y=s["e_y"],
+        mu=s["mu"],
+        vary_e_y=s["vary_e_y"],
+        vary_mu=s["vary_mu"],
+        psi_grid_deg=(s["psi_grid_deg"]["start"], s["psi_grid_deg"]["stop"], s["psi_grid_deg"]["num"]),
+        psi_history_deg=s["psi_history_deg"],
+        n_time=s["n_time"],
+    )
+    for b in ds.ball.values:
+        f = ds.sel(ball=b)
+        log.info("%s: eta2 = %.3f +- %.3f (n = %d, reduced chi2 %.2f)", b, f.eta2, f.eta2_err, f.eta2_n, f.eta2_redchi)
+    write_dataset(
+        ds,
+        snakemake.output.stronge,
+        title=f"Stronge contact model fitted to dataset {snakemake.wildcards.dataset} (Sec. V.A)",
+        rule=snakemake.rule,
+        inputs=data_inputs(snakemake.input),
+        config=dict(snakemake.params),
+    )
