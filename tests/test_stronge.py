@@ -110,6 +110,9 @@ def test_broadcasting_symmetry_and_psi_zero_limit():
     assert stronge_ex(0.0, 4.75, 0.5, 0.5) == pytest.approx(-np.cos(rho * np.pi / 2 * 1.5), abs=1e-14)
     assert stronge_ex(1e-9, 4.75, 0.5, 0.5) == pytest.approx(-np.cos(rho * np.pi / 2 * 1.5), abs=1e-8)
     assert stronge_solve(0.0, 4.75, 0.5, 0.5).regime == "stick"
+    # empty input
+    assert stronge_ex(np.zeros((0, 3)), 4.75, 0.5, 0.5).shape == (0, 3)
+    assert stronge_solve(np.array([]), 4.75, 0.5, 0.5, histories=True, n_time=5).u.shape == (0, 5)
 
 
 def test_invalid_inputs_raise_with_names():

@@ -427,7 +427,7 @@ class _Pieces:
 
 def _engine(p: _Params, idx) -> _Pieces:
     """Run the phase machine for the impacts ``idx`` (flat indices into ``p``), in blocks."""
-    blocks = [_engine_block(p, idx[a : a + CHUNK]) for a in range(0, idx.size, CHUNK)]
+    blocks = [_engine_block(p, idx[a : a + CHUNK]) for a in range(0, max(idx.size, 1), CHUNK)]
     if len(blocks) == 1:
         return blocks[0]
     P = max(b.start.shape[1] for b in blocks)
@@ -689,7 +689,7 @@ def _regimes(pc: _Pieces):
             names.append("gross-slip")
         else:
             names.append("-".join(seq))
-    width = max(len(s) for s in names)
+    width = max((len(s) for s in names), default=1)
     return np.array(names, dtype=f"<U{width}")[inv.ravel()], comp, nph
 
 
@@ -770,7 +770,7 @@ def stronge_solve(
         n_phases=nph.reshape(sh),
     )
     if histories:
-        t = np.linspace(0.0, float(np.max(1.0 + p.e)), int(n_time))
+        t = np.linspace(0.0, float(np.max(1.0 + p.e, initial=1.0)), int(n_time))
         th = np.broadcast_to(t * HALF_PI, (n, t.size))
         after = th > p.thf[:, None]
         thc = np.minimum(th, p.thf[:, None])
