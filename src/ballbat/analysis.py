@@ -23,6 +23,11 @@ from .kinematics import (
 )
 from .properties import Ball, Bat, recoil_factors
 
+#: Values of ``flag`` in reconstruct.nc: those of Eq. angmom, and impacts excluded when a
+#: measured file was read (``ingest_flag`` > 0; the reason names the ingest reason).
+FLAGS = {**RECONSTRUCT_FLAGS, 4: "excluded when the measured file was read (see ingest_flag_reason)"}
+FLAG_INGEST = 4
+
 
 def _attrs(units, long_name, **extra):
     return {"units": units, "long_name": long_name, **extra}
@@ -75,6 +80,11 @@ def reconstruct(ds: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]) ->
     v_bat, v_ball, theta, omega = (ds[k].values for k in ("v_bat", "v_ball", "theta", "omega"))
     psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
     reasons = np.array([RECONSTRUCT_FLAGS[int(f)] for f in flag], dtype=object).astype(str)
+    if "ingest_flag" in ds:  # measured data: keep the ingest's exclusions out of every fit
+        excluded = ds["ingest_flag"].values != 0
+        flag = np.where(excluded, FLAG_INGEST, flag).astype(np.int8)
+        ingest_reasons = ds["ingest_flag_reason"].values.astype(str)
+        reasons = np.where(excluded, np.char.add("excluded at ingest: ", ingest_reasons), reasons)
 
     out = ds.copy()
     out["r"] = ("impact", r, _attrs("m", "ball radius"))
@@ -90,11 +100,11 @@ def reconstruct(ds: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]) ->
         {
             "units": "1",
             "long_name": "reconstruction flag (0: usable)",
-            "flag_values": np.array(sorted(RECONSTRUCT_FLAGS), dtype=np.int8),
-            "flag_meanings": " ".join(f"{k}:{v.replace(' ', '_')}" for k, v in sorted(RECONSTRUCT_FLAGS.items())),
+            "flag_values": np.array(sorted(FLAGS), dtype=np.int8),
+            "flag_meanings": " ".join(f"{k}:{v.replace(' ', '_')}" for k, v in sorted(FLAGS.items())),
         },
     )
-    out["flag_reason"] = ("impact", reasons, {"long_name": "why the impact cannot be reconstructed (ok if it can)"})
+    out["flag_reason"] = ("impact", reasons, {"long_name": "why the impact is not used (ok if it is)"})
     with np.errstate(invalid="ignore"):
         out["D"] = ("impact", offset_from_psi(psi, r, R), _attrs("m", "ball-bat offset D (Eq. D)"))
         out["v_n"] = ("impact", v_ball * np.cos(psi - theta), _attrs("m s-1", "normal component of the exit velocity"))

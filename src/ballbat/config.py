@@ -30,6 +30,9 @@ def _message(error) -> str:
             f"{where + '.' if where != '<top level>' else ''}{k}: unknown key (allowed: {', '.join(allowed)})"
             for k in extra
         )
+    if error.validator == "oneOf" and not error.context:  # more than one form matches
+        forms = [" + ".join(f.get("required", [])) or "?" for f in error.validator_value]
+        return f"{_path(error)}: give exactly one of {', '.join(forms)}, not several"
     if error.validator in ("oneOf", "anyOf") and error.context:
         inner = sorted({_message(e) for e in error.context})
         return f"{_path(error)}: matches none of the allowed forms: " + " | ".join(inner)

@@ -30,6 +30,9 @@ from .kinematics import V_BAT_REF, e_y_from_tan_ratio_slope, gross_slip_onset
 #: The measured quantities, in the order of the Jacobian columns.
 MEASURED = ("v_bat", "v_ball", "theta", "omega")
 
+#: Fewest usable impacts for a fit of e_x per bat or pooled; fewer give NaN with n and a note.
+MIN_FIT_IMPACTS = 3
+
 
 @dataclass(frozen=True)
 class LineFit:
@@ -227,6 +230,13 @@ def _weights(jx, jy, sigma, slope):
     return 1.0 / np.sqrt(var) if np.all(var > 0) else None
 
 
+def _fit_note(fit: LineFit) -> str:
+    """Why a fit of e_x has no value ('ok' when it has one)."""
+    if fit.n < MIN_FIT_IMPACTS:
+        return f"not fitted: {fit.n} usable impact(s), fewer than {MIN_FIT_IMPACTS}"
+    return "ok" if fit.success else "fit failed"
+
+
 def analyze_impacts(ds, v_ref=V_BAT_REF, mu_k_example=0.5) -> dict:
     """Sec. IV analysis of a reconstructed dataset (output of ``analysis.reconstruct``).
 
@@ -249,10 +259,15 @@ def analyze_impacts(ds, v_ref=V_BAT_REF, mu_k_example=0.5) -> dict:
         "speed_theta_slope": {},
         "gross_slip": {},
         "truth": {},
+        "e_x_note": {},
+        "e_x_pooled_note": {},
     }
     truth = res["truth"]
 
     def spin_fit(sel):
+        n = int(np.sum(sel))
+        if n < MIN_FIT_IMPACTS:  # too few for a slope and its error: report, do not fit
+            return LineFit(np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, n, np.nan, False), np.nan
         r, r_x, alpha = (ds[k].values[sel] for k in ("r", "r_x", "alpha"))
         x, y, jx, jy = spin_design(*_measured(ds, sel), r, r_x, alpha)
         sig = _sigma(ds, sel)
@@ -269,9 +284,11 @@ def analyze_impacts(ds, v_ref=V_BAT_REF, mu_k_example=0.5) -> dict:
             sel = in_ball & (bats == bat)
             fit, t = spin_fit(sel)
             res["e_x"][(ball, bat)] = fit
+            res["e_x_note"][(ball, bat)] = _fit_note(fit)
             truth[("e_x", ball, bat)] = t
         fit, t = spin_fit(in_ball)
         res["e_x_pooled"][ball] = fit
+        res["e_x_pooled_note"][ball] = _fit_note(fit)
         truth[("e_x_pooled", ball)] = t
 
         r, r_x, r_y, alpha = (ds[k].values[in_ball] for k in ("r", "r_x", "r_y", "alpha"))
@@ -457,6 +474,12 @@ def results_dataset(res: dict, has_truth: bool, mu_k_example: float):
             np.array([res[name][b].intercept for b in balls]),
             {"units": units, "long_name": f"intercept at theta = 0 of the fit of {name}"},
         )
+    for name, dims in (("e_x", ("ball", "bat")), ("e_x_pooled", ("ball",))):
+        note = np.full(tuple(len(coords[d]) for d in dims), "no impacts", dtype=object)
+        for key, text in res.get(f"{name}_note", {}).items():
+            keys = key if isinstance(key, tuple) else (key,)
+            note[tuple(coords[d].index(k) for d, k in zip(dims, keys, strict=True))] = text
+        data[f"{name}_note"] = (dims, note.astype(str), {"long_name": f"why {name} has no value (ok if it has one)"})
     ey = np.array([res["e_y_implied"][b] for b in balls])
     data["e_y_implied"] = (
         ("ball",),

@@ -14,3 +14,20 @@ rule simulate:
         "results/{dataset}/benchmarks/simulate.tsv"
     script:
         "../scripts/simulate.py"
+
+
+rule ingest:
+    """Read a measured dataset (CSV or NetCDF, paper units), check every row, convert to SI."""
+    input:
+        impacts=get_measured_impacts,
+        balls=get_balls_table,
+        bats=get_bats_table,
+        code=code("ingest.py"),
+    output:
+        impacts="results/{dataset}/ingest.nc",
+    log:
+        "results/{dataset}/logs/ingest.log",
+    benchmark:
+        "results/{dataset}/benchmarks/ingest.tsv"
+    script:
+        "../scripts/ingest.py"

@@ -13,7 +13,9 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         bats=load_bats(snakemake.input.bats),
     )
     bad = int((ds["flag"] != 0).sum())
-    log.info("%d of %d impacts cannot be reconstructed (flagged, kept in the file)", bad, ds.sizes["impact"])
+    log.info("%d of %d impacts not used (flagged, kept in the file)", bad, ds.sizes["impact"])
+    for i in (ds["flag"].values != 0).nonzero()[0]:
+        log.info("not used: impact %d: %s", int(ds["impact"].values[i]), ds["flag_reason"].values[i])
     write_dataset(
         ds,
         snakemake.output.impacts,

@@ -1,0 +1,488 @@
+"""Measured impacts from a user's file: read, check every row, convert to SI.
+
+A measured dataset is a CSV file (or a NetCDF file with the same content) with one row per
+impact and the columns of :data:`REQUIRED` in the paper's units (mph, deg, rpm), optional
+``impact_id`` and optional per-row standard uncertainties ``<column>_err``. :func:`ingest`
+checks the file whole against the ball and bat tables and returns the impacts in SI with
+the variable names of a synthetic experiment (``v_bat``, ``v_ball``, ``theta``, ``omega``
+and ``*_err``), so every later stage treats both alike.
+
+Two kinds of problems (docs/ingest.md):
+
+* **Stop** (:class:`~ballbat.properties.InputError` listing every problem, each naming the
+  file, the row (CSV line number; the header is line 1) and the column): an unreadable
+  file, missing, unknown or repeated columns, empty or non-numeric cells, non-finite
+  values, non-positive speeds, angles outside (-90, 90) deg, negative uncertainties, a
+  ball or bat not in the property tables, duplicate impact ids, a bad property table, and
+  a file in which no bat x ball pair has :data:`MIN_FIT_IMPACTS` usable impacts. These
+  are mistakes a person must fix; guessing would hide them.
+* **Exclude** (the row is kept with ``ingest_flag`` > 0 and ``ingest_flag_reason``):
+  well-formed measurements the physics cannot use, i.e. impacts whose psi cannot be
+  reconstructed (|alpha r omega / v_ball| > 1, Eq. angmom) or lands at |psi| >= 90 deg.
+
+Warnings (log and the ``ingest_warnings`` attribute) flag what is possible but suspicious:
+a bat x ball pair with fewer than :data:`MIN_FIT_IMPACTS` usable impacts (not fitted per
+bat), only some of the four uncertainty columns (the fits are then unweighted), and values
+that betray a unit mistake (:func:`unit_warnings`).
+
+References
+----------
+.. [1] J. R. Kensrud, A. M. Nathan and L. V. Smith, "Oblique collisions of baseballs and
+   softballs with a bat", Am. J. Phys. 85, 503 (2017), Secs. II-III.
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+from pathlib import Path
+
+import numpy as np
+import xarray as xr
+
+from .kinematics import spin_bracket
+from .properties import Ball, Bat, InputError, load_balls, load_bats, recoil_factors
+from .units import DEGREE, MPH, RPM
+
+#: Required columns of an impacts file.
+REQUIRED = ("bat", "ball", "v_bat_mph", "v_ball_mph", "theta_deg", "omega_rpm")
+
+#: Measured columns: file column -> (variable in SI, factor to SI, long name).
+MEASURED_COLUMNS = {
+    "v_bat_mph": ("v_bat", MPH, "bat speed at the impact point"),
+    "v_ball_mph": ("v_ball", MPH, "exit speed of the ball"),
+    "theta_deg": ("theta", DEGREE, "angle of the batted ball from the bat's direction of travel"),
+    "omega_rpm": ("omega", RPM, "spin of the batted ball (positive: backspin, Fig. 2)"),
+}
+SI_UNITS = {"v_bat": "m s-1", "v_ball": "m s-1", "theta": "rad", "omega": "rad s-1"}
+
+#: Optional columns: an impact's own id and the standard uncertainty of each measurement.
+OPTIONAL = ("impact_id", *(f"{c}_err" for c in MEASURED_COLUMNS))
+
+#: Fewest usable impacts for a fit of e_x (same value as ``ballbat.fitting.MIN_FIT_IMPACTS``).
+MIN_FIT_IMPACTS = 3
+
+#: Values of ``ingest_flag``: why an impact is excluded (kept in the file, never dropped).
+INGEST_FLAGS = {
+    0: "ok",
+    1: "psi cannot be reconstructed: |alpha r omega / v_ball| > 1 (Eq. angmom)",
+    2: "reconstructed |psi| >= 90 deg: the bat cannot reach the ball there",
+}
+
+#: Range of e_x (Eq. omega) that real ball-bat impacts can show; used only to spot unit mistakes.
+E_X_PLAUSIBLE = (-0.5, 1.0)
+#: Impacts with |psi| below this are too head-on for an implied e_x (sin psi ~ 0).
+PSI_MIN_FOR_E_X = 10.0 * DEGREE
+#: A check that fails for more than this fraction of impacts triggers a unit warning ...
+UNIT_WARN_FRACTION = 0.5
+#: ... and a suspected mistake is named when correcting it leaves at most this fraction.
+UNIT_FIX_FRACTION = 0.2
+
+
+# ---------------------------------------------------------------------------------------
+# Reading: every cell as text, with the label of its row
+
+_EXTRA = "\0extra"  # key of a row's surplus cells (cannot clash with a column name)
+
+
+def _read_csv(path: Path) -> tuple[list[str], list[tuple[str, dict]]]:
+    with open(path, newline="") as fh:
+        reader = csv.reader(fh)
+        header = next(reader, None)
+        if header is None:
+            raise InputError([f"{path}: empty file (expected a header line with {', '.join(REQUIRED)})"])
+        header = [h.strip() for h in header]
+        rows = []
+        for cells in reader:
+            if not any(c.strip() for c in cells):
+                continue  # blank line
+            line = reader.line_num
+            row = {h: (cells[i].strip() if i < len(cells) else "") for i, h in enumerate(header)}
+            if len(cells) > len(header):
+                row[_EXTRA] = str(len(cells) - len(header))
+            rows.append((f"row {line}", row))
+    return header, rows
+
+
+def _cell_text(v) -> str:
+    if isinstance(v, bytes):
+        v = v.decode()
+    if isinstance(v, str):
+        return v.strip()
+    if v is None or (isinstance(v, float | np.floating) and math.isnan(v)):
+        return ""
+    return repr(float(v)) if isinstance(v, float | np.floating) else str(v)
+
+
+def _read_netcdf(path: Path) -> tuple[list[str], list[tuple[str, dict]]]:
+    try:
+        with xr.open_dataset(path) as ds:
+            ds = ds.load()
+    except (OSError, ValueError) as exc:
+        raise InputError([f"{path}: cannot be read as NetCDF ({exc})"]) from None
+    dims = sorted({d for v in ds.variables.values() for d in v.dims})
+    if len(dims) != 1:
+        raise InputError([f"{path}: expected one dimension (impact), found {', '.join(dims) or 'none'}"])
+    dim = dims[0]
+    header = [str(k) for k, v in ds.variables.items() if v.dims == (dim,) and k != dim]
+    problems = []
+    for col, (_, _, _) in MEASURED_COLUMNS.items():
+        units = ds[col].attrs.get("units") if col in ds else None
+        expected = col.rsplit("_", 1)[1]
+        if units is not None and units != expected:
+            problems.append(f"{path}: variable {col}: units {units!r}, expected {expected!r}")
+    if problems:
+        raise InputError(problems)
+    cols = {k: ds[k].values for k in header}
+    rows = [(f"impact {i}", {k: _cell_text(cols[k][i]) for k in header}) for i in range(ds.sizes[dim])]
+    return header, rows
+
+
+def read_impacts_table(path) -> tuple[list[str], list[tuple[str, dict]]]:
+    """Header and rows (label, {column: text}) of a CSV or NetCDF impacts file.
+
+    A CSV row's label is its line number (``row 5``; the header is line 1); a NetCDF row's
+    is its index along the impact dimension (``impact 3``).
+    """
+    path = Path(path)
+    if not path.is_file():
+        raise InputError([f"{path}: file not found"])
+    if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
+        return _read_netcdf(path)
+    try:
+        return _read_csv(path)
+    except UnicodeDecodeError:
+        raise InputError([f"{path}: not a text (CSV) file; NetCDF files must end in .nc"]) from None
+
+
+# ---------------------------------------------------------------------------------------
+# Checks
+
+
+def _number(raw: str, where: str, problems: list[str]) -> float:
+    if raw == "":
+        problems.append(f"{where}: empty (every impact needs a value; delete the row or fill it in)")
+        return math.nan
+    try:
+        val = float(raw)
+    except ValueError:
+        problems.append(f"{where}: {raw!r} is not a number")
+        return math.nan
+    if not math.isfinite(val):
+        problems.append(f"{where}: {raw!r} is not finite")
+        return math.nan
+    return val
+
+
+def check_rows(path, header, rows, balls: dict | None, bats: dict | None) -> tuple[dict, list[str]]:
+    """Check header and cells; return (columns as arrays in the file's units, problems).
+
+    ``balls`` / ``bats`` None (their table was bad) skip the membership checks.
+    """
+    problems: list[str] = []
+    allowed = (*REQUIRED, *OPTIONAL)
+    missing = [c for c in REQUIRED if c not in header]
+    if missing:
+        problems.append(
+            f"{path}: missing column(s) {', '.join(missing)} (required: {', '.join(REQUIRED)}; "
+            f"optional: {', '.join(OPTIONAL)})"
+        )
+    unknown = [c for c in header if c not in allowed]
+    if unknown:
+        problems.append(f"{path}: unknown column(s) {', '.join(map(repr, unknown))} (allowed: {', '.join(allowed)})")
+    repeated = sorted({c for c in header if header.count(c) > 1})
+    if repeated:
+        problems.append(f"{path}: column(s) {', '.join(repeated)} appear more than once")
+    if missing:
+        return {}, problems
+    if not rows:
+        problems.append(f"{path}: no impacts (only a header)")
+        return {}, problems
+    errs = [c for c in OPTIONAL if c.endswith("_err") and c in header]
+    out: dict = {c: [] for c in ("label", "bat", "ball", "impact_id", *MEASURED_COLUMNS, *errs)}
+    seen_ids: dict[str, str] = {}
+    for label, row in rows:
+        at = f"{path}: {label}"
+        if _EXTRA in row:
+            problems.append(f"{at}: {row[_EXTRA]} more cell(s) than the header has columns")
+        for key, table, what in (("bat", bats, "bat"), ("ball", balls, "ball")):
+            name = row.get(key, "")
+            if not name:
+                problems.append(f"{at}, column {key}: empty")
+            elif table is not None and name not in table:
+                problems.append(
+                    f"{at}, column {key}: {what} {name!r} is not in the {what} table "
+                    f"(known: {', '.join(sorted(table))})"
+                )
+            out[key].append(name)
+        vals = {c: _number(row.get(c, ""), f"{at}, column {c}", problems) for c in MEASURED_COLUMNS}
+        for c in ("v_bat_mph", "v_ball_mph"):
+            if vals[c] <= 0:
+                problems.append(f"{at}, column {c}: {row[c]} mph; a speed must be positive")
+        if abs(vals["theta_deg"]) >= 90:
+            problems.append(
+                f"{at}, column theta_deg: {row['theta_deg']} deg is outside the physical range (-90, 90) "
+                "(the ball leaves the bat forwards)"
+            )
+        for c in MEASURED_COLUMNS:
+            out[c].append(vals[c])
+        for c in errs:
+            e = _number(row.get(c, ""), f"{at}, column {c}", problems)
+            if e < 0:
+                problems.append(f"{at}, column {c}: {row[c]} is negative; an uncertainty must be >= 0")
+            out[c].append(e)
+        iid = row.get("impact_id", "") if "impact_id" in header else label
+        if "impact_id" in header:
+            if not iid:
+                problems.append(f"{at}, column impact_id: empty")
+            elif iid in seen_ids:
+                problems.append(f"{at}, column impact_id: {iid!r} duplicates {seen_ids[iid]}")
+            else:
+                seen_ids[iid] = label
+        out["impact_id"].append(iid)
+        out["label"].append(label)
+    return {k: np.asarray(v) for k, v in out.items()}, problems
+
+
+def exclusions(v_ball, theta, omega, r, alpha) -> tuple[np.ndarray, np.ndarray]:
+    """Per impact: ``(ingest_flag, ingest_flag_reason)`` for impacts psi cannot use (SI inputs).
+
+    Notes
+    -----
+    Eq. angmom: sin(psi - theta) = alpha r omega / v_ball; outside [-1, 1] psi does not
+    exist (flag 1); a psi with |psi| >= 90 deg puts the bat behind the ball (flag 2).
+    """
+    q = alpha * r * omega / v_ball
+    with np.errstate(invalid="ignore"):
+        psi = theta + np.arcsin(np.clip(q, -1, 1))
+    flag = np.zeros(q.shape, dtype=np.int8)
+    flag[np.abs(psi) >= np.pi / 2] = 2
+    flag[np.abs(q) > 1] = 1
+    reason = np.array(
+        [
+            "ok"
+            if f == 0
+            else f"alpha r omega / v_ball = {qq:.3g}: psi cannot be reconstructed (Eq. angmom)"
+            if f == 1
+            else f"reconstructed psi = {np.degrees(p):.1f} deg: the bat cannot reach the ball there"
+            for f, qq, p in zip(flag, q, psi, strict=True)
+        ],
+        dtype=object,
+    ).astype(str)
+    return flag, reason
+
+
+def implausible(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y) -> dict[str, tuple[int, int]]:
+    """Physics checks that betray unit mistakes: name -> (failing, checked) impact counts (SI).
+
+    Notes
+    -----
+    * ``psi``: Eq. angmom has a solution with |psi| < 90 deg.
+    * ``ratio_high``: v_ball / v_bat <= 2 / (1 + r_y): with e_y, e_x <= 1, Eqs. vballn and vxf
+      bound the exit speed of a ball at rest.
+    * ``ratio_low``: v_ball / v_bat >= cos psi / (1 + r_y): the normal component alone
+      (Eq. vballn, e_y >= 0).
+    * ``e_x``: the e_x each impact implies through Eq. omega lies in :data:`E_X_PLAUSIBLE`
+      (impacts with |psi| >= :data:`PSI_MIN_FOR_E_X` only).
+    """
+    q = alpha * r * omega / v_ball
+    with np.errstate(invalid="ignore", divide="ignore"):
+        psi = theta + np.arcsin(np.clip(q, -1, 1))
+        psi_ok = (np.abs(q) <= 1) & (np.abs(psi) < np.pi / 2)
+        ratio = v_ball / v_bat
+        e_x = omega / spin_bracket(v_bat, psi, r, r_x, alpha) - 1.0
+    use_ex = psi_ok & (np.abs(psi) >= PSI_MIN_FOR_E_X)
+    n = q.size
+    return {
+        "psi": (int((~psi_ok).sum()), n),
+        "ratio_high": (int((ratio > 2.0 / (1.0 + r_y)).sum()), n),
+        "ratio_low": (int((psi_ok & (ratio < np.cos(psi) / (1.0 + r_y))).sum()), int(psi_ok.sum())),
+        "e_x": (
+            int((use_ex & ~((e_x >= E_X_PLAUSIBLE[0]) & (e_x <= E_X_PLAUSIBLE[1]))).sum()),
+            int(use_ex.sum()),
+        ),
+    }
+
+
+_CHECK_WORDS = {
+    "psi": "psi cannot be reconstructed (Eq. angmom)",
+    "ratio_high": "exit speed above 2/(1 + r_y) times the bat speed, more than any collision allows",
+    "ratio_low": "exit speed below cos(psi)/(1 + r_y) times the bat speed, less than any collision allows",
+    "e_x": f"implied e_x (Eq. omega) outside [{E_X_PLAUSIBLE[0]:g}, {E_X_PLAUSIBLE[1]:g}]",
+}
+
+#: Suspected unit mistakes: (columns, what went wrong, correction of the SI arrays).
+_MISTAKES = (
+    ("omega_rpm", "spin in rad/s, not rpm", lambda d: {**d, "omega": d["omega"] / RPM}),
+    ("v_bat_mph", "bat speed in m/s, not mph", lambda d: {**d, "v_bat": d["v_bat"] / MPH}),
+    ("v_ball_mph", "exit speed in m/s, not mph", lambda d: {**d, "v_ball": d["v_ball"] / MPH}),
+    (
+        "v_bat_mph, v_ball_mph",
+        "speeds in m/s, not mph",
+        lambda d: {**d, "v_bat": d["v_bat"] / MPH, "v_ball": d["v_ball"] / MPH},
+    ),
+    ("theta_deg", "angle in radians, not degrees", lambda d: {**d, "theta": d["theta"] / DEGREE}),
+    # last: on a tie the mistakes above are the likelier
+    ("omega_rpm", "spin with the opposite sign (omega > 0 is backspin, Fig. 2)", lambda d: {**d, "omega": -d["omega"]}),
+)
+
+
+def _score(checks: dict) -> float:
+    """Largest fraction of impacts failing one check (checks with fewer than 3 impacts skipped)."""
+    return max((bad / n for bad, n in checks.values() if n >= 3), default=0.0)
+
+
+def unit_warnings(path, data: dict, r, alpha, r_x, r_y) -> list[str]:
+    """Warnings naming a column whose values look like a unit mistake (SI ``data``).
+
+    When a physics check of :func:`implausible` fails for most impacts, each suspected
+    mistake of :data:`_MISTAKES` is undone in turn; one that makes the data plausible is
+    named with its column. Only warnings: such values are possible, just unlikely.
+    """
+    args = (r, alpha, r_x, r_y)
+    theta_deg = np.abs(data["theta"]) / DEGREE
+    if theta_deg.size >= 5 and np.all(theta_deg < 90 * DEGREE) and np.ptp(theta_deg) > 0:
+        return [
+            f"{path}: column theta_deg: every |theta| is below {90 * DEGREE:.2f} deg, a range no oblique "
+            "impacts span: the values look like radians, not degrees"
+        ]
+    raw = implausible(data["v_bat"], data["v_ball"], data["theta"], data["omega"], *args)
+    if _score(raw) <= UNIT_WARN_FRACTION:
+        return []
+    failing = "; ".join(f"{_CHECK_WORDS[k]} for {bad} of {n}" for k, (bad, n) in raw.items() if bad)
+    best = None
+    for cols, what, fix in _MISTAKES:
+        d = fix(data)
+        s = _score(implausible(d["v_bat"], d["v_ball"], d["theta"], d["omega"], *args))
+        if s <= UNIT_FIX_FRACTION and (best is None or s < best[0]):
+            best = (s, cols, what)
+    if best is None:
+        return [
+            f"{path}: most impacts are physically implausible ({failing}); check the units of "
+            "v_bat_mph and v_ball_mph (mph), theta_deg (deg) and omega_rpm (rpm, positive for backspin)"
+        ]
+    s, cols, what = best
+    return [
+        f"{path}: column {cols}: most impacts are physically implausible ({failing}); the values look like "
+        f"{what} (corrected for that, every check passes for at least {100 * (1 - s):.0f} % of impacts)"
+    ]
+
+
+# ---------------------------------------------------------------------------------------
+# The whole file
+
+
+def _var(data, units, long_name, **extra):
+    return ("impact", np.asarray(data), {"units": units, "long_name": long_name, **extra})
+
+
+def ingest(impacts_path, balls_path, bats_path) -> tuple[xr.Dataset, list[str]]:
+    """Read and check a measured dataset; return ``(impacts in SI, warnings)``.
+
+    Raises :class:`~ballbat.properties.InputError` listing every problem that stops the
+    dataset (bad property tables included). Impacts psi cannot use stay in the output with
+    ``ingest_flag`` > 0 and the reason in ``ingest_flag_reason``.
+    """
+    problems: list[str] = []
+    balls: dict[str, Ball] | None = None
+    bats: dict[str, Bat] | None = None
+    try:
+        balls = load_balls(balls_path)
+    except InputError as exc:
+        problems += exc.problems
+    try:
+        bats = load_bats(bats_path)
+    except InputError as exc:
+        problems += exc.problems
+    try:
+        header, rows = read_impacts_table(impacts_path)
+    except InputError as exc:
+        raise InputError(problems + exc.problems) from None
+    cols, row_problems = check_rows(impacts_path, header, rows, balls, bats)
+    problems += row_problems
+    if problems:
+        raise InputError(problems)
+
+    data = {si: cols[c] * factor for c, (si, factor, _) in MEASURED_COLUMNS.items()}
+    ball_ids, bat_ids = cols["ball"].astype(str), cols["bat"].astype(str)
+    r = np.array([balls[b].r for b in ball_ids])
+    alpha = np.array([balls[b].alpha for b in ball_ids])
+    rxy = {(b, t): recoil_factors(balls[b], bats[t]) for b, t in set(zip(ball_ids, bat_ids, strict=True))}
+    r_x = np.array([rxy[(b, t)][0] for b, t in zip(ball_ids, bat_ids, strict=True)])
+    r_y = np.array([rxy[(b, t)][1] for b, t in zip(ball_ids, bat_ids, strict=True)])
+    flag, reason = exclusions(data["v_ball"], data["theta"], data["omega"], r, alpha)
+
+    warnings: list[str] = []
+    usable = flag == 0
+    groups = sorted({(str(b), str(t)) for b, t in zip(ball_ids, bat_ids, strict=True)})
+    counts = {g: int((usable & (ball_ids == g[0]) & (bat_ids == g[1])).sum()) for g in groups}
+    for (b, t), k in counts.items():
+        if k < MIN_FIT_IMPACTS:
+            warnings.append(
+                f"{impacts_path}: ball {b!r} on bat {t!r}: {k} usable impact(s), fewer than {MIN_FIT_IMPACTS}: "
+                "e_x of this bat is not fitted (reported as NaN); its impacts still enter the pooled fit"
+            )
+    if not any(k >= MIN_FIT_IMPACTS for k in counts.values()):
+        raise InputError(
+            [
+                f"{impacts_path}: no ball x bat pair has {MIN_FIT_IMPACTS} usable impacts "
+                f"({', '.join(f'{b} on {t}: {k}' for (b, t), k in counts.items())}): nothing to fit"
+            ]
+        )
+    errs = [c for c in MEASURED_COLUMNS if f"{c}_err" in cols]
+    if errs and len(errs) < len(MEASURED_COLUMNS):
+        given = ", ".join(f"{c}_err" for c in errs)
+        warnings.append(
+            f"{impacts_path}: only {given} of the four uncertainty columns given: the fits are unweighted "
+            "and their reduced chi-square undefined"
+        )
+    warnings += unit_warnings(impacts_path, data, r, alpha, r_x, r_y)
+
+    n = len(ball_ids)
+    out = {}
+    for c, (si, factor, long_name) in MEASURED_COLUMNS.items():
+        out[si] = _var(data[si], SI_UNITS[si], f"measured {long_name}", ballbat_role="measurement")
+        if f"{c}_err" in cols:
+            out[f"{si}_err"] = _var(
+                cols[f"{c}_err"] * factor,
+                SI_UNITS[si],
+                f"standard uncertainty of measured {long_name}",
+                ballbat_role="uncertainty",
+            )
+    out["impact_id"] = ("impact", cols["impact_id"].astype(str), {"long_name": "impact id given in the source file"})
+    out["source_row"] = (
+        "impact",
+        cols["label"].astype(str),
+        {"long_name": "where the impact is in the source file (CSV line number, header = 1; NetCDF index)"},
+    )
+    out["ingest_flag"] = _var(
+        flag,
+        "1",
+        "exclusion flag set when the file was read (0: usable)",
+        flag_values=np.array(sorted(INGEST_FLAGS), dtype=np.int8),
+        flag_meanings=" ".join(f"{k}:{v.split(':')[0].replace(' ', '_')}" for k, v in sorted(INGEST_FLAGS.items())),
+    )
+    out["ingest_flag_reason"] = ("impact", reason, {"long_name": "why the impact is excluded (ok if it is not)"})
+    ds = xr.Dataset(
+        out,
+        coords={
+            "impact": ("impact", np.arange(n, dtype=np.int64), {"long_name": "impact number", "units": "1"}),
+            "ball": ("impact", ball_ids, {"long_name": "ball type (key of the ball table)"}),
+            "bat": ("impact", bat_ids, {"long_name": "bat (key of the bat table)"}),
+        },
+    )
+    ds.attrs["source_file"] = str(impacts_path)
+    ds.attrs["n_impacts"] = int(n)
+    ds.attrs["n_excluded"] = int((flag != 0).sum())
+    ds.attrs["n_warnings"] = len(warnings)
+    ds.attrs["ingest_warnings"] = "\n".join(warnings)
+    return ds, warnings
+
+
+def excluded_listing(ds: xr.Dataset) -> list[str]:
+    """One line per excluded impact: id, where it is in the file, and why."""
+    bad = np.flatnonzero(ds["ingest_flag"].values != 0)
+    return [
+        f"impact {ds['impact_id'].values[i]} ({ds['source_row'].values[i]}): {ds['ingest_flag_reason'].values[i]}"
+        for i in bad
+    ]
