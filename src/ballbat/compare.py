@@ -86,7 +86,7 @@ def fit_rows(fit) -> list[dict]:
 
 
 def impact_rows(rec) -> list[dict]:
-    """Rows from the reconstructed impacts: psi_max, D_max and n_impacts per ball (Table I)."""
+    """Rows from the reconstructed impacts: psi_max, D_max, n_impacts (usable) and n_excluded per ball."""
     rows = []
     ok = rec["flag"].values == 0
     ball = rec["ball"].values.astype(str)
@@ -120,6 +120,13 @@ def impact_rows(rec) -> list[dict]:
                 "bat": "",
                 "value": int(sel.sum()),
                 "truth": int((ball == b).sum()) if has_truth else None,
+                "unit": "1",
+            },
+            {  # impacts kept in reconstruct.nc with flag > 0 (the reasons are there)
+                "quantity": "n_excluded",
+                "ball": b,
+                "bat": "",
+                "value": int((~ok & (ball == b)).sum()),
                 "unit": "1",
             },
         ]

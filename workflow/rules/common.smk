@@ -7,6 +7,9 @@ from ballbat.codedeps import module_files
 from ballbat.config import validate_config
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
+# A dataset set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.
+if isinstance(config.get("datasets"), dict):
+    config["datasets"] = {k: v for k, v in config["datasets"].items() if v is not None}
 with open(SCHEMA) as _fh:
     validate_config(config, yaml.safe_load(_fh), source="config (config/config.yaml and --configfile/--config overrides)")
 
@@ -41,9 +44,19 @@ def get_bats_table(wildcards):
     return dataset_config(wildcards).get("bats", config["tables"]["bats"])
 
 
+def is_measured(name):
+    """A measured dataset names its impacts file; a synthetic one has `synthetic` settings."""
+    return "impacts" in config["datasets"][name]
+
+
+def get_measured_impacts(wildcards):
+    return dataset_config(wildcards)["impacts"]
+
+
 def get_source(wildcards):
-    """The first stage of a dataset: its synthetic experiment."""
-    return f"results/{wildcards.dataset}/simulate.nc"
+    """The first stage of a dataset: its synthetic experiment or its measured impacts, checked."""
+    stage = "ingest" if is_measured(wildcards.dataset) else "simulate"
+    return f"results/{wildcards.dataset}/{stage}.nc"
 
 
 #: Final products; each rule file appends its own (rule all asks for all of them).
