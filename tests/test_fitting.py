@@ -134,3 +134,20 @@ def test_design_jacobians_match_finite_differences(design):
         xd, yd, _, _ = fun(dn)
         np.testing.assert_allclose(jx[:, k], (xu - xd) / (2 * h), rtol=1e-5, atol=1e-8)
         np.testing.assert_allclose(jy[:, k], (yu - yd) / (2 * h), rtol=1e-5, atol=1e-8)
+
+
+def test_ball_with_too_few_usable_impacts_is_reported_not_fitted(default_settings, balls, bats):
+    """A ball with 2 usable impacts: every per-ball result NaN with n = 2, no warnings, no crash."""
+    from ballbat.stronge_analysis import stronge_dataset
+
+    settings = {**default_settings, "impacts": {"baseball": {"wood": 12}, "softball": {"wood": 2}}}
+    rec = reconstruct(normalize(simulate_experiment(SyntheticSettings(**settings), balls, bats)), balls, bats)
+    fit = fit_dataset(rec)
+    soft = fit.sel(ball="softball")
+    assert int(soft.e_x_pooled_n) == 2 and np.isnan(soft.e_x_pooled)
+    for q in ("tan_ratio_slope", "spin_theta_slope", "e_y_implied", "mu_k_lower_bound"):
+        assert np.isnan(soft[q]), q
+    assert np.isfinite(fit.e_x_pooled.sel(ball="baseball"))
+    st = stronge_dataset(rec, n_time=50)
+    assert list(st.ball.values) == ["baseball"]
+    assert "softball: 2 usable impacts" in st.attrs["balls_not_fitted"]

@@ -290,6 +290,14 @@ def analyze_impacts(ds, v_ref=V_BAT_REF, mu_k_example=0.5) -> dict:
         res["e_x_pooled"][ball] = fit
         res["e_x_pooled_note"][ball] = _fit_note(fit)
         truth[("e_x_pooled", ball)] = t
+        if int(in_ball.sum()) < MIN_FIT_IMPACTS:  # per-ball fits need the same minimum: report NaN
+            nan_fit = LineFit(np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, int(in_ball.sum()), np.nan, False)
+            for key in ("tan_ratio_slope", "spin_theta_slope", "speed_theta_slope"):
+                res[key][ball] = nan_fit
+            res["e_y_implied"][ball] = (np.nan, np.nan)
+            res["mu_k_lower_bound"][ball] = (np.nan, np.nan, -1)
+            res["gross_slip"][ball] = (np.nan, np.nan, np.nan)
+            continue
 
         r, r_x, r_y, alpha = (ds[k].values[in_ball] for k in ("r", "r_x", "r_y", "alpha"))
         x, y, jx, jy = tan_ratio_design(*_measured(ds, in_ball), r, alpha)

@@ -18,7 +18,7 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .fitting import MEASURED, effective_sigma, vtf_design, wls_slope
+from .fitting import MEASURED, MIN_FIT_IMPACTS, effective_sigma, vtf_design, wls_slope
 from .stronge import omega_ratio, regime_boundaries, stronge_ex, stronge_solve
 from .stronge_fit import fit_eta2
 
@@ -65,7 +65,10 @@ def stronge_dataset(
     """
     usable = rec["flag"].values == 0
     ball_ids = rec["ball"].values.astype(str)
-    balls = sorted(set(ball_ids[usable]))
+    # A ball needs at least MIN_FIT_IMPACTS usable impacts for a fit (as the e_x fits do).
+    counts = {b: int(np.sum(usable & (ball_ids == b))) for b in set(ball_ids)}
+    balls = sorted(b for b, n in counts.items() if n >= MIN_FIT_IMPACTS)
+    skipped = {b: n for b, n in counts.items() if n < MIN_FIT_IMPACTS}
     psi_grid = np.deg2rad(np.linspace(*psi_grid_deg[:2], int(psi_grid_deg[2])))
     psi_h = np.deg2rad(psi_history_deg)
     nb, ng = len(balls), psi_grid.size
@@ -164,7 +167,7 @@ def stronge_dataset(
         data_err.append(sigma if sigma is not None else np.full(x.size, np.nan))
 
     if hist is None:
-        raise ValueError("fit_stronge: no usable impacts in the dataset")
+        raise ValueError(f"fit_stronge: no ball has {MIN_FIT_IMPACTS} usable impacts (usable per ball: {counts})")
     u = "1"
     data = {
         "eta2": (("ball",), scal["eta2"], _attrs(u, "eta^2 = k_n/k_t fitted to Eq. vtf (Sec. V.A)")),
@@ -290,4 +293,8 @@ def stronge_dataset(
         },
     )
     ds.attrs.update({"psi_history_deg": float(psi_history_deg), "frame": "bat (recoil factors r_x, r_y)"})
+    if skipped:
+        ds.attrs["balls_not_fitted"] = "; ".join(
+            f"{b}: {n} usable impacts (< {MIN_FIT_IMPACTS})" for b, n in sorted(skipped.items())
+        )
     return ds
