@@ -8,6 +8,9 @@ min_version("9.0")
 configfile: "config/config.yaml"
 
 
+report: "workflow/report/workflow.rst"
+
+
 include: "workflow/rules/common.smk"
 include: "workflow/rules/source.smk"
 include: "workflow/rules/normalize.smk"
@@ -15,6 +18,7 @@ include: "workflow/rules/reconstruct.smk"
 include: "workflow/rules/fit_ex.smk"
 include: "workflow/rules/compare.smk"
 include: "workflow/rules/implications.smk"
+include: "workflow/rules/plots.smk"  # last: draws what the others write
 
 
 rule all:

@@ -13,7 +13,7 @@ import yaml
 
 from ballbat.compare import read_csv
 from ballbat.provenance import sha256_file
-from workflow_helpers import ROOT, make_workdir, planned_jobs, snakemake
+from workflow_helpers import ROOT, assert_not_blank, make_workdir, planned_jobs, snakemake
 
 pytestmark = pytest.mark.slow
 
@@ -126,10 +126,15 @@ def test_rerun_is_noop_and_byte_identical(run_dir):
     res = run_dir / "results" / "small"
     assert planned_jobs(run_dir) == {}
     files = sorted(res.glob("*.nc")) + sorted((run_dir / "results" / "implications").glob("*.nc"))
+    files += sorted(run_dir.glob("results/*/figures/*.png"))  # figures too: no timestamps
     before = {p: sha256_file(p) for p in files}
     snakemake(run_dir, "-c2", "--forceall")
     after = {p: sha256_file(p) for p in files}
     assert before == after
+
+
+DATASET_PLOTS = {f"plot_fig{n}": 1 for n in (3, 4, 5, 6, 9, 10)}
+ALL_PLOTS = {**DATASET_PLOTS, "plot_fig11": 1, "plot_launch": 1}
 
 
 def _jobs_after_edit(run_dir, path):
@@ -146,11 +151,16 @@ def test_code_edit_reruns_only_dependents(run_dir):
     """Editing a package module marks the outputs that import it out of date; README does not."""
     pkg = run_dir / "src" / "ballbat"
     # implications use this dataset's pooled e_x, so they follow the fit
+    # figures and report tables follow what they draw (PLOTS: one job each)
     assert _jobs_after_edit(run_dir, pkg / "fitting.py") == {
         "fit_ex": 1,
         "compare": 1,
         "implications": 1,
         "implications_compare": 1,
+        "fit_stronge": 1,
+        **DATASET_PLOTS,
+        "plot_fig11": 1,
+        "comparison_html": 2,
     }
     assert _jobs_after_edit(run_dir, pkg / "kinematics.py") == {
         "simulate": 1,
@@ -160,8 +170,18 @@ def test_code_edit_reruns_only_dependents(run_dir):
         "compare": 1,
         "implications": 1,
         "implications_compare": 1,
+        "fit_stronge": 1,
+        **DATASET_PLOTS,
+        "plot_fig11": 1,
+        "comparison_html": 2,
     }
-    assert _jobs_after_edit(run_dir, pkg / "flight.py") == {"implications": 2, "implications_compare": 1}
+    assert _jobs_after_edit(run_dir, pkg / "flight.py") == {
+        "implications": 2,
+        "implications_compare": 1,
+        "plot_fig11": 1,
+        "plot_launch": 1,
+        "comparison_html": 1,
+    }
     assert planned_jobs(run_dir) == {}  # restoring the text restores the state
     (run_dir / "README.md").write_text("an unrelated edit\n")
     assert planned_jobs(run_dir) == {}
@@ -195,3 +215,48 @@ def test_jobs_import_only_what_they_use(script):
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]", (script, out.stdout)
+
+
+def test_figures_drawn(run_dir):
+    """Every figure of the paper that the data support is drawn, is not blank, and has its caption numbers."""
+    figs = run_dir / "results" / "small" / "figures"
+    for name in ("fig3", "fig4", "fig5", "fig6", "fig9a", "fig9b", "fig10"):
+        assert_not_blank(figs / f"{name}.png")
+    imp = run_dir / "results" / "implications" / "figures"
+    for name in ("paper_fig11a", "paper_fig11b", "flyballs_launch"):
+        assert_not_blank(imp / f"{name}.png")
+    assert not (imp / "flyballs_fig11a.png").exists() and not (imp / "paper_launch.png").exists()
+    # The caption numbers are the fitted ones, in the paper's units.
+    fit = xr.open_dataset(run_dir / "results" / "small" / "fit_ex.nc")
+    slope = float(fit.spin_theta_slope.sel(ball="baseball")) * 60 / (2 * np.pi) * np.pi / 180
+    text3 = (figs / "fig3.rst").read_text()
+    assert f"baseball: {slope:.3g} ± " in text3 and "paper 179 rpm/deg" in text3
+    assert "Impacts shown: 36 of 36 (0 flagged" in text3
+    e_x = float(fit.e_x_pooled.sel(ball="softball"))
+    assert f"e_x = {e_x:.3f} ± " in (figs / "fig5.rst").read_text()
+    assert "Longest carry" in (imp / "paper_fig11.rst").read_text()
+    eta2 = float(xr.open_dataset(run_dir / "results" / "small" / "stronge.nc").eta2.sel(ball="baseball"))
+    assert f"baseball: η² = {eta2:.3g} ± " in (figs / "fig9.rst").read_text()
+    assert "<td>e_x_pooled</td>" in (run_dir / "results" / "small" / "paper_comparison.html").read_text()
+
+
+def test_report_builds(run_dir):
+    """`snakemake --report` embeds every figure with its caption numbers and the comparison tables."""
+    snakemake(run_dir, "--report", "results/report.html")
+    html = (run_dir / "results" / "report.html").read_text()
+    assert len(html) > 100_000
+    for name in ("fig3.png", "fig6.png", "fig9b.png", "fig10.png", "paper_fig11a.png", "flyballs_launch.png"):
+        assert name in html, name
+    assert "paper_comparison.html" in html
+    e_x = float(xr.open_dataset(run_dir / "results" / "small" / "fit_ex.nc").e_x_pooled.sel(ball="baseball"))
+    assert f"e_x = {e_x:.3f}" in html  # a caption quoting the fitted number
+    assert "v_ref_mph" in html  # the run's config
+
+
+def test_plot_edit_reruns_only_plots(run_dir):
+    """Restyling a figure (editing plotting.py) never reruns a fit: only the plot jobs are planned."""
+    pkg = run_dir / "src" / "ballbat"
+    assert _jobs_after_edit(run_dir, pkg / "plotting.py") == ALL_PLOTS
+    assert _jobs_after_edit(run_dir, pkg / "reporting.py") == {**ALL_PLOTS, "comparison_html": 2}
+    assert _jobs_after_edit(run_dir, run_dir / "workflow" / "report" / "fig3.rst") == {}  # captions: report only
+    assert planned_jobs(run_dir) == {}

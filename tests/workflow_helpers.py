@@ -41,6 +41,18 @@ def snakemake(workdir: Path, *args: str, check: bool = True, timeout: int = 600)
     return proc
 
 
+def assert_not_blank(png, min_colors: int = 6) -> None:
+    """The PNG is a real picture: several distinct colours and some contrast."""
+    import numpy as np
+    from PIL import Image
+
+    with Image.open(png) as im:
+        img = np.asarray(im.convert("RGB"))
+    assert img.shape[0] > 200 and img.shape[1] > 200, png
+    assert len(np.unique(img.reshape(-1, 3), axis=0)) >= min_colors, png
+    assert img.std() > 10, png
+
+
 def planned_jobs(workdir: Path, *args: str) -> dict[str, int]:
     """Rule -> job count of a dry run (empty when nothing is to be done)."""
     out = snakemake(workdir, "-n", *args)

@@ -63,6 +63,13 @@ def get_source(wildcards):
 TARGETS = []
 
 
+def rule_writes(pattern):
+    """Whether a rule included so far writes ``pattern`` (lets optional stages switch figures on)."""
+    from snakemake.io import strip_wildcard_constraints
+
+    return any(strip_wildcard_constraints(str(f)) == pattern for r in workflow.rules for f in r.output)
+
+
 SCENARIOS = sorted(config.get("implications", {}).get("scenarios", {}))
 for _name, _sc in config.get("implications", {}).get("scenarios", {}).items():
     if "e_x_from_dataset" in _sc and _sc["e_x_from_dataset"] not in DATASETS:

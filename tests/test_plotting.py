@@ -1,0 +1,144 @@
+"""Figures and report text, from small fake datasets (the workflow's figures: test_workflow.py)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import xarray as xr
+from matplotlib.figure import Figure
+from PIL import Image
+
+from ballbat import plotting, reporting
+from ballbat.ncio import write_dataset
+from workflow_helpers import assert_not_blank
+
+BALLS = ["baseball", "softball"]
+
+
+def _attrs(units, long_name):
+    return {"units": units, "long_name": long_name}
+
+
+def fake_stronge() -> xr.Dataset:
+    """A dataset with the variables and dimensions of results/{dataset}/stronge.nc (the contract)."""
+    psi = np.radians(np.linspace(0.0, 85.0, 86))
+    r_x = np.array([0.12, 0.10])[:, None]
+    eta2 = np.array([4.9, 6.1])
+    vtf_x = np.tan(psi)[None, :] / (1 + r_x)
+    e_x = np.array([0.40, 0.15])[:, None] * np.clip(1.2 - psi[None, :] / np.radians(60), 0, 1)
+    e_x_pub = e_x * 1.03
+    rng = np.random.default_rng(1)
+    n = [30, 25]
+    data_ball = np.repeat(BALLS, n)
+    psi_d = np.concatenate([rng.uniform(0, np.radians(30), n[0]), rng.uniform(0, np.radians(41), n[1])])
+    k = (data_ball == "softball").astype(int)
+    data_x = np.tan(psi_d) / (1 + r_x[k, 0])
+    data_y = (1 + np.array([0.40, 0.15])[k]) * data_x + rng.normal(0, 0.01, psi_d.size)
+    t = np.linspace(0.0, 1.7, 171)
+    n_force = np.where(t <= 1.5, np.sin(np.pi * np.clip(t, 0, 1.5) / 1.5), np.nan)
+    stick = np.where(t < 1.4, 1.0, np.where(t <= 1.5, 0.0, np.nan))
+    tb = np.stack([t, t])
+    ds = xr.Dataset(
+        {
+            "eta2": ("ball", eta2, _attrs("1", "eta^2")),
+            "eta2_err": ("ball", [0.2, 0.3], _attrs("1", "se of eta^2")),
+            "eta2_ci_low": ("ball", eta2 - 0.4, _attrs("1", "low")),
+            "eta2_ci_high": ("ball", eta2 + 0.4, _attrs("1", "high")),
+            "e_y": ("ball", [0.5, 0.5], _attrs("1", "e_y")),
+            "mu": ("ball", [0.5, 0.5], _attrs("1", "mu")),
+            "omega_ratio": ("ball", [0.85, 0.76], _attrs("1", "Omega_t/Omega_n")),
+            "vtf_x_model": (("ball", "psi_grid"), vtf_x, _attrs("1", "x")),
+            "vtf_y_model": (("ball", "psi_grid"), (1 + e_x) * vtf_x, _attrs("1", "y")),
+            "e_x_model": (("ball", "psi_grid"), e_x, _attrs("1", "e_x")),
+            "vtf_y_published": (("ball", "psi_grid"), (1 + e_x_pub) * vtf_x, _attrs("1", "y pub")),
+            "e_x_published": (("ball", "psi_grid"), e_x_pub, _attrs("1", "e_x pub")),
+            "data_ball": ("impact_fit", data_ball, {"long_name": "ball"}),
+            "data_vtf_x": ("impact_fit", data_x, _attrs("1", "x")),
+            "data_vtf_y": ("impact_fit", data_y, _attrs("1", "y")),
+            "data_vtf_y_err": ("impact_fit", np.full(psi_d.size, 0.01), _attrs("1", "y err")),
+            "t_over_tc": ("time", t, _attrs("1", "t/t_c")),
+            "normal_force": (("ball", "time"), np.stack([n_force, n_force]), _attrs("1", "N/N_max")),
+            "tangential_force": (("ball", "time"), 0.3 * np.sin(2 * tb) * np.stack([n_force] * 2), _attrs("1", "F")),
+            "tangential_velocity": (("ball", "time"), 0.5 * np.cos(2.5 * tb), _attrs("1", "u")),
+            "spring_stretch": (("ball", "time"), np.sin(tb), _attrs("1", "s")),
+            "stick": (("ball", "time"), np.stack([stick, stick]), _attrs("1", "stick")),
+            "psi_stick_boundary": ("ball", np.radians([22.0, 25.0]), _attrs("rad", "stick boundary")),
+            "psi_gross_slip_boundary": ("ball", np.radians([58.0, 62.0]), _attrs("rad", "gross slip boundary")),
+        },
+        coords={
+            "ball": ("ball", np.array(BALLS), {"long_name": "ball"}),
+            "psi_grid": ("psi_grid", psi, _attrs("rad", "psi")),
+        },
+        attrs={"psi_history_deg": 30},
+    )
+    return ds
+
+
+def test_stick_period():
+    t = np.linspace(0, 1.6, 17)
+    stick = np.where(t < 1.4, 1.0, np.where(t <= 1.5, 0.0, np.nan))
+    assert reporting.stick_period(t, stick) == (0.0, pytest.approx(1.4))
+    assert reporting.stick_period(t, np.zeros_like(t)) == (None, None)
+    late = np.where((t > 0.2) & (t < 0.5), 1.0, 0.0)  # initial slip, then stick
+    assert reporting.stick_period(t, late) == (pytest.approx(0.3), pytest.approx(0.5))
+
+
+@pytest.mark.parametrize(
+    "func", [plotting.fig9a_stronge_fit, plotting.fig9b_stronge_extrapolation, plotting.fig10_time_history]
+)
+def test_stronge_figures_from_the_contract(func, tmp_path):
+    fig = func(fake_stronge())
+    assert isinstance(fig, Figure)
+    path = plotting.save_figure(fig, tmp_path / "f.png")
+    assert_not_blank(path)
+    assert fig.axes[0].get_legend() is not None or fig.legends
+
+
+def test_draw_fig9_writes_pngs_and_caption_numbers(tmp_path):
+    nc = write_dataset(fake_stronge(), tmp_path / "stronge.nc", title="fake", rule="test", inputs=[], config={})
+    out = {"fig9a": tmp_path / "a.png", "fig9b": tmp_path / "b.png", "numbers": tmp_path / "fig9.rst"}
+    plotting.draw("fig9", {"stronge": nc}, out)
+    for key in ("fig9a", "fig9b"):
+        assert_not_blank(out[key])
+    text = out["numbers"].read_text()
+    assert "baseball: η² = 4.9 ± 0.2" in text and "paper 4.75" in text
+    assert "softball: η² = 6.1 ± 0.3" in text and "paper 6.3" in text
+    assert "22.0°" in text and "62.0°" in text
+    plotting.draw("fig10", {"stronge": nc}, {"png": tmp_path / "c.png", "numbers": tmp_path / "fig10.rst"})
+    text10 = (tmp_path / "fig10.rst").read_text()
+    assert "initial stick until t/t_c = 1.4" in text10 and "separation at t/t_c = 1.5" in text10
+    assert "Ω_t/Ω_n = 0.85 (paper 0.86)" in text10
+
+
+def test_save_figure_is_deterministic(tmp_path):
+    a = plotting.save_figure(plotting.fig10_time_history(fake_stronge()), tmp_path / "a.png")
+    b = plotting.save_figure(plotting.fig10_time_history(fake_stronge()), tmp_path / "b.png")
+    assert a.read_bytes() == b.read_bytes()
+    with Image.open(a) as im:
+        info = dict(im.info)
+    assert "Software" not in info and not any("time" in k.lower() for k in info)
+
+
+def test_unknown_figure_names_the_known_ones(tmp_path):
+    with pytest.raises(ValueError, match="fig3, fig4"):
+        plotting.draw("fig7", {}, {})
+
+
+def test_comparison_html(tmp_path):
+    csv = tmp_path / "t.csv"
+    csv.write_text(
+        "quantity,ball,bat,paper,paper_uncertainty,value,uncertainty,truth,unit\n"
+        "e_x,baseball,wood,0.464,0.014,0.47,0.02,,1\n"
+    )
+    text = reporting.comparison_html(csv, tmp_path / "t.html", title="A & B")
+    assert "<td>0.464</td>" in text and "A &amp; B" in text
+    assert (tmp_path / "t.html").read_text() == text
+
+
+def test_matplotlib_only_in_plotting():
+    """Only the plotting module imports matplotlib (jobs that do not draw stay light)."""
+    from pathlib import Path
+
+    pkg = Path(plotting.__file__).parent
+    users = sorted(p.name for p in pkg.glob("*.py") if "import matplotlib" in p.read_text())
+    assert users == ["plotting.py"]

@@ -1,0 +1,11 @@
+"""Rule comparison_html: adapter around ballbat.reporting.comparison_html (table for the report)."""
+
+from ballbat.reporting import comparison_html
+from ballbat.runlog import logged
+
+with logged(snakemake.log[0], snakemake.rule):
+    comparison_html(
+        snakemake.input.csv,
+        snakemake.output.html,
+        title=f"results/{snakemake.wildcards.source}: the paper's numbers beside ours",
+    )
