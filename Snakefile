@@ -16,6 +16,7 @@ include: "workflow/rules/source.smk"
 include: "workflow/rules/normalize.smk"
 include: "workflow/rules/reconstruct.smk"
 include: "workflow/rules/fit_ex.smk"
+include: "workflow/rules/stronge.smk"
 include: "workflow/rules/compare.smk"
 include: "workflow/rules/implications.smk"
 include: "workflow/rules/plots.smk"  # last: draws what the others write

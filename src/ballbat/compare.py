@@ -197,3 +197,31 @@ def write_table(rows, csv_path, md_path, title, published=PUBLISHED) -> list[dic
     atomic_write_text(csv_path, to_csv(table))
     atomic_write_text(md_path, to_markdown(table, title))
     return table
+
+
+def stronge_rows(stronge) -> list[dict]:
+    """Rows from ``stronge.nc``: eta2 (with its standard error) and Omega_t/Omega_n per ball (Sec. V.A)."""
+    rows = []
+    for b in map(str, stronge["ball"].values):
+        s = stronge.sel(ball=b)
+        rows += [
+            {
+                "quantity": "eta2",
+                "ball": b,
+                "bat": "",
+                "value": float(s.eta2),
+                "uncertainty": float(s.eta2_err),
+                "unit": "1",
+            },
+            {"quantity": "omega_t_over_omega_n", "ball": b, "bat": "", "value": float(s.omega_ratio), "unit": "1"},
+            {
+                "quantity": "stretch_max_time_psi30",
+                "ball": b,
+                "bat": "",
+                "value": float(s.t_stretch_max),
+                "unit": "t_c",
+            },
+            {"quantity": "stick_end_time_psi30", "ball": b, "bat": "", "value": float(s.t_stick_end), "unit": "t_c"},
+            {"quantity": "separation_time_psi30", "ball": b, "bat": "", "value": float(s.t_separation), "unit": "t_c"},
+        ]
+    return rows

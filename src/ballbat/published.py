@@ -56,6 +56,19 @@ PUBLISHED: tuple[Published, ...] = (
     Published("psi_max", _SOFT, "", 41.0, None, "deg", "Table I"),
     Published("D_max", _BASE, "", 1.35, None, "in", "Table I"),
     Published("D_max", _SOFT, "", 2.00, None, "in", "Table I"),
+    # Sec. V.A: Stronge's model fitted with e_y = mu = 0.5.
+    Published("eta2", _BASE, "", 4.75, None, "1", "Sec. V.A"),
+    Published("eta2", _SOFT, "", 6.30, None, "1", "Sec. V.A"),
+    Published("omega_t_over_omega_n", _BASE, "", 0.86, None, "1", "Sec. V.A"),
+    Published("omega_t_over_omega_n", _SOFT, "", 0.75, None, "1", "Sec. V.A"),
+    # Sec. V.A and Fig. 10, psi = 30 deg: stick until ~1.4 t_c, separation 1.5 t_c, stretch
+    # largest at 1.16 t_c (baseball) and 1.33 t_c (softball).
+    Published("stretch_max_time_psi30", _BASE, "", 1.16, None, "t_c", "Sec. V.A, Fig. 10"),
+    Published("stretch_max_time_psi30", _SOFT, "", 1.33, None, "t_c", "Sec. V.A, Fig. 10"),
+    Published("stick_end_time_psi30", _BASE, "", 1.4, None, "t_c", "Sec. V.A, Fig. 10 ('about')"),
+    Published("stick_end_time_psi30", _SOFT, "", 1.4, None, "t_c", "Sec. V.A, Fig. 10 ('about')"),
+    Published("separation_time_psi30", _BASE, "", 1.5, None, "t_c", "Sec. V.A, Fig. 10"),
+    Published("separation_time_psi30", _SOFT, "", 1.5, None, "t_c", "Sec. V.A, Fig. 10"),
     # Table I: number of impacts.
     Published("n_impacts", _BASE, "", 58, None, "1", "Table I"),
     Published("n_impacts", _SOFT, "", 50, None, "1", "Table I"),

@@ -2,10 +2,11 @@ TARGETS += expand("results/{dataset}/paper_comparison.csv", dataset=DATASETS)
 
 
 rule compare:
-    """Tabulate every published number of Secs. II-IV beside ours and the truth."""
+    """Tabulate every published number of Secs. II-V.A beside ours and the truth."""
     input:
         fit=rules.fit_ex.output.fit,
         impacts=rules.reconstruct.output.impacts,
+        stronge=rules.fit_stronge.output.stronge,
         code=code("compare.py"),
     output:
         csv="results/{dataset}/paper_comparison.csv",
