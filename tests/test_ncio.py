@@ -77,3 +77,15 @@ def test_config_validation_lists_all_problems(root):
         validate_config(bad, schema)
     assert "datasets.d.synthetic.sed: unknown key" in str(exc.value)
     assert "extra: unknown key" in str(exc.value)
+
+
+def test_results_are_readable_by_others(tmp_path):
+    """mkstemp makes private files; results get the usual 0666 less the umask."""
+    import os
+
+    umask = os.umask(0o022)
+    try:
+        path = write_dataset(_ds(), tmp_path / "a.nc", title="t", rule="r", inputs={}, config={})
+    finally:
+        os.umask(umask)
+    assert path.stat().st_mode & 0o777 == 0o644

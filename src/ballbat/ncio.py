@@ -9,14 +9,13 @@ never leaves a half-written file. :func:`read_dataset` loads a file fully and ch
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 import xarray as xr
 
 from . import __version__
+from .atomic import atomic_target
 from .provenance import provenance_attrs
 
 CONVENTIONS = "CF-1.10"
@@ -74,15 +73,8 @@ def write_dataset(
             encoding[name] = {"_FillValue": np.nan}
         elif var.dtype.kind in "OU":
             encoding[name] = {"dtype": str}
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
+    with atomic_target(path) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=encoding)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return path
 
 
@@ -99,13 +91,6 @@ def read_dataset(path, require: tuple[str, ...] = ()) -> xr.Dataset:
 def atomic_write_text(path, text: str) -> Path:
     """Write a text file atomically (temporary file renamed into place)."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
-    try:
-        with os.fdopen(fd, "w", newline="") as fh:
-            fh.write(text)
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
+    with atomic_target(path) as tmp:
+        tmp.write_text(text, newline="")
     return path

@@ -17,8 +17,6 @@ This is the only module that imports matplotlib (with the non-interactive Agg ba
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import matplotlib
@@ -30,6 +28,7 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
 from . import reporting  # noqa: E402
+from .atomic import atomic_target  # noqa: E402
 from .ncio import atomic_write_text, read_dataset  # noqa: E402
 from .units import from_si  # noqa: E402
 
@@ -587,18 +586,8 @@ FIGURES = {
 def save_figure(fig: Figure, path) -> Path:
     """Save ``fig`` as PNG atomically, without timestamp or software metadata (same data, same bytes)."""
     path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".png", dir=path.parent)
-    os.close(fd)
-    try:
+    with atomic_target(path, suffix=".png") as tmp:
         fig.savefig(tmp, format="png", dpi=DPI, metadata={"Software": None})
-        umask = os.umask(0)
-        os.umask(umask)
-        os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes 0600; a figure is for sharing
-        os.replace(tmp, path)
-    except BaseException:
-        Path(tmp).unlink(missing_ok=True)
-        raise
     return path
 
 
