@@ -9,7 +9,7 @@ another module) does not. Standard library only: this runs when the Snakefile is
 
 from __future__ import annotations
 
-import ast
+import re
 from functools import cache
 from pathlib import Path
 
@@ -17,28 +17,47 @@ PACKAGE = "ballbat"
 PACKAGE_DIR = Path(__file__).resolve().parent
 
 
-def _imports(path: Path, module: str | None) -> set[str]:
-    """ballbat submodule names imported anywhere in ``path`` (``module`` is its own name)."""
-    tree = ast.parse(path.read_text(), filename=str(path))
+_IMPORT = re.compile(
+    r"^[ \t]*(?:from[ \t]+(?P<from>\.+[\w.]*|[\w.]+)[ \t]+import[ \t]+(?P<names>\([^)]*\)|[^\n#]+)"
+    r"|import[ \t]+(?P<mods>[^\n#]+))",
+    re.MULTILINE,
+)
+
+
+@cache
+def _imports_cached(path: str, mtime_ns: int, module: str | None) -> frozenset[str]:
     found: set[str] = set()
-    for node in ast.walk(tree):
-        if isinstance(node, ast.Import):
-            for alias in node.names:
-                if alias.name == PACKAGE or alias.name.startswith(PACKAGE + "."):
-                    found.add(alias.name)
-        elif isinstance(node, ast.ImportFrom):
-            if node.level:  # relative import inside the package
-                base = PACKAGE if module is None else module.rsplit(".", node.level)[0]
-                target = f"{base}.{node.module}" if node.module else base
-            else:
-                target = node.module or ""
-            if target == PACKAGE or target.startswith(PACKAGE + "."):
-                found.add(target)
-                for alias in node.names:  # from ballbat import kinematics
-                    cand = f"{target}.{alias.name}"
-                    if _module_file(cand) is not None:
-                        found.add(cand)
-    return found
+    for m in _IMPORT.finditer(Path(path).read_text()):
+        if m.group("mods"):
+            for part in m.group("mods").split(","):
+                name = part.split(" as ")[0].strip()
+                if name == PACKAGE or name.startswith(PACKAGE + "."):
+                    found.add(name)
+            continue
+        target = m.group("from")
+        if target.startswith("."):  # relative import inside the package
+            level = len(target) - len(target.lstrip("."))
+            base = PACKAGE if module is None else module.rsplit(".", level)[0]
+            rest = target[level:]
+            target = f"{base}.{rest}" if rest else base
+        if target == PACKAGE or target.startswith(PACKAGE + "."):
+            found.add(target)
+            for part in m.group("names").strip("()").split(","):
+                name = part.split(" as ")[0].strip()
+                cand = f"{target}.{name}"
+                if name and _module_file(cand) is not None:  # from ballbat import kinematics
+                    found.add(cand)
+    return frozenset(found)
+
+
+def _imports(path: Path, module: str | None) -> set[str]:
+    """ballbat submodule names imported anywhere in ``path`` (``module`` is its own name).
+
+    Reads import statements with a regular expression (this runs every time Snakemake parses
+    the workflow, where a full parse of every module would cost a noticeable fraction of a
+    no-op run); results are cached per file and modification time.
+    """
+    return set(_imports_cached(str(path), path.stat().st_mtime_ns, module))
 
 
 def _module_file(name: str) -> Path | None:
