@@ -27,6 +27,8 @@ report: run
 
 bench: install
 	$(BIN)/python bench/bench_workflow.py
+	$(BIN)/python bench/bench_stronge.py
+	$(BIN)/python bench/bench_flight.py
 
 lint: install
 	$(BIN)/ruff check .
