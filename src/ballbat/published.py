@@ -91,3 +91,8 @@ def lookup(quantity: str, ball: str, bat: str = "", published=PUBLISHED) -> Publ
         if (p.quantity, p.ball, p.bat) == (quantity, ball, bat):
             return p
     return None
+
+
+def per_ball(quantity: str, published=PUBLISHED) -> dict[str, float]:
+    """Published values of a per-ball quantity (no bat), as {ball: value}."""
+    return {p.ball: p.value for p in published if p.quantity == quantity and not p.bat}

@@ -19,16 +19,17 @@ import numpy as np
 
 from .compare import COLUMNS, read_csv
 from .ncio import atomic_write_text
+from .published import per_ball
 from .units import from_si
 
-#: The paper's numbers the figures quote (captions of Figs. 3-6 and Sec. V.A).
+#: The paper's values the figures and captions quote (from ballbat.published, the one source).
 PAPER = {
-    "spin_theta_slope": {"baseball": 179.0, "softball": 98.0},  # rpm/deg, Fig. 3
-    "speed_theta_slope": {"baseball": -0.65, "softball": -0.72},  # mph/deg, Fig. 4
-    "fig5_slope": {"baseball": 1.405, "softball": 1.146},  # 1 + e_x, Fig. 5
-    "tan_ratio_slope": {"baseball": 0.281, "softball": 0.252},  # Fig. 6
-    "eta2": {"baseball": 4.75, "softball": 6.30},  # Sec. V.A, Fig. 9
-    "omega_ratio": {"baseball": 0.86, "softball": 0.75},  # Omega_t / Omega_n, Sec. V.A
+    "spin_theta_slope": per_ball("spin_theta_slope"),  # rpm/deg, Fig. 3
+    "speed_theta_slope": per_ball("speed_theta_slope"),  # mph/deg, Fig. 4
+    "fig5_slope": {b: 1.0 + v for b, v in per_ball("e_x_pooled").items()},  # 1 + e_x, Fig. 5
+    "tan_ratio_slope": per_ball("tan_ratio_slope"),  # Fig. 6
+    "eta2": per_ball("eta2"),  # Sec. V.A, Fig. 9
+    "omega_ratio": per_ball("omega_t_over_omega_n"),  # Omega_t / Omega_n, Sec. V.A
 }
 
 

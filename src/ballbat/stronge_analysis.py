@@ -19,11 +19,12 @@ import numpy as np
 import xarray as xr
 
 from .fitting import MEASURED, MIN_FIT_IMPACTS, effective_sigma, vtf_design, wls_slope
+from .published import per_ball
 from .stronge import omega_ratio, regime_boundaries, stronge_ex, stronge_solve
 from .stronge_fit import fit_eta2
 
 #: eta^2 published in Sec. V.A (with e_y = mu = 0.5), drawn beside the fits.
-PUBLISHED_ETA2 = {"baseball": 4.75, "softball": 6.30}
+PUBLISHED_ETA2 = per_ball("eta2")
 
 
 def _attrs(units, long_name, **extra):
