@@ -2,11 +2,11 @@
 
 Run: ``.venv/bin/python bench/bench_stronge.py``. Prints
 
-* impacts/s of :func:`ballbat.stronge.stronge_ex` for 1e6 impacts drawn from realistic
+* impacts/s of :func:`ballbat.stronge.model.stronge_ex` for 1e6 impacts drawn from realistic
   ranges (psi 0-45 deg, eta2 4-8, e_y 0.4-0.6, mu 0.2-0.8, (r_x, r_y) of the Table I x II
   ball-bat pairs), and for a mix that needs the general phase machine (eta2 2-3.5);
 * the reference solver's (solve_ivp) time per impact and the speed ratio;
-* the time of :func:`ballbat.stronge_fit.fit_eta2` for one ball (58 impacts), with and
+* the time of :func:`ballbat.stronge.fit.fit_eta2` for one ball (58 impacts), with and
   without a free mu, lmfit's import time excluded (and printed separately).
 
 Targets (task brief): >= 1e6 impacts/s, >= 1000x the reference, < 1 s per fit.
@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ballbat.properties import load_balls, load_bats, recoil_factors
-from ballbat.stronge import stronge_ex, stronge_reference, stronge_solve
+from ballbat.stronge.model import stronge_ex, stronge_reference, stronge_solve
 
 ROOT = Path(__file__).resolve().parents[1]
 DEG = np.pi / 180
@@ -73,7 +73,7 @@ def main() -> None:
     import lmfit  # noqa: F401
 
     t_imp = time.perf_counter() - t0
-    from ballbat.stronge_fit import fit_eta2
+    from ballbat.stronge.fit import fit_eta2
 
     ball = balls["baseball"]
     rr = np.array([recoil_factors(ball, bats[b]) for b in ("wood", "metal_rough", "metal_smooth")])

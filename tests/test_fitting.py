@@ -138,7 +138,7 @@ def test_design_jacobians_match_finite_differences(design):
 
 def test_ball_with_too_few_usable_impacts_is_reported_not_fitted(default_settings, balls, bats):
     """A ball with 2 usable impacts: every per-ball result NaN with n = 2, no warnings, no crash."""
-    from ballbat.stronge_analysis import stronge_dataset
+    from ballbat.stronge.analysis import stronge_dataset
 
     settings = {**default_settings, "impacts": {"baseball": {"wood": 12}, "softball": {"wood": 2}}}
     rec = reconstruct(normalize(simulate_experiment(SyntheticSettings(**settings), balls, bats)), balls, bats)

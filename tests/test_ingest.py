@@ -14,8 +14,8 @@ import yaml
 
 from ballbat import fitting, ingest
 from ballbat.analysis import FLAG_INGEST, normalize, reconstruct
-from ballbat.config import ConfigError, validate_config
-from ballbat.ncio import check_metadata
+from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.pipeline.ncio import check_metadata
 from ballbat.properties import InputError, load_balls, load_bats
 from ballbat.units import DEGREE, MPH, RPM
 from workflow_helpers import ROOT
@@ -328,13 +328,9 @@ def test_config_bad_dataset_forms(schema_and_base, dataset, message):
 
 
 def test_ingest_job_imports_no_fitting_or_plotting():
-    from ballbat.codedeps import module_files
+    from ballbat.pipeline.codedeps import module_names
 
-    mods = sorted(
-        "ballbat." + p.rsplit("/", 1)[-1][:-3]
-        for p in module_files(str(ROOT / "workflow" / "scripts" / "ingest.py"))
-        if not p.endswith("__init__.py")
-    )
+    mods = module_names(str(ROOT / "workflow" / "scripts" / "ingest.py"))
     assert "ballbat.fitting" not in mods
     code = "import sys\n" + "".join(f"import {m}\n" for m in mods)
     code += "print(sorted(m for m in ('lmfit', 'matplotlib') if m in sys.modules))"

@@ -6,9 +6,9 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ballbat.config import ConfigError, validate_config
-from ballbat.ncio import MetadataError, read_dataset, write_dataset
-from ballbat.provenance import package_source_hash, sha256_file
+from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.pipeline.ncio import MetadataError, read_dataset, write_dataset
+from ballbat.pipeline.provenance import package_source_hash, sha256_file
 
 
 def _ds():

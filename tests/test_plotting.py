@@ -9,7 +9,7 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 from ballbat import plotting, reporting
-from ballbat.ncio import write_dataset
+from ballbat.pipeline.ncio import write_dataset
 from workflow_helpers import assert_not_blank
 
 BALLS = ["baseball", "softball"]

@@ -1,4 +1,4 @@
-"""Tests of Stronge's lumped-parameter contact model (ballbat.stronge, ballbat.stronge_fit).
+"""Tests of Stronge's lumped-parameter contact model (ballbat.stronge, ballbat.stronge.fit).
 
 Published numbers are from Sec. V.A and the Fig. 10 caption of Kensrud, Nathan & Smith,
 Am. J. Phys. 85, 503 (2017) ("the paper"). Where the paper's prose and the model as
@@ -16,14 +16,14 @@ import numpy as np
 import pytest
 
 from ballbat.properties import recoil_factors
-from ballbat.stronge import (
+from ballbat.stronge.fit import Eta2FitError, fit_eta2
+from ballbat.stronge.model import (
     omega_ratio,
     regime_boundaries,
     stronge_ex,
     stronge_reference,
     stronge_solve,
 )
-from ballbat.stronge_fit import Eta2FitError, fit_eta2
 
 DEG = np.pi / 180
 #: Paper, Sec. V.A: fitted eta^2 with e_y = mu = 0.5.
@@ -427,7 +427,7 @@ def test_fit_input_errors(balls, bats):
 def test_import_is_light():
     """Importing the model and the fit module does not import lmfit or matplotlib."""
     code = (
-        "import sys, ballbat.stronge, ballbat.stronge_fit; "
+        "import sys, ballbat.stronge, ballbat.stronge.fit; "
         "bad = [m for m in ('lmfit', 'matplotlib') if m in sys.modules]; "
         "assert not bad, bad"
     )

@@ -6,8 +6,8 @@ import yaml
 
 from ballbat.analysis import normalize, reconstruct
 from ballbat.compare import stronge_rows
-from ballbat.stronge import stronge_ex
-from ballbat.stronge_analysis import stronge_dataset
+from ballbat.stronge.analysis import stronge_dataset
+from ballbat.stronge.model import stronge_ex
 from ballbat.synthetic import SyntheticSettings, simulate_experiment
 
 

@@ -12,7 +12,7 @@ import xarray as xr
 import yaml
 
 from ballbat.compare import read_csv
-from ballbat.provenance import sha256_file
+from ballbat.pipeline.provenance import sha256_file
 from workflow_helpers import ROOT, assert_not_blank, make_workdir, planned_jobs, snakemake
 
 pytestmark = pytest.mark.slow
@@ -201,13 +201,9 @@ def test_config_error_names_the_key(tmp_path):
 @pytest.mark.parametrize("script", ["simulate", "normalize", "reconstruct", "fit_ex", "compare"])
 def test_jobs_import_only_what_they_use(script):
     """No job imports lmfit or matplotlib unless it fits or draws (issue 2, speed)."""
-    from ballbat.codedeps import module_files
+    from ballbat.pipeline.codedeps import module_names
 
-    mods = [
-        f"ballbat.{p.rsplit('/', 1)[-1][:-3]}"
-        for p in module_files(str(ROOT / "workflow" / "scripts" / f"{script}.py"))
-    ]
-    mods = [m.replace(".__init__", "") for m in mods]
+    mods = module_names(str(ROOT / "workflow" / "scripts" / f"{script}.py"))
     code = (
         "import sys\n"
         + "".join(f"import {m}\n" for m in mods)

@@ -183,7 +183,7 @@ def read_csv(path) -> list[dict]:
 
 def write_comparison(fit, impacts, csv_path, md_path, title, extra_rows=()) -> list[dict]:
     """Build the comparison from ``fit_ex.nc`` and ``reconstruct.nc``; write CSV and Markdown."""
-    from .ncio import read_dataset
+    from .pipeline.ncio import read_dataset
 
     rows = fit_rows(read_dataset(fit)) + impact_rows(read_dataset(impacts)) + list(extra_rows)
     return write_table(rows, csv_path, md_path, title)
@@ -191,7 +191,7 @@ def write_comparison(fit, impacts, csv_path, md_path, title, extra_rows=()) -> l
 
 def write_table(rows, csv_path, md_path, title, published=PUBLISHED) -> list[dict]:
     """Merge ``rows`` with the published values; write the CSV and its Markdown rendering."""
-    from .ncio import atomic_write_text
+    from .pipeline.ncio import atomic_write_text
 
     table = comparison_table(rows, published)
     atomic_write_text(csv_path, to_csv(table))

@@ -203,7 +203,7 @@ def comparison_rows(ds) -> list[dict]:
 
 def pooled_e_x(fit_path, ball: str) -> float:
     """The pooled e_x of ``ball`` fitted on a dataset (its ``fit_ex.nc``)."""
-    from .ncio import read_dataset
+    from .pipeline.ncio import read_dataset
 
     fit = read_dataset(fit_path, require=("e_x_pooled",))
     if ball not in fit["ball"].values:

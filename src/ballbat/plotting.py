@@ -1,7 +1,7 @@
 """The paper's figures, drawn from the workflow's NetCDF files alone.
 
 Each ``fig*`` function takes the datasets a figure needs (as read by
-:func:`ballbat.ncio.read_dataset`) and returns a matplotlib Figure; nothing here fits or
+:func:`ballbat.pipeline.ncio.read_dataset`) and returns a matplotlib Figure; nothing here fits or
 recomputes a model, so restyling a figure never reruns a fit. Axes are in the paper's units
 (:func:`ballbat.units.from_si`). As in the paper, closed markers are baseballs and open
 markers softballs; the marker shape tells the bat. Fitted lines are dashed, the paper's
@@ -28,8 +28,8 @@ from matplotlib.figure import Figure  # noqa: E402
 from matplotlib.patches import Rectangle  # noqa: E402
 
 from . import reporting  # noqa: E402
-from .atomic import atomic_target  # noqa: E402
-from .ncio import atomic_write_text, read_dataset  # noqa: E402
+from .pipeline.atomic import atomic_target  # noqa: E402
+from .pipeline.ncio import atomic_write_text, read_dataset  # noqa: E402
 from .units import from_si  # noqa: E402
 
 #: Colour of each ball; baseballs are drawn with closed markers, softballs with open ones.

@@ -18,7 +18,7 @@ import math
 import numpy as np
 
 from .compare import COLUMNS, read_csv
-from .ncio import atomic_write_text
+from .pipeline.ncio import atomic_write_text
 from .published import per_ball
 from .units import from_si
 

@@ -3,8 +3,8 @@ from pathlib import Path
 
 import yaml
 
-from ballbat.codedeps import module_files
-from ballbat.config import validate_config
+from ballbat.pipeline.codedeps import module_files
+from ballbat.pipeline.config import validate_config
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 # A dataset set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.

@@ -1,8 +1,8 @@
 """Rule compare: adapter around ballbat.compare."""
 
 from ballbat.compare import stronge_rows, write_comparison
-from ballbat.ncio import read_dataset
-from ballbat.runlog import logged
+from ballbat.pipeline.ncio import read_dataset
+from ballbat.pipeline.runlog import logged
 
 with logged(snakemake.log[0], snakemake.rule):
     write_comparison(

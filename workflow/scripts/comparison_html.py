@@ -1,7 +1,7 @@
 """Rule comparison_html: adapter around ballbat.reporting.comparison_html (table for the report)."""
 
+from ballbat.pipeline.runlog import logged
 from ballbat.reporting import comparison_html
-from ballbat.runlog import logged
 
 with logged(snakemake.log[0], snakemake.rule):
     comparison_html(

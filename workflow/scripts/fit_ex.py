@@ -1,9 +1,9 @@
 """Rule fit_ex: adapter around ballbat.fitting.fit_dataset."""
 
 from ballbat.fitting import fit_dataset
-from ballbat.ncio import read_dataset, write_dataset
-from ballbat.provenance import data_inputs
-from ballbat.runlog import logged
+from ballbat.pipeline.ncio import read_dataset, write_dataset
+from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.runlog import logged
 from ballbat.units import MPH
 
 with logged(snakemake.log[0], snakemake.rule) as log:

@@ -1,9 +1,9 @@
-"""Rule fit_stronge: adapter around ballbat.stronge_analysis.stronge_dataset."""
+"""Rule fit_stronge: adapter around ballbat.stronge.analysis.stronge_dataset."""
 
-from ballbat.ncio import read_dataset, write_dataset
-from ballbat.provenance import data_inputs
-from ballbat.runlog import logged
-from ballbat.stronge_analysis import stronge_dataset
+from ballbat.pipeline.ncio import read_dataset, write_dataset
+from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.runlog import logged
+from ballbat.stronge.analysis import stronge_dataset
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     s = snakemake.params.stronge

@@ -1,10 +1,10 @@
 """Rule implications: adapter around ballbat.implications.run_scenario."""
 
 from ballbat.implications import pooled_e_x, run_scenario
-from ballbat.ncio import write_dataset
+from ballbat.pipeline.ncio import write_dataset
+from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
-from ballbat.provenance import data_inputs
-from ballbat.runlog import logged
 
 with logged(snakemake.log[0], snakemake.rule):
     scenario = snakemake.params.scenario

@@ -2,9 +2,9 @@
 
 from ballbat.compare import write_table
 from ballbat.implications import comparison_rows
-from ballbat.ncio import read_dataset
+from ballbat.pipeline.ncio import read_dataset
+from ballbat.pipeline.runlog import logged
 from ballbat.published import PUBLISHED_IMPLICATIONS
-from ballbat.runlog import logged
 
 with logged(snakemake.log[0], snakemake.rule):
     write_table(

@@ -1,9 +1,9 @@
 """Rule ingest: adapter around ballbat.ingest.ingest."""
 
 from ballbat.ingest import excluded_listing, ingest
-from ballbat.ncio import write_dataset
-from ballbat.provenance import data_inputs
-from ballbat.runlog import logged
+from ballbat.pipeline.ncio import write_dataset
+from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.runlog import logged
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     ds, warnings = ingest(snakemake.input.impacts, balls_path=snakemake.input.balls, bats_path=snakemake.input.bats)

@@ -1,9 +1,9 @@
 """Rule normalize: adapter around ballbat.analysis.normalize."""
 
 from ballbat.analysis import normalize
-from ballbat.ncio import read_dataset, write_dataset
-from ballbat.provenance import data_inputs
-from ballbat.runlog import logged
+from ballbat.pipeline.ncio import read_dataset, write_dataset
+from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.runlog import logged
 from ballbat.units import MPH
 
 with logged(snakemake.log[0], snakemake.rule):

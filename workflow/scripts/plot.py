@@ -1,8 +1,8 @@
 """Rules plot_*: adapter around ballbat.plotting.draw (figures from NetCDF files only)."""
 
+from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.runlog import logged
 from ballbat.plotting import draw
-from ballbat.provenance import data_inputs
-from ballbat.runlog import logged
 
 with logged(snakemake.log[0], snakemake.rule):
     draw(

@@ -1,10 +1,10 @@
 """Rule reconstruct: adapter around ballbat.analysis.reconstruct."""
 
 from ballbat.analysis import reconstruct
-from ballbat.ncio import read_dataset, write_dataset
+from ballbat.pipeline.ncio import read_dataset, write_dataset
+from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
-from ballbat.provenance import data_inputs
-from ballbat.runlog import logged
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     ds = reconstruct(

@@ -1,9 +1,9 @@
 """Rule simulate: adapter around ballbat.synthetic.simulate_experiment."""
 
-from ballbat.ncio import write_dataset
+from ballbat.pipeline.ncio import write_dataset
+from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
-from ballbat.provenance import data_inputs
-from ballbat.runlog import logged
 from ballbat.synthetic import SyntheticSettings, simulate_experiment
 
 with logged(snakemake.log[0], snakemake.rule):

@@ -14,7 +14,7 @@ from functools import cache
 from pathlib import Path
 
 PACKAGE = "ballbat"
-PACKAGE_DIR = Path(__file__).resolve().parent
+PACKAGE_DIR = Path(__file__).resolve().parent.parent  # src/ballbat
 
 
 _IMPORT = re.compile(
@@ -73,8 +73,8 @@ def _module_file(name: str) -> Path | None:
 
 
 @cache
-def module_files(script: str) -> tuple[str, ...]:
-    """Source files of every ballbat module ``script`` imports, transitively (sorted)."""
+def _modules(script: str) -> dict[str, Path]:
+    """Every ballbat module ``script`` imports, transitively: name -> source file."""
     todo = sorted(_imports(Path(script), None))
     seen: dict[str, Path] = {PACKAGE: PACKAGE_DIR / "__init__.py"}
     while todo:
@@ -86,4 +86,14 @@ def module_files(script: str) -> tuple[str, ...]:
             continue
         seen[name] = f
         todo += sorted(_imports(f, name if f.name != "__init__.py" else name + "._"))
-    return tuple(sorted(str(p) for p in seen.values()))
+    return seen
+
+
+def module_files(script: str) -> tuple[str, ...]:
+    """Source files of every ballbat module ``script`` imports, transitively (sorted)."""
+    return tuple(sorted(str(p) for p in _modules(script).values()))
+
+
+def module_names(script: str) -> tuple[str, ...]:
+    """Dotted names of every ballbat module ``script`` imports, transitively (sorted)."""
+    return tuple(sorted(_modules(script)))

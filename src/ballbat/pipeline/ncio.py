@@ -14,7 +14,7 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from . import __version__
+from .. import __version__
 from .atomic import atomic_target
 from .provenance import provenance_attrs
 

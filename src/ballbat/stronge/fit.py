@@ -2,7 +2,7 @@
 
 The data are ``y = (v_ball,t + r omega)/v_bat,n`` against ``x = tan(psi)/(1 + r_x)``
 (Eq. vtf); the model is ``y = (1 + e_x(psi; eta2, e_y, mu, r_x, r_y)) x`` with e_x from
-:func:`ballbat.stronge.stronge_ex` in the bat's frame, each impact with its own recoil
+:func:`ballbat.stronge.model.stronge_ex` in the bat's frame, each impact with its own recoil
 factors. The paper fitted eta^2 = 4.75 (baseball) and 6.30 (softball) with e_y = mu = 0.5.
 
 Uncertainties (documented in docs/stronge.md, "The eta^2 fit"):
@@ -27,7 +27,7 @@ from dataclasses import asdict, dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .stronge import stronge_ex
+from .model import stronge_ex
 
 __all__ = ["Eta2Fit", "Eta2FitError", "fit_eta2"]
 

@@ -2,7 +2,7 @@
 
 For each ball the Eq. vtf data of the usable impacts (``flag == 0``) are fitted with
 Stronge's lumped-parameter model in the bat frame, each impact with its own recoil
-factors (:func:`ballbat.stronge_fit.fit_eta2`). The result holds the fitted parameters and
+factors (:func:`ballbat.stronge.fit.fit_eta2`). The result holds the fitted parameters and
 intervals, the model curves on a psi grid (Fig. 9a and its extrapolation, Fig. 9b) for the
 fitted and for the published eta^2, the time histories at psi = 30 deg (Fig. 10) and the
 regime boundaries in psi.
@@ -18,10 +18,10 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from .fitting import MEASURED, MIN_FIT_IMPACTS, effective_sigma, vtf_design, wls_slope
-from .published import per_ball
-from .stronge import omega_ratio, regime_boundaries, stronge_ex, stronge_solve
-from .stronge_fit import fit_eta2
+from ..fitting import MEASURED, MIN_FIT_IMPACTS, effective_sigma, vtf_design, wls_slope
+from ..published import per_ball
+from .fit import fit_eta2
+from .model import omega_ratio, regime_boundaries, stronge_ex, stronge_solve
 
 #: eta^2 published in Sec. V.A (with e_y = mu = 0.5), drawn beside the fits.
 PUBLISHED_ETA2 = per_ball("eta2")

@@ -1,0 +1,5 @@
+"""Stronge's lumped-parameter contact model (Sec. V.A of Kensrud et al. 2017).
+
+:mod:`.model` is the closed-form solver, :mod:`.fit` the eta^2 fit, :mod:`.analysis` the
+per-dataset analysis that the ``fit_stronge`` rule runs.
+"""
