@@ -69,7 +69,11 @@ def write_dataset(
     }
     encoding = {}
     for name, var in ds.variables.items():
-        if var.dtype.kind == "f":
+        if name in ds.coords:  # CF: coordinates have no missing values, so no _FillValue
+            encoding[name] = {"_FillValue": None}
+            if var.dtype.kind in "OU":
+                encoding[name]["dtype"] = str
+        elif var.dtype.kind == "f":
             encoding[name] = {"_FillValue": np.nan}
         elif var.dtype.kind in "OU":
             encoding[name] = {"dtype": str}
