@@ -57,16 +57,20 @@ def fit_times(sizes=(1_000, 10_000, 100_000)) -> list[tuple[int, float]]:
     bats = load_bats(ROOT / "config" / "bats.csv")
     base = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["datasets"]["synthetic"]["synthetic"]
     total = sum(sum(v.values()) for v in base["impacts"].values())
-    fit_dataset(reconstruct(normalize(simulate_experiment(SyntheticSettings(**base), balls, bats)), balls, bats))
+    fit_dataset(
+        reconstruct(normalize(simulate_experiment(SyntheticSettings(**base), balls, bats), 77.0), balls, bats), 0.5
+    )
     out = []
     for n in sizes:
         scale = n / total
         impacts = {b: {t: max(3, round(k * scale)) for t, k in v.items()} for b, v in base["impacts"].items()}
         ds = reconstruct(
-            normalize(simulate_experiment(SyntheticSettings(**{**base, "impacts": impacts}), balls, bats)), balls, bats
+            normalize(simulate_experiment(SyntheticSettings(**{**base, "impacts": impacts}), balls, bats), 77.0),
+            balls,
+            bats,
         )
         t0 = time.perf_counter()
-        fit_dataset(ds)
+        fit_dataset(ds, 0.5)
         out.append((ds.sizes["impact"], time.perf_counter() - t0))
     return out
 

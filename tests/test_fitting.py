@@ -5,8 +5,10 @@ import pytest
 import yaml
 
 from ballbat.analysis import normalize, reconstruct
-from ballbat.fitting import LineFit, fit_dataset, fit_line, wls_slope
+from ballbat.fitting import fit_dataset
+from ballbat.linefit import fit_line, wls_slope
 from ballbat.synthetic import SyntheticSettings, simulate_experiment
+from ballbat.units import MPH
 
 
 @pytest.fixture(scope="module")
@@ -17,7 +19,7 @@ def default_settings(root):
 
 def run(settings, balls, bats, **over):
     s = SyntheticSettings(**{**settings, **over})
-    return fit_dataset(reconstruct(normalize(simulate_experiment(s, balls, bats)), balls, bats))
+    return fit_dataset(reconstruct(normalize(simulate_experiment(s, balls, bats), 77.0), balls, bats), 0.5)
 
 
 def test_fit_line_matches_closed_form():
@@ -36,8 +38,12 @@ def test_fit_line_matches_closed_form():
 
 
 def test_fit_line_too_few_points():
-    assert not fit_line(np.array([1.0]), np.array([2.0])).success
-    assert isinstance(fit_line(np.array([1.0]), np.array([2.0])), LineFit)
+    """One point fixes a slope but not its error: no fit, NaN values, the count kept."""
+    one = fit_line(np.array([1.0]), np.array([2.0]))
+    assert not one.success and one.n == 1 and np.isnan(one.slope) and np.isnan(one.slope_err)
+    two = fit_line(np.array([1.0, 2.0]), np.array([2.0, 4.1]), through_origin=False)
+    assert not two.success and two.n == 2 and np.isnan(two.intercept)
+    assert fit_line(np.array([1.0, 2.0]), np.array([2.0, 4.1])).success  # through the origin: 1 dof
 
 
 def test_effective_variance_chi2_is_one_for_pure_noise():
@@ -110,7 +116,9 @@ def test_wls_slope():
 @pytest.mark.parametrize("design", ["spin", "tan_ratio", "vtf", "theta_spin", "theta_speed"])
 def test_design_jacobians_match_finite_differences(design):
     """The effective-variance weights rest on these derivatives: check them numerically."""
-    from ballbat import fitting as f
+    from ballbat import designs as f
+
+    v_ref = 77 * MPH
 
     rng = np.random.default_rng(3)
     n = 5
@@ -120,8 +128,8 @@ def test_design_jacobians_match_finite_differences(design):
         "spin": lambda m: f.spin_design(*m, r, r_x, alpha),
         "tan_ratio": lambda m: f.tan_ratio_design(*m, r, alpha),
         "vtf": lambda m: f.vtf_design(*m, r, r_x, alpha),
-        "theta_spin": lambda m: f.normalized_theta_design(m[0], m[3], m[2], "omega"),
-        "theta_speed": lambda m: f.normalized_theta_design(m[0], m[1], m[2], "v_ball"),
+        "theta_spin": lambda m: f.normalized_theta_design(m[0], m[3] * v_ref / m[0], m[2], "omega", v_ref),
+        "theta_speed": lambda m: f.normalized_theta_design(m[0], m[1] * v_ref / m[0], m[2], "v_ball", v_ref),
     }[design]
     x, y, jx, jy = fun(meas)
     for k in range(4):
@@ -141,8 +149,8 @@ def test_ball_with_too_few_usable_impacts_is_reported_not_fitted(default_setting
     from ballbat.stronge.analysis import stronge_dataset
 
     settings = {**default_settings, "impacts": {"baseball": {"wood": 12}, "softball": {"wood": 2}}}
-    rec = reconstruct(normalize(simulate_experiment(SyntheticSettings(**settings), balls, bats)), balls, bats)
-    fit = fit_dataset(rec)
+    rec = reconstruct(normalize(simulate_experiment(SyntheticSettings(**settings), balls, bats), 77.0), balls, bats)
+    fit = fit_dataset(rec, 0.5)
     soft = fit.sel(ball="softball")
     assert int(soft.e_x_pooled_n) == 2 and np.isnan(soft.e_x_pooled)
     for q in ("tan_ratio_slope", "spin_theta_slope", "e_y_implied", "mu_k_lower_bound"):

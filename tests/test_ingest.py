@@ -13,7 +13,9 @@ import xarray as xr
 import yaml
 
 from ballbat import fitting, ingest
-from ballbat.analysis import FLAG_INGEST, normalize, reconstruct
+from ballbat.analysis import normalize, reconstruct
+from ballbat.fitting import FitStatus
+from ballbat.kinematics import ImpactFlag
 from ballbat.pipeline.config import ConfigError, validate_config
 from ballbat.pipeline.ncio import check_metadata
 from ballbat.properties import InputError, load_balls, load_bats
@@ -83,15 +85,16 @@ def test_example_reads_clean():
 
 def test_exclusion_reaches_reconstruct_and_is_kept_out_of_fits():
     ds, _ = ingest.ingest(EXAMPLE, BALLS, MAPLE_BATS)
-    rec = reconstruct(normalize(ds), load_balls(BALLS), load_bats(MAPLE_BATS))
+    rec = reconstruct(normalize(ds, 77.0), load_balls(BALLS), load_bats(MAPLE_BATS))
     check_metadata(rec, "reconstruct")
-    excluded = rec["flag"].values == FLAG_INGEST
+    excluded = rec["flag"].values == ImpactFlag.EXCLUDED_AT_INGEST
     assert excluded.sum() == 1 and (rec["flag"].values[~excluded] == 0).all()
     assert rec["flag_reason"].values[excluded][0].startswith("excluded at ingest: alpha r omega / v_ball")
-    assert "4:excluded_when_the_measured_file_was_read" in rec["flag"].attrs["flag_meanings"]
-    fit = fitting.fit_dataset(rec)
+    meanings = rec["flag"].attrs["flag_meanings"].split()
+    assert meanings[list(rec["flag"].attrs["flag_values"]).index(4)] == "excluded_at_ingest"
+    fit = fitting.fit_dataset(rec, 0.5)
     assert int(fit["e_x_n"].sel(ball="baseball", bat="maple")) == 30
-    assert str(fit["e_x_note"].sel(ball="baseball", bat="maple").values) == "ok"
+    assert int(fit["e_x_status"].sel(ball="baseball", bat="maple")) == FitStatus.OK
     assert fit.attrs["n_excluded"] == 1
     # the example's truth: e_x = 0.42 (config/examples/make_maple.py)
     e_x, err = (float(fit[v].sel(ball="baseball", bat="maple")) for v in ("e_x", "e_x_err"))
@@ -279,14 +282,13 @@ def test_small_group_not_fitted(tmp_path):
         ["B2", "metal_rough", "baseball", "78.0", "86.0", "12.0", "2300"],
     ]
     ds, _ = ingest.ingest(write_csv(tmp_path / "g.csv", rows), BALLS, BATS)
-    fit = fitting.fit_dataset(reconstruct(normalize(ds), load_balls(BALLS), load_bats(BATS)))
+    fit = fitting.fit_dataset(reconstruct(normalize(ds, 77.0), load_balls(BALLS), load_bats(BATS)), 0.5)
     small = fit.sel(ball="baseball", bat="metal_rough")
     assert np.isnan(float(small["e_x"])) and int(small["e_x_n"]) == 2
-    assert str(small["e_x_note"].values) == "not fitted: 2 usable impact(s), fewer than 3"
+    assert int(small["e_x_status"]) == FitStatus.TOO_FEW_IMPACTS
     assert np.isfinite(float(fit["e_x"].sel(ball="baseball", bat="wood")))
     assert int(fit["e_x_pooled_n"].sel(ball="baseball")) == 6
-    assert str(fit["e_x_note"].sel(ball="baseball", bat="wood").values) == "ok"
-    assert fitting.MIN_FIT_IMPACTS == ingest.MIN_FIT_IMPACTS
+    assert int(fit["e_x_status"].sel(ball="baseball", bat="wood")) == FitStatus.OK
 
 
 @pytest.fixture(scope="module")

@@ -48,7 +48,7 @@ def test_reconstruct_inverts_forward(wood_baseball):
     ball, r_x, r_y = wood_baseball
     psi = np.linspace(-5, 60, 40) * DEGREE
     out = ball_at_rest_collision(34.0, psi, 0.4, 0.5, ball.r, r_x, r_y)
-    got, flag = reconstruct_psi(out.v_ball, out.theta, out.omega, ball.r)
+    got, flag = reconstruct_psi(out.v_ball, out.theta, out.omega, ball.r, ball.alpha)
     np.testing.assert_allclose(got, psi, atol=1e-12)
     assert (flag == 0).all()
 
@@ -56,7 +56,7 @@ def test_reconstruct_inverts_forward(wood_baseball):
 def test_reconstruct_flags_instead_of_clipping(balls):
     r = balls["baseball"].r
     # alpha r omega / v_ball = 0.4 * 0.036 * 4000 / 20 > 1: impossible measurement
-    psi, flag = reconstruct_psi(np.array([20.0, 30.0, 0.0, np.nan]), 0.1, np.array([4000.0, 100.0, 100.0, 1.0]), r)
+    psi, flag = reconstruct_psi(np.array([20.0, 30.0, 0.0, np.nan]), 0.1, np.array([4000.0, 100.0, 100.0, 1.0]), r, 0.4)
     assert np.isnan(psi[0]) and flag[0] == 1
     assert flag[1] == 0 and np.isfinite(psi[1])
     assert flag[2] == 2 and flag[3] == 2 and np.isnan(psi[2:]).all()
@@ -64,8 +64,8 @@ def test_reconstruct_flags_instead_of_clipping(balls):
 
 def test_normalisation_uses_77_over_v_bat():
     # Sec. II: scale to 77 mph. Only 77/v_bat makes a value measured at 88 mph smaller.
-    assert normalize_to_bat_speed(100.0, 88 * MPH) == pytest.approx(100.0 * 77 / 88, rel=1e-14)
-    assert normalize_to_bat_speed(100.0, 77 * MPH) == pytest.approx(100.0, rel=1e-14)
+    assert normalize_to_bat_speed(100.0, 88 * MPH, 77 * MPH) == pytest.approx(100.0 * 77 / 88, rel=1e-14)
+    assert normalize_to_bat_speed(100.0, 77 * MPH, 77 * MPH) == pytest.approx(100.0, rel=1e-14)
 
 
 def test_spin_bracket_slope_is_one_plus_ex(wood_baseball):

@@ -15,7 +15,7 @@ from ballbat.synthetic import SyntheticSettings, simulate_experiment
 def products(root, balls, bats):
     cfg = yaml.safe_load((root / "config" / "config.yaml").read_text())
     s = SyntheticSettings(**cfg["datasets"]["synthetic"]["synthetic"])
-    rec = reconstruct(normalize(simulate_experiment(s, balls, bats)), balls, bats)
+    rec = reconstruct(normalize(simulate_experiment(s, balls, bats), 77.0), balls, bats)
     return stronge_dataset(rec, n_time=201)
 
 

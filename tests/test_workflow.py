@@ -152,7 +152,18 @@ def test_code_edit_reruns_only_dependents(run_dir):
     pkg = run_dir / "src" / "ballbat"
     # implications use this dataset's pooled e_x, so they follow the fit
     # figures and report tables follow what they draw (PLOTS: one job each)
+    # the Sec. IV orchestration: not the Stronge fit, which shares only the line fit and the designs
+    stronge_plots = {"plot_fig9": 1, "plot_fig10": 1}
     assert _jobs_after_edit(run_dir, pkg / "fitting.py") == {
+        "fit_ex": 1,
+        "compare": 1,
+        "implications": 1,
+        "implications_compare": 1,
+        **{k: v for k, v in DATASET_PLOTS.items() if k not in stronge_plots},
+        "plot_fig11": 1,
+        "comparison_html": 2,
+    }
+    assert _jobs_after_edit(run_dir, pkg / "linefit.py") == {
         "fit_ex": 1,
         "compare": 1,
         "implications": 1,

@@ -40,7 +40,9 @@ from pathlib import Path
 import numpy as np
 import xarray as xr
 
-from .kinematics import spin_bracket
+from .kinematics import FLAG_TEXT, ImpactFlag, angmom_argument, reconstruct_psi, spin_bracket
+from .linefit import MIN_FIT_IMPACTS
+from .pipeline.products import flag_attrs
 from .properties import Ball, Bat, InputError, load_balls, load_bats, recoil_factors
 from .units import DEGREE, MPH, RPM
 
@@ -59,15 +61,6 @@ SI_UNITS = {"v_bat": "m s-1", "v_ball": "m s-1", "theta": "rad", "omega": "rad s
 #: Optional columns: an impact's own id and the standard uncertainty of each measurement.
 OPTIONAL = ("impact_id", *(f"{c}_err" for c in MEASURED_COLUMNS))
 
-#: Fewest usable impacts for a fit of e_x (same value as ``ballbat.fitting.MIN_FIT_IMPACTS``).
-MIN_FIT_IMPACTS = 3
-
-#: Values of ``ingest_flag``: why an impact is excluded (kept in the file, never dropped).
-INGEST_FLAGS = {
-    0: "ok",
-    1: "psi cannot be reconstructed: |alpha r omega / v_ball| > 1 (Eq. angmom)",
-    2: "reconstructed |psi| >= 90 deg: the bat cannot reach the ball there",
-}
 
 #: Range of e_x (Eq. omega) that real ball-bat impacts can show; used only to spot unit mistakes.
 E_X_PLAUSIBLE = (-0.5, 1.0)
@@ -247,26 +240,22 @@ def check_rows(path, header, rows, balls: dict | None, bats: dict | None) -> tup
 def exclusions(v_ball, theta, omega, r, alpha) -> tuple[np.ndarray, np.ndarray]:
     """Per impact: ``(ingest_flag, ingest_flag_reason)`` for impacts psi cannot use (SI inputs).
 
-    Notes
-    -----
-    Eq. angmom: sin(psi - theta) = alpha r omega / v_ball; outside [-1, 1] psi does not
-    exist (flag 1); a psi with |psi| >= 90 deg puts the bat behind the ball (flag 2).
+    The flag is that of :func:`ballbat.kinematics.reconstruct_psi` (an
+    :class:`~ballbat.kinematics.ImpactFlag`); the reason quotes the offending number.
     """
-    q = alpha * r * omega / v_ball
+    psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
+    q = angmom_argument(v_ball, omega, r, alpha)
     with np.errstate(invalid="ignore"):
-        psi = theta + np.arcsin(np.clip(q, -1, 1))
-    flag = np.zeros(q.shape, dtype=np.int8)
-    flag[np.abs(psi) >= np.pi / 2] = 2
-    flag[np.abs(q) > 1] = 1
+        psi_clipped = theta + np.arcsin(np.clip(q, -1, 1))
+    words = {
+        ImpactFlag.PSI_UNDEFINED: lambda qq, p: f"alpha r omega / v_ball = {qq:.3g}: psi cannot be reconstructed "
+        "(Eq. angmom)",
+        ImpactFlag.BAD_SPEED: lambda qq, p: FLAG_TEXT[ImpactFlag.BAD_SPEED],
+        ImpactFlag.BAT_BEHIND_BALL: lambda qq, p: f"reconstructed psi = {np.degrees(p):.1f} deg: "
+        "the bat cannot reach the ball there",
+    }
     reason = np.array(
-        [
-            "ok"
-            if f == 0
-            else f"alpha r omega / v_ball = {qq:.3g}: psi cannot be reconstructed (Eq. angmom)"
-            if f == 1
-            else f"reconstructed psi = {np.degrees(p):.1f} deg: the bat cannot reach the ball there"
-            for f, qq, p in zip(flag, q, psi, strict=True)
-        ],
+        ["ok" if f == 0 else words[ImpactFlag(f)](qq, p) for f, qq, p in zip(flag, q, psi_clipped, strict=True)],
         dtype=object,
     ).astype(str)
     return flag, reason
@@ -285,18 +274,18 @@ def implausible(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y) -> dict[str, tu
     * ``e_x``: the e_x each impact implies through Eq. omega lies in :data:`E_X_PLAUSIBLE`
       (impacts with |psi| >= :data:`PSI_MIN_FOR_E_X` only).
     """
-    q = alpha * r * omega / v_ball
+    psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
+    psi_ok = flag == ImpactFlag.OK
     with np.errstate(invalid="ignore", divide="ignore"):
-        psi = theta + np.arcsin(np.clip(q, -1, 1))
-        psi_ok = (np.abs(q) <= 1) & (np.abs(psi) < np.pi / 2)
         ratio = v_ball / v_bat
         e_x = omega / spin_bracket(v_bat, psi, r, r_x, alpha) - 1.0
-    use_ex = psi_ok & (np.abs(psi) >= PSI_MIN_FOR_E_X)
-    n = q.size
+        use_ex = psi_ok & (np.abs(psi) >= PSI_MIN_FOR_E_X)
+        ratio_low = psi_ok & (ratio < np.cos(psi) / (1.0 + r_y))
+    n = psi.size
     return {
         "psi": (int((~psi_ok).sum()), n),
         "ratio_high": (int((ratio > 2.0 / (1.0 + r_y)).sum()), n),
-        "ratio_low": (int((psi_ok & (ratio < np.cos(psi) / (1.0 + r_y))).sum()), int(psi_ok.sum())),
+        "ratio_low": (int(ratio_low.sum()), int(psi_ok.sum())),
         "e_x": (
             int((use_ex & ~((e_x >= E_X_PLAUSIBLE[0]) & (e_x <= E_X_PLAUSIBLE[1]))).sum()),
             int(use_ex.sum()),
@@ -459,8 +448,7 @@ def ingest(impacts_path, balls_path, bats_path) -> tuple[xr.Dataset, list[str]]:
         flag,
         "1",
         "exclusion flag set when the file was read (0: usable)",
-        flag_values=np.array(sorted(INGEST_FLAGS), dtype=np.int8),
-        flag_meanings=" ".join(f"{k}:{v.split(':')[0].replace(' ', '_')}" for k, v in sorted(INGEST_FLAGS.items())),
+        **flag_attrs(ImpactFlag),
     )
     out["ingest_flag_reason"] = ("impact", reason, {"long_name": "why the impact is excluded (ok if it is not)"})
     ds = xr.Dataset(

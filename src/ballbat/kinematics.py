@@ -18,22 +18,15 @@ References
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass
 
 import numpy as np
-
-#: Reference bat speed of the paper's normalisation, m/s (77 mph, Sec. II).
-V_BAT_REF = 77.0 * 0.44704
 
 
 def offset_from_psi(psi, r, R):
     """Ball-bat offset D from the impact angle psi (Eq. D): D = (r + R) sin psi."""
     return (r + R) * np.sin(psi)
-
-
-def psi_from_offset(D, r, R):
-    """Inverse of Eq. D: psi = asin(D / (r + R))."""
-    return np.arcsin(np.asarray(D, dtype=float) / (r + R))
 
 
 def spin_bracket(v_bat, psi, r, r_x, alpha=0.4):
@@ -98,39 +91,73 @@ def ball_at_rest_collision(v_bat, psi, e_x, e_y, r, r_x, r_y, alpha=0.4) -> Outg
     )
 
 
-#: Reasons a measured impact cannot be reconstructed (value of the ``flag`` variable).
-RECONSTRUCT_FLAGS = {
-    0: "ok",
-    1: "alpha r omega / v_ball outside [-1, 1]: psi undefined (Eq. angmom)",
-    2: "non-finite or non-positive measured speed",
-    3: "reconstructed |psi| >= 90 deg: the bat cannot reach the ball there",
+class ImpactFlag(enum.IntEnum):
+    """Why an impact cannot be used (the ``flag`` of reconstruct.nc, ``ingest_flag`` of ingest.nc).
+
+    One code list for every stage: Eq. angmom's failures (1-3), set wherever psi is
+    reconstructed, and the exclusions made when a measured file is read (4).
+    """
+
+    OK = 0
+    PSI_UNDEFINED = 1
+    BAD_SPEED = 2
+    BAT_BEHIND_BALL = 3
+    EXCLUDED_AT_INGEST = 4
+
+
+#: A sentence per :class:`ImpactFlag`, for the readable ``*_reason`` variables.
+FLAG_TEXT = {
+    ImpactFlag.OK: "ok",
+    ImpactFlag.PSI_UNDEFINED: "alpha r omega / v_ball outside [-1, 1]: psi undefined (Eq. angmom)",
+    ImpactFlag.BAD_SPEED: "non-finite or non-positive measured speed",
+    ImpactFlag.BAT_BEHIND_BALL: "reconstructed |psi| >= 90 deg: the bat cannot reach the ball there",
+    ImpactFlag.EXCLUDED_AT_INGEST: "excluded when the measured file was read (see ingest_flag_reason)",
 }
 
 
-def reconstruct_psi(v_ball, theta, omega, r, alpha=0.4):
+def angmom_argument(v_ball, omega, r, alpha):
+    """The argument of Eq. angmom's arcsine: sin(psi - theta) = alpha r omega / v_ball."""
+    return alpha * r * np.asarray(omega, dtype=float) / np.asarray(v_ball, dtype=float)
+
+
+def reconstruct_psi(v_ball, theta, omega, r, alpha):
     """Impact angle psi from measured exit speed, angle and spin (Eq. angmom).
 
     Returns ``(psi, flag)``. Angular momentum of the ball about the contact point
     vanishes (Eq. angmom): alpha m r^2 omega = m v_ball r sin(psi - theta), so
     psi = theta + asin(alpha r omega / v_ball). Where the argument lies outside [-1, 1]
-    psi is NaN and ``flag`` is 1 (see :data:`RECONSTRUCT_FLAGS`): never clipped. A small
+    psi is NaN and ``flag`` is :attr:`ImpactFlag.PSI_UNDEFINED`: never clipped. A small
     negative psi (bat over the ball's centre, or noise near head-on impacts) is valid.
+    This is the one implementation of Eq. angmom; :func:`psi_partials` adds its derivatives.
     """
     v_ball = np.asarray(v_ball, dtype=float)
-    arg = alpha * r * np.asarray(omega, dtype=float) / np.where(v_ball > 0, v_ball, np.nan)
     bad_speed = ~np.isfinite(v_ball) | (v_ball <= 0)
+    arg = angmom_argument(np.where(bad_speed, np.nan, v_ball), omega, r, alpha)
     out_of_range = ~bad_speed & (np.abs(arg) > 1.0)
     with np.errstate(invalid="ignore"):
         psi = np.where(bad_speed | out_of_range, np.nan, theta + np.arcsin(np.clip(arg, -1, 1)))
     flag = np.zeros(np.shape(psi), dtype=np.int8)
-    flag[out_of_range] = 1
-    flag[bad_speed] = 2
+    flag[out_of_range] = ImpactFlag.PSI_UNDEFINED
+    flag[bad_speed] = ImpactFlag.BAD_SPEED
     with np.errstate(invalid="ignore"):
-        flag[(flag == 0) & ~(np.abs(psi) < np.pi / 2)] = 3
+        flag[(flag == 0) & ~(np.abs(psi) < np.pi / 2)] = ImpactFlag.BAT_BEHIND_BALL
     return psi, flag
 
 
-def normalize_to_bat_speed(value, v_bat, v_ref=V_BAT_REF):
+def psi_partials(v_ball, theta, omega, r, alpha):
+    """psi of Eq. angmom and its derivatives with respect to (v_bat, v_ball, theta, omega).
+
+    For usable impacts (|alpha r omega / v_ball| < 1). Returns ``(psi, dpsi)`` with ``dpsi``
+    of shape (n, 4), the columns in the order of :data:`ballbat.designs.MEASURED`.
+    """
+    q = angmom_argument(v_ball, omega, r, alpha)
+    root = np.sqrt(1.0 - q**2)
+    psi = theta + np.arcsin(q)
+    d = np.stack([np.zeros_like(q), -q / (v_ball * root), np.ones_like(q), alpha * r / (v_ball * root)], axis=1)
+    return psi, d
+
+
+def normalize_to_bat_speed(value, v_bat, v_ref):
     """Scale a measured spin or exit speed to the reference bat speed (Sec. II).
 
     Both scale linearly with bat speed (Eqs. vballn, vxf, omega), so the normalised value

@@ -6,7 +6,6 @@ rule fit_ex:
     output:
         fit="results/{dataset}/fit_ex.nc",
     params:
-        v_ref_mph=config["normalize"]["v_ref_mph"],
         mu_k_example=config["analysis"]["mu_k_example"],
     log:
         "results/{dataset}/logs/fit_ex.log",

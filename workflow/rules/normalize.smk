@@ -1,5 +1,5 @@
 rule normalize:
-    """Scale measured spin and exit speed to the reference bat speed of 77 mph (Sec. II)."""
+    """Scale measured spin and exit speed to the reference bat speed (normalize.v_ref_mph; Sec. II)."""
     input:
         impacts=get_source,
         code=code("normalize.py"),

@@ -1,21 +1,19 @@
 """Rule fit_ex: adapter around ballbat.fitting.fit_dataset."""
 
-from ballbat.fitting import fit_dataset
+import numpy as np
+
+from ballbat.fitting import FitStatus, fit_dataset
 from ballbat.pipeline.ncio import read_dataset, write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import logged
-from ballbat.units import MPH
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    ds = fit_dataset(
-        read_dataset(snakemake.input.impacts),
-        v_ref=snakemake.params.v_ref_mph * MPH,
-        mu_k_example=snakemake.params.mu_k_example,
-    )
+    ds = fit_dataset(read_dataset(snakemake.input.impacts), mu_k_example=snakemake.params.mu_k_example)
     for name in ("e_x", "e_x_pooled"):
-        for where, note in ds[f"{name}_note"].to_series().items():
-            if note not in ("ok", "no impacts"):
-                log.warning("%s %s: %s", name, where, note)
+        for where, status in ds[f"{name}_status"].to_series().items():
+            if FitStatus(status) not in (FitStatus.OK, FitStatus.NO_IMPACTS):
+                n = int(ds[f"{name}_n"].sel(dict(zip(ds[name].dims, np.atleast_1d(where), strict=True))))
+                log.warning("%s %s: not fitted: %s (%d usable impacts)", name, where, FitStatus(status).name, n)
     write_dataset(
         ds,
         snakemake.output.fit,

@@ -4,10 +4,9 @@ from ballbat.analysis import normalize
 from ballbat.pipeline.ncio import read_dataset, write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import logged
-from ballbat.units import MPH
 
 with logged(snakemake.log[0], snakemake.rule):
-    ds = normalize(read_dataset(snakemake.input.impacts), v_ref=snakemake.params.v_ref_mph * MPH)
+    ds = normalize(read_dataset(snakemake.input.impacts), v_ref_mph=snakemake.params.v_ref_mph)
     write_dataset(
         ds,
         snakemake.output.impacts,

@@ -119,3 +119,19 @@ def build_dataset(
         name: (var.dims, np.asarray(val), var.attributes()) for name, (var, val) in (coords or {}).items()
     }
     return xr.Dataset(data_vars, coords=coord_vars, attrs=dict(attrs or {}))
+
+
+def add_variables(ds: xr.Dataset, table: Mapping[str, Var], values: Mapping[str, Any]) -> xr.Dataset:
+    """A copy of ``ds`` with the declared variables of ``table`` that ``values`` gives, in table order.
+
+    For stages that extend their input file (normalize, reconstruct); a value not declared
+    in ``table`` is a :class:`KeyError`.
+    """
+    undeclared = sorted(set(values) - set(table))
+    if undeclared:
+        raise KeyError(f"values not declared in the table: {undeclared}")
+    out = ds.copy()
+    for name, var in table.items():
+        if name in values:
+            out[name] = (var.dims, np.asarray(values[name]), var.attributes())
+    return out

@@ -18,7 +18,8 @@ from __future__ import annotations
 import numpy as np
 import xarray as xr
 
-from ..fitting import MEASURED, MIN_FIT_IMPACTS, effective_sigma, vtf_design, wls_slope
+from ..designs import MEASURED, vtf_design
+from ..linefit import MIN_FIT_IMPACTS, effective_sigma, wls_slope
 from ..published import per_ball
 from .fit import fit_eta2
 from .model import omega_ratio, regime_boundaries, stronge_ex, stronge_solve

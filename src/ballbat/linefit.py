@@ -1,0 +1,136 @@
+"""Straight-line fits with the effective variance of each residual (lmfit).
+
+Measurement uncertainties enter through the *effective variance* of each impact's residual:
+the abscissa and the ordinate are both functions of the measured (v_bat, v_ball, theta,
+omega), so the residual y - (a + s x) has variance sum_k (dy/dm_k - s dx/dm_k)^2 sigma_k^2
+over the measured quantities m_k (correlations between x and y through psi included). The
+weights depend on the slope, so the fit is iterated (three passes converge to far below the
+standard error). Standard errors are lmfit's, scaled by the reduced chi-square (as the
+paper's standard errors come from the scatter of the data); the reduced chi-square itself
+tells whether the stated measurement uncertainties explain that scatter. 95 % intervals use
+Student's t with n - p degrees of freedom. Without uncertainties the fit is unweighted and
+the reduced chi-square is undefined (NaN). lmfit and scipy are imported inside
+:func:`fit_line` only, so that modules which merely read these names start fast.
+
+References
+----------
+.. [1] J. Orear, "Least squares when both variables have uncertainties",
+   Am. J. Phys. 50, 912 (1982) (effective variance).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+#: Fewest usable impacts for a fit of e_x per bat or pooled; fewer give NaN with n and a note.
+MIN_FIT_IMPACTS = 3
+
+
+@dataclass(frozen=True)
+class LineFit:
+    """Result of a straight-line fit."""
+
+    slope: float
+    slope_err: float
+    slope_ci_low: float
+    slope_ci_high: float
+    intercept: float  # 0 for fits through the origin
+    intercept_err: float
+    n: int
+    redchi: float
+    success: bool
+
+    @classmethod
+    def not_fitted(cls, n: int) -> LineFit:
+        """The result of a fit that was not made (too few impacts) or failed: NaN with ``n``."""
+        return cls(np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, n, np.nan, False)
+
+
+def _line(x, slope, intercept=0.0):
+    return intercept + slope * x
+
+
+def fit_line(x, y, jx=None, jy=None, sigma=None, through_origin=True, iterations=3) -> LineFit:
+    """Fit y = slope x (+ intercept) with lmfit, weighting by the effective variance.
+
+    Parameters
+    ----------
+    x, y : (n,) arrays.
+    jx, jy : (n, k) partial derivatives of x and y with respect to the k measured
+        quantities; ``sigma`` (n, k) their standard uncertainties. All three or none.
+    through_origin : fit y = slope x (Eq. omega, Eq. ratio) or a line with intercept.
+    """
+    import lmfit
+    from scipy import stats
+
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    n = x.size
+    p = 1 if through_origin else 2
+    if n <= p:
+        return LineFit.not_fitted(n)
+    model = lmfit.Model(_line, independent_vars=["x"])
+    params = model.make_params(slope=1.0, intercept=0.0)
+    if through_origin:
+        params["intercept"].set(value=0.0, vary=False)
+    weighted = sigma is not None and np.all(np.isfinite(sigma)) and np.any(np.asarray(sigma) > 0)
+    # Closed-form start (ordinary least squares) keeps lmfit's iterations few.
+    if through_origin:
+        params["slope"].set(value=float(np.dot(x, y) / np.dot(x, x)))
+    else:
+        s0, c0 = np.polyfit(x, y, 1)
+        params["slope"].set(value=float(s0))
+        params["intercept"].set(value=float(c0))
+    weights = None
+    result = None
+    for _ in range(iterations if weighted else 1):
+        if weighted:
+            s = params["slope"].value
+            var = np.sum((np.asarray(jy) - s * np.asarray(jx)) ** 2 * np.asarray(sigma) ** 2, axis=1)
+            if np.any(var <= 0):
+                weights = None
+                weighted = False
+            else:
+                weights = 1.0 / np.sqrt(var)
+        result = model.fit(y, params, x=x, weights=weights, scale_covar=True)
+        params = result.params
+    if not result.success or result.params["slope"].stderr is None:
+        return LineFit.not_fitted(n)
+    slope = float(result.params["slope"].value)
+    err = float(result.params["slope"].stderr)
+    tq = float(stats.t.ppf(0.975, n - p))
+    icpt = 0.0 if through_origin else float(result.params["intercept"].value)
+    icpt_err = 0.0 if through_origin else float(result.params["intercept"].stderr)
+    return LineFit(
+        slope=slope,
+        slope_err=err,
+        slope_ci_low=slope - tq * err,
+        slope_ci_high=slope + tq * err,
+        intercept=icpt,
+        intercept_err=icpt_err,
+        n=n,
+        redchi=float(result.redchi) if weighted else np.nan,
+        success=True,
+    )
+
+
+def wls_slope(x, y, weights=None, through_origin=True) -> tuple[float, float]:
+    """Weighted least-squares (slope, intercept) in closed form (used for truth values)."""
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    w = np.ones_like(x) if weights is None else np.asarray(weights, dtype=float) ** 2
+    if through_origin:
+        return float(np.sum(w * x * y) / np.sum(w * x * x)), 0.0
+    xm = np.sum(w * x) / np.sum(w)
+    ym = np.sum(w * y) / np.sum(w)
+    s = np.sum(w * (x - xm) * (y - ym)) / np.sum(w * (x - xm) ** 2)
+    return float(s), float(ym - s * xm)
+
+
+def effective_sigma(jx, jy, sigma, slope):
+    """Standard deviation of y - slope x from the measurement uncertainties (effective variance)."""
+    if sigma is None:
+        return None
+    return np.sqrt(np.sum((jy - slope * jx) ** 2 * sigma**2, axis=1))
