@@ -4,6 +4,7 @@ from pathlib import Path
 
 import pytest
 
+from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -12,6 +13,12 @@ ROOT = Path(__file__).resolve().parents[1]
 @pytest.fixture(scope="session")
 def root():
     return ROOT
+
+
+@pytest.fixture(scope="session")
+def config():
+    """The default config/config.yaml, validated, with the schema's defaults (as the workflow sees it)."""
+    return load_config(ROOT / "config" / "config.yaml")
 
 
 @pytest.fixture(scope="session")

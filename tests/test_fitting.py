@@ -144,7 +144,7 @@ def test_design_jacobians_match_finite_differences(design):
         np.testing.assert_allclose(jy[:, k], (yu - yd) / (2 * h), rtol=1e-5, atol=1e-8)
 
 
-def test_ball_with_too_few_usable_impacts_is_reported_not_fitted(default_settings, balls, bats):
+def test_ball_with_too_few_usable_impacts_is_reported_not_fitted(default_settings, config, balls, bats):
     """A ball with 2 usable impacts: every per-ball result NaN with n = 2, no warnings, no crash."""
     from ballbat.stronge.analysis import stronge_dataset
 
@@ -156,6 +156,6 @@ def test_ball_with_too_few_usable_impacts_is_reported_not_fitted(default_setting
     for q in ("tan_ratio_slope", "spin_theta_slope", "e_y_implied", "mu_k_lower_bound"):
         assert np.isnan(soft[q]), q
     assert np.isfinite(fit.e_x_pooled.sel(ball="baseball"))
-    st = stronge_dataset(rec, n_time=50)
+    st = stronge_dataset(rec, **{**config["stronge"], "n_time": 50})
     assert list(st.ball.values) == ["baseball"]
     assert "softball: 2 usable impacts" in st.attrs["balls_not_fitted"]

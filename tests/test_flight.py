@@ -93,8 +93,7 @@ def _reference_ivp(v0, la, sa, wb, ws, wind=(0.0, 0.0), rho=DEFAULT_RHO, tau=30.
 
     ground.terminal, ground.direction = True, -1
     y0 = np.concatenate([DEFAULT_START, v0 * np.array([ct * sp, ct * cp, st])])
-    sol = solve_ivp(rhs, (0, 20), y0, method="DOP853", rtol=1e-12, atol=1e-12, events=ground,
-                    dense_output=True)
+    sol = solve_ivp(rhs, (0, 20), y0, method="DOP853", rtol=1e-12, atol=1e-12, events=ground, dense_output=True)
     assert sol.status == 1
     tl = sol.t_events[0][0]
     tt = np.linspace(0, tl, 2001)
@@ -200,8 +199,13 @@ def test_wind():
 def test_vectorised_equals_one_at_a_time():
     rng = np.random.default_rng(7)
     n = 20
-    args = (rng.uniform(60, 115, n) * MPH, rng.uniform(-5, 65, n) * DEGREE, rng.uniform(-45, 45, n) * DEGREE,
-            rng.uniform(-1000, 5000, n) * RPM, rng.uniform(-1500, 1500, n) * RPM)
+    args = (
+        rng.uniform(60, 115, n) * MPH,
+        rng.uniform(-5, 65, n) * DEGREE,
+        rng.uniform(-45, 45, n) * DEGREE,
+        rng.uniform(-1000, 5000, n) * RPM,
+        rng.uniform(-1500, 1500, n) * RPM,
+    )
     for method in ("accurate", "calculator"):
         many = fly(*args, method=method)
         for i in (0, 7, 19):

@@ -1,16 +1,32 @@
 """Sec. V.B scenarios: the paper's D sweep shows what the paper reports; launch scenarios."""
 
+import copy
+
 import numpy as np
 import pytest
 import yaml
 
 from ballbat.implications import comparison_rows, density_from_conditions, launch_conditions, run_scenario
+from ballbat.pipeline.config import validate_config
 from ballbat.units import DEGREE, FOOT, INCH, MPH, RPM
 
 
 @pytest.fixture(scope="module")
-def cfg(root):
-    return yaml.safe_load((root / "config" / "config.yaml").read_text())["implications"]
+def cfg(config):
+    return config["implications"]
+
+
+@pytest.fixture(scope="module")
+def complete(config, root):
+    """A scenario as the workflow sees it: checked against the schema, its defaults filled."""
+    schema = yaml.safe_load((root / "workflow" / "schemas" / "config.schema.yaml").read_text())
+
+    def fill(sc):
+        cfg = copy.deepcopy(config)
+        cfg["implications"]["scenarios"] = {"s": sc}
+        return validate_config(cfg, schema)["implications"]["scenarios"]["s"]
+
+    return fill
 
 
 @pytest.fixture(scope="module")
@@ -58,31 +74,33 @@ def test_comparison_rows(paper):
     assert rows["backspin_at_D0"]["value"] < 0
 
 
-def test_launch_conditions_grid_and_list():
-    grid = launch_conditions({"exit_speed_mph": [90, 100], "launch_deg": [20, 25, 30], "combine": "grid"})
+def test_launch_conditions_grid_and_list(complete):
+    def launch(**kw):
+        return complete({"ball": "baseball", "launch": kw})["launch"]
+
+    grid = launch_conditions(launch(exit_speed_mph=[90, 100], launch_deg=[20, 25, 30], combine="grid"))
     assert grid["exit_speed"].size == 6
-    lst = launch_conditions(
-        {"exit_speed_mph": [90, 100], "launch_deg": [20, 25], "backspin_rpm": 2000, "combine": "list"}
-    )
+    lst = launch_conditions(launch(exit_speed_mph=[90, 100], launch_deg=[20, 25], backspin_rpm=2000, combine="list"))
     np.testing.assert_allclose(lst["launch_angle"], np.radians([20, 25]))
     np.testing.assert_allclose(lst["backspin"], 2000 * RPM)
     with pytest.raises(ValueError, match="the lists must have one length.*exit_speed_mph has 2, launch_deg has 3"):
-        launch_conditions({"exit_speed_mph": [90, 100], "launch_deg": [20, 25, 30], "combine": "list"})
+        launch_conditions(launch(exit_speed_mph=[90, 100], launch_deg=[20, 25, 30], combine="list"))
 
 
-def test_launch_scenario_flies_calculator_case(cfg, balls, bats):
+def test_launch_scenario_flies_calculator_case(cfg, complete, balls, bats):
     # The calculator's published case with our baseball (5.04 oz, r = 1.42 in), not its 5.125 oz:
     # a lighter, smaller ball; only check it flies to the right neighbourhood and is sane.
-    sc = {"ball": "baseball", "launch": {"exit_speed_mph": 103, "launch_deg": 27.5, "backspin_rpm": 2500}}
+    sc = complete({"ball": "baseball", "launch": {"exit_speed_mph": 103, "launch_deg": 27.5, "backspin_rpm": 2500}})
     ds = run_scenario(sc, balls, bats, cfg["air"])
     assert ds.sizes["case"] == 1
     assert 400 < float(ds.carry[0]) / FOOT < 440
     assert float(ds.trajectory_z[0, -1]) == pytest.approx(0.0, abs=1e-6)
 
 
-def test_unknown_ball_or_bat(cfg, balls, bats):
+def test_unknown_ball_or_bat(cfg, complete, balls, bats):
+    cricket = complete({"ball": "cricket", "launch": {"exit_speed_mph": 90, "launch_deg": 20}})
     with pytest.raises(ValueError, match="scenario ball 'cricket' is not in the ball table"):
-        run_scenario({"ball": "cricket", "launch": {"exit_speed_mph": 90, "launch_deg": 20}}, balls, bats, cfg["air"])
+        run_scenario(cricket, balls, bats, cfg["air"])
     sc = {**cfg["scenarios"]["paper"], "bat": "oak"}
     with pytest.raises(ValueError, match="scenario bat 'oak' is not in the bat table"):
         run_scenario(sc, balls, bats, cfg["air"])

@@ -56,12 +56,12 @@ def fake_stronge() -> xr.Dataset:
             "data_vtf_x": ("impact_fit", data_x, _attrs("1", "x")),
             "data_vtf_y": ("impact_fit", data_y, _attrs("1", "y")),
             "data_vtf_y_err": ("impact_fit", np.full(psi_d.size, 0.01), _attrs("1", "y err")),
-            "t_over_tc": ("time", t, _attrs("1", "t/t_c")),
-            "normal_force": (("ball", "time"), np.stack([n_force, n_force]), _attrs("1", "N/N_max")),
-            "tangential_force": (("ball", "time"), 0.3 * np.sin(2 * tb) * np.stack([n_force] * 2), _attrs("1", "F")),
-            "tangential_velocity": (("ball", "time"), 0.5 * np.cos(2.5 * tb), _attrs("1", "u")),
-            "spring_stretch": (("ball", "time"), np.sin(tb), _attrs("1", "s")),
-            "stick": (("ball", "time"), np.stack([stick, stick]), _attrs("1", "stick")),
+            "t_over_tc": ("sample", t, _attrs("1", "t/t_c")),
+            "normal_force": (("ball", "sample"), np.stack([n_force, n_force]), _attrs("1", "N/N_max")),
+            "tangential_force": (("ball", "sample"), 0.3 * np.sin(2 * tb) * np.stack([n_force] * 2), _attrs("1", "F")),
+            "tangential_velocity": (("ball", "sample"), 0.5 * np.cos(2.5 * tb), _attrs("1", "u")),
+            "spring_stretch": (("ball", "sample"), np.sin(tb), _attrs("1", "s")),
+            "stick": (("ball", "sample"), np.stack([stick, stick]), _attrs("1", "stick")),
             "psi_stick_boundary": ("ball", np.radians([22.0, 25.0]), _attrs("rad", "stick boundary")),
             "psi_gross_slip_boundary": ("ball", np.radians([58.0, 62.0]), _attrs("rad", "gross slip boundary")),
         },
@@ -72,6 +72,18 @@ def fake_stronge() -> xr.Dataset:
         attrs={"psi_history_deg": 30},
     )
     return ds
+
+
+def test_fake_stronge_follows_the_declared_table():
+    """The hand-made stronge.nc above has the names and dimensions the fit_stronge job declares."""
+    from ballbat.stronge.analysis import STRONGE_COORDS, stronge_table
+
+    real = {**stronge_table(False, False), **STRONGE_COORDS}
+    fake = fake_stronge()
+    for name, var in {**fake.data_vars, **fake.coords}.items():
+        assert name in real, name
+        assert var.dims == real[name].dims, name
+    assert "psi_history_deg" in fake.attrs
 
 
 def test_stick_period():
@@ -116,7 +128,7 @@ def test_save_figure_is_deterministic(tmp_path):
     assert a.read_bytes() == b.read_bytes()
     with Image.open(a) as im:
         info = dict(im.info)
-    assert "Software" not in info and not any("time" in k.lower() for k in info)
+    assert "Software" not in info and not any("sample" in k.lower() for k in info)
 
 
 def test_unknown_figure_names_the_known_ones(tmp_path):

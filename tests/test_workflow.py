@@ -184,6 +184,7 @@ def test_code_edit_reruns_only_dependents(run_dir):
         "fit_stronge": 1,
         **DATASET_PLOTS,
         "plot_fig11": 1,
+        "plot_launch": 1,  # captions quote D through the comparison code (Eq. D)
         "comparison_html": 2,
     }
     assert _jobs_after_edit(run_dir, pkg / "flight.py") == {

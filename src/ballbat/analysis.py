@@ -72,9 +72,7 @@ RECONSTRUCT_TABLE = {
     "v_n": Var(("impact",), "m s-1", "normal component of the exit velocity"),
     "v_t": Var(("impact",), "m s-1", "tangential component of the exit velocity"),
     "v_bat_n": Var(("impact",), "m s-1", "normal component of the bat velocity"),
-    "spin_bracket": Var(
-        ("impact",), "rad s-1", "bracket of Eq. omega: v_bat sin psi / (r (1 + r_x)(1 + alpha))"
-    ),
+    "spin_bracket": Var(("impact",), "rad s-1", "bracket of Eq. omega: v_bat sin psi / (r (1 + r_x)(1 + alpha))"),
     "vtf_x": Var(("impact",), "1", "bracket of Eq. vtf: tan psi / (1 + r_x)"),
     "vtf_y": Var(("impact",), "1", "left side of Eq. vtf: (v_ball,t + r omega) / v_bat,n"),
     "tan_psi": Var(("impact",), "1", "tan psi (Fig. 6 abscissa)"),

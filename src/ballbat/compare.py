@@ -14,6 +14,7 @@ import math
 
 import numpy as np
 
+from .kinematics import offset_from_psi
 from .published import PUBLISHED, UNPUBLISHED
 from .units import from_si
 
@@ -96,7 +97,7 @@ def impact_rows(rec) -> list[dict]:
         psi = rec["psi"].values[sel]
         D = rec["D"].values[sel]
         tpsi = rec["truth_psi"].values[ball == b] if has_truth else None
-        tD = (rec["r"].values + rec["R"].values)[ball == b] * np.sin(tpsi) if has_truth else None
+        tD = offset_from_psi(tpsi, rec["r"].values[ball == b], rec["R"].values[ball == b]) if has_truth else None
         rows += [
             {
                 "quantity": "psi_max",
@@ -202,6 +203,7 @@ def write_table(rows, csv_path, md_path, title, published=PUBLISHED) -> list[dic
 def stronge_rows(stronge) -> list[dict]:
     """Rows from ``stronge.nc``: eta2 (with its standard error) and Omega_t/Omega_n per ball (Sec. V.A)."""
     rows = []
+    at = f"_psi{stronge.attrs['psi_history_deg']:g}"  # the paper's timeline is at psi = 30 deg
     for b in map(str, stronge["ball"].values):
         s = stronge.sel(ball=b)
         rows += [
@@ -215,13 +217,13 @@ def stronge_rows(stronge) -> list[dict]:
             },
             {"quantity": "omega_t_over_omega_n", "ball": b, "bat": "", "value": float(s.omega_ratio), "unit": "1"},
             {
-                "quantity": "stretch_max_time_psi30",
+                "quantity": "stretch_max_time" + at,
                 "ball": b,
                 "bat": "",
                 "value": float(s.t_stretch_max),
                 "unit": "t_c",
             },
-            {"quantity": "stick_end_time_psi30", "ball": b, "bat": "", "value": float(s.t_stick_end), "unit": "t_c"},
-            {"quantity": "separation_time_psi30", "ball": b, "bat": "", "value": float(s.t_separation), "unit": "t_c"},
+            {"quantity": "stick_end_time" + at, "ball": b, "bat": "", "value": float(s.t_stick_end), "unit": "t_c"},
+            {"quantity": "separation_time" + at, "ball": b, "bat": "", "value": float(s.t_separation), "unit": "t_c"},
         ]
     return rows

@@ -258,18 +258,14 @@ def fit_ex_table(has_truth: bool, mu_k_example: float) -> dict[str, Var]:
         "normal COR e_y implied by the Eq. ratio slope and pooled e_x (mean r_x, r_y)",
         {"ancillary_variables": "e_y_implied_err"},
     )
-    table["e_y_implied_err"] = Var(
-        ("ball",), "1", "standard error of e_y implied (slope and e_x errors, uncorrelated)"
-    )
+    table["e_y_implied_err"] = Var(("ball",), "1", "standard error of e_y implied (slope and e_x errors, uncorrelated)")
     table["mu_k_lower_bound"] = Var(
         ("ball",),
         "1",
         "lower bound on mu_k: largest tan(psi - theta) (Eq. muk)",
         {"ancillary_variables": "mu_k_lower_bound_err mu_k_lower_bound_impact"},
     )
-    table["mu_k_lower_bound_err"] = Var(
-        ("ball",), "1", "measurement uncertainty of that largest tan(psi - theta)"
-    )
+    table["mu_k_lower_bound_err"] = Var(("ball",), "1", "measurement uncertainty of that largest tan(psi - theta)")
     table["mu_k_lower_bound_impact"] = Var(("ball",), "1", "impact number of the largest tan(psi - theta)")
     for nm, units, what in (
         ("psi", "rad", "impact angle psi"),
@@ -302,9 +298,7 @@ def results_dataset(res: Sec4):
     for name in ("spin_theta_slope", "speed_theta_slope"):
         values[f"{name}_intercept"] = getattr(res, name).field("intercept")
     for name in _SLOPE_IS_ONE_PLUS:
-        values[f"{name}_status"] = np.vectorize(lambda f: int(fit_status(f)), otypes=[np.int8])(
-            getattr(res, name).fits
-        )
+        values[f"{name}_status"] = np.vectorize(lambda f: int(fit_status(f)), otypes=[np.int8])(getattr(res, name).fits)
     values.update({k: v for k, v in res.per_ball.items() if res.has_truth or not k.startswith("truth_")})
     coords = {
         "ball": (Var(("ball",), None, "ball type"), np.array(res.balls, dtype=str)),

@@ -21,6 +21,7 @@ import xarray as xr
 
 from .collision import pitched_ball_collision
 from .flight import air_density, fly
+from .pipeline.products import variable
 from .properties import Ball, Bat
 from .units import DEGREE, FOOT, INCH, INHG_IN_MMHG, MPH, RPM, fahrenheit_to_celsius
 
@@ -45,8 +46,8 @@ def launch_conditions(launch: dict) -> dict:
     ``combine: grid`` takes every combination of the listed values; ``combine: list`` pairs
     them element by element (lists of length 1 are repeated).
     """
-    values = {k: np.atleast_1d(np.asarray(launch.get(k, [0.0]), dtype=float)) for k in LAUNCH_KEYS}
-    if launch.get("combine", "grid") == "grid":
+    values = {k: np.atleast_1d(np.asarray(launch[k], dtype=float)) for k in LAUNCH_KEYS}
+    if launch["combine"] == "grid":
         grid = list(itertools.product(*(values[k] for k in LAUNCH_KEYS)))
         cols = {k: np.array([g[i] for g in grid]) for i, k in enumerate(LAUNCH_KEYS)}
     else:
@@ -63,10 +64,6 @@ def launch_conditions(launch: dict) -> dict:
         "backspin": cols["backspin_rpm"] * RPM,
         "sidespin": cols["sidespin_rpm"] * RPM,
     }
-
-
-def _v(dims, data, units, long_name, **extra):
-    return (dims, np.asarray(data), {"units": units, "long_name": long_name, **extra})
 
 
 def run_scenario(scenario: dict, balls: dict[str, Ball], bats: dict[str, Bat], air: dict, e_x: float | None = None):
@@ -86,10 +83,10 @@ def run_scenario(scenario: dict, balls: dict[str, Ball], bats: dict[str, Bat], a
         raise ValueError(f"scenario bat {scenario['bat']!r} is not in the bat table ({', '.join(bats)})")
     ball = balls[scenario["ball"]]
     rho = density_from_conditions(air)
-    flight = scenario.get("flight", {})
+    flight = scenario["flight"]
     data = {}
     coords = {}
-    e_x_used = float(scenario.get("e_x", 0.4) if e_x is None else e_x)
+    e_x_used = float(scenario["e_x"] if e_x is None else e_x)
     if "sweep" in scenario:
         sw = scenario["sweep"]
         bat = bats[scenario["bat"]]
@@ -111,14 +108,14 @@ def run_scenario(scenario: dict, balls: dict[str, Ball], bats: dict[str, Bat], a
         launch = {
             "exit_speed": col.exit_speed,
             "launch_angle": col.launch_angle,
-            "spray_angle": np.full(n, flight.get("spray_deg", 0.0) * DEGREE),
+            "spray_angle": np.full(n, flight["spray_deg"] * DEGREE),
             "backspin": col.backspin,
             "sidespin": np.zeros(n),
         }
-        data["D"] = _v("case", D, "m", "ball-bat offset D (along the relative velocity)")
-        data["psi"] = _v("case", col.psi, "rad", "impact angle psi")
-        data["friction_ratio"] = _v("case", col.friction_ratio, "1", "required friction |J_t / J_n|")
-        data["exceeds_mu"] = _v(
+        data["D"] = variable("case", D, "m", "ball-bat offset D (along the relative velocity)")
+        data["psi"] = variable("case", col.psi, "rad", "impact angle psi")
+        data["friction_ratio"] = variable("case", col.friction_ratio, "1", "required friction |J_t / J_n|")
+        data["exceeds_mu"] = variable(
             "case",
             col.exceeds_mu.astype(np.int8),
             "1",
@@ -137,10 +134,10 @@ def run_scenario(scenario: dict, balls: dict[str, Ball], bats: dict[str, Bat], a
         ball_mass=ball.m,
         ball_radius=ball.r,
         rho=rho,
-        wind=np.asarray(flight.get("wind_mph", [0.0, 0.0]), dtype=float) * MPH,
-        tau=flight.get("tau_s", 30.0),
-        method=flight.get("method", "accurate"),
-        n_points=int(flight.get("n_points", 101)),
+        wind=np.asarray(flight["wind_mph"], dtype=float) * MPH,
+        tau=flight["tau_s"],
+        method=flight["method"],
+        n_points=int(flight["n_points"]),
     )
     n = np.size(launch["exit_speed"])
     coords["case"] = ("case", np.arange(n, dtype=np.int64), {"units": "1", "long_name": "case number"})
@@ -149,19 +146,21 @@ def run_scenario(scenario: dict, balls: dict[str, Ball], bats: dict[str, Bat], a
         np.arange(res.points.shape[-2], dtype=np.int64),
         {"units": "1", "long_name": "trajectory sample"},
     )
-    data["exit_speed"] = _v("case", launch["exit_speed"], "m s-1", "exit speed of the batted ball")
-    data["launch_angle"] = _v("case", launch["launch_angle"], "rad", "launch angle above the horizontal")
-    data["spray_angle"] = _v("case", launch["spray_angle"], "rad", "spray angle from centre field toward first base")
-    data["backspin"] = _v("case", launch["backspin"], "rad s-1", "backspin (negative: topspin)")
-    data["sidespin"] = _v("case", launch["sidespin"], "rad s-1", "sidespin (positive curves toward third base)")
-    data["carry"] = _v("case", res.carry, "m", "carry: horizontal distance from home plate at landing")
-    data["apex"] = _v("case", res.apex, "m", "apex height above the ground")
-    data["hang_time"] = _v("case", res.hang_time, "s", "hang time")
-    data["landing_x"] = _v("case", res.landing[..., 0], "m", "landing point x (toward first base)")
-    data["landing_y"] = _v("case", res.landing[..., 1], "m", "landing point y (toward centre field)")
-    data["trajectory_t"] = _v(("case", "point"), res.t, "s", "time since contact")
+    data["exit_speed"] = variable("case", launch["exit_speed"], "m s-1", "exit speed of the batted ball")
+    data["launch_angle"] = variable("case", launch["launch_angle"], "rad", "launch angle above the horizontal")
+    data["spray_angle"] = variable(
+        "case", launch["spray_angle"], "rad", "spray angle from centre field toward first base"
+    )
+    data["backspin"] = variable("case", launch["backspin"], "rad s-1", "backspin (negative: topspin)")
+    data["sidespin"] = variable("case", launch["sidespin"], "rad s-1", "sidespin (positive curves toward third base)")
+    data["carry"] = variable("case", res.carry, "m", "carry: horizontal distance from home plate at landing")
+    data["apex"] = variable("case", res.apex, "m", "apex height above the ground")
+    data["hang_time"] = variable("case", res.hang_time, "s", "hang time")
+    data["landing_x"] = variable("case", res.landing[..., 0], "m", "landing point x (toward first base)")
+    data["landing_y"] = variable("case", res.landing[..., 1], "m", "landing point y (toward centre field)")
+    data["trajectory_t"] = variable(("case", "point"), res.t, "s", "time since contact")
     for i, axis in enumerate("xyz"):
-        data[f"trajectory_{axis}"] = _v(("case", "point"), res.points[..., i], "m", f"trajectory {axis}")
+        data[f"trajectory_{axis}"] = variable(("case", "point"), res.points[..., i], "m", f"trajectory {axis}")
     ds = xr.Dataset(data, coords=coords)
     ds.attrs.update(
         {
@@ -169,8 +168,9 @@ def run_scenario(scenario: dict, balls: dict[str, Ball], bats: dict[str, Bat], a
             "bat": scenario.get("bat", ""),
             "kind": "D sweep" if "sweep" in scenario else "launch conditions",
             "e_x": e_x_used,
-            "air_density_kg_m-3": rho,
-            "flight_method": flight.get("method", "accurate"),
+            "air_density": rho,
+            "air_density_units": "kg m-3",
+            "flight_method": flight["method"],
         }
     )
     return ds

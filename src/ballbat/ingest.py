@@ -42,7 +42,7 @@ import xarray as xr
 
 from .kinematics import FLAG_TEXT, ImpactFlag, angmom_argument, reconstruct_psi, spin_bracket
 from .linefit import MIN_FIT_IMPACTS
-from .pipeline.products import flag_attrs
+from .pipeline.products import flag_attrs, variable
 from .properties import Ball, Bat, InputError, load_balls, load_bats, recoil_factors
 from .units import DEGREE, MPH, RPM
 
@@ -248,11 +248,13 @@ def exclusions(v_ball, theta, omega, r, alpha) -> tuple[np.ndarray, np.ndarray]:
     with np.errstate(invalid="ignore"):
         psi_clipped = theta + np.arcsin(np.clip(q, -1, 1))
     words = {
-        ImpactFlag.PSI_UNDEFINED: lambda qq, p: f"alpha r omega / v_ball = {qq:.3g}: psi cannot be reconstructed "
-        "(Eq. angmom)",
+        ImpactFlag.PSI_UNDEFINED: lambda qq, p: (
+            f"alpha r omega / v_ball = {qq:.3g}: psi cannot be reconstructed (Eq. angmom)"
+        ),
         ImpactFlag.BAD_SPEED: lambda qq, p: FLAG_TEXT[ImpactFlag.BAD_SPEED],
-        ImpactFlag.BAT_BEHIND_BALL: lambda qq, p: f"reconstructed psi = {np.degrees(p):.1f} deg: "
-        "the bat cannot reach the ball there",
+        ImpactFlag.BAT_BEHIND_BALL: lambda qq, p: (
+            f"reconstructed psi = {np.degrees(p):.1f} deg: the bat cannot reach the ball there"
+        ),
     }
     reason = np.array(
         ["ok" if f == 0 else words[ImpactFlag(f)](qq, p) for f, qq, p in zip(flag, q, psi_clipped, strict=True)],
@@ -361,10 +363,6 @@ def unit_warnings(path, data: dict, r, alpha, r_x, r_y) -> list[str]:
 # The whole file
 
 
-def _var(data, units, long_name, **extra):
-    return ("impact", np.asarray(data), {"units": units, "long_name": long_name, **extra})
-
-
 def ingest(impacts_path, balls_path, bats_path) -> tuple[xr.Dataset, list[str]]:
     """Read and check a measured dataset; return ``(impacts in SI, warnings)``.
 
@@ -430,9 +428,10 @@ def ingest(impacts_path, balls_path, bats_path) -> tuple[xr.Dataset, list[str]]:
     n = len(ball_ids)
     out = {}
     for c, (si, factor, long_name) in MEASURED_COLUMNS.items():
-        out[si] = _var(data[si], SI_UNITS[si], f"measured {long_name}", ballbat_role="measurement")
+        out[si] = variable("impact", data[si], SI_UNITS[si], f"measured {long_name}", ballbat_role="measurement")
         if f"{c}_err" in cols:
-            out[f"{si}_err"] = _var(
+            out[f"{si}_err"] = variable(
+                "impact",
                 cols[f"{c}_err"] * factor,
                 SI_UNITS[si],
                 f"standard uncertainty of measured {long_name}",
@@ -444,7 +443,8 @@ def ingest(impacts_path, balls_path, bats_path) -> tuple[xr.Dataset, list[str]]:
         cols["label"].astype(str),
         {"long_name": "where the impact is in the source file (CSV line number, header = 1; NetCDF index)"},
     )
-    out["ingest_flag"] = _var(
+    out["ingest_flag"] = variable(
+        "impact",
         flag,
         "1",
         "exclusion flag set when the file was read (0: usable)",

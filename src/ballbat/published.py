@@ -81,16 +81,12 @@ PUBLISHED_IMPLICATIONS: tuple[Published, ...] = (
     Published("D_at_exit_speed_max", _BASE, "wood", 0.0, None, "in", "Sec. V.B: exit speed peaks at D ~ 0, Fig. 11a"),
 )
 
+#: Sec. V.A: "e_y = mu = 0.5 was assumed" for the published eta^2 (Stronge's model).
+STRONGE_E_Y = 0.5
+STRONGE_MU = 0.5
+
 #: Quantities with no published value that the comparison still reports (Sec. IV).
 UNPUBLISHED = {"e_y_implied": "1"}
-
-
-def lookup(quantity: str, ball: str, bat: str = "", published=PUBLISHED) -> Published | None:
-    """The published entry for (quantity, ball, bat), or None."""
-    for p in published:
-        if (p.quantity, p.ball, p.bat) == (quantity, ball, bat):
-            return p
-    return None
 
 
 def per_ball(quantity: str, published=PUBLISHED) -> dict[str, float]:

@@ -10,12 +10,13 @@ Seeded: the same settings give the same numbers.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
 
 from .kinematics import ball_at_rest_collision
+from .pipeline.products import variable
 from .properties import Ball, Bat, recoil_factors
 from .units import DEGREE, MPH, RPM
 
@@ -23,6 +24,10 @@ from .units import DEGREE, MPH, RPM
 @dataclass
 class SyntheticSettings:
     """Settings of a synthetic experiment, in the paper's units (as in the config).
+
+    Every field is required: the defaults live in the config schema alone (the workflow
+    passes the validated config; :func:`ballbat.pipeline.config.load_config` gives it to
+    other callers).
 
     ``impacts[ball][bat]`` is the number of impacts; ``e_x[ball][bat]`` the true tangential
     COR (default: Table II); ``e_y[ball]`` the true normal COR; ``psi_deg[ball]`` the range
@@ -34,20 +39,15 @@ class SyntheticSettings:
     impacts: dict
     e_x: dict
     e_y: dict
-    seed: int = 0
-    v_bat_mph: tuple = (63.0, 88.0)
-    psi_deg: dict = field(default_factory=dict)
-    noise: dict = field(
-        default_factory=lambda: {"v_bat_mph": 0.5, "v_ball_mph": 0.5, "theta_deg": 0.5, "omega_rpm": 60.0}
-    )
-    e_x_scatter: float = 0.0
+    seed: int
+    v_bat_mph: tuple
+    psi_deg: dict
+    noise: dict
+    e_x_scatter: float
 
 
-def _var(data, units, long_name, role=None, **extra):
-    attrs = {"units": units, "long_name": long_name, **extra}
-    if role:
-        attrs["ballbat_role"] = role
-    return ("impact", np.asarray(data), attrs)
+def _var(data, units, long_name, role):
+    return variable("impact", data, units, long_name, ballbat_role=role)
 
 
 def simulate_experiment(settings: SyntheticSettings, balls: dict[str, Ball], bats: dict[str, Bat]) -> xr.Dataset:

@@ -6,17 +6,7 @@ from ballbat.pipeline.runlog import logged
 from ballbat.stronge.analysis import stronge_dataset
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    s = snakemake.params.stronge
-    ds = stronge_dataset(
-        read_dataset(snakemake.input.impacts),
-        e_y=s["e_y"],
-        mu=s["mu"],
-        vary_e_y=s["vary_e_y"],
-        vary_mu=s["vary_mu"],
-        psi_grid_deg=(s["psi_grid_deg"]["start"], s["psi_grid_deg"]["stop"], s["psi_grid_deg"]["num"]),
-        psi_history_deg=s["psi_history_deg"],
-        n_time=s["n_time"],
-    )
+    ds = stronge_dataset(read_dataset(snakemake.input.impacts), **snakemake.params.stronge)
     for b in ds.ball.values:
         f = ds.sel(ball=b)
         log.info("%s: eta2 = %.3f +- %.3f (n = %d, reduced chi2 %.2f)", b, f.eta2, f.eta2_err, f.eta2_n, f.eta2_redchi)

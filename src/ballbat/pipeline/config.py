@@ -50,7 +50,12 @@ def _resolve(schema, root):
 
 
 def fill_defaults(instance, schema, root=None):
-    """Fill missing keys that have a ``default`` in ``schema`` (recursively, in place)."""
+    """Fill missing keys that have a ``default`` in ``schema`` (recursively, in place).
+
+    Each default is stated once, on the key it belongs to: a missing object whose
+    properties have defaults is created empty and filled, so no object restates the
+    defaults of its members.
+    """
     root = schema if root is None else root
     schema = _resolve(schema, root)
     if not isinstance(instance, dict) or schema.get("type") != "object":
@@ -60,6 +65,9 @@ def fill_defaults(instance, schema, root=None):
         sub = _resolve(sub, root)
         if key not in instance and "default" in sub:
             instance[key] = copy.deepcopy(sub["default"])
+        elif key not in instance and sub.get("type") == "object" and key not in schema.get("required", ()):
+            if any("default" in _resolve(v, root) for v in sub.get("properties", {}).values()):
+                instance[key] = {}
         if key in instance:
             fill_defaults(instance[key], sub, root)
     if isinstance(schema.get("additionalProperties"), dict):
@@ -80,3 +88,23 @@ def validate_config(config: dict, schema: dict, source: str = "config") -> dict:
         raise ConfigError(f"{source} is not valid:\n  " + "\n  ".join(lines))
     fill_defaults(config, schema)
     return config
+
+
+def load_config(path=None, schema_path=None) -> dict:
+    """The workflow's config file (default ``config/config.yaml``), validated, with the schema's defaults.
+
+    For callers outside Snakemake (tests, benchmarks, examples) that need the same values
+    the workflow uses. Paths default to the repository checkout this package lives in.
+    """
+    from pathlib import Path
+
+    import yaml
+
+    root = Path(__file__).resolve().parents[3]
+    path = Path(path) if path else root / "config" / "config.yaml"
+    schema_path = Path(schema_path) if schema_path else root / "workflow" / "schemas" / "config.schema.yaml"
+    with open(schema_path) as fh:
+        schema = yaml.safe_load(fh)
+    with open(path) as fh:
+        config = yaml.safe_load(fh)
+    return validate_config(config, schema, source=str(path))

@@ -55,6 +55,16 @@ class Var:
         return out
 
 
+def variable(dims: str | tuple[str, ...], data: Any, units: str | None, long_name: str, **attrs: Any) -> tuple:
+    """One variable as the ``(dims, values, attributes)`` tuple xarray takes.
+
+    For stages whose variables depend on the case at hand (a D sweep or launch conditions,
+    synthetic truth); the attributes come from :class:`Var`, as in the declared tables.
+    """
+    dims = (dims,) if isinstance(dims, str) else tuple(dims)
+    return (dims, np.asarray(data), Var(dims, units, long_name, attrs).attributes())
+
+
 def _flag_word(text: str) -> str:
     """A flag meaning as CF wants it: one blank-free word per value."""
     return re.sub(r"[^A-Za-z0-9_.+-]+", "_", text).strip("_")
@@ -112,12 +122,8 @@ def build_dataset(
     missing = sorted(set(table) - set(values))
     if undeclared or missing:
         raise KeyError(f"values do not match the declared table: undeclared {undeclared}, missing {missing}")
-    data_vars = {
-        name: (var.dims, np.asarray(values[name]), var.attributes()) for name, var in table.items()
-    }
-    coord_vars = {
-        name: (var.dims, np.asarray(val), var.attributes()) for name, (var, val) in (coords or {}).items()
-    }
+    data_vars = {name: (var.dims, np.asarray(values[name]), var.attributes()) for name, var in table.items()}
+    coord_vars = {name: (var.dims, np.asarray(val), var.attributes()) for name, (var, val) in (coords or {}).items()}
     return xr.Dataset(data_vars, coords=coord_vars, attrs=dict(attrs or {}))
 
 

@@ -20,16 +20,15 @@ import xarray as xr
 
 from ..designs import MEASURED, vtf_design
 from ..linefit import MIN_FIT_IMPACTS, effective_sigma, wls_slope
+from ..pipeline.products import Var, build_dataset, flag_attrs
+from ..published import STRONGE_E_Y as PUBLISHED_E_Y
+from ..published import STRONGE_MU as PUBLISHED_MU
 from ..published import per_ball
 from .fit import fit_eta2
-from .model import omega_ratio, regime_boundaries, stronge_ex, stronge_solve
+from .model import Regime, omega_ratio, regime_boundaries, regime_code, stronge_ex, stronge_solve
 
 #: eta^2 published in Sec. V.A (with e_y = mu = 0.5), drawn beside the fits.
 PUBLISHED_ETA2 = per_ball("eta2")
-
-
-def _attrs(units, long_name, **extra):
-    return {"units": units, "long_name": long_name, **extra}
 
 
 def _fit_inputs(rec, sel):
@@ -45,15 +44,85 @@ def _fit_inputs(rec, sel):
     return x, y, sigma
 
 
+#: The coordinates of stronge.nc.
+STRONGE_COORDS = {
+    "ball": Var(("ball",), None, "ball type"),
+    "psi_grid": Var(("psi_grid",), "rad", "incidence angle psi of the model curves"),
+    "sample": Var(("sample",), "1", "sample of the time histories"),
+    "t_over_tc": Var(("sample",), "1", "time / t_c, t_c = (pi/2)/Omega_n"),
+    "impact_fit": Var(("impact_fit",), "1", "fitted impact number"),
+}
+
+
+def stronge_table(vary_e_y: bool, vary_mu: bool) -> dict[str, Var]:
+    """The variables of stronge.nc, declared once (name -> :class:`Var`)."""
+    b, g, h, f = ("ball",), ("ball", "psi_grid"), ("ball", "sample"), ("impact_fit",)
+    at = "at psi_history"
+    table = {
+        "eta2": Var(
+            b,
+            "1",
+            "eta^2 = k_n/k_t fitted to Eq. vtf (Sec. V.A)",
+            {"ancillary_variables": "eta2_err eta2_ci_low eta2_ci_high eta2_n eta2_redchi"},
+        ),
+        "eta2_err": Var(b, "1", "standard error of eta^2 (covariance scaled by reduced chi^2)"),
+        "eta2_ci_low": Var(b, "1", "lower end of the 95 % profile-likelihood interval of eta^2"),
+        "eta2_ci_high": Var(b, "1", "upper end of the 95 % profile-likelihood interval of eta^2"),
+        "eta2_published": Var(b, "1", "eta^2 published in Sec. V.A"),
+        "eta2_n": Var(b, "1", "number of impacts in the eta^2 fit"),
+        "eta2_redchi": Var(b, "1", "reduced chi-square of the eta^2 fit"),
+        "e_y": Var(b, "1", "normal COR e_y of the model (fixed unless fitted)", {"vary": int(vary_e_y)}),
+        "e_y_err": Var(b, "1", "standard error of e_y (NaN when fixed)"),
+        "mu": Var(b, "1", "friction coefficient mu of the model (fixed unless fitted)", {"vary": int(vary_mu)}),
+        "mu_err": Var(b, "1", "standard error of mu (NaN when fixed)"),
+        "omega_ratio": Var(b, "1", "Omega_t/Omega_n on a rigid surface at the fitted eta^2 (Sec. V.A)"),
+        "r_x_mean": Var(b, "1", "mean r_x of the ball's impacts (model curves)"),
+        "r_y_mean": Var(b, "1", "mean r_y of the ball's impacts (model curves)"),
+        "psi_stick_boundary": Var(b, "rad", "psi where initial stick ends (solver)"),
+        "psi_gross_slip_boundary": Var(b, "rad", "psi where gross slip begins (solver)"),
+        "psi_stick_paper": Var(b, "rad", "atan(mu eta^2): end of initial stick as the paper states"),
+        "psi_gross_slip_paper": Var(b, "rad", "atan(3.5 mu (1 + e_y)): onset of gross slip as the paper states"),
+        "t_stick_end": Var(b, "1", f"end of initial stick {at}, in units of t_c"),
+        "t_separation": Var(b, "1", f"separation {at}, in units of t_c"),
+        "t_stretch_max": Var(b, "1", f"time of largest spring stretch {at}, in units of t_c"),
+        "regime_history": Var(b, "1", f"phase sequence {at}", flag_attrs(Regime)),
+        "vtf_x_model": Var(g, "1", "tan psi / (1 + mean r_x) (Fig. 9 abscissa)"),
+        "vtf_y_model": Var(g, "1", "(1 + e_x) tan psi / (1 + mean r_x), fitted eta^2"),
+        "e_x_model": Var(g, "1", "e_x of the model at the fitted eta^2"),
+        "vtf_y_published": Var(
+            g,
+            "1",
+            f"(1 + e_x) tan psi / (1 + mean r_x), published eta^2, e_y = {PUBLISHED_E_Y}, mu = {PUBLISHED_MU}",
+        ),
+        "e_x_published": Var(
+            g, "1", f"e_x of the model at the published eta^2, e_y = {PUBLISHED_E_Y}, mu = {PUBLISHED_MU}"
+        ),
+        "data_ball": Var(f, None, "ball of each fitted impact"),
+        "data_vtf_x": Var(f, "1", "tan psi / (1 + r_x) of each fitted impact"),
+        "data_vtf_y": Var(f, "1", "(v_ball,t + r omega)/v_bat,n of each fitted impact"),
+        "data_vtf_y_err": Var(f, "1", "effective standard uncertainty of data_vtf_y (NaN: none given)"),
+    }
+    for k, what in (
+        ("normal_force", "normal force / peak normal force"),
+        ("tangential_force", "tangential spring force / peak normal force"),
+        ("tangential_velocity", "tangential velocity of the ball's contact point / initial normal speed"),
+        ("spring_stretch", "tangential spring stretch / (v_n / Omega_n)"),
+        ("stick", "1 while the contact point sticks, 0 while it slips (NaN after separation)"),
+    ):
+        table[k] = Var(h, "1", f"{what} {at}")
+    return table
+
+
 def stronge_dataset(
     rec: xr.Dataset,
-    e_y: float = 0.5,
-    mu: float = 0.5,
-    vary_e_y: bool = False,
-    vary_mu: bool = False,
-    psi_grid_deg: tuple = (0.0, 85.0, 171),
-    psi_history_deg: float = 30.0,
-    n_time: int = 301,
+    *,
+    e_y: float,
+    mu: float,
+    vary_e_y: bool,
+    vary_mu: bool,
+    psi_grid_deg: dict,
+    psi_history_deg: float,
+    n_time: int,
 ) -> xr.Dataset:
     """Fit eta^2 per ball and build the Figs. 9-10 products (see module docstring).
 
@@ -61,7 +130,9 @@ def stronge_dataset(
     ----------
     rec : reconstructed impacts (``results/{dataset}/reconstruct.nc``).
     e_y, mu : fixed values, or starting values when ``vary_e_y``/``vary_mu``.
-    psi_grid_deg : (start, stop, num) of the psi grid of the model curves, deg.
+    psi_grid_deg : ``{start, stop, num}`` of the psi grid of the model curves, deg.
+
+    The arguments are the config's ``stronge`` section (defaults in the config schema).
     psi_history_deg : psi of the time histories (Fig. 10), deg.
     n_time : points of the time histories.
     """
@@ -71,7 +142,7 @@ def stronge_dataset(
     counts = {b: int(np.sum(usable & (ball_ids == b))) for b in set(ball_ids)}
     balls = sorted(b for b, n in counts.items() if n >= MIN_FIT_IMPACTS)
     skipped = {b: n for b, n in counts.items() if n < MIN_FIT_IMPACTS}
-    psi_grid = np.deg2rad(np.linspace(*psi_grid_deg[:2], int(psi_grid_deg[2])))
+    psi_grid = np.deg2rad(np.linspace(psi_grid_deg["start"], psi_grid_deg["stop"], int(psi_grid_deg["num"])))
     psi_h = np.deg2rad(psi_history_deg)
     nb, ng = len(balls), psi_grid.size
 
@@ -88,7 +159,6 @@ def stronge_dataset(
             "mu_err",
             "redchi",
             "omega_ratio",
-            "omega_ratio_bat",
             "r_x_mean",
             "r_y_mean",
             "psi_stick_boundary",
@@ -125,7 +195,6 @@ def stronge_dataset(
         rxm, rym = float(np.mean(r_x)), float(np.mean(r_y))
         scal["r_x_mean"][i], scal["r_y_mean"][i] = rxm, rym
         scal["omega_ratio"][i] = float(omega_ratio(fit.eta2, 0.0, 0.0, a))
-        scal["omega_ratio_bat"][i] = float(omega_ratio(fit.eta2, rxm, rym, a))
         # Model curves on the grid (bat frame, mean recoil factors of the ball's impacts).
         xg = np.tan(psi_grid) / (1.0 + rxm)
         ex = stronge_ex(psi_grid, fit.eta2, fit.e_y, fit.mu, rxm, rym, a)
@@ -135,7 +204,7 @@ def stronge_dataset(
         pub = PUBLISHED_ETA2.get(ball)
         if pub is not None:
             scal["eta2_published"][i] = pub
-            exp = stronge_ex(psi_grid, pub, 0.5, 0.5, rxm, rym, a)
+            exp = stronge_ex(psi_grid, pub, PUBLISHED_E_Y, PUBLISHED_MU, rxm, rym, a)
             curves["e_x_published"][i] = exp
             curves["vtf_y_published"][i] = (1.0 + exp) * xg
         rb = regime_boundaries(fit.eta2, fit.e_y, fit.mu, rxm, rym, a)
@@ -162,7 +231,7 @@ def stronge_dataset(
         scal["t_stick_end"][i] = float(sol.t_stick_end)
         scal["t_separation"][i] = float(sol.t_separation)
         scal["t_stretch_max"][i] = float(sol.t_stretch_max)
-        regimes_h.append(str(sol.regime))
+        regimes_h.append(int(regime_code(str(sol.regime))))
         data_ball += [ball] * x.size
         data_x.append(x)
         data_y.append(y)
@@ -170,130 +239,28 @@ def stronge_dataset(
 
     if hist is None:
         raise ValueError(f"fit_stronge: no ball has {MIN_FIT_IMPACTS} usable impacts (usable per ball: {counts})")
-    u = "1"
-    data = {
-        "eta2": (("ball",), scal["eta2"], _attrs(u, "eta^2 = k_n/k_t fitted to Eq. vtf (Sec. V.A)")),
-        "eta2_err": (
-            ("ball",),
-            scal["eta2_err"],
-            _attrs(u, "standard error of eta^2 (covariance scaled by reduced chi^2)"),
-        ),
-        "eta2_ci_low": (
-            ("ball",),
-            scal["eta2_ci_low"],
-            _attrs(u, "lower end of the 95 % profile-likelihood interval of eta^2"),
-        ),
-        "eta2_ci_high": (
-            ("ball",),
-            scal["eta2_ci_high"],
-            _attrs(u, "upper end of the 95 % profile-likelihood interval of eta^2"),
-        ),
-        "eta2_published": (("ball",), scal["eta2_published"], _attrs(u, "eta^2 published in Sec. V.A")),
-        "eta2_n": (("ball",), n_fit, _attrs(u, "number of impacts in the eta^2 fit")),
-        "eta2_redchi": (("ball",), scal["redchi"], _attrs(u, "reduced chi-square of the eta^2 fit")),
-        "e_y": (
-            ("ball",),
-            scal["e_y"],
-            _attrs(u, "normal COR e_y of the model (fixed unless fitted)", vary=int(vary_e_y)),
-        ),
-        "e_y_err": (("ball",), scal["e_y_err"], _attrs(u, "standard error of e_y (NaN when fixed)")),
-        "mu": (
-            ("ball",),
-            scal["mu"],
-            _attrs(u, "friction coefficient mu of the model (fixed unless fitted)", vary=int(vary_mu)),
-        ),
-        "mu_err": (("ball",), scal["mu_err"], _attrs(u, "standard error of mu (NaN when fixed)")),
-        "omega_ratio": (
-            ("ball",),
-            scal["omega_ratio"],
-            _attrs(u, "Omega_t/Omega_n in the bat frame at the fitted eta^2"),
-        ),
-        "r_x_mean": (("ball",), scal["r_x_mean"], _attrs(u, "mean r_x of the ball's impacts (model curves)")),
-        "r_y_mean": (("ball",), scal["r_y_mean"], _attrs(u, "mean r_y of the ball's impacts (model curves)")),
-        "psi_stick_boundary": (
-            ("ball",),
-            scal["psi_stick_boundary"],
-            _attrs("rad", "psi where initial stick ends (solver)"),
-        ),
-        "psi_gross_slip_boundary": (
-            ("ball",),
-            scal["psi_gross_slip_boundary"],
-            _attrs("rad", "psi where gross slip begins (solver)"),
-        ),
-        "psi_stick_paper": (
-            ("ball",),
-            scal["psi_stick_paper"],
-            _attrs("rad", "atan(mu eta^2): end of initial stick as the paper states"),
-        ),
-        "psi_gross_slip_paper": (
-            ("ball",),
-            scal["psi_gross_slip_paper"],
-            _attrs("rad", "atan(3.5 mu (1 + e_y)): onset of gross slip as the paper states"),
-        ),
-        "t_stick_end": (
-            ("ball",),
-            scal["t_stick_end"],
-            _attrs(u, "end of initial stick at psi_history, in units of t_c"),
-        ),
-        "t_separation": (("ball",), scal["t_separation"], _attrs(u, "separation at psi_history, in units of t_c")),
-        "t_stretch_max": (
-            ("ball",),
-            scal["t_stretch_max"],
-            _attrs(u, "time of largest spring stretch at psi_history, in units of t_c"),
-        ),
-        "regime_history": (("ball",), np.array(regimes_h, dtype=str), {"long_name": "phase sequence at psi_history"}),
-        "vtf_x_model": (
-            ("ball", "psi_grid"),
-            curves["vtf_x_model"],
-            _attrs(u, "tan psi / (1 + mean r_x) (Fig. 9 abscissa)"),
-        ),
-        "vtf_y_model": (
-            ("ball", "psi_grid"),
-            curves["vtf_y_model"],
-            _attrs(u, "(1 + e_x) tan psi / (1 + mean r_x), fitted eta^2"),
-        ),
-        "e_x_model": (("ball", "psi_grid"), curves["e_x_model"], _attrs(u, "e_x of the model at the fitted eta^2")),
-        "vtf_y_published": (
-            ("ball", "psi_grid"),
-            curves["vtf_y_published"],
-            _attrs(u, "(1 + e_x) tan psi / (1 + mean r_x), published eta^2, e_y = mu = 0.5"),
-        ),
-        "e_x_published": (
-            ("ball", "psi_grid"),
-            curves["e_x_published"],
-            _attrs(u, "e_x of the model at the published eta^2, e_y = mu = 0.5"),
-        ),
-        "data_ball": (("impact_fit",), np.array(data_ball, dtype=str), {"long_name": "ball of each fitted impact"}),
-        "data_vtf_x": (("impact_fit",), np.concatenate(data_x), _attrs(u, "tan psi / (1 + r_x) of each fitted impact")),
-        "data_vtf_y": (
-            ("impact_fit",),
-            np.concatenate(data_y),
-            _attrs(u, "(v_ball,t + r omega)/v_bat,n of each fitted impact"),
-        ),
-        "data_vtf_y_err": (
-            ("impact_fit",),
-            np.concatenate(data_err),
-            _attrs(u, "effective standard uncertainty of data_vtf_y (NaN: none given)"),
-        ),
+    table = stronge_table(vary_e_y, vary_mu)
+    values = {
+        **{k: scal[k] for k in table if k in scal},
+        "eta2_n": n_fit,
+        "eta2_redchi": scal["redchi"],
+        "regime_history": np.array(regimes_h, dtype=np.int8),
+        **curves,
+        "data_ball": np.array(data_ball, dtype=str),
+        "data_vtf_x": np.concatenate(data_x),
+        "data_vtf_y": np.concatenate(data_y),
+        "data_vtf_y_err": np.concatenate(data_err),
+        **hist,
     }
-    for k, what in (
-        ("normal_force", "normal force / peak normal force"),
-        ("tangential_force", "tangential spring force / peak normal force"),
-        ("tangential_velocity", "tangential velocity of the ball's contact point / initial normal speed"),
-        ("spring_stretch", "tangential spring stretch / (v_n / Omega_n)"),
-        ("stick", "1 while the contact point sticks, 0 while it slips (NaN after separation)"),
-    ):
-        data[k] = (("ball", "time"), hist[k], _attrs(u, f"{what} at psi_history"))
-    ds = xr.Dataset(
-        data,
-        coords={
-            "ball": ("ball", np.array(balls, dtype=str), {"long_name": "ball type"}),
-            "psi_grid": ("psi_grid", psi_grid, _attrs("rad", "incidence angle psi of the model curves")),
-            "time": ("time", np.arange(t_grid.size, dtype=np.int64), _attrs(u, "time sample")),
-            "t_over_tc": ("time", t_grid, _attrs(u, "time / t_c, t_c = (pi/2)/Omega_n")),
-            "impact_fit": ("impact_fit", np.arange(len(data_ball), dtype=np.int64), _attrs(u, "fitted impact number")),
-        },
-    )
+    coord_values = {
+        "ball": np.array(balls, dtype=str),
+        "psi_grid": psi_grid,
+        "sample": np.arange(t_grid.size, dtype=np.int64),
+        "t_over_tc": t_grid,
+        "impact_fit": np.arange(len(data_ball), dtype=np.int64),
+    }
+    coords = {k: (STRONGE_COORDS[k], v) for k, v in coord_values.items()}
+    ds = build_dataset(table, {k: values[k] for k in table}, coords)
     ds.attrs.update({"psi_history_deg": float(psi_history_deg), "frame": "bat (recoil factors r_x, r_y)"})
     if skipped:
         ds.attrs["balls_not_fitted"] = "; ".join(

@@ -35,6 +35,7 @@ References
 
 from __future__ import annotations
 
+import enum
 from dataclasses import dataclass
 
 import numpy as np
@@ -668,6 +669,24 @@ def _stretch_max(pc: _Pieces, rho, Lam, e, thf):
     k = np.argmax(A, axis=1)
     rows = np.arange(n)
     return Cf[rows, k], S[rows, k]
+
+
+class Regime(enum.IntEnum):
+    """Phase sequences of an impact (the names :func:`stronge_solve` gives), as CF flag values."""
+
+    OTHER = 0
+    GROSS_SLIP = 1
+    STICK_SLIP = 2
+    SLIP_STICK_SLIP = 3
+    STICK = 4
+    SLIP_STICK = 5
+    STICK_SLIP_STICK = 6
+    STICK_SLIP_STICK_SLIP = 7
+
+
+def regime_code(name: str) -> Regime:
+    """The :class:`Regime` of a phase-sequence name such as ``"stick-slip"`` (OTHER if unlisted)."""
+    return Regime.__members__.get(name.upper().replace("-", "_"), Regime.OTHER)
 
 
 def _regimes(pc: _Pieces):
