@@ -19,11 +19,11 @@ include: "workflow/rules/fit_ex.smk"
 include: "workflow/rules/stronge.smk"
 include: "workflow/rules/compare.smk"
 include: "workflow/rules/implications.smk"
-include: "workflow/rules/plots.smk"  # last: draws what the others write
+include: "workflow/rules/plots.smk"
 
 
+# All products of every dataset and scenario, intermediate files included (common.smk: final_targets).
 rule all:
-    """Every dataset's paper comparison (and all that it needs)."""
-    input:
-        TARGETS,
     default_target: True
+    input:
+        final_targets(),

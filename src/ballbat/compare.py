@@ -11,12 +11,21 @@ from __future__ import annotations
 import csv
 import io
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from .kinematics import offset_from_psi
 from .published import PUBLISHED, UNPUBLISHED
 from .units import from_si
+
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Iterable, Sequence
+
+    import xarray as xr
+
+    from .published import Published
 
 COLUMNS = ("quantity", "ball", "bat", "paper", "paper_uncertainty", "value", "uncertainty", "truth", "unit")
 
@@ -57,7 +66,7 @@ def _pick(ds, var, ball, bat):
     return float(v.values)
 
 
-def fit_rows(fit) -> list[dict]:
+def fit_rows(fit: xr.Dataset) -> list[dict]:
     """Rows for the quantities of ``fit_ex.nc`` (values in SI converted to the table's units)."""
     rows = []
     balls = [str(b) for b in fit["ball"].values]
@@ -86,7 +95,7 @@ def fit_rows(fit) -> list[dict]:
     return rows
 
 
-def impact_rows(rec) -> list[dict]:
+def impact_rows(rec: xr.Dataset) -> list[dict]:
     """Rows from the reconstructed impacts: psi_max, D_max, n_impacts (usable) and n_excluded per ball."""
     rows = []
     ok = rec["flag"].values == 0
@@ -134,7 +143,7 @@ def impact_rows(rec) -> list[dict]:
     return rows
 
 
-def comparison_table(rows: list[dict], published=PUBLISHED) -> list[dict]:
+def comparison_table(rows: list[dict], published: Sequence[Published] = PUBLISHED) -> list[dict]:
     """Merge our rows with the published values: one row per published number, plus ours."""
     ours = {(r["quantity"], r["ball"], r["bat"]): r for r in rows}
     table = []
@@ -176,13 +185,20 @@ def to_markdown(table: list[dict], title: str) -> str:
     return "\n".join(lines) + "\n"
 
 
-def read_csv(path) -> list[dict]:
+def read_csv(path: str | os.PathLike[str]) -> list[dict]:
     """Read a comparison CSV back (strings)."""
     with open(path, newline="") as fh:
         return list(csv.DictReader(fh))
 
 
-def write_comparison(fit, impacts, csv_path, md_path, title, extra_rows=()) -> list[dict]:
+def write_comparison(
+    fit: xr.Dataset,
+    impacts: xr.Dataset,
+    csv_path: str | os.PathLike[str],
+    md_path: str | os.PathLike[str],
+    title: str,
+    extra_rows: Iterable[dict] = (),
+) -> list[dict]:
     """Build the comparison from ``fit_ex.nc`` and ``reconstruct.nc``; write CSV and Markdown."""
     from .pipeline.ncio import read_dataset
 
@@ -190,7 +206,13 @@ def write_comparison(fit, impacts, csv_path, md_path, title, extra_rows=()) -> l
     return write_table(rows, csv_path, md_path, title)
 
 
-def write_table(rows, csv_path, md_path, title, published=PUBLISHED) -> list[dict]:
+def write_table(
+    rows: list[dict],
+    csv_path: str | os.PathLike[str],
+    md_path: str | os.PathLike[str],
+    title: str,
+    published: Sequence[Published] = PUBLISHED,
+) -> list[dict]:
     """Merge ``rows`` with the published values; write the CSV and its Markdown rendering."""
     from .pipeline.ncio import atomic_write_text
 
@@ -200,7 +222,7 @@ def write_table(rows, csv_path, md_path, title, published=PUBLISHED) -> list[dic
     return table
 
 
-def stronge_rows(stronge) -> list[dict]:
+def stronge_rows(stronge: xr.Dataset) -> list[dict]:
     """Rows from ``stronge.nc``: eta2 (with its standard error) and Omega_t/Omega_n per ball (Sec. V.A)."""
     rows = []
     at = f"_psi{stronge.attrs['psi_history_deg']:g}"  # the paper's timeline is at psi = 30 deg

@@ -8,15 +8,31 @@ variances. psi and its derivatives come from Eq. angmom (:func:`ballbat.kinemati
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
 from .kinematics import psi_partials
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+#: What a design returns: x, y and their Jacobians (n, 4) with respect to :data:`MEASURED`.
+Design = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
 #: The measured quantities, in the order of the Jacobian columns.
 MEASURED = ("v_bat", "v_ball", "theta", "omega")
 
 
-def spin_design(v_bat, v_ball, theta, omega, r, r_x, alpha):
+def spin_design(
+    v_bat: ArrayLike,
+    v_ball: ArrayLike,
+    theta: ArrayLike,
+    omega: ArrayLike,
+    r: ArrayLike,
+    r_x: ArrayLike,
+    alpha: ArrayLike,
+) -> Design:
     """Eq. omega: x = v_bat sin psi / (r (1 + r_x)(1 + alpha)), y = omega."""
     psi, dpsi = psi_partials(v_ball, theta, omega, r, alpha)
     c = 1.0 / (r * (1.0 + r_x) * (1.0 + alpha))
@@ -28,7 +44,9 @@ def spin_design(v_bat, v_ball, theta, omega, r, r_x, alpha):
     return x, omega, jx, jy
 
 
-def tan_ratio_design(v_bat, v_ball, theta, omega, r, alpha):
+def tan_ratio_design(
+    v_bat: ArrayLike, v_ball: ArrayLike, theta: ArrayLike, omega: ArrayLike, r: ArrayLike, alpha: ArrayLike
+) -> Design:
     """Eq. ratio: x = tan psi, y = tan(psi - theta) = q / sqrt(1 - q^2), q = alpha r omega / v_ball."""
     psi, dpsi = psi_partials(v_ball, theta, omega, r, alpha)
     q = alpha * r * omega / v_ball
@@ -42,7 +60,15 @@ def tan_ratio_design(v_bat, v_ball, theta, omega, r, alpha):
     return x, y, jx, jy
 
 
-def vtf_design(v_bat, v_ball, theta, omega, r, r_x, alpha):
+def vtf_design(
+    v_bat: ArrayLike,
+    v_ball: ArrayLike,
+    theta: ArrayLike,
+    omega: ArrayLike,
+    r: ArrayLike,
+    r_x: ArrayLike,
+    alpha: ArrayLike,
+) -> Design:
     """Eq. vtf: x = tan psi / (1 + r_x), y = (v_ball,t + r omega) / v_bat,n.
 
     With Eq. angmom, v_ball,t = alpha r omega, so y = (1 + alpha) r omega / (v_bat cos psi).
@@ -57,7 +83,7 @@ def vtf_design(v_bat, v_ball, theta, omega, r, r_x, alpha):
     return x, y, jx, jy
 
 
-def normalized_theta_design(v_bat, y, theta, which, v_ref):
+def normalized_theta_design(v_bat: ArrayLike, y: ArrayLike, theta: ArrayLike, which: str, v_ref: float) -> Design:
     """Figs. 3-4: x = theta, y = the normalised ``which`` (omega or v_ball) = value v_ref / v_bat.
 
     ``y`` is the normalised value as ``normalize`` computed it

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -33,6 +34,9 @@ from .designs import MEASURED, normalized_theta_design, spin_design, tan_ratio_d
 from .kinematics import e_y_from_tan_ratio_slope, gross_slip_onset, normalize_to_bat_speed
 from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, wls_slope
 from .pipeline.products import Var, build_dataset, estimate_vars, flag_attrs
+
+if TYPE_CHECKING:
+    import xarray as xr
 
 
 class FitStatus(enum.IntEnum):
@@ -121,7 +125,7 @@ def _weights(jx, jy, sigma, slope):
     return 1.0 / np.sqrt(var) if np.all(var > 0) else None
 
 
-def analyze_impacts(ds, mu_k_example: float) -> Sec4:
+def analyze_impacts(ds: xr.Dataset, mu_k_example: float) -> Sec4:
     """Sec. IV analysis of a normalised and reconstructed dataset (output of ``reconstruct``).
 
     Uses only impacts with ``flag == 0``. The Figs. 3-4 fits read the normalised spin and
@@ -281,7 +285,7 @@ def fit_ex_table(has_truth: bool, mu_k_example: float) -> dict[str, Var]:
     return table
 
 
-def results_dataset(res: Sec4):
+def results_dataset(res: Sec4) -> xr.Dataset:
     """fit_ex.nc's contents: the :class:`Sec4` results on the declared table (dims ball, bat)."""
     values: dict[str, np.ndarray] = {}
     for name in FIT_FAMILIES:
@@ -309,7 +313,7 @@ def results_dataset(res: Sec4):
     )
 
 
-def fit_dataset(impacts, mu_k_example: float):
+def fit_dataset(impacts: xr.Dataset, mu_k_example: float) -> xr.Dataset:
     """The Sec. IV fits of a reconstructed dataset, as a Dataset ready to write."""
     ds = results_dataset(analyze_impacts(impacts, mu_k_example))
     ds.attrs["n_impacts"] = int(impacts.sizes["impact"])

@@ -15,6 +15,7 @@ References
 from __future__ import annotations
 
 import itertools
+from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
@@ -24,6 +25,9 @@ from .flight import air_density, fly
 from .pipeline.products import variable
 from .properties import Ball, Bat
 from .units import DEGREE, FOOT, INCH, INHG_IN_MMHG, MPH, RPM, fahrenheit_to_celsius
+
+if TYPE_CHECKING:
+    import os
 
 LAUNCH_KEYS = ("exit_speed_mph", "launch_deg", "spray_deg", "backspin_rpm", "sidespin_rpm")
 
@@ -66,7 +70,9 @@ def launch_conditions(launch: dict) -> dict:
     }
 
 
-def run_scenario(scenario: dict, balls: dict[str, Ball], bats: dict[str, Bat], air: dict, e_x: float | None = None):
+def run_scenario(
+    scenario: dict, balls: dict[str, Ball], bats: dict[str, Bat], air: dict, e_x: float | None = None
+) -> xr.Dataset:
     """Run one scenario; return an xarray Dataset with one entry per case.
 
     Parameters
@@ -176,7 +182,7 @@ def run_scenario(scenario: dict, balls: dict[str, Ball], bats: dict[str, Bat], a
     return ds
 
 
-def comparison_rows(ds) -> list[dict]:
+def comparison_rows(ds: xr.Dataset) -> list[dict]:
     """Rows of ``results/implications/paper_comparison.csv`` for a D sweep (paper units).
 
     carry_max (ft) and D_at_carry_max (in), to set against the paper's "400-ft home run at
@@ -201,7 +207,7 @@ def comparison_rows(ds) -> list[dict]:
     ]
 
 
-def pooled_e_x(fit_path, ball: str) -> float:
+def pooled_e_x(fit_path: str | os.PathLike[str], ball: str) -> float:
     """The pooled e_x of ``ball`` fitted on a dataset (its ``fit_ex.nc``)."""
     from .pipeline.ncio import read_dataset
 

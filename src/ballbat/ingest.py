@@ -36,6 +36,7 @@ from __future__ import annotations
 import csv
 import math
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
@@ -45,6 +46,11 @@ from .linefit import MIN_FIT_IMPACTS
 from .pipeline.products import flag_attrs, variable
 from .properties import Ball, Bat, InputError, load_balls, load_bats, recoil_factors
 from .units import DEGREE, MPH, RPM
+
+if TYPE_CHECKING:
+    import os
+
+    from numpy.typing import ArrayLike
 
 #: Required columns of an impacts file.
 REQUIRED = ("bat", "ball", "v_bat_mph", "v_ball_mph", "theta_deg", "omega_rpm")
@@ -131,7 +137,7 @@ def _read_netcdf(path: Path) -> tuple[list[str], list[tuple[str, dict]]]:
     return header, rows
 
 
-def read_impacts_table(path) -> tuple[list[str], list[tuple[str, dict]]]:
+def read_impacts_table(path: str | os.PathLike[str]) -> tuple[list[str], list[tuple[str, dict]]]:
     """Header and rows (label, {column: text}) of a CSV or NetCDF impacts file.
 
     A CSV row's label is its line number (``row 5``; the header is line 1); a NetCDF row's
@@ -167,7 +173,9 @@ def _number(raw: str, where: str, problems: list[str]) -> float:
     return val
 
 
-def check_rows(path, header, rows, balls: dict | None, bats: dict | None) -> tuple[dict, list[str]]:
+def check_rows(
+    path: str | os.PathLike[str], header: list[str], rows: list[dict], balls: dict | None, bats: dict | None
+) -> tuple[dict, list[str]]:
     """Check header and cells; return (columns as arrays in the file's units, problems).
 
     ``balls`` / ``bats`` None (their table was bad) skip the membership checks.
@@ -237,7 +245,9 @@ def check_rows(path, header, rows, balls: dict | None, bats: dict | None) -> tup
     return {k: np.asarray(v) for k, v in out.items()}, problems
 
 
-def exclusions(v_ball, theta, omega, r, alpha) -> tuple[np.ndarray, np.ndarray]:
+def exclusions(
+    v_ball: ArrayLike, theta: ArrayLike, omega: ArrayLike, r: ArrayLike, alpha: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
     """Per impact: ``(ingest_flag, ingest_flag_reason)`` for impacts psi cannot use (SI inputs).
 
     The flag is that of :func:`ballbat.kinematics.reconstruct_psi` (an
@@ -263,7 +273,16 @@ def exclusions(v_ball, theta, omega, r, alpha) -> tuple[np.ndarray, np.ndarray]:
     return flag, reason
 
 
-def implausible(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y) -> dict[str, tuple[int, int]]:
+def implausible(
+    v_bat: ArrayLike,
+    v_ball: ArrayLike,
+    theta: ArrayLike,
+    omega: ArrayLike,
+    r: ArrayLike,
+    alpha: ArrayLike,
+    r_x: ArrayLike,
+    r_y: ArrayLike,
+) -> dict[str, tuple[int, int]]:
     """Physics checks that betray unit mistakes: name -> (failing, checked) impact counts (SI).
 
     Notes
@@ -323,7 +342,9 @@ def _score(checks: dict) -> float:
     return max((bad / n for bad, n in checks.values() if n >= 3), default=0.0)
 
 
-def unit_warnings(path, data: dict, r, alpha, r_x, r_y) -> list[str]:
+def unit_warnings(
+    path: str | os.PathLike[str], data: dict, r: ArrayLike, alpha: ArrayLike, r_x: ArrayLike, r_y: ArrayLike
+) -> list[str]:
     """Warnings naming a column whose values look like a unit mistake (SI ``data``).
 
     When a physics check of :func:`implausible` fails for most impacts, each suspected
@@ -363,7 +384,9 @@ def unit_warnings(path, data: dict, r, alpha, r_x, r_y) -> list[str]:
 # The whole file
 
 
-def ingest(impacts_path, balls_path, bats_path) -> tuple[xr.Dataset, list[str]]:
+def ingest(
+    impacts_path: str | os.PathLike[str], balls_path: str | os.PathLike[str], bats_path: str | os.PathLike[str]
+) -> tuple[xr.Dataset, list[str]]:
     """Read and check a measured dataset; return ``(impacts in SI, warnings)``.
 
     Raises :class:`~ballbat.properties.InputError` listing every problem that stops the

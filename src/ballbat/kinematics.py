@@ -20,16 +20,20 @@ from __future__ import annotations
 
 import enum
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
-def offset_from_psi(psi, r, R):
+
+def offset_from_psi(psi: ArrayLike, r: ArrayLike, R: ArrayLike) -> np.ndarray:
     """Ball-bat offset D from the impact angle psi (Eq. D): D = (r + R) sin psi."""
     return (r + R) * np.sin(psi)
 
 
-def spin_bracket(v_bat, psi, r, r_x, alpha=0.4):
+def spin_bracket(v_bat: ArrayLike, psi: ArrayLike, r: ArrayLike, r_x: ArrayLike, alpha: ArrayLike = 0.4) -> np.ndarray:
     """The bracket of Eq. omega: v_bat sin psi / (r (1 + r_x)(1 + alpha)), rad s-1.
 
     The measured spin is (1 + e_x) times this term; Fig. 5 plots omega against it.
@@ -37,12 +41,14 @@ def spin_bracket(v_bat, psi, r, r_x, alpha=0.4):
     return v_bat * np.sin(psi) / (r * (1.0 + r_x) * (1.0 + alpha))
 
 
-def vtf_bracket(psi, r_x):
+def vtf_bracket(psi: ArrayLike, r_x: ArrayLike) -> np.ndarray:
     """The bracket of Eq. vtf: tan psi / (1 + r_x) (dimensionless, Fig. 9 abscissa)."""
     return np.tan(psi) / (1.0 + r_x)
 
 
-def vtf_ordinate(v_ball, theta, omega, v_bat, psi, r):
+def vtf_ordinate(
+    v_ball: ArrayLike, theta: ArrayLike, omega: ArrayLike, v_bat: ArrayLike, psi: ArrayLike, r: ArrayLike
+) -> np.ndarray:
     """The left side of Eq. vtf: (v_ball,t + r omega) / v_bat,n (Fig. 9 ordinate).
 
     v_ball,t = v_ball sin(psi - theta) and v_bat,n = v_bat cos psi.
@@ -61,7 +67,16 @@ class Outgoing:
     theta: np.ndarray  # rad, angle from the bat's direction of travel
 
 
-def ball_at_rest_collision(v_bat, psi, e_x, e_y, r, r_x, r_y, alpha=0.4) -> Outgoing:
+def ball_at_rest_collision(
+    v_bat: ArrayLike,
+    psi: ArrayLike,
+    e_x: ArrayLike,
+    e_y: ArrayLike,
+    r: ArrayLike,
+    r_x: ArrayLike,
+    r_y: ArrayLike,
+    alpha: ArrayLike = 0.4,
+) -> Outgoing:
     """Outgoing ball after a bat at speed ``v_bat`` and angle ``psi`` hits a ball at rest.
 
     Parameters
@@ -115,12 +130,14 @@ FLAG_TEXT = {
 }
 
 
-def angmom_argument(v_ball, omega, r, alpha):
+def angmom_argument(v_ball: ArrayLike, omega: ArrayLike, r: ArrayLike, alpha: ArrayLike) -> np.ndarray:
     """The argument of Eq. angmom's arcsine: sin(psi - theta) = alpha r omega / v_ball."""
     return alpha * r * np.asarray(omega, dtype=float) / np.asarray(v_ball, dtype=float)
 
 
-def reconstruct_psi(v_ball, theta, omega, r, alpha):
+def reconstruct_psi(
+    v_ball: ArrayLike, theta: ArrayLike, omega: ArrayLike, r: ArrayLike, alpha: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
     """Impact angle psi from measured exit speed, angle and spin (Eq. angmom).
 
     Returns ``(psi, flag)``. Angular momentum of the ball about the contact point
@@ -144,7 +161,9 @@ def reconstruct_psi(v_ball, theta, omega, r, alpha):
     return psi, flag
 
 
-def psi_partials(v_ball, theta, omega, r, alpha):
+def psi_partials(
+    v_ball: ArrayLike, theta: ArrayLike, omega: ArrayLike, r: ArrayLike, alpha: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
     """psi of Eq. angmom and its derivatives with respect to (v_bat, v_ball, theta, omega).
 
     For usable impacts (|alpha r omega / v_ball| < 1). Returns ``(psi, dpsi)`` with ``dpsi``
@@ -157,7 +176,7 @@ def psi_partials(v_ball, theta, omega, r, alpha):
     return psi, d
 
 
-def normalize_to_bat_speed(value, v_bat, v_ref):
+def normalize_to_bat_speed(value: ArrayLike, v_bat: ArrayLike, v_ref: float) -> np.ndarray:
     """Scale a measured spin or exit speed to the reference bat speed (Sec. II).
 
     Both scale linearly with bat speed (Eqs. vballn, vxf, omega), so the normalised value
@@ -167,17 +186,29 @@ def normalize_to_bat_speed(value, v_bat, v_ref):
     return np.asarray(value, dtype=float) * (v_ref / np.asarray(v_bat, dtype=float))
 
 
-def tan_ratio_slope_model(e_x, e_y, r_x, r_y, alpha=0.4):
+def tan_ratio_slope_model(
+    e_x: ArrayLike, e_y: ArrayLike, r_x: ArrayLike, r_y: ArrayLike, alpha: ArrayLike = 0.4
+) -> np.ndarray:
     """Slope of tan(psi - theta) against tan psi predicted by Eq. ratio."""
     return alpha / (1.0 + alpha) * (1.0 + e_x) / (1.0 + r_x) * (1.0 + r_y) / (1.0 + e_y)
 
 
-def e_y_from_tan_ratio_slope(slope, e_x, r_x, r_y, alpha=0.4):
+def e_y_from_tan_ratio_slope(
+    slope: ArrayLike, e_x: ArrayLike, r_x: ArrayLike, r_y: ArrayLike, alpha: ArrayLike = 0.4
+) -> np.ndarray:
     """Invert Eq. ratio for the normal COR e_y that a measured slope implies."""
     return alpha / (1.0 + alpha) * (1.0 + e_x) / (1.0 + r_x) * (1.0 + r_y) / slope - 1.0
 
 
-def gross_slip_onset(mu_k, tan_slope, v_bat, e_x, r, r_x, alpha=0.4):
+def gross_slip_onset(
+    mu_k: ArrayLike,
+    tan_slope: ArrayLike,
+    v_bat: ArrayLike,
+    e_x: ArrayLike,
+    r: ArrayLike,
+    r_x: ArrayLike,
+    alpha: ArrayLike = 0.4,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Largest psi before gross slip for friction ``mu_k`` (Sec. IV example).
 
     Gross slip sets in where tan(psi - theta) reaches mu_k (Eq. muk); with the measured

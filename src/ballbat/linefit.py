@@ -21,8 +21,12 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 #: Fewest usable impacts for a fit of e_x per bat or pooled; fewer give NaN with n and a note.
 MIN_FIT_IMPACTS = 3
@@ -52,7 +56,15 @@ def _line(x, slope, intercept=0.0):
     return intercept + slope * x
 
 
-def fit_line(x, y, jx=None, jy=None, sigma=None, through_origin=True, iterations=3) -> LineFit:
+def fit_line(
+    x: ArrayLike,
+    y: ArrayLike,
+    jx: ArrayLike = None,
+    jy: ArrayLike = None,
+    sigma: ArrayLike = None,
+    through_origin: bool = True,
+    iterations: int = 3,
+) -> LineFit:
     """Fit y = slope x (+ intercept) with lmfit, weighting by the effective variance.
 
     Parameters
@@ -116,7 +128,9 @@ def fit_line(x, y, jx=None, jy=None, sigma=None, through_origin=True, iterations
     )
 
 
-def wls_slope(x, y, weights=None, through_origin=True) -> tuple[float, float]:
+def wls_slope(
+    x: ArrayLike, y: ArrayLike, weights: ArrayLike = None, through_origin: bool = True
+) -> tuple[float, float]:
     """Weighted least-squares (slope, intercept) in closed form (used for truth values)."""
     x = np.asarray(x, dtype=float)
     y = np.asarray(y, dtype=float)
@@ -129,7 +143,7 @@ def wls_slope(x, y, weights=None, through_origin=True) -> tuple[float, float]:
     return float(s), float(ym - s * xm)
 
 
-def effective_sigma(jx, jy, sigma, slope):
+def effective_sigma(jx: ArrayLike, jy: ArrayLike, sigma: ArrayLike, slope: ArrayLike) -> np.ndarray | None:
     """Standard deviation of y - slope x from the measurement uncertainties (effective variance)."""
     if sigma is None:
         return None

@@ -18,6 +18,7 @@ This is the only module that imports matplotlib (with the non-interactive Agg ba
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import matplotlib
 
@@ -32,6 +33,12 @@ from .pipeline.atomic import atomic_target  # noqa: E402
 from .pipeline.ncio import atomic_write_text, read_dataset  # noqa: E402
 from .units import from_si  # noqa: E402
 
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Sequence
+
+    import xarray as xr
+
 #: Colour of each ball; baseballs are drawn with closed markers, softballs with open ones.
 BALL_COLOR = {"baseball": "#1f3b73", "softball": "#c0392b"}
 OTHER_COLORS = ("#2e7d32", "#6a1b9a", "#ef6c00", "#00838f")
@@ -44,7 +51,7 @@ WIDE = (8.6, 4.8)
 DPI = 110
 
 
-def ball_color(ball: str, order=()) -> str:
+def ball_color(ball: str, order: Sequence[str] = ()) -> str:
     if ball in BALL_COLOR:
         return BALL_COLOR[ball]
     others = [b for b in order if b not in BALL_COLOR]
@@ -56,7 +63,7 @@ def is_closed(ball: str) -> bool:
     return ball != "softball"
 
 
-def bat_marker(bat: str, order=()) -> str:
+def bat_marker(bat: str, order: Sequence[str] = ()) -> str:
     if bat in BAT_MARKER:
         return BAT_MARKER[bat]
     others = [b for b in order if b not in BAT_MARKER]
@@ -190,7 +197,7 @@ def _slope_figure(impacts, fit, yvar, var, unit_y, unit_slope, published, ylabel
     return fig
 
 
-def fig3_spin_vs_theta(impacts, fit) -> Figure:
+def fig3_spin_vs_theta(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
     """Fig. 3: normalised spin against launch angle, with the fitted and published slopes."""
     return _slope_figure(
         impacts,
@@ -205,7 +212,7 @@ def fig3_spin_vs_theta(impacts, fit) -> Figure:
     )
 
 
-def fig4_speed_vs_theta(impacts, fit) -> Figure:
+def fig4_speed_vs_theta(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
     """Fig. 4: normalised exit speed against launch angle, with the fitted and published slopes."""
     return _slope_figure(
         impacts,
@@ -220,7 +227,7 @@ def fig4_speed_vs_theta(impacts, fit) -> Figure:
     )
 
 
-def fig5_spin_vs_bracket(impacts, fit) -> Figure:
+def fig5_spin_vs_bracket(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
     """Fig. 5: spin against the bracket of Eq. omega; slopes 1 + e_x, and the unit slope."""
     n_excluded = reporting.excluded_count(impacts)
     imp = _usable(impacts)
@@ -271,7 +278,7 @@ def fig5_spin_vs_bracket(impacts, fit) -> Figure:
     return fig
 
 
-def fig6_tan_ratio(impacts, fit) -> Figure:
+def fig6_tan_ratio(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
     """Fig. 6: tan(ψ − θ) against tan ψ, with the fitted and published slopes (Eq. ratio)."""
     n_excluded = reporting.excluded_count(impacts)
     imp = _usable(impacts)
@@ -340,7 +347,7 @@ def _eta2_paper(s, ball):
     return reporting.PAPER["eta2"].get(ball)
 
 
-def fig9a_stronge_fit(stronge) -> Figure:
+def fig9a_stronge_fit(stronge: xr.Dataset) -> Figure:
     """Fig. 9a: the data of Eq. vtf and Stronge's model with the fitted η², over the data's range."""
     balls = _stronge_balls(stronge)
     fig, ax = _new()
@@ -380,7 +387,7 @@ def fig9a_stronge_fit(stronge) -> Figure:
     return fig
 
 
-def fig9b_stronge_extrapolation(stronge) -> Figure:
+def fig9b_stronge_extrapolation(stronge: xr.Dataset) -> Figure:
     """Fig. 9b: the model extrapolated to ψ = 85° (fitted and published η²), regime boundaries marked."""
     balls = _stronge_balls(stronge)
     fig = Figure(figsize=(6.4, 7.0), dpi=DPI, layout="constrained")
@@ -427,7 +434,7 @@ def fig9b_stronge_extrapolation(stronge) -> Figure:
     return fig
 
 
-def fig10_time_history(stronge) -> Figure:
+def fig10_time_history(stronge: xr.Dataset) -> Figure:
     """Fig. 10: forces (curves, left) and tangential velocity (points, right) against t/t_c."""
     balls = _stronge_balls(stronge)
     t = stronge["t_over_tc"].values
@@ -471,7 +478,7 @@ def fig10_time_history(stronge) -> Figure:
 # --- Sec. V.B: batted balls (results/implications/{scenario}.nc) ------------------------------
 
 
-def fig11a_exit_vs_D(scenario) -> Figure:
+def fig11a_exit_vs_D(scenario: xr.Dataset) -> Figure:
     """Fig. 11a: exit speed (left) and backspin (right) against D; launch angle on the top axis."""
     D = from_si(scenario["D"].values, "in")
     fig, ax = _new()
@@ -510,7 +517,7 @@ def _pick_offsets(D_in, targets=(0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0)):
     return idx
 
 
-def fig11b_trajectories(scenario) -> Figure:
+def fig11b_trajectories(scenario: xr.Dataset) -> Figure:
     """Fig. 11b: height against horizontal distance for a handful of offsets D, labelled on each curve."""
     D = from_si(scenario["D"].values, "in")
     fig, ax = _new((7.2, 4.2))
@@ -532,7 +539,7 @@ def fig11b_trajectories(scenario) -> Figure:
     return fig
 
 
-def launch_carry(scenario) -> Figure:
+def launch_carry(scenario: xr.Dataset) -> Figure:
     """Launch-conditions scenario: trajectories (left) and carry against launch angle (right)."""
     fig = Figure(figsize=(9.0, 4.0), dpi=DPI, layout="constrained")
     left, right = fig.subplots(1, 2)
@@ -583,7 +590,7 @@ FIGURES = {
 }
 
 
-def save_figure(fig: Figure, path) -> Path:
+def save_figure(fig: Figure, path: str | os.PathLike[str]) -> Path:
     """Save ``fig`` as PNG atomically, without timestamp or software metadata (same data, same bytes)."""
     path = Path(path)
     with atomic_target(path, suffix=".png") as tmp:

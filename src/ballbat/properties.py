@@ -15,10 +15,17 @@ from __future__ import annotations
 
 import csv
 import math
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .units import INCH, OUNCE, OZ_IN2
+
+if TYPE_CHECKING:
+    import os
+
+    import numpy as np
+    from numpy.typing import ArrayLike
 
 
 class InputError(ValueError):
@@ -141,7 +148,7 @@ def _read_table(path: Path, columns: dict, key: str) -> list[dict]:
     return out
 
 
-def load_balls(path) -> dict[str, Ball]:
+def load_balls(path: str | os.PathLike[str]) -> dict[str, Ball]:
     """Read a ball table (Table I layout, paper units) into SI :class:`Ball` records."""
     balls = {}
     for rec in _read_table(path, BALL_COLUMNS, "ball"):
@@ -157,7 +164,7 @@ def load_balls(path) -> dict[str, Ball]:
     return balls
 
 
-def load_bats(path) -> dict[str, Bat]:
+def load_bats(path: str | os.PathLike[str]) -> dict[str, Bat]:
     """Read a bat table (Table II layout, paper units) into SI :class:`Bat` records."""
     return {
         rec["bat"]: Bat(
@@ -173,12 +180,7 @@ def load_bats(path) -> dict[str, Bat]:
     }
 
 
-def as_dict(record) -> dict:
-    """A property record as a plain dict (for provenance)."""
-    return asdict(record)
-
-
-def recoil_normal(m, M, I0, b):
+def recoil_normal(m: ArrayLike, M: ArrayLike, I0: ArrayLike, b: ArrayLike) -> np.ndarray:
     """Normal recoil factor r_y of the bat (Eq. ry of Kensrud et al. 2017).
 
     Parameters
@@ -194,7 +196,9 @@ def recoil_normal(m, M, I0, b):
     return m * (1.0 / M + b**2 / I0)
 
 
-def recoil_tangential(m, M, I0, Iz, b, R, alpha=0.4):
+def recoil_tangential(
+    m: ArrayLike, M: ArrayLike, I0: ArrayLike, Iz: ArrayLike, b: ArrayLike, R: ArrayLike, alpha: ArrayLike = 0.4
+) -> np.ndarray:
     """Tangential recoil factor r_x of the bat (Eq. rx of Kensrud et al. 2017).
 
     Notes

@@ -8,6 +8,10 @@ never used as inputs of a fit. Units are the paper's (the comparison table's uni
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
 
 
 @dataclass(frozen=True)
@@ -89,6 +93,6 @@ STRONGE_MU = 0.5
 UNPUBLISHED = {"e_y_implied": "1"}
 
 
-def per_ball(quantity: str, published=PUBLISHED) -> dict[str, float]:
+def per_ball(quantity: str, published: Sequence[Published] = PUBLISHED) -> dict[str, float]:
     """Published values of a per-ball quantity (no bat), as {ball: value}."""
     return {p.ball: p.value for p in published if p.quantity == quantity and not p.bat}

@@ -14,6 +14,7 @@ from __future__ import annotations
 
 import html
 import math
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -21,6 +22,12 @@ from .compare import COLUMNS, read_csv
 from .pipeline.ncio import atomic_write_text
 from .published import per_ball
 from .units import from_si
+
+if TYPE_CHECKING:
+    import os
+
+    import xarray as xr
+    from numpy.typing import ArrayLike
 
 #: The paper's values the figures and captions quote (from ballbat.published, the one source).
 PAPER = {
@@ -50,7 +57,7 @@ def _paper(key, ball, fmt=".3g") -> str:
     return "not given" if value is None else _f(value, fmt)
 
 
-def excluded_count(impacts) -> int:
+def excluded_count(impacts: xr.Dataset) -> int:
     """Number of impacts flagged as not reconstructable (flag != 0), left out of the figures."""
     return int(np.count_nonzero(impacts["flag"].values != 0))
 
@@ -77,7 +84,7 @@ def _slope_lines(fit, var, unit, paper_key, fmt=".3g") -> list[str]:
     return lines
 
 
-def fig3_numbers(impacts, fit) -> str:
+def fig3_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     """Fitted slopes of normalised spin against launch angle (Fig. 3)."""
     return "\n".join(
         ["Fitted slopes (standard errors):", "", *_slope_lines(fit, "spin_theta_slope", "rpm/deg", "spin_theta_slope")]
@@ -86,7 +93,7 @@ def fig3_numbers(impacts, fit) -> str:
     )
 
 
-def fig4_numbers(impacts, fit) -> str:
+def fig4_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     """Fitted slopes of normalised exit speed against launch angle (Fig. 4)."""
     return "\n".join(
         [
@@ -99,7 +106,7 @@ def fig4_numbers(impacts, fit) -> str:
     )
 
 
-def fig5_numbers(impacts, fit) -> str:
+def fig5_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     """Pooled and per-bat e_x (Fig. 5, Eq. ex, Table II)."""
     lines = ["Slopes 1 + e_x of the pooled fits through the origin (standard errors):", ""]
     for ball in fit["ball"].values.astype(str):
@@ -119,7 +126,7 @@ def fig5_numbers(impacts, fit) -> str:
     return "\n".join(lines + [""] + _header(impacts))
 
 
-def fig6_numbers(impacts, fit) -> str:
+def fig6_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     """Eq. ratio slopes, implied e_y and the mu_k lower bound (Fig. 6)."""
     lines = [
         "Fitted slopes through the origin (standard errors):",
@@ -137,7 +144,7 @@ def fig6_numbers(impacts, fit) -> str:
     return "\n".join(lines + [""] + _header(impacts))
 
 
-def fig9_numbers(stronge) -> str:
+def fig9_numbers(stronge: xr.Dataset) -> str:
     """Fitted eta^2 of Stronge's model beside the paper's (Fig. 9, Sec. V.A)."""
     lines = ["Fitted tangential-stiffness parameter η² (standard error, 95 % interval):", ""]
     for ball in stronge["ball"].values.astype(str):
@@ -154,7 +161,7 @@ def fig9_numbers(stronge) -> str:
     return "\n".join(lines)
 
 
-def fig10_numbers(stronge) -> str:
+def fig10_numbers(stronge: xr.Dataset) -> str:
     """Frequency ratio and the stick period of the time histories (Fig. 10)."""
     psi = stronge.attrs.get("psi_history_deg", 30)
     lines = [f"At ψ = {_f(psi)}° with the fitted η²:", ""]
@@ -171,7 +178,7 @@ def fig10_numbers(stronge) -> str:
     return "\n".join(lines)
 
 
-def stick_period(t, stick) -> tuple[float | None, float | None]:
+def stick_period(t: ArrayLike, stick: ArrayLike) -> tuple[float | None, float | None]:
     """Start and end (in units of ``t``) of the first run of ``stick == 1``; (None, None) if none."""
     stuck = np.asarray(stick) == 1
     if not stuck.any():
@@ -182,7 +189,7 @@ def stick_period(t, stick) -> tuple[float | None, float | None]:
     return float(t[i0]), float(t[i1])
 
 
-def fig11_numbers(scenario) -> str:
+def fig11_numbers(scenario: xr.Dataset) -> str:
     """Exit speed, spin and carry of a D sweep (Fig. 11, Sec. V.B)."""
     D = from_si(scenario["D"].values, "in")
     speed = from_si(scenario["exit_speed"].values, "mph")
@@ -204,7 +211,7 @@ def fig11_numbers(scenario) -> str:
     return "\n".join(lines)
 
 
-def launch_numbers(scenario) -> str:
+def launch_numbers(scenario: xr.Dataset) -> str:
     """Carry of each launch condition of a launch-conditions scenario."""
     lines = ["Carry of each launch condition:", ""]
     for i in range(scenario.sizes["case"]):
@@ -218,7 +225,7 @@ def launch_numbers(scenario) -> str:
     return "\n".join(lines)
 
 
-def comparison_html(csv_path, html_path, title: str) -> str:
+def comparison_html(csv_path: str | os.PathLike[str], html_path: str | os.PathLike[str], title: str) -> str:
     """Write a paper-comparison CSV as a self-contained HTML table (for the report)."""
     rows = read_csv(csv_path)
     head = "".join(f"<th>{html.escape(c)}</th>" for c in COLUMNS)

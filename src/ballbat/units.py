@@ -9,7 +9,12 @@ All factors are exact by definition (NIST SP 811, Appendix B).
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
 
 #: 1 international inch in metres (exact).
 INCH = 0.0254
@@ -51,7 +56,7 @@ TO_SI = {
 }
 
 
-def to_si(value, unit: str):
+def to_si(value: ArrayLike, unit: str) -> np.ndarray | float:
     """Convert ``value`` given in ``unit`` (a key of :data:`TO_SI`) to SI."""
     try:
         return np.asarray(value, dtype=float) * TO_SI[unit] if np.ndim(value) else float(value) * TO_SI[unit]
@@ -59,7 +64,7 @@ def to_si(value, unit: str):
         raise ValueError(f"unknown unit {unit!r}; known units: {sorted(TO_SI)}") from None
 
 
-def from_si(value, unit: str):
+def from_si(value: ArrayLike, unit: str) -> np.ndarray | float:
     """Convert an SI ``value`` to ``unit`` (a key of :data:`TO_SI`)."""
     try:
         return np.asarray(value, dtype=float) / TO_SI[unit] if np.ndim(value) else float(value) / TO_SI[unit]
@@ -67,6 +72,6 @@ def from_si(value, unit: str):
         raise ValueError(f"unknown unit {unit!r}; known units: {sorted(TO_SI)}") from None
 
 
-def fahrenheit_to_celsius(t_f):
+def fahrenheit_to_celsius(t_f: ArrayLike) -> np.ndarray | float:
     """Temperature in degrees Fahrenheit to degrees Celsius."""
     return (np.asarray(t_f, dtype=float) - 32.0) * 5.0 / 9.0

@@ -1,4 +1,5 @@
 # Config validation, input functions and code dependencies shared by all rules.
+from argparse import Namespace
 from pathlib import Path
 
 import yaml
@@ -17,6 +18,8 @@ with open(SCHEMA) as _fh:
 
 DATASETS = sorted(config["datasets"])
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
+#: The software environment of every rule (requirements.lock as a conda file; `--sdm conda`).
+ENV = "../envs/ballbat.yaml"
 
 
 wildcard_constraints:
@@ -61,17 +64,6 @@ def get_source(wildcards):
     return f"results/{wildcards.dataset}/{stage}.nc"
 
 
-#: Final products; each rule file appends its own (rule all asks for all of them).
-TARGETS = []
-
-
-def rule_writes(pattern):
-    """Whether a rule included so far writes ``pattern`` (lets optional stages switch figures on)."""
-    from snakemake.io import strip_wildcard_constraints
-
-    return any(strip_wildcard_constraints(str(f)) == pattern for r in workflow.rules for f in r.output)
-
-
 SCENARIOS = sorted(config.get("implications", {}).get("scenarios", {}))
 for _name, _sc in config.get("implications", {}).get("scenarios", {}).items():
     if "e_x_from_dataset" in _sc and _sc["e_x_from_dataset"] not in DATASETS:
@@ -85,6 +77,26 @@ wildcard_constraints:
     scenario="|".join(SCENARIOS) or "^$",
 
 
+SWEEP_SCENARIOS = [s for s in SCENARIOS if "sweep" in config["implications"]["scenarios"][s]]
+LAUNCH_SCENARIOS = [s for s in SCENARIOS if s not in SWEEP_SCENARIOS]
+
+
+def final_targets():
+    """Everything a default run makes: every dataset's intermediate files, fits, figures and tables, and
+    every scenario's (rule all asks for these; an intermediate deleted by hand is therefore rebuilt)."""
+    per_dataset = ["normalize.nc", "reconstruct.nc", "fit_ex.nc", "stronge.nc"]
+    per_dataset += ["paper_comparison.csv", "paper_comparison.html"]
+    per_dataset += [f"figures/{fig}.png" for fig in ("fig3", "fig4", "fig5", "fig6", "fig9a", "fig9b", "fig10")]
+    targets = [get_source(Namespace(dataset=d)) for d in DATASETS]
+    targets += [f"results/{d}/{f}" for d in DATASETS for f in per_dataset]
+    targets += [f"results/implications/{s}.nc" for s in SCENARIOS]
+    targets += [f"results/implications/figures/{s}_fig11{p}.png" for s in SWEEP_SCENARIOS for p in "ab"]
+    targets += [f"results/implications/figures/{s}_launch.png" for s in LAUNCH_SCENARIOS]
+    if "paper" in SWEEP_SCENARIOS:  # the paper's own scenario is compared with Sec. V.B
+        targets += ["results/implications/paper_comparison.csv", "results/implications/paper_comparison.html"]
+    return targets
+
+
 def get_scenario(wildcards):
     return config["implications"]["scenarios"][wildcards.scenario]
 
@@ -93,4 +105,3 @@ def get_scenario_fit(wildcards):
     """fit_ex.nc of the dataset whose pooled e_x the scenario uses (none by default)."""
     name = get_scenario(wildcards).get("e_x_from_dataset")
     return {"fit": f"results/{name}/fit_ex.nc"} if name else {}
-

@@ -1,6 +1,3 @@
-TARGETS += expand("results/{dataset}/paper_comparison.csv", dataset=DATASETS)
-
-
 rule compare:
     """Tabulate every published number of Secs. II-V.A beside ours and the truth."""
     input:
@@ -13,5 +10,7 @@ rule compare:
         md="results/{dataset}/paper_comparison.md",
     log:
         "results/{dataset}/logs/compare.log",
+    conda:
+        ENV
     script:
         "../scripts/compare.py"

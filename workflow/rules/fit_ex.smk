@@ -5,11 +5,13 @@ rule fit_ex:
         code=code("fit_ex.py"),
     output:
         fit="results/{dataset}/fit_ex.nc",
-    params:
-        mu_k_example=config["analysis"]["mu_k_example"],
     log:
         "results/{dataset}/logs/fit_ex.log",
     benchmark:
         "results/{dataset}/benchmarks/fit_ex.tsv"
+    conda:
+        ENV
+    params:
+        mu_k_example=config["analysis"]["mu_k_example"],
     script:
         "../scripts/fit_ex.py"

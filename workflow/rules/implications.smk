@@ -1,8 +1,3 @@
-TARGETS += expand("results/implications/{scenario}.nc", scenario=SCENARIOS)
-if "paper" in SCENARIOS and "sweep" in config["implications"]["scenarios"]["paper"]:
-    TARGETS.append("results/implications/paper_comparison.csv")
-
-
 rule implications:
     """Collide a pitched ball with a bat and fly it, or fly given launch conditions (Sec. V.B)."""
     input:
@@ -12,13 +7,15 @@ rule implications:
         code=code("implications.py"),
     output:
         scenario="results/implications/{scenario}.nc",
-    params:
-        scenario=get_scenario,
-        air=config["implications"]["air"],
     log:
         "results/implications/logs/{scenario}.log",
     benchmark:
         "results/implications/benchmarks/{scenario}.tsv"
+    conda:
+        ENV
+    params:
+        scenario=get_scenario,
+        air=config["implications"]["air"],
     script:
         "../scripts/implications.py"
 
@@ -33,5 +30,7 @@ rule implications_compare:
         md="results/implications/paper_comparison.md",
     log:
         "results/implications/logs/paper_comparison.log",
+    conda:
+        ENV
     script:
         "../scripts/implications_compare.py"

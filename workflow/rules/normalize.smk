@@ -5,11 +5,13 @@ rule normalize:
         code=code("normalize.py"),
     output:
         impacts="results/{dataset}/normalize.nc",
-    params:
-        v_ref_mph=config["normalize"]["v_ref_mph"],
     log:
         "results/{dataset}/logs/normalize.log",
     benchmark:
         "results/{dataset}/benchmarks/normalize.tsv"
+    conda:
+        ENV
+    params:
+        v_ref_mph=config["normalize"]["v_ref_mph"],
     script:
         "../scripts/normalize.py"

@@ -11,5 +11,7 @@ rule reconstruct:
         "results/{dataset}/logs/reconstruct.log",
     benchmark:
         "results/{dataset}/benchmarks/reconstruct.tsv"
+    conda:
+        ENV
     script:
         "../scripts/reconstruct.py"

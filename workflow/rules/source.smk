@@ -6,12 +6,14 @@ rule simulate:
         code=code("simulate.py"),
     output:
         impacts="results/{dataset}/simulate.nc",
-    params:
-        settings=get_synthetic_settings,
     log:
         "results/{dataset}/logs/simulate.log",
     benchmark:
         "results/{dataset}/benchmarks/simulate.tsv"
+    conda:
+        ENV
+    params:
+        settings=get_synthetic_settings,
     script:
         "../scripts/simulate.py"
 
@@ -29,5 +31,7 @@ rule ingest:
         "results/{dataset}/logs/ingest.log",
     benchmark:
         "results/{dataset}/benchmarks/ingest.tsv"
+    conda:
+        ENV
     script:
         "../scripts/ingest.py"

@@ -5,11 +5,13 @@ rule fit_stronge:
         code=code("fit_stronge.py"),
     output:
         stronge="results/{dataset}/stronge.nc",
-    params:
-        stronge=config["stronge"],
     log:
         "results/{dataset}/logs/fit_stronge.log",
     benchmark:
         "results/{dataset}/benchmarks/fit_stronge.tsv"
+    conda:
+        ENV
+    params:
+        stronge=config["stronge"],
     script:
         "../scripts/fit_stronge.py"

@@ -16,7 +16,7 @@ from pathlib import Path
 
 
 @contextmanager
-def atomic_target(path, suffix: str = ".tmp") -> Iterator[Path]:
+def atomic_target(path: str | os.PathLike[str], suffix: str = ".tmp") -> Iterator[Path]:
     """Yield a temporary path to write; on success it replaces ``path``."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)

@@ -8,6 +8,10 @@ is not of type 'integer'``). Missing keys that the schema gives a ``default`` ar
 from __future__ import annotations
 
 import copy
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import os
 
 
 class ConfigError(ValueError):
@@ -49,7 +53,7 @@ def _resolve(schema, root):
     return schema
 
 
-def fill_defaults(instance, schema, root=None):
+def fill_defaults(instance: object, schema: dict, root: dict | None = None) -> object:
     """Fill missing keys that have a ``default`` in ``schema`` (recursively, in place).
 
     Each default is stated once, on the key it belongs to: a missing object whose
@@ -90,7 +94,7 @@ def validate_config(config: dict, schema: dict, source: str = "config") -> dict:
     return config
 
 
-def load_config(path=None, schema_path=None) -> dict:
+def load_config(path: str | os.PathLike[str] = None, schema_path: str | os.PathLike[str] = None) -> dict:
     """The workflow's config file (default ``config/config.yaml``), validated, with the schema's defaults.
 
     For callers outside Snakemake (tests, benchmarks, examples) that need the same values

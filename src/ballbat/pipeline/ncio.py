@@ -10,6 +10,7 @@ never leaves a half-written file. :func:`read_dataset` loads a file fully and ch
 from __future__ import annotations
 
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
@@ -17,6 +18,10 @@ import xarray as xr
 from .. import __version__
 from .atomic import atomic_target
 from .provenance import provenance_attrs
+
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Mapping
 
 CONVENTIONS = "CF-1.10"
 REFERENCES = (
@@ -46,11 +51,11 @@ def check_metadata(ds: xr.Dataset, where: str = "dataset") -> None:
 
 def write_dataset(
     ds: xr.Dataset,
-    path,
+    path: str | os.PathLike[str],
     *,
     title: str,
     rule: str,
-    inputs,
+    inputs: Mapping[str, object],
     config: dict,
     history: str | None = None,
 ) -> Path:
@@ -82,7 +87,7 @@ def write_dataset(
     return path
 
 
-def read_dataset(path, require: tuple[str, ...] = ()) -> xr.Dataset:
+def read_dataset(path: str | os.PathLike[str], require: tuple[str, ...] = ()) -> xr.Dataset:
     """Load a results file fully into memory and check the variables ``require`` names."""
     with xr.open_dataset(path, engine="netcdf4") as ds:
         ds = ds.load()
@@ -92,7 +97,7 @@ def read_dataset(path, require: tuple[str, ...] = ()) -> xr.Dataset:
     return ds
 
 
-def atomic_write_text(path, text: str) -> Path:
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
     """Write a text file atomically (temporary file renamed into place)."""
     path = Path(path)
     with atomic_target(path) as tmp:

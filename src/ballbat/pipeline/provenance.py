@@ -14,8 +14,13 @@ import subprocess
 from functools import lru_cache
 from importlib import metadata
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 from .. import __version__
+
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Mapping
 
 #: Distributions whose versions every file records.
 STACK = ("numpy", "scipy", "xarray", "netCDF4", "lmfit", "matplotlib", "snakemake")
@@ -23,7 +28,7 @@ STACK = ("numpy", "scipy", "xarray", "netCDF4", "lmfit", "matplotlib", "snakemak
 PACKAGE_DIR = Path(__file__).resolve().parent.parent  # src/ballbat
 
 
-def sha256_file(path, chunk: int = 1 << 20) -> str:
+def sha256_file(path: str | os.PathLike[str], chunk: int = 1 << 20) -> str:
     """Hex sha256 of a file's bytes."""
     h = hashlib.sha256()
     with open(path, "rb") as fh:
@@ -93,12 +98,12 @@ def _jsonable(obj):
     return obj
 
 
-def dumps(obj) -> str:
+def dumps(obj: object) -> str:
     """Canonical JSON (sorted keys) of a provenance record."""
     return json.dumps(_jsonable(obj), sort_keys=True, separators=(",", ": "))
 
 
-def provenance_attrs(rule: str, inputs: dict | list, config: dict, workdir=None) -> dict:
+def provenance_attrs(rule: str, inputs: dict | list, config: dict, workdir: str | os.PathLike[str] = None) -> dict:
     """NetCDF global attributes recording what produced a file.
 
     Parameters
@@ -127,6 +132,6 @@ def provenance_attrs(rule: str, inputs: dict | list, config: dict, workdir=None)
     }
 
 
-def data_inputs(named_input) -> dict:
+def data_inputs(named_input: Mapping[str, object]) -> dict:
     """A Snakemake job's named inputs without the code files (recorded by the source hash)."""
     return {k: v for k, v in named_input.items() if k != "code"}

@@ -6,10 +6,15 @@ import logging
 import time
 from contextlib import contextmanager
 from pathlib import Path
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Iterator
 
 
 @contextmanager
-def logged(log_path, rule: str):
+def logged(log_path: str | os.PathLike[str], rule: str) -> Iterator[logging.Logger]:
     """Log a job's start, end and any exception (with traceback) to ``log_path``."""
     Path(log_path).parent.mkdir(parents=True, exist_ok=True)
     handler = logging.FileHandler(log_path, mode="w")

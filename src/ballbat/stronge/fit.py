@@ -22,7 +22,7 @@ lmfit and scipy.stats are imported inside :func:`fit_eta2` only.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass
+from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike
@@ -57,9 +57,6 @@ class Eta2Fit:
     scale_covar: bool
     success: bool
     message: str
-
-    def as_dict(self) -> dict:
-        return asdict(self)
 
 
 def _describe(psi, e_y, mu, vary_e_y, vary_mu) -> str:

@@ -77,7 +77,7 @@ _PHASE_NAMES = {_STICK: "stick", _SLIP: "slip"}
 # --------------------------------------------------------------------------------------
 # parameters
 # --------------------------------------------------------------------------------------
-def omega_ratio(eta2: ArrayLike, r_x: ArrayLike = 0.0, r_y: ArrayLike = 0.0, alpha: ArrayLike = 0.4):
+def omega_ratio(eta2: ArrayLike, r_x: ArrayLike = 0.0, r_y: ArrayLike = 0.0, alpha: ArrayLike = 0.4) -> np.ndarray:
     """Ratio Omega_t / Omega_n of the tangential and normal vibration frequencies.
 
     Parameters
