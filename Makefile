@@ -30,13 +30,18 @@ bench: install
 	$(BIN)/python bench/bench_stronge.py
 	$(BIN)/python bench/bench_flight.py
 
+# Habits enforced (CI runs this): ruff (pycodestyle, pyflakes, docstrings, RUF), the format
+# of Python and rule files, and Snakemake's own linter. Type hints: tests/test_lint.py.
 lint: install
 	$(BIN)/ruff check .
+	$(BIN)/ruff format --check .
+	$(BIN)/snakefmt --check --line-length 120 .
 	$(BIN)/snakemake --lint
 
-# Re-pin the stack after changing pyproject.toml's dependencies.
+# Re-pin the stack after changing pyproject.toml's dependencies (and the rules' conda file with it).
 lock: install
 	$(BIN)/python -m pip freeze --exclude-editable | grep -v '^ballbat' > requirements.lock
+	$(BIN)/python workflow/envs/make_env.py
 
 clean:
 	rm -rf results .snakemake

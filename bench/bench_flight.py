@@ -17,6 +17,7 @@ from ballbat.units import DEGREE, FOOT, MPH, RPM
 
 
 def launch_conditions(n: int, seed: int = 2017) -> tuple[np.ndarray, ...]:
+    """Draw ``n`` launch conditions (fixed seed)."""
     rng = np.random.default_rng(seed)
     return (
         rng.uniform(60, 115, n) * MPH,
@@ -28,6 +29,7 @@ def launch_conditions(n: int, seed: int = 2017) -> tuple[np.ndarray, ...]:
 
 
 def best_time(n: int, method: str, repeat: int = 3) -> tuple[float, np.ndarray]:
+    """Return the best of ``repeat`` wall-clock times of ``n`` flights, and the carries."""
     args = launch_conditions(n)
     best = np.inf
     for _ in range(repeat):
@@ -38,6 +40,7 @@ def best_time(n: int, method: str, repeat: int = 3) -> tuple[float, np.ndarray]:
 
 
 def main() -> None:
+    """Print the timings."""
     fly(*launch_conditions(10))  # warm-up (imports, caches)
     for n, method in ((10_000, "accurate"), (1_000, "calculator")):
         dt, carry = best_time(n, method)

@@ -27,6 +27,7 @@ DEG = np.pi / 180
 
 
 def best_of(fn, repeat=3):
+    """Return the best of ``repeat`` wall-clock times of ``fn()``."""
     times = []
     for _ in range(repeat):
         t0 = time.perf_counter()
@@ -36,6 +37,7 @@ def best_of(fn, repeat=3):
 
 
 def main() -> None:
+    """Print the timings."""
     balls = load_balls(ROOT / "config" / "balls.csv")
     bats = load_bats(ROOT / "config" / "bats.csv")
     pairs = np.array([recoil_factors(b, t) for b in balls.values() for t in bats.values()])

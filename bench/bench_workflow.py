@@ -24,12 +24,14 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def timed(cmd, cwd) -> float:
+    """Return the wall-clock time of a command."""
     t0 = time.perf_counter()
     subprocess.run(cmd, cwd=cwd, check=True, capture_output=True)
     return time.perf_counter() - t0
 
 
 def snakemake_times(repeats: int = 5) -> dict:
+    """Return the times of a cold run and of no-op reruns of the default workflow."""
     sm = [sys.executable, "-m", "snakemake", "-c2"]
     with tempfile.TemporaryDirectory() as tmp:
         wd = Path(tmp) / "wf"
@@ -48,6 +50,7 @@ def snakemake_times(repeats: int = 5) -> dict:
 
 
 def fit_times(sizes=(1_000, 10_000, 100_000)) -> list[tuple[int, float]]:
+    """Return the fit-stage time for each number of impacts."""
     from ballbat.analysis import normalize, reconstruct
     from ballbat.fitting import fit_dataset
     from ballbat.properties import load_balls, load_bats
@@ -76,6 +79,7 @@ def fit_times(sizes=(1_000, 10_000, 100_000)) -> list[tuple[int, float]]:
 
 
 def main() -> None:
+    """Print the timings."""
     sm = snakemake_times()
     print("workflow (default config, snakemake -c2)")
     print(f"  cold run                       {sm['cold']:7.2f} s")

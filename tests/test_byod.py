@@ -1,5 +1,6 @@
 """Bring your own data: the example measured dataset through the real workflow, a bad
-dataset beside it under --keep-going, and which jobs a swapped file or table reruns."""
+dataset beside it under --keep-going, and which jobs a swapped file or table reruns.
+"""
 
 from __future__ import annotations
 

@@ -35,7 +35,8 @@ PAPER = dict(
 
 def sec3_ball_at_rest(D, v_bat, e_x, e_y, ball, bat):
     """Sec. III of Kensrud et al. 2017 written out directly: Eqs. (D), (vballn), (vxf),
-    (omega) and theta = psi - atan(v_t / v_n) (PHYSICS.md, Sec. III forward model)."""
+    (omega) and theta = psi - atan(v_t / v_n) (PHYSICS.md, Sec. III forward model).
+    """
     r_x, r_y = recoil_factors(ball, bat)
     alpha, r = ball.alpha, ball.r
     psi = np.arcsin(D / (r + bat.R))  # Eq. (D)
@@ -84,7 +85,8 @@ def test_friction_ratio_matches_eq_ratio_for_ball_at_rest():
 
 def _bat_contact_after(res, W, psi, ball, bat):
     """Bat's contact-point velocity components along n and t after the impact, in the frame
-    where the pitch was at rest before it (effective masses m/r_y and m alpha/((1+alpha) r_x))."""
+    where the pitch was at rest before it (effective masses m/r_y and m alpha/((1+alpha) r_x)).
+    """
     r_x, r_y = recoil_factors(ball, bat)
     m, a = ball.m, ball.alpha
     V_n = W * np.cos(psi) - r_y * res.J_n / m

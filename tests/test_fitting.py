@@ -131,7 +131,7 @@ def test_design_jacobians_match_finite_differences(design):
         "theta_spin": lambda m: f.normalized_theta_design(m[0], m[3] * v_ref / m[0], m[2], "omega", v_ref),
         "theta_speed": lambda m: f.normalized_theta_design(m[0], m[1] * v_ref / m[0], m[2], "v_ball", v_ref),
     }[design]
-    x, y, jx, jy = fun(meas)
+    _x, _y, jx, jy = fun(meas)
     for k in range(4):
         h = 1e-6 * max(1.0, float(np.mean(np.abs(meas[k]))))
         up = [m.copy() for m in meas]

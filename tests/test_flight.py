@@ -58,7 +58,8 @@ def test_calculator_reproduces_published_case():
 def test_calculator_with_exact_units_and_accurate_integrator():
     """Exact unit factors move the calculator's landing by +0.3 ft (docs/flight.md); the
     accurate integrator lands ~0.8 ft beyond the fixed-step scheme (PHYSICS.md) and within
-    2 ft of the published 421.5 ft."""
+    2 ft of the published 421.5 ft.
+    """
     exact = fly(**CASE, method="calculator", calculator_rounding=False)
     acc = fly(**CASE, method="accurate")
     assert exact.carry / FOOT == pytest.approx(421.8, abs=0.05)
@@ -121,7 +122,7 @@ def test_vacuum_is_the_analytic_projectile(method):
     la = np.array([10.0, 45.0, 80.0]) * DEGREE
     # Exact unit factors: the spreadsheet's rounded mph and g would change the analytic numbers.
     res = fly(v0, la, 0.0, 2000 * RPM, 500 * RPM, rho=0.0, method=method, calculator_rounding=False)
-    x0, y0, z0 = DEFAULT_START
+    _x0, y0, z0 = DEFAULT_START
     vh, vz = v0 * np.cos(la), v0 * np.sin(la)
     T = (vz + np.sqrt(vz**2 + 2 * G * z0)) / G
     carry = y0 + vh * T
@@ -173,7 +174,8 @@ def test_sidespin_mirror_symmetry(method):
 @pytest.mark.parametrize("method", ["accurate", "calculator"])
 def test_spray_angle_rotates_about_the_start(method):
     """Without wind the spray angle rotates the whole flight about the vertical through the
-    start point; positive spray goes towards +x (first base)."""
+    start point; positive spray goes towards +x (first base).
+    """
     kw = dict(v0=95 * MPH, launch_angle=30 * DEGREE, backspin=2200 * RPM, sidespin=700 * RPM, method=method)
     phis = np.array([-35.0, 0.0, 20.0]) * DEGREE
     res = fly(spray_angle=phis, **kw)
@@ -216,7 +218,7 @@ def test_vectorised_equals_one_at_a_time():
 
 
 def test_carry_is_measured_from_home_plate():
-    """carry = |(x, y)| of the landing point, with home plate at the origin (not the start)."""
+    """Carry = |(x, y)| of the landing point, with home plate at the origin (not the start)."""
     res = fly(**CASE, start=(0.0, 0.0, 3 * FOOT))
     shifted = fly(**CASE)  # starts 2 ft in front of the plate
     assert shifted.carry - res.carry == pytest.approx(2 * FOOT, rel=1e-9)

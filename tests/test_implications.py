@@ -83,7 +83,7 @@ def test_launch_conditions_grid_and_list(complete):
     lst = launch_conditions(launch(exit_speed_mph=[90, 100], launch_deg=[20, 25], backspin_rpm=2000, combine="list"))
     np.testing.assert_allclose(lst["launch_angle"], np.radians([20, 25]))
     np.testing.assert_allclose(lst["backspin"], 2000 * RPM)
-    with pytest.raises(ValueError, match="the lists must have one length.*exit_speed_mph has 2, launch_deg has 3"):
+    with pytest.raises(ValueError, match=r"the lists must have one length.*exit_speed_mph has 2, launch_deg has 3"):
         launch_conditions(launch(exit_speed_mph=[90, 100], launch_deg=[20, 25, 30], combine="list"))
 
 

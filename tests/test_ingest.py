@@ -277,7 +277,8 @@ def test_unit_mistakes_warn_naming_the_column(tmp_path, column, factor, expected
 
 
 def test_small_group_not_fitted(tmp_path):
-    rows = copy.deepcopy(GOOD) + [
+    rows = [
+        *copy.deepcopy(GOOD),
         ["B1", "metal_rough", "baseball", "75.0", "84.0", "10.0", "1900"],
         ["B2", "metal_rough", "baseball", "78.0", "86.0", "12.0", "2300"],
     ]
@@ -321,7 +322,7 @@ def test_config_bad_dataset_forms(schema_and_base, dataset, message):
     schema, base = schema_and_base
     cfg = copy.deepcopy(base)
     cfg["datasets"]["m"] = dataset
-    with pytest.raises(ConfigError, match="datasets.m"):
+    with pytest.raises(ConfigError, match=r"datasets\.m"):
         validate_config(cfg, schema)
     try:
         validate_config(cfg, schema)

@@ -1,6 +1,7 @@
 """Habits enforced, not offered (issue 9): type hints on the public API, the conda file in step
 with the lock file. `make lint` runs ruff, snakefmt and `snakemake --lint`; these checks are the
-ones no linter does."""
+ones no linter does.
+"""
 
 import importlib
 import inspect

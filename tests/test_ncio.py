@@ -80,7 +80,7 @@ def test_config_validation_lists_all_problems(root):
 
 
 def test_results_are_readable_by_others(tmp_path):
-    """mkstemp makes private files; results get the usual 0666 less the umask."""
+    """Mkstemp makes private files; results get the usual 0666 less the umask."""
     import os
 
     umask = os.umask(0o022)

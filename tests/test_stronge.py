@@ -260,7 +260,8 @@ def test_regimes_for_fitted_eta2_no_slip_stick_slip():
 def test_regimes_slip_stick_slip_needs_omega_t_above_omega_n():
     """MODEL: slip-stick-slip occurs only when Omega_t > Omega_n (eta2 < 3.5 on a rigid
     surface), and for e_y = 0.5 its upper end is tan psi = 3.5 mu, not the paper's
-    3.5 mu (1 + e_y) (re-stick can then happen only before maximum compression)."""
+    3.5 mu (1 + e_y) (re-stick can then happen only before maximum compression).
+    """
     rb = regime_boundaries(2.5, 0.5, 0.5)
     assert rb.below == ("stick-slip", "slip-stick-slip")
     assert rb.above == ("slip-stick-slip", "gross-slip")
@@ -284,7 +285,8 @@ def test_regimes_slip_stick_slip_needs_omega_t_above_omega_n():
 def test_small_psi_insensitive_to_mu():
     """Paper, Sec. V.A: "for small psi, the final speed is insensitive to the size of mu, as
     long as the initial stick criterion is satisfied". Model: over mu = 0.3..1 (all initial
-    stick) e_x spreads by <= 0.02 at psi <= 10 deg, but by 0.065 at psi = 30 deg."""
+    stick) e_x spreads by <= 0.02 at psi <= 10 deg, but by 0.065 at psi = 30 deg.
+    """
     mu = np.linspace(0.3, 1.0, 15)
     for psi in (2.0, 5.0, 10.0):
         ex = stronge_ex(psi * DEG, 4.75, 0.5, mu)
@@ -296,7 +298,8 @@ def test_ex_sensitive_to_e_y_at_fixed_eta2(wood):
     """ERRATA-like: the paper says the results are "insensitive to" e_y and mu over the
     experiment's psi. MODEL: at fixed eta2, e_y 0.4 -> 0.6 moves e_x(psi=10 deg) from
     0.30 to 0.54 (baseball, rigid); only after refitting eta2 (4.15 / 5.39) do the curves
-    agree (tested in test_fit_absorbs_e_y)."""
+    agree (tested in test_fit_absorbs_e_y).
+    """
     ex = stronge_ex(10 * DEG, 4.75, np.array([0.4, 0.5, 0.6]), 0.5)
     np.testing.assert_allclose(ex, [0.298, 0.421, 0.538], atol=0.002)
 
@@ -305,7 +308,8 @@ def test_curves_linear_then_flat_after_gross_slip(wood):
     """Paper, Sec. V.A / Fig. 9b: (v_t + r omega)/v_bat,n against tan psi/(1 + r_x) is "quite
     linear over a broad range of psi" and "eventually flatten[s] after the transition to
     gross slip". MODEL: in gross slip the ordinate is exactly constant,
-    rho^2 mu eta2 (1 + e_y)/(1 + r_x)."""
+    rho^2 mu eta2 (1 + e_y)/(1 + r_x).
+    """
     for ball in ("baseball", "softball"):
         r_x, r_y = wood[ball]
         psi = np.linspace(0, 88, 881) * DEG
@@ -328,7 +332,8 @@ def test_ex_over_experiment_range(ball, published, balls, bats):
     """Paper, Secs. IV and V.A: at the fitted eta2 the model is "consistent with the constant
     value of e_x" (0.405 +- 0.010 baseball, 0.146 +- 0.009 softball, Eq. ex). MODEL (bat
     frame, each bat of Table II, psi from 0 to psi_max of Table I): e_x falls slowly with psi;
-    its mean is within 0.05 of the published value and its spread below 0.08."""
+    its mean is within 0.05 of the published value and its spread below 0.08.
+    """
     psi = np.linspace(0, balls[ball].psi_max, 61)
     means = []
     for bat in bats.values():
@@ -369,7 +374,8 @@ def _synthetic(balls, bats, rng, eta2=4.75, n=58, noise=0.01):
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_fit_recovers_eta2(seed, balls, bats):
     """Synthetic Eq. (vtf) data at eta2 = 4.75 with noise: recovered within 3 standard errors,
-    the 95 % profile interval brackets the fit, and one ball's fit takes < 1 s."""
+    the 95 % profile interval brackets the fit, and one ball's fit takes < 1 s.
+    """
     import lmfit  # noqa: F401  (import once, outside the timing)
 
     psi, x, y, r_x, r_y = _synthetic(balls, bats, np.random.default_rng(seed))
@@ -400,7 +406,8 @@ def test_fit_with_free_mu(balls, bats):
 def test_fit_absorbs_e_y(balls, bats, wood):
     """With e_y fixed at 0.4 or 0.6 instead of 0.5, the refitted eta2 moves (4.15 / 5.39 for
     exact baseball model data) but the fitted curve stays within 5e-3 rms of the data: the
-    paper's 'insensitive' holds for the curves, not for eta2."""
+    paper's 'insensitive' holds for the curves, not for eta2.
+    """
     r_x, r_y = wood["baseball"]
     psi = np.linspace(0.01, balls["baseball"].psi_max, 60)
     x = np.tan(psi) / (1 + r_x)

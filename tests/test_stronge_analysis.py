@@ -68,7 +68,8 @@ def test_comparison_rows(products):
 def test_published_eta2_gives_the_published_pooled_e_x(products):
     """Sec. V.A: the model at eta^2 = 4.75 / 6.30 (e_y = mu = 0.5) accounts for the data, whose
     pooled e_x is 0.405 / 0.146 (Sec. IV, Fig. 5). Its e_x averaged over the experiment's psi
-    range (Table I: psi_max 30 / 41 deg) lies within 0.03 of those values."""
+    range (Table I: psi_max 30 / 41 deg) lies within 0.03 of those values.
+    """
     for ball, psi_max, pooled in (("baseball", 30.0, 0.405), ("softball", 41.0, 0.146)):
         f = products.sel(ball=ball)
         inside = (products.psi_grid.values > 0) & (products.psi_grid.values <= np.radians(psi_max))

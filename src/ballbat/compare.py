@@ -169,6 +169,7 @@ def comparison_table(rows: list[dict], published: Sequence[Published] = PUBLISHE
 
 
 def to_csv(table: list[dict]) -> str:
+    """Return the comparison table as CSV text (columns :data:`COLUMNS`)."""
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(COLUMNS)
@@ -178,6 +179,7 @@ def to_csv(table: list[dict]) -> str:
 
 
 def to_markdown(table: list[dict], title: str) -> str:
+    """Return the comparison table as a Markdown table under the heading ``title``."""
     lines = [f"# {title}", "", "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     for r in table:
         cells = [r[c] or "" if c in ("quantity", "ball", "bat", "unit") else _num(r[c]) for c in COLUMNS]

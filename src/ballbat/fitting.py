@@ -49,7 +49,7 @@ class FitStatus(enum.IntEnum):
 
 
 def fit_status(fit: LineFit) -> FitStatus:
-    """The :class:`FitStatus` of a fit of e_x."""
+    """Return the :class:`FitStatus` of a fit of e_x."""
     if fit.n == 0:
         return FitStatus.NO_IMPACTS
     if fit.n < MIN_FIT_IMPACTS:
@@ -66,7 +66,7 @@ class FitGrid:
 
     @classmethod
     def empty(cls, shape: tuple[int, ...]) -> FitGrid:
-        """A grid of fits not made (no impacts)."""
+        """Return a grid of fits not made (no impacts)."""
         fits = np.empty(shape, dtype=object)
         for idx in np.ndindex(shape):
             fits[idx] = LineFit.not_fitted(0)
@@ -240,7 +240,7 @@ _SLOPE_IS_ONE_PLUS = ("e_x", "e_x_pooled")
 
 
 def fit_ex_table(has_truth: bool, mu_k_example: float) -> dict[str, Var]:
-    """The variables of fit_ex.nc, declared once (name -> :class:`Var`)."""
+    """Return the variables of fit_ex.nc, declared once (name -> :class:`Var`)."""
     table: dict[str, Var] = {}
     for name, (dims, units, what) in FIT_FAMILIES.items():
         table.update(estimate_vars(name, dims, units, what))
@@ -314,7 +314,7 @@ def results_dataset(res: Sec4) -> xr.Dataset:
 
 
 def fit_dataset(impacts: xr.Dataset, mu_k_example: float) -> xr.Dataset:
-    """The Sec. IV fits of a reconstructed dataset, as a Dataset ready to write."""
+    """Return the Sec. IV fits of a reconstructed dataset, as a Dataset ready to write."""
     ds = results_dataset(analyze_impacts(impacts, mu_k_example))
     ds.attrs["n_impacts"] = int(impacts.sizes["impact"])
     ds.attrs["n_excluded"] = int((impacts["flag"].values != 0).sum())

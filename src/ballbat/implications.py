@@ -208,7 +208,7 @@ def comparison_rows(ds: xr.Dataset) -> list[dict]:
 
 
 def pooled_e_x(fit_path: str | os.PathLike[str], ball: str) -> float:
-    """The pooled e_x of ``ball`` fitted on a dataset (its ``fit_ex.nc``)."""
+    """Return the pooled e_x of ``ball`` fitted on a dataset (its ``fit_ex.nc``)."""
     from .pipeline.ncio import read_dataset
 
     fit = read_dataset(fit_path, require=("e_x_pooled",))

@@ -253,7 +253,7 @@ def exclusions(
     The flag is that of :func:`ballbat.kinematics.reconstruct_psi` (an
     :class:`~ballbat.kinematics.ImpactFlag`); the reason quotes the offending number.
     """
-    psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
+    _psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
     q = angmom_argument(v_ball, omega, r, alpha)
     with np.errstate(invalid="ignore"):
         psi_clipped = theta + np.arcsin(np.clip(q, -1, 1))

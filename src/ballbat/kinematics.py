@@ -34,7 +34,7 @@ def offset_from_psi(psi: ArrayLike, r: ArrayLike, R: ArrayLike) -> np.ndarray:
 
 
 def spin_bracket(v_bat: ArrayLike, psi: ArrayLike, r: ArrayLike, r_x: ArrayLike, alpha: ArrayLike = 0.4) -> np.ndarray:
-    """The bracket of Eq. omega: v_bat sin psi / (r (1 + r_x)(1 + alpha)), rad s-1.
+    """Return the bracket of Eq. omega: v_bat sin psi / (r (1 + r_x)(1 + alpha)), rad s-1.
 
     The measured spin is (1 + e_x) times this term; Fig. 5 plots omega against it.
     """
@@ -42,14 +42,14 @@ def spin_bracket(v_bat: ArrayLike, psi: ArrayLike, r: ArrayLike, r_x: ArrayLike,
 
 
 def vtf_bracket(psi: ArrayLike, r_x: ArrayLike) -> np.ndarray:
-    """The bracket of Eq. vtf: tan psi / (1 + r_x) (dimensionless, Fig. 9 abscissa)."""
+    """Return the bracket of Eq. vtf: tan psi / (1 + r_x) (dimensionless, Fig. 9 abscissa)."""
     return np.tan(psi) / (1.0 + r_x)
 
 
 def vtf_ordinate(
     v_ball: ArrayLike, theta: ArrayLike, omega: ArrayLike, v_bat: ArrayLike, psi: ArrayLike, r: ArrayLike
 ) -> np.ndarray:
-    """The left side of Eq. vtf: (v_ball,t + r omega) / v_bat,n (Fig. 9 ordinate).
+    """Return the left side of Eq. vtf: (v_ball,t + r omega) / v_bat,n (Fig. 9 ordinate).
 
     v_ball,t = v_ball sin(psi - theta) and v_bat,n = v_bat cos psi.
     """
@@ -131,7 +131,7 @@ FLAG_TEXT = {
 
 
 def angmom_argument(v_ball: ArrayLike, omega: ArrayLike, r: ArrayLike, alpha: ArrayLike) -> np.ndarray:
-    """The argument of Eq. angmom's arcsine: sin(psi - theta) = alpha r omega / v_ball."""
+    """Return the argument of Eq. angmom's arcsine: sin(psi - theta) = alpha r omega / v_ball."""
     return alpha * r * np.asarray(omega, dtype=float) / np.asarray(v_ball, dtype=float)
 
 
@@ -164,7 +164,7 @@ def reconstruct_psi(
 def psi_partials(
     v_ball: ArrayLike, theta: ArrayLike, omega: ArrayLike, r: ArrayLike, alpha: ArrayLike
 ) -> tuple[np.ndarray, np.ndarray]:
-    """psi of Eq. angmom and its derivatives with respect to (v_bat, v_ball, theta, omega).
+    """Psi of Eq. angmom and its derivatives with respect to (v_bat, v_ball, theta, omega).
 
     For usable impacts (|alpha r omega / v_ball| < 1). Returns ``(psi, dpsi)`` with ``dpsi``
     of shape (n, 4), the columns in the order of :data:`ballbat.designs.MEASURED`.

@@ -48,7 +48,7 @@ class LineFit:
 
     @classmethod
     def not_fitted(cls, n: int) -> LineFit:
-        """The result of a fit that was not made (too few impacts) or failed: NaN with ``n``."""
+        """Return the result of a fit that was not made (too few impacts) or failed: NaN with ``n``."""
         return cls(np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, n, np.nan, False)
 
 
@@ -144,7 +144,7 @@ def wls_slope(
 
 
 def effective_sigma(jx: ArrayLike, jy: ArrayLike, sigma: ArrayLike, slope: ArrayLike) -> np.ndarray | None:
-    """Standard deviation of y - slope x from the measurement uncertainties (effective variance)."""
+    """Return the standard deviation of y - slope x from the measurement uncertainties (effective variance)."""
     if sigma is None:
         return None
     return np.sqrt(np.sum((jy - slope * jx) ** 2 * sigma**2, axis=1))

@@ -24,14 +24,14 @@ import matplotlib
 
 matplotlib.use("Agg")
 
-import numpy as np  # noqa: E402
-from matplotlib.figure import Figure  # noqa: E402
-from matplotlib.patches import Rectangle  # noqa: E402
+import numpy as np
+from matplotlib.figure import Figure
+from matplotlib.patches import Rectangle
 
-from . import reporting  # noqa: E402
-from .pipeline.atomic import atomic_target  # noqa: E402
-from .pipeline.ncio import atomic_write_text, read_dataset  # noqa: E402
-from .units import from_si  # noqa: E402
+from . import reporting
+from .pipeline.atomic import atomic_target
+from .pipeline.ncio import atomic_write_text, read_dataset
+from .units import from_si
 
 if TYPE_CHECKING:
     import os
@@ -52,6 +52,7 @@ DPI = 110
 
 
 def ball_color(ball: str, order: Sequence[str] = ()) -> str:
+    """Return the colour of a ball type: the paper's two fixed, others from a palette in ``order``."""
     if ball in BALL_COLOR:
         return BALL_COLOR[ball]
     others = [b for b in order if b not in BALL_COLOR]
@@ -59,11 +60,12 @@ def ball_color(ball: str, order: Sequence[str] = ()) -> str:
 
 
 def is_closed(ball: str) -> bool:
-    """Closed markers for baseballs (and anything not a softball), open for softballs (as in the paper)."""
+    """Tell whether a ball gets closed markers: baseballs (and all but softballs), as in the paper."""
     return ball != "softball"
 
 
 def bat_marker(bat: str, order: Sequence[str] = ()) -> str:
+    """Return the marker of a bat: Table II's four fixed, others from a list in ``order``."""
     if bat in BAT_MARKER:
         return BAT_MARKER[bat]
     others = [b for b in order if b not in BAT_MARKER]
@@ -109,7 +111,7 @@ def _groups(impacts):
 
 
 def _errorbars(ax, impacts, x, y, xerr=None, yerr=None):
-    """Data points with error bars, one legend entry per ball and bat (only usable impacts)."""
+    """Draw data points with error bars, one legend entry per ball and bat (only usable impacts)."""
     groups, ball_order, bat_order = _groups(impacts)
     for ball, bat, idx in groups:
         kw = _marker_kw(ball, bat, ball_order, bat_order)
@@ -341,7 +343,7 @@ def _boundaries(s):
 
 
 def _eta2_paper(s, ball):
-    """The paper's eta^2 for a ball: from the file when it says, else Sec. V.A's."""
+    """Return the paper's eta^2 for a ball: from the file when it says, else Sec. V.A's."""
     if "eta2_published" in s and np.isfinite(float(s["eta2_published"])):
         return float(s["eta2_published"])
     return reporting.PAPER["eta2"].get(ball)

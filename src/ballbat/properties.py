@@ -181,7 +181,7 @@ def load_bats(path: str | os.PathLike[str]) -> dict[str, Bat]:
 
 
 def recoil_normal(m: ArrayLike, M: ArrayLike, I0: ArrayLike, b: ArrayLike) -> np.ndarray:
-    """Normal recoil factor r_y of the bat (Eq. ry of Kensrud et al. 2017).
+    """Return the normal recoil factor r_y of the bat (Eq. ry of Kensrud et al. 2017).
 
     Parameters
     ----------

@@ -16,6 +16,8 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class Published:
+    """A number the paper publishes: quantity, ball, bat, value, uncertainty, unit and where it stands."""
+
     quantity: str
     ball: str
     bat: str
@@ -94,5 +96,5 @@ UNPUBLISHED = {"e_y_implied": "1"}
 
 
 def per_ball(quantity: str, published: Sequence[Published] = PUBLISHED) -> dict[str, float]:
-    """Published values of a per-ball quantity (no bat), as {ball: value}."""
+    """Return the published values of a per-ball quantity (no bat), as {ball: value}."""
     return {p.ball: p.value for p in published if p.quantity == quantity and not p.bat}

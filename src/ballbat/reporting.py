@@ -58,7 +58,7 @@ def _paper(key, ball, fmt=".3g") -> str:
 
 
 def excluded_count(impacts: xr.Dataset) -> int:
-    """Number of impacts flagged as not reconstructable (flag != 0), left out of the figures."""
+    """Return the number of impacts flagged as not reconstructable (flag != 0), left out of the figures."""
     return int(np.count_nonzero(impacts["flag"].values != 0))
 
 
@@ -87,9 +87,13 @@ def _slope_lines(fit, var, unit, paper_key, fmt=".3g") -> list[str]:
 def fig3_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     """Fitted slopes of normalised spin against launch angle (Fig. 3)."""
     return "\n".join(
-        ["Fitted slopes (standard errors):", "", *_slope_lines(fit, "spin_theta_slope", "rpm/deg", "spin_theta_slope")]
-        + [""]
-        + _header(impacts)
+        [
+            "Fitted slopes (standard errors):",
+            "",
+            *_slope_lines(fit, "spin_theta_slope", "rpm/deg", "spin_theta_slope"),
+            "",
+            *_header(impacts),
+        ]
     )
 
 
@@ -100,9 +104,9 @@ def fig4_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
             "Fitted slopes (standard errors):",
             "",
             *_slope_lines(fit, "speed_theta_slope", "mph/deg", "speed_theta_slope"),
+            "",
+            *_header(impacts),
         ]
-        + [""]
-        + _header(impacts)
     )
 
 
@@ -123,7 +127,7 @@ def fig5_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
             v, e = float(fit["e_x"].sel(ball=ball, bat=bat)), float(fit["e_x_err"].sel(ball=ball, bat=bat))
             if math.isfinite(v):
                 lines.append(f"- {ball}, {bat}: {_pm(v, e, '.3f')} (n = {int(fit['e_x_n'].sel(ball=ball, bat=bat))})")
-    return "\n".join(lines + [""] + _header(impacts))
+    return "\n".join([*lines, "", *_header(impacts)])
 
 
 def fig6_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
@@ -141,7 +145,7 @@ def fig6_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
             f"- {ball}: e_y = {_pm(fit['e_y_implied'].sel(ball=ball), fit['e_y_implied_err'].sel(ball=ball))},"
             f" mu_k ≥ {_f(fit['mu_k_lower_bound'].sel(ball=ball))}"
         )
-    return "\n".join(lines + [""] + _header(impacts))
+    return "\n".join([*lines, "", *_header(impacts)])
 
 
 def fig9_numbers(stronge: xr.Dataset) -> str:

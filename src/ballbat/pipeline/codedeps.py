@@ -51,7 +51,7 @@ def _imports_cached(path: str, mtime_ns: int, module: str | None) -> frozenset[s
 
 
 def _imports(path: Path, module: str | None) -> set[str]:
-    """ballbat submodule names imported anywhere in ``path`` (``module`` is its own name).
+    """Ballbat submodule names imported anywhere in ``path`` (``module`` is its own name).
 
     Reads import statements with a regular expression (this runs every time Snakemake parses
     the workflow, where a full parse of every module would cost a noticeable fraction of a

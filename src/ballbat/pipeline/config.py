@@ -94,8 +94,8 @@ def validate_config(config: dict, schema: dict, source: str = "config") -> dict:
     return config
 
 
-def load_config(path: str | os.PathLike[str] = None, schema_path: str | os.PathLike[str] = None) -> dict:
-    """The workflow's config file (default ``config/config.yaml``), validated, with the schema's defaults.
+def load_config(path: str | os.PathLike[str] | None = None, schema_path: str | os.PathLike[str] | None = None) -> dict:
+    """Return the workflow's config file (default ``config/config.yaml``), validated, with the schema's defaults.
 
     For callers outside Snakemake (tests, benchmarks, examples) that need the same values
     the workflow uses. Paths default to the repository checkout this package lives in.

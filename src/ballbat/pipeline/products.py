@@ -66,7 +66,7 @@ def variable(dims: str | tuple[str, ...], data: Any, units: str | None, long_nam
 
 
 def _flag_word(text: str) -> str:
-    """A flag meaning as CF wants it: one blank-free word per value."""
+    """Return a flag meaning as CF wants it: one blank-free word per value."""
     return re.sub(r"[^A-Za-z0-9_.+-]+", "_", text).strip("_")
 
 
@@ -88,7 +88,7 @@ def estimate_vars(
     fit: bool = True,
     interval: bool = True,
 ) -> dict[str, Var]:
-    """Declarations of an estimate and its uncertainty family, linked as CF ancillaries.
+    """Declare an estimate and its uncertainty family, linked as CF ancillaries.
 
     Returns ``name`` (the value), ``name_err`` (standard error), optionally
     ``name_ci_low``/``name_ci_high`` (95 % interval), and, for fits, ``name_n`` (impacts
@@ -112,7 +112,7 @@ def build_dataset(
     coords: Mapping[str, tuple[Var, Any]] | None = None,
     attrs: Mapping[str, Any] | None = None,
 ) -> xr.Dataset:
-    """An :class:`xarray.Dataset` of ``values`` described by ``table``.
+    """Return an :class:`xarray.Dataset` of ``values`` described by ``table``.
 
     Every key of ``values`` must be declared in ``table`` and every declared variable
     given (a :class:`KeyError` names the difference): the table is the file's contents.
@@ -128,7 +128,7 @@ def build_dataset(
 
 
 def add_variables(ds: xr.Dataset, table: Mapping[str, Var], values: Mapping[str, Any]) -> xr.Dataset:
-    """A copy of ``ds`` with the declared variables of ``table`` that ``values`` gives, in table order.
+    """Return a copy of ``ds`` with the declared variables of ``table`` that ``values`` gives, in table order.
 
     For stages that extend their input file (normalize, reconstruct); a value not declared
     in ``table`` is a :class:`KeyError`.

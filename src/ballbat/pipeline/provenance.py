@@ -38,7 +38,7 @@ def sha256_file(path: str | os.PathLike[str], chunk: int = 1 << 20) -> str:
 
 
 def package_sources(package_dir: Path = PACKAGE_DIR) -> list[Path]:
-    """The package's Python source files, sorted."""
+    """Return the package's Python source files, sorted."""
     return sorted(p for p in package_dir.rglob("*.py") if "__pycache__" not in p.parts)
 
 
@@ -103,7 +103,9 @@ def dumps(obj: object) -> str:
     return json.dumps(_jsonable(obj), sort_keys=True, separators=(",", ": "))
 
 
-def provenance_attrs(rule: str, inputs: dict | list, config: dict, workdir: str | os.PathLike[str] = None) -> dict:
+def provenance_attrs(
+    rule: str, inputs: dict | list, config: dict, workdir: str | os.PathLike[str] | None = None
+) -> dict:
     """NetCDF global attributes recording what produced a file.
 
     Parameters
@@ -133,5 +135,5 @@ def provenance_attrs(rule: str, inputs: dict | list, config: dict, workdir: str 
 
 
 def data_inputs(named_input: Mapping[str, object]) -> dict:
-    """A Snakemake job's named inputs without the code files (recorded by the source hash)."""
+    """Return a Snakemake job's named inputs without the code files (recorded by the source hash)."""
     return {k: v for k, v in named_input.items() if k != "code"}

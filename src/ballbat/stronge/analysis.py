@@ -55,7 +55,7 @@ STRONGE_COORDS = {
 
 
 def stronge_table(vary_e_y: bool, vary_mu: bool) -> dict[str, Var]:
-    """The variables of stronge.nc, declared once (name -> :class:`Var`)."""
+    """Return the variables of stronge.nc, declared once (name -> :class:`Var`)."""
     b, g, h, f = ("ball",), ("ball", "psi_grid"), ("ball", "sample"), ("impact_fit",)
     at = "at psi_history"
     table = {

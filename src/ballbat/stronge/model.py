@@ -36,6 +36,7 @@ References
 from __future__ import annotations
 
 import enum
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
@@ -166,7 +167,7 @@ def _sincos(x):
 # fast path: Omega_t <= Omega_n
 # --------------------------------------------------------------------------------------
 def _uf_soft(rho, Lam, e, thf):
-    """Final U = u_f/u_0 for rho = Omega_t/Omega_n <= 1 (1-D arrays).
+    """Return the final U = u_f/u_0 for rho = Omega_t/Omega_n <= 1 (1-D arrays).
 
     For rho <= 1 the phase sequence is provably simple (docs/stronge.md, "Fast path"):
     either gross slip (Lam <= 1) or one stick phase from t = 0 followed by slip to
@@ -192,12 +193,12 @@ def _uf_soft(rho, Lam, e, thf):
     i = np.flatnonzero(load)
     if i.size:
         th = _root_loading(rho[i], Lam[i])
-        sr, cr = _sincos(rho[i] * th)
+        _, cr = _sincos(rho[i] * th)
         out[i] = cr - r2[i] * Lam[i] * (e[i] + np.cos(th))
     j = np.flatnonzero(~load & ~through)
     if j.size:
         x = _root_unloading(rho[j], Lam[j], e[j], thf[j], x0[j])
-        sr, cr = _sincos(rho[j] * (thf[j] - e[j] * x))
+        _sr, cr = _sincos(rho[j] * (thf[j] - e[j] * x))
         sh = np.sin(0.5 * x)
         out[j] = cr - r2[j] * Lam[j] * 2.0 * e[j] * sh * sh
     uf[st] = out
@@ -647,7 +648,7 @@ def _eval_pieces(pc: _Pieces, rho, Lam, e, thf, th):
 
 def _stretch_max(pc: _Pieces, rho, Lam, e, thf):
     """Time and value of max |S| over the contact, from the pieces (T-scaled S)."""
-    n, P = pc.start.shape
+    n, _P = pc.start.shape
     end = np.concatenate([pc.start[:, 1:], np.full((n, 1), np.inf)], axis=1)
     end = np.minimum(end, thf[:, None])
     cands = [pc.start, end]
@@ -664,7 +665,7 @@ def _stretch_max(pc: _Pieces, rho, Lam, e, thf):
     C = np.concatenate(cands, axis=1)
     C = np.where(np.isfinite(C) & (C <= thf[:, None]), C, np.nan)
     Cf = np.where(np.isnan(C), 0.0, C)
-    U, S, W, N = _eval_pieces(pc, rho, Lam, e, thf, Cf)
+    _U, S, _W, _N = _eval_pieces(pc, rho, Lam, e, thf, Cf)
     A = np.where(np.isnan(C), -1.0, np.abs(S))
     k = np.argmax(A, axis=1)
     rows = np.arange(n)
@@ -685,7 +686,7 @@ class Regime(enum.IntEnum):
 
 
 def regime_code(name: str) -> Regime:
-    """The :class:`Regime` of a phase-sequence name such as ``"stick-slip"`` (OTHER if unlisted)."""
+    """Return the :class:`Regime` of a phase-sequence name such as ``"stick-slip"`` (OTHER if unlisted)."""
     return Regime.__members__.get(name.upper().replace("-", "_"), Regime.OTHER)
 
 
@@ -753,7 +754,7 @@ def stronge_solve(
     n = p.rho.size
     idx = np.arange(n)
     pc = _engine(p, idx)
-    regime, comp, nph = _regimes(pc)
+    regime, _comp, nph = _regimes(pc)
     to_t = 1.0 / HALF_PI
     P = pc.start.shape[1]
     valid = np.arange(P)[None, :] < pc.n[:, None]
@@ -804,7 +805,7 @@ def stronge_solve(
         En = np.where(th < HALF_PI, 1.0, p.e[:, None] ** 2)
         E = (En + (u * u + r2 * s * s) / (eta2 * r2)) / (1.0 + T * T / (eta2 * r2))
         E = np.where(after, np.nan, E)
-        shp = sh + (t.size,)
+        shp = (*sh, t.size)
         kw.update(
             t=t,
             normal_force=N.reshape(shp),
@@ -833,7 +834,7 @@ def stronge_reference(
     rtol: float = 1e-12,
     atol: float = 1e-14,
 ) -> dict:
-    """Reference solution of the same model by numerical integration (for tests).
+    """Return the reference solution of the same model by numerical integration (for tests).
 
     Integrates the equations of motion of PHYSICS.md, Sec. V.A, in physical form (unit
     ball mass, unit k_n, unit incident speed; normal compression and velocity are state
@@ -964,7 +965,7 @@ def _reference_one(psi, eta2, e, mu, r_x, r_y, alpha, rtol, atol):
         evs.append((t, seq[-1]))
     else:
         raise RuntimeError(f"stronge_reference: too many phase changes for psi={psi:g}, eta2={eta2:g}")
-    merged = [seq[0]] + [b for a, b in zip(seq, seq[1:], strict=False) if a != b]
+    merged = [seq[0]] + [b for a, b in itertools.pairwise(seq) if a != b]
     regime = "gross-slip" if merged == ["slip"] else "-".join(merged)
     return -y[2] / u0, regime, t_c, [(te / t_c, ph) for te, ph in evs]
 
