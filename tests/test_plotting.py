@@ -145,12 +145,3 @@ def test_comparison_html(tmp_path):
     text = reporting.comparison_html(csv, tmp_path / "t.html", title="A & B")
     assert "<td>0.464</td>" in text and "A &amp; B" in text
     assert (tmp_path / "t.html").read_text() == text
-
-
-def test_matplotlib_only_in_plotting():
-    """Only the plotting module imports matplotlib (jobs that do not draw stay light)."""
-    from pathlib import Path
-
-    pkg = Path(plotting.__file__).parent
-    users = sorted(p.name for p in pkg.glob("*.py") if "import matplotlib" in p.read_text())
-    assert users == ["plotting.py"]

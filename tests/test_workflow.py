@@ -5,6 +5,7 @@ from __future__ import annotations
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -210,9 +211,23 @@ def test_config_error_names_the_key(tmp_path):
     assert "normalize.v_ref_mph: 'fast' is not of type 'number'" in text
 
 
-@pytest.mark.parametrize("script", ["simulate", "normalize", "reconstruct", "fit_ex", "compare"])
+@pytest.mark.parametrize(
+    "script",
+    [
+        "simulate",
+        "ingest",
+        "normalize",
+        "reconstruct",
+        "fit_ex",
+        "fit_stronge",
+        "compare",
+        "comparison_html",
+        "implications",
+        "implications_compare",
+    ],
+)
 def test_jobs_import_only_what_they_use(script):
-    """No job imports lmfit or matplotlib unless it fits or draws (issue 2, speed)."""
+    """No job but the plot jobs imports matplotlib, and none imports lmfit before it fits (start-up time)."""
     from ballbat.pipeline.codedeps import module_names
 
     mods = module_names(str(ROOT / "workflow" / "scripts" / f"{script}.py"))
@@ -223,6 +238,36 @@ def test_jobs_import_only_what_they_use(script):
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "[]", (script, out.stdout)
+
+
+def test_results_pass_the_cf_checker(run_dir):
+    """Every NetCDF file of a run passes the IOOS compliance-checker's CF 1.10 suite (issue 9).
+
+    The checker raises inside its own monotonicity check on string-valued coordinates (ball,
+    bat); that check is then not scored, so it cannot hide a failure of another.
+    """
+    import json
+
+    files = sorted(str(p) for p in (run_dir / "results").rglob("*.nc"))
+    assert len(files) >= 7  # small: simulate .. stronge; implications: paper, flyballs
+    report = run_dir / "cf.json"
+    checker = Path(sys.executable).parent / "compliance-checker"
+    subprocess.run(
+        [str(checker), "--test", "cf:1.10", "-f", "json_new", "-o", str(report), *files],
+        capture_output=True,
+        timeout=600,
+    )
+    results = json.loads(report.read_text())
+    assert sorted(results) == files
+    for name, res in results.items():
+        cf = res["cf:1.10"]
+        failed = [
+            f"{c['name']}: {c['msgs']}"
+            for level in ("high_priorities", "medium_priorities", "low_priorities")
+            for c in cf[level]
+            if c["msgs"]
+        ]
+        assert cf["scored_points"] == cf["possible_points"] and not failed, (name, failed)
 
 
 def test_figures_drawn(run_dir):

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 import os
-import re
 import shutil
 import subprocess
 import sys
@@ -54,16 +53,19 @@ def assert_not_blank(png, min_colors: int = 6) -> None:
 
 
 def planned_jobs(workdir: Path, *args: str) -> dict[str, int]:
-    """Rule -> job count of a dry run (empty when nothing is to be done)."""
-    out = snakemake(workdir, "-n", *args)
-    text = out.stdout + out.stderr
-    if "Nothing to be done" in text:
-        return {}
-    m = re.search(r"Job stats:\n.*?\n-+\s+-+\n(.*?)\ntotal", text, re.S)
-    assert m, text[-3000:]
-    jobs = {}
-    for line in m.group(1).strip().splitlines():
-        name, count = line.split()
-        jobs[name] = int(count)
-    jobs.pop("all", None)
-    return jobs
+    """Rule -> job count of what a run would do (empty when nothing is to be done).
+
+    Reads Snakemake's machine-readable ``--summary`` table (tab-separated: output file, date,
+    rule, log file(s), status, plan): a job is one (rule, log file) pair with an output whose
+    plan is "update pending" (every rule of this workflow has a log of its own per job).
+    """
+    out = snakemake(workdir, "--summary", *args)
+    lines = out.stdout.splitlines()
+    header = lines[0].split("\t")
+    col = {name: header.index(name) for name in ("rule", "log-file(s)", "plan")}
+    jobs: dict[str, set[str]] = {}
+    for line in lines[1:]:
+        cells = line.split("\t")
+        if len(cells) == len(header) and cells[col["plan"]] == "update pending":
+            jobs.setdefault(cells[col["rule"]], set()).add(cells[col["log-file(s)"]])
+    return {rule: len(logs) for rule, logs in jobs.items()}

@@ -1,4 +1,4 @@
-"""Per-impact analysis stages: normalisation to 77 mph and psi reconstruction (Secs. II-III).
+"""Per-impact analysis stages: normalisation to the reference bat speed and psi reconstruction (Secs. II-III).
 
 Each function takes the impacts as an :class:`xarray.Dataset` (dimension ``impact``, SI
 units) and returns a copy with new variables, every one with units and a long name.
@@ -62,7 +62,7 @@ RECONSTRUCT_TABLE = {
     "r": Var(("impact",), "m", "ball radius"),
     "m": Var(("impact",), "kg", "ball mass"),
     "alpha": Var(("impact",), "1", "ball moment of inertia over m r^2 (Eq. iball)"),
-    "R": Var(("impact",), "m", "bat radius at the impact location"),
+    "R_bat": Var(("impact",), "m", "bat radius R at the impact location (Table II)"),
     "r_x": Var(("impact",), "1", "tangential recoil factor r_x (Eq. rx)"),
     "r_y": Var(("impact",), "1", "normal recoil factor r_y (Eq. ry)"),
     "psi": Var(("impact",), "rad", "impact angle psi reconstructed from Eq. angmom"),
@@ -115,7 +115,7 @@ def reconstruct(ds: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]) ->
         "r": r,
         "m": np.array([balls[b].m for b in ball_ids]),
         "alpha": alpha,
-        "R": R,
+        "R_bat": R,
         "r_x": r_x,
         "r_y": np.array([pairs[(b, t)][1] for b, t in zip(ball_ids, bat_ids, strict=True)]),
         "psi": psi,

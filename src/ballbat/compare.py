@@ -106,7 +106,7 @@ def impact_rows(rec: xr.Dataset) -> list[dict]:
         psi = rec["psi"].values[sel]
         D = rec["D"].values[sel]
         tpsi = rec["truth_psi"].values[ball == b] if has_truth else None
-        tD = offset_from_psi(tpsi, rec["r"].values[ball == b], rec["R"].values[ball == b]) if has_truth else None
+        tD = offset_from_psi(tpsi, rec["r"].values[ball == b], rec["R_bat"].values[ball == b]) if has_truth else None
         rows += [
             {
                 "quantity": "psi_max",

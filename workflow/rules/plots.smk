@@ -68,7 +68,7 @@ rule plot_fig9:
 
 
 rule plot_fig10:
-    """Draw Fig. 10: Stronge's model's forces and tangential velocity against time at psi = 30 deg."""
+    """Draw Fig. 10: Stronge's model's forces and tangential velocity against time at stronge.psi_history_deg."""
     input:
         stronge=rules.fit_stronge.output.stronge,
         code=code("plot.py"),

@@ -4,7 +4,7 @@ For each ball the Eq. vtf data of the usable impacts (``flag == 0``) are fitted 
 Stronge's lumped-parameter model in the bat frame, each impact with its own recoil
 factors (:func:`ballbat.stronge.fit.fit_eta2`). The result holds the fitted parameters and
 intervals, the model curves on a psi grid (Fig. 9a and its extrapolation, Fig. 9b) for the
-fitted and for the published eta^2, the time histories at psi = 30 deg (Fig. 10) and the
+fitted and for the published eta^2, the time histories at psi_history_deg (Fig. 10; the paper shows 30 deg) and the
 regime boundaries in psi.
 
 References
