@@ -20,7 +20,8 @@ from pathlib import Path
 import numpy as np
 
 from ballbat.properties import load_balls, load_bats, recoil_factors
-from ballbat.stronge.model import stronge_ex, stronge_reference, stronge_solve
+from ballbat.stronge.model import stronge_ex, stronge_solve
+from ballbat.stronge.reference import stronge_reference
 
 ROOT = Path(__file__).resolve().parents[1]
 DEG = np.pi / 180

@@ -17,13 +17,9 @@ import pytest
 
 from ballbat.properties import recoil_factors
 from ballbat.stronge.fit import Eta2FitError, fit_eta2
-from ballbat.stronge.model import (
-    omega_ratio,
-    regime_boundaries,
-    stronge_ex,
-    stronge_reference,
-    stronge_solve,
-)
+from ballbat.stronge.model import omega_ratio, stronge_ex, stronge_solve
+from ballbat.stronge.reference import stronge_reference
+from ballbat.stronge.regimes import regime_boundaries
 
 DEG = np.pi / 180
 #: Paper, Sec. V.A: fitted eta^2 with e_y = mu = 0.5.

@@ -25,7 +25,8 @@ from ..published import STRONGE_E_Y as PUBLISHED_E_Y
 from ..published import STRONGE_MU as PUBLISHED_MU
 from ..published import per_ball
 from .fit import fit_eta2
-from .model import Regime, omega_ratio, regime_boundaries, regime_code, stronge_ex, stronge_solve
+from .model import Regime, omega_ratio, regime_code, stronge_ex, stronge_solve
+from .regimes import regime_boundaries
 
 #: eta^2 published in Sec. V.A (with e_y = mu = 0.5), drawn beside the fits.
 PUBLISHED_ETA2 = per_ball("eta2")

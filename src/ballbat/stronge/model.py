@@ -21,7 +21,7 @@ Dimensionless variables used throughout (``theta = Omega_n t``, so ``t_c`` is
 
 Every phase is linear with constant coefficients, so :func:`stronge_ex` and
 :func:`stronge_solve` evaluate each phase in closed form and find the phase-change times
-by vectorised root finding (no loop over impacts). :func:`stronge_reference` integrates
+by vectorised root finding (no loop over impacts). :func:`ballbat.stronge.reference.stronge_reference` integrates
 the same model numerically with ``scipy.integrate.solve_ivp`` and is meant for tests.
 
 References
@@ -36,19 +36,17 @@ References
 from __future__ import annotations
 
 import enum
-import itertools
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
-    "RegimeBoundaries",
+    "Regime",
     "StrongeSolution",
     "omega_ratio",
-    "regime_boundaries",
+    "regime_code",
     "stronge_ex",
-    "stronge_reference",
     "stronge_solve",
 ]
 
@@ -818,244 +816,3 @@ def stronge_solve(
     if not sh:
         kw = {k: (v[()] if isinstance(v, np.ndarray) and k != "t" and v.ndim == 0 else v) for k, v in kw.items()}
     return StrongeSolution(**kw)
-
-
-# --------------------------------------------------------------------------------------
-# independent reference: numerical integration with events
-# --------------------------------------------------------------------------------------
-def stronge_reference(
-    psi: ArrayLike,
-    eta2: ArrayLike,
-    e_y: ArrayLike,
-    mu: ArrayLike,
-    r_x: ArrayLike = 0.0,
-    r_y: ArrayLike = 0.0,
-    alpha: ArrayLike = 0.4,
-    rtol: float = 1e-12,
-    atol: float = 1e-14,
-) -> dict:
-    """Return the reference solution of the same model by numerical integration (for tests).
-
-    Integrates the equations of motion of PHYSICS.md, Sec. V.A, in physical form (unit
-    ball mass, unit k_n, unit incident speed; normal compression and velocity are state
-    variables, so the normal force law is integrated rather than evaluated in closed form)
-    with ``scipy.integrate.solve_ivp`` (DOP853, tolerances ``rtol``/``atol``) and terminal
-    events for maximum compression, separation, stick-to-slip (k_t|s| = mu N) and
-    slip-to-stick (w = u - ds/dt = 0). A Python loop over impacts: slow, by design simple.
-
-    Returns
-    -------
-    dict
-        ``e_x`` (array of the broadcast shape), ``regime`` (array of str), ``t_c`` (the
-        integrated time of maximum compression, in units of 1/Omega_n), ``events`` (list of
-        lists of (t/t_c, new phase) per impact).
-
-    Notes
-    -----
-    At psi = 0 the tangential motion has zero amplitude; the limit psi -> 0 is computed by
-    integrating with unit tangential speed and no friction limit (stick throughout), which
-    is the limit of the model as tan(psi)/(mu eta2) -> 0.
-    """
-    arrs = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (psi, eta2, e_y, mu, r_x, r_y, alpha)))
-    shape = arrs[0].shape
-    out = [_reference_one(*args, rtol=rtol, atol=atol) for args in zip(*(a.ravel() for a in arrs), strict=True)]
-    ex = np.array([o[0] for o in out])
-    return {
-        "e_x": ex.reshape(shape) if shape else float(ex[0]),
-        "regime": np.array([o[1] for o in out]).reshape(shape),
-        "t_c": np.array([o[2] for o in out]).reshape(shape),
-        "events": [o[3] for o in out],
-    }
-
-
-def _reference_one(psi, eta2, e, mu, r_x, r_y, alpha, rtol, atol):
-    """One impact of :func:`stronge_reference`: (e_x, regime, t_c, events)."""
-    from scipy.integrate import solve_ivp
-
-    m_n = 1.0 / (1.0 + r_y)
-    m_t = alpha / ((1.0 + alpha) * (1.0 + r_x))
-    k_n = 1.0
-    k_t = k_n / eta2
-    v_n = np.cos(psi)
-    u0 = abs(np.sin(psi))
-    fric = mu
-    if u0 == 0.0:
-        u0, fric = 1.0, np.inf
-    st = {"unloading": False, "d_m": np.nan}
-
-    def normal_force(d):
-        if st["unloading"]:
-            return (k_n / e**2) * (d - st["d_m"] * (1.0 - e**2))
-        return k_n * d
-
-    def dN_dt(d, v):
-        return (k_n / e**2 if st["unloading"] else k_n) * v
-
-    def rhs(t, y, mode):
-        d, v, u, s = y
-        N = normal_force(d)
-        if mode == 0:
-            return [v, -N / m_n, -k_t * s / m_t, u]
-        return [v, -N / m_n, -mode * fric * N / m_t, mode * fric * dN_dt(d, v) / k_t]
-
-    def ev_compression(t, y):
-        return y[1]
-
-    def ev_separation(t, y):
-        return normal_force(y[0])
-
-    def ev_stick_pos(t, y):
-        return k_t * y[3] - fric * normal_force(y[0])
-
-    def ev_stick_neg(t, y):
-        return -k_t * y[3] - fric * normal_force(y[0])
-
-    def ev_slip(t, y, mode):
-        return y[2] - mode * fric * dN_dt(y[0], y[1]) / k_t
-
-    for f, d in ((ev_compression, -1), (ev_separation, -1), (ev_stick_pos, 1), (ev_stick_neg, 1)):
-        f.terminal, f.direction = True, d
-
-    y = np.array([0.0, v_n, u0, 0.0])
-    t = 0.0
-    mode = 0 if (np.isinf(fric) or k_t * u0 < fric * k_n * v_n) else 1
-    seq = ["stick" if mode == 0 else "slip"]
-    evs = []
-    t_c = np.nan
-    for _ in range(200):
-        evl = [ev_separation if st["unloading"] else ev_compression]
-        if mode == 0 and np.isfinite(fric):
-            evl += [ev_stick_pos, ev_stick_neg]
-        elif mode != 0:
-
-            def ev(t, y, mode=mode):
-                return ev_slip(t, y, mode)
-
-            ev.terminal, ev.direction = True, -mode
-            evl.append(ev)
-        sol = solve_ivp(
-            lambda t, y, mode=mode: rhs(t, y, mode),
-            (t, t + 10.0),
-            y,
-            method="DOP853",
-            rtol=rtol,
-            atol=atol,
-            events=evl,
-        )
-        if sol.status != 1:
-            raise RuntimeError(
-                f"stronge_reference: integration failed ({sol.message}) for psi={psi:g}, eta2={eta2:g},"
-                f" e_y={e:g}, mu={mu:g}, r_x={r_x:g}, r_y={r_y:g}"
-            )
-        t, k_hit = min((te[0], k) for k, te in enumerate(sol.t_events) if te.size)
-        y = sol.y_events[k_hit][0].copy()
-        if k_hit == 0:
-            if st["unloading"]:
-                break  # separation
-            st["unloading"], st["d_m"] = True, y[0]
-            t_c = t
-            continue
-        if mode == 0:
-            mode = 1 if k_hit == 1 else -1
-            y[3] = mode * fric * normal_force(y[0]) / k_t
-            seq.append("slip")
-        else:
-            mode = 0
-            seq.append("stick")
-        evs.append((t, seq[-1]))
-    else:
-        raise RuntimeError(f"stronge_reference: too many phase changes for psi={psi:g}, eta2={eta2:g}")
-    merged = [seq[0]] + [b for a, b in itertools.pairwise(seq) if a != b]
-    regime = "gross-slip" if merged == ["slip"] else "-".join(merged)
-    return -y[2] / u0, regime, t_c, [(te / t_c, ph) for te, ph in evs]
-
-
-# --------------------------------------------------------------------------------------
-# regime boundaries
-# --------------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class RegimeBoundaries:
-    """Incidence angles where the phase sequence of Stronge's model changes.
-
-    Attributes
-    ----------
-    psi : angles (rad) where the solver's regime changes, increasing.
-    below, above : the regime just below and just above each angle.
-    psi_stick_paper : atan(mu eta2), the paper's (and the model's) end of initial stick.
-    psi_gross_paper : atan(3.5 mu (1 + e_y)), the paper's onset of gross slip.
-    psi_rigid_reversal : atan(rho^2 mu eta2 (1 + e_y)): where gross slip of the model gives
-        u_f = 0 (e_x = 0); equals the paper's 3.5 mu (1 + e_y) in the rigid frame. It is the
-        rigid-body (Coulomb, no tangential compliance) onset of gross slip.
-    psi_gross_model : the model's onset of gross slip in closed form (docs/stronge.md):
-        atan(mu eta2) when Omega_t <= Omega_n, otherwise
-        atan(rho^2 mu eta2 max(1, 1 + e_y - 1/(rho^2 e_y))) (C's slip velocity at t_c, or at
-        separation, reaching zero). It tends to the paper's 3.5 mu (1 + e_y) as eta2 -> 0.
-    """
-
-    psi: NDArray
-    below: tuple
-    above: tuple
-    psi_stick_paper: float
-    psi_gross_paper: float
-    psi_rigid_reversal: float
-    psi_gross_model: float
-
-
-def regime_boundaries(
-    eta2: float,
-    e_y: float,
-    mu: float,
-    r_x: float = 0.0,
-    r_y: float = 0.0,
-    alpha: float = 0.4,
-    n_grid: int = 721,
-    psi_max: float = np.deg2rad(89.9),
-) -> RegimeBoundaries:
-    """Find where the regime (phase sequence) of :func:`stronge_solve` changes with psi.
-
-    Parameters
-    ----------
-    eta2, e_y, mu, r_x, r_y, alpha : scalars, as in :func:`stronge_ex`.
-    n_grid : number of psi values scanned in (0, psi_max].
-    psi_max : largest psi scanned, rad.
-
-    Returns
-    -------
-    RegimeBoundaries
-        The solver's boundaries (scan, then bisection on the regime label to ~1e-13 rad)
-        next to the boundaries stated in Sec. V.A of Kensrud et al. (2017).
-
-    Notes
-    -----
-    The paper (after Stronge) states: stick-slip for tan psi < mu eta2, slip-stick-slip for
-    mu eta2 <= tan psi < 3.5 mu (1 + e_y), gross slip above. psi = 0 itself is left out of
-    the scan (there the tangential motion vanishes and the limit psi -> 0 is pure stick).
-    Two changes closer together than the scan step may be missed.
-    """
-    args = [float(a) for a in (eta2, e_y, mu, r_x, r_y, alpha)]
-    psi = np.linspace(0.0, psi_max, int(n_grid) + 1)[1:]
-    reg = stronge_solve(psi, *args).regime
-    ch = np.flatnonzero(reg[1:] != reg[:-1])
-    lo, hi = psi[ch], psi[ch + 1]
-    left = reg[ch]
-    for _ in range(60):
-        if lo.size == 0:
-            break
-        mid = 0.5 * (lo + hi)
-        same = stronge_solve(mid, *args).regime == left
-        lo = np.where(same, mid, lo)
-        hi = np.where(same, hi, mid)
-        if np.all(hi - lo < 1e-13):
-            break
-    rho = omega_ratio(args[0], args[3], args[4], args[5])
-    return RegimeBoundaries(
-        psi=0.5 * (lo + hi),
-        below=tuple(str(r) for r in reg[ch]),
-        above=tuple(str(r) for r in reg[ch + 1]),
-        psi_stick_paper=float(np.arctan(mu * eta2)),
-        psi_gross_paper=float(np.arctan(3.5 * mu * (1.0 + e_y))),
-        psi_rigid_reversal=float(np.arctan(rho**2 * mu * eta2 * (1.0 + e_y))),
-        psi_gross_model=float(
-            np.arctan(mu * eta2 * (1.0 if rho <= 1 else rho**2 * max(1.0, 1.0 + e_y - 1.0 / (rho**2 * e_y))))
-        ),
-    )
