@@ -287,6 +287,9 @@ def test_small_group_not_fitted(tmp_path):
     small = fit.sel(ball="baseball", bat="metal_rough")
     assert np.isnan(float(small["e_x"])) and int(small["e_x_n"]) == 2
     assert int(small["e_x_status"]) == FitStatus.TOO_FEW_IMPACTS
+    assert fitting.not_fitted(fit) == [
+        "e_x (ball baseball, bat metal_rough): not fitted: too few impacts (2 usable impacts)"
+    ]
     assert np.isfinite(float(fit["e_x"].sel(ball="baseball", bat="wood")))
     assert int(fit["e_x_pooled_n"].sel(ball="baseball")) == 6
     assert int(fit["e_x_status"].sel(ball="baseball", bat="wood")) == FitStatus.OK

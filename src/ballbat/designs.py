@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .kinematics import psi_partials
+from .kinematics import angmom_argument, psi_partials
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -49,7 +49,7 @@ def tan_ratio_design(
 ) -> Design:
     """Eq. ratio: x = tan psi, y = tan(psi - theta) = q / sqrt(1 - q^2), q = alpha r omega / v_ball."""
     psi, dpsi = psi_partials(v_ball, theta, omega, r, alpha)
-    q = alpha * r * omega / v_ball
+    q = angmom_argument(v_ball, omega, r, alpha)
     x = np.tan(psi)
     y = q / np.sqrt(1.0 - q**2)
     jx = (1.0 / np.cos(psi) ** 2)[:, None] * dpsi

@@ -320,3 +320,15 @@ def fit_dataset(impacts: xr.Dataset, mu_k_example: float) -> xr.Dataset:
     ds.attrs["n_excluded"] = int((impacts["flag"].values != 0).sum())
     ds.attrs["v_ref"] = float(impacts.attrs["v_ref"])
     return ds
+
+
+def not_fitted(ds: xr.Dataset) -> list[str]:
+    """List the fits of e_x in fit_ex.nc that have impacts but no value, one line each (for the log)."""
+    lines = []
+    for name in _SLOPE_IS_ONE_PLUS:
+        status, n = ds[f"{name}_status"], ds[f"{name}_n"]
+        for idx in zip(*np.nonzero(status.values > FitStatus.NO_IMPACTS), strict=True):
+            where = ", ".join(f"{d} {ds[d].values[i]}" for d, i in zip(status.dims, idx, strict=True))
+            reason = FitStatus(int(status.values[idx])).name.lower().replace("_", " ")
+            lines.append(f"{name} ({where}): not fitted: {reason} ({int(n.values[idx])} usable impacts)")
+    return lines

@@ -146,6 +146,15 @@ def _legend(ax, **kw):
     ax.legend(fontsize=7, frameon=False, **kw)
 
 
+def _axes_from_origin(ax, xlabel: str, ylabel: str, title: str) -> None:
+    """Label a plot whose data start at the origin (both axes from 0)."""
+    ax.set_xlim(left=0)
+    ax.set_ylim(bottom=0)
+    ax.set_xlabel(xlabel)
+    ax.set_ylabel(ylabel)
+    ax.set_title(title, fontsize=10)
+
+
 def _legend_outside(fig, ax):
     """Legend to the right of the axes, so it never hides data points."""
     fig.legend(*ax.get_legend_handles_labels(), loc="outside right center", fontsize=7, frameon=False)
@@ -270,11 +279,9 @@ def fig5_spin_vs_bracket(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
             family="monospace",
             bbox={"facecolor": "white", "edgecolor": "0.8", "alpha": 0.9},
         )
-    ax.set_xlim(left=0)
-    ax.set_ylim(bottom=0)
-    ax.set_xlabel("v_bat sin ψ / [r (1 + r_x)(1 + α)]  (rpm)")
-    ax.set_ylabel("spin ω (rpm)")
-    ax.set_title("Fig. 5: spin vs the bracket of Eq. (omega)", fontsize=10)
+    _axes_from_origin(
+        ax, "v_bat sin ψ / [r (1 + r_x)(1 + α)]  (rpm)", "spin ω (rpm)", "Fig. 5: spin vs the bracket of Eq. (omega)"
+    )
     _legend_outside(fig, ax)
     _excluded_note(ax, n_excluded)
     return fig
@@ -299,11 +306,7 @@ def fig6_tan_ratio(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
         paper = reporting.PAPER["tan_ratio_slope"].get(ball)
         if paper is not None:
             ax.plot(xb, paper * xb, ":", color=c, lw=2.2, alpha=0.6, label=f"{ball} paper: {paper:g}")
-    ax.set_xlim(left=0)
-    ax.set_ylim(bottom=0)
-    ax.set_xlabel("tan ψ")
-    ax.set_ylabel("tan(ψ − θ)")
-    ax.set_title("Fig. 6: tan(ψ − θ) vs tan ψ (Eq. ratio)", fontsize=10)
+    _axes_from_origin(ax, "tan ψ", "tan(ψ − θ)", "Fig. 6: tan(ψ − θ) vs tan ψ (Eq. ratio)")
     _legend_outside(fig, ax)
     _excluded_note(ax, n_excluded)
     return fig
@@ -380,11 +383,9 @@ def fig9a_stronge_fit(stronge: xr.Dataset) -> Figure:
                 lw=1.5,
                 label=f"{ball} paper: η² = {paper:g}" if paper else f"{ball} paper η²",
             )
-    ax.set_xlim(left=0)
-    ax.set_ylim(bottom=0)
-    ax.set_xlabel("tan ψ / (1 + r_x)")
-    ax.set_ylabel("(v_ball,t + r ω) / v_bat,n")
-    ax.set_title("Fig. 9a: data and Stronge's model (fitted η²)", fontsize=10)
+    _axes_from_origin(
+        ax, "tan ψ / (1 + r_x)", "(v_ball,t + r ω) / v_bat,n", "Fig. 9a: data and Stronge's model (fitted η²)"
+    )
     _legend(ax, loc="upper left")
     return fig
 
@@ -533,11 +534,7 @@ def fig11b_trajectories(scenario: xr.Dataset) -> Figure:
         ax.plot(x[ok], z[ok], "-", color=c, lw=1.5)
         j = int(np.nanargmax(np.where(ok, z, -np.inf)))
         ax.annotate(f"D = {D[i]:.2f} in", (x[j], z[j]), xytext=(2, 3), textcoords="offset points", fontsize=7, color=c)
-    ax.set_xlim(left=0)
-    ax.set_ylim(bottom=0)
-    ax.set_xlabel("horizontal distance (ft)")
-    ax.set_ylabel("height (ft)")
-    ax.set_title("Fig. 11b: trajectories for several offsets D", fontsize=10)
+    _axes_from_origin(ax, "horizontal distance (ft)", "height (ft)", "Fig. 11b: trajectories for several offsets D")
     return fig
 
 

@@ -1,7 +1,6 @@
 """Rule fit_stronge: adapter around ballbat.stronge.analysis.stronge_dataset."""
 
-from ballbat.pipeline.ncio import read_dataset, write_dataset
-from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.ncio import read_dataset, write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.stronge.analysis import stronge_dataset
 
@@ -10,11 +9,6 @@ with logged(snakemake.log[0], snakemake.rule) as log:
     for b in ds.ball.values:
         f = ds.sel(ball=b)
         log.info("%s: eta2 = %.3f +- %.3f (n = %d, reduced chi2 %.2f)", b, f.eta2, f.eta2_err, f.eta2_n, f.eta2_redchi)
-    write_dataset(
-        ds,
-        snakemake.output.stronge,
-        title=f"Stronge contact model fitted to dataset {snakemake.wildcards.dataset} (Sec. V.A)",
-        rule=snakemake.rule,
-        inputs=data_inputs(snakemake.input),
-        config=dict(snakemake.params),
+    write_job_output(
+        ds, snakemake, "stronge", f"Stronge contact model fitted to dataset {snakemake.wildcards.dataset} (Sec. V.A)"
     )

@@ -1,8 +1,7 @@
 """Rule implications: adapter around ballbat.implications.run_scenario."""
 
 from ballbat.implications import pooled_e_x, run_scenario
-from ballbat.pipeline.ncio import write_dataset
-from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
 
@@ -15,11 +14,9 @@ with logged(snakemake.log[0], snakemake.rule):
         air=snakemake.params.air,
         e_x=pooled_e_x(snakemake.input.fit, scenario["ball"]) if "fit" in snakemake.input.keys() else None,
     )
-    write_dataset(
+    write_job_output(
         ds,
-        snakemake.output.scenario,
-        title=f"Batted-ball scenario {snakemake.wildcards.scenario}: collision and flight (Sec. V.B)",
-        rule=snakemake.rule,
-        inputs=data_inputs(snakemake.input),
-        config=dict(snakemake.params),
+        snakemake,
+        "scenario",
+        f"Batted-ball scenario {snakemake.wildcards.scenario}: collision and flight (Sec. V.B)",
     )

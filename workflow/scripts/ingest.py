@@ -1,8 +1,7 @@
 """Rule ingest: adapter around ballbat.ingest.ingest."""
 
 from ballbat.ingest import excluded_listing, ingest
-from ballbat.pipeline.ncio import write_dataset
-from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
 
 with logged(snakemake.log[0], snakemake.rule) as log:
@@ -13,11 +12,10 @@ with logged(snakemake.log[0], snakemake.rule) as log:
     log.info("%d of %d impacts excluded (kept in the file, flagged)", len(excluded), ds.sizes["impact"])
     for line in excluded:
         log.info("excluded: %s", line)
-    write_dataset(
+    write_job_output(
         ds,
-        snakemake.output.impacts,
-        title=f"Measured ball-bat impacts of dataset {snakemake.wildcards.dataset}, checked and in SI",
-        rule=snakemake.rule,
-        inputs=data_inputs(snakemake.input),
+        snakemake,
+        "impacts",
+        f"Measured ball-bat impacts of dataset {snakemake.wildcards.dataset}, checked and in SI",
         config={},
     )

@@ -1,8 +1,7 @@
 """Rule reconstruct: adapter around ballbat.analysis.reconstruct."""
 
 from ballbat.analysis import reconstruct
-from ballbat.pipeline.ncio import read_dataset, write_dataset
-from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.ncio import read_dataset, write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
 
@@ -16,11 +15,10 @@ with logged(snakemake.log[0], snakemake.rule) as log:
     log.info("%d of %d impacts not used (flagged, kept in the file)", bad, ds.sizes["impact"])
     for i in (ds["flag"].values != 0).nonzero()[0]:
         log.info("not used: impact %d: %s", int(ds["impact"].values[i]), ds["flag_reason"].values[i])
-    write_dataset(
+    write_job_output(
         ds,
-        snakemake.output.impacts,
-        title=f"Impacts of dataset {snakemake.wildcards.dataset} with the reconstructed geometry (Sec. III)",
-        rule=snakemake.rule,
-        inputs=data_inputs(snakemake.input),
+        snakemake,
+        "impacts",
+        f"Impacts of dataset {snakemake.wildcards.dataset} with the reconstructed geometry (Sec. III)",
         config={},
     )

@@ -17,7 +17,7 @@ import xarray as xr
 
 from .. import __version__
 from .atomic import atomic_target
-from .provenance import provenance_attrs
+from .provenance import data_inputs, provenance_attrs
 
 if TYPE_CHECKING:
     import os
@@ -85,6 +85,23 @@ def write_dataset(
     with atomic_target(path) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=encoding)
     return path
+
+
+def write_job_output(ds: xr.Dataset, job: object, output: str, title: str, config: dict | None = None) -> Path:
+    """Write ``ds`` to a Snakemake job's output ``output``, with the job's provenance.
+
+    ``job`` is the ``snakemake`` object of a rule's script: its rule name, its data inputs
+    (:func:`~ballbat.pipeline.provenance.data_inputs`) and, unless ``config`` is given, its
+    params are recorded.
+    """
+    return write_dataset(
+        ds,
+        job.output[output],
+        title=title,
+        rule=job.rule,
+        inputs=data_inputs(job.input),
+        config=dict(job.params) if config is None else config,
+    )
 
 
 def read_dataset(path: str | os.PathLike[str], require: tuple[str, ...] = ()) -> xr.Dataset:
