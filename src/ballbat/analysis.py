@@ -18,6 +18,7 @@ from .kinematics import (
     offset_from_psi,
     reconstruct_psi,
     spin_bracket,
+    tan_psi_minus_theta,
     vtf_bracket,
     vtf_ordinate,
 )
@@ -132,6 +133,6 @@ def reconstruct(ds: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]) ->
             vtf_x=vtf_bracket(psi, r_x),
             vtf_y=vtf_ordinate(v_ball, theta, omega, v_bat, psi, r),
             tan_psi=np.tan(psi),
-            tan_psi_minus_theta=np.tan(psi - theta),
+            tan_psi_minus_theta=tan_psi_minus_theta(v_ball, omega, r, alpha),
         )
     return add_variables(ds, RECONSTRUCT_TABLE, values)

@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .kinematics import angmom_argument, psi_partials
+from .kinematics import angmom_argument, psi_partials, tan_psi_minus_theta
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -51,7 +51,7 @@ def tan_ratio_design(
     psi, dpsi = psi_partials(v_ball, theta, omega, r, alpha)
     q = angmom_argument(v_ball, omega, r, alpha)
     x = np.tan(psi)
-    y = q / np.sqrt(1.0 - q**2)
+    y = tan_psi_minus_theta(v_ball, omega, r, alpha)
     jx = (1.0 / np.cos(psi) ** 2)[:, None] * dpsi
     dydq = (1.0 - q**2) ** -1.5
     jy = np.zeros_like(jx)

@@ -161,6 +161,18 @@ def reconstruct_psi(
     return psi, flag
 
 
+def tan_psi_minus_theta(v_ball: ArrayLike, omega: ArrayLike, r: ArrayLike, alpha: ArrayLike) -> np.ndarray:
+    """Return tan(psi - theta) = v_ball,t / v_ball,n, the right side of Eq. muk.
+
+    The ratio of tangential to normal impulse bounds the kinetic friction from below
+    (mu_k >= tan(psi - theta), Eq. muk). With Eq. angmom, sin(psi - theta) = q =
+    alpha r omega / v_ball, so tan(psi - theta) = q / sqrt(1 - q^2) (NaN where |q| > 1).
+    """
+    q = angmom_argument(v_ball, omega, r, alpha)
+    with np.errstate(invalid="ignore"):
+        return q / np.sqrt(1.0 - q**2)
+
+
 def psi_partials(
     v_ball: ArrayLike, theta: ArrayLike, omega: ArrayLike, r: ArrayLike, alpha: ArrayLike
 ) -> tuple[np.ndarray, np.ndarray]:
