@@ -10,6 +10,9 @@ from PIL import Image
 
 from ballbat import plotting, reporting
 from ballbat.pipeline.ncio import write_dataset
+from ballbat.pipeline.products import build_dataset
+from ballbat.stronge.analysis import PUBLISHED_ETA2, STRONGE_COORDS, stronge_variables
+from ballbat.stronge.regimes import Regime
 from workflow_helpers import assert_not_blank
 
 BALLS = ["baseball", "softball"]
@@ -20,7 +23,12 @@ def _attrs(units, long_name):
 
 
 def fake_stronge() -> xr.Dataset:
-    """A dataset with the variables and dimensions of results/{dataset}/stronge.nc (the contract)."""
+    """Made-up values in the declared layout of results/{dataset}/stronge.nc.
+
+    The layout is the package's own table (``stronge_variables``, ``STRONGE_COORDS``) and
+    ``build_dataset`` refuses values that miss or add a variable, so the fake cannot drift
+    from the file the workflow writes.
+    """
     psi = np.radians(np.linspace(0.0, 85.0, 86))
     r_x = np.array([0.12, 0.10])[:, None]
     eta2 = np.array([4.9, 6.1])
@@ -38,52 +46,60 @@ def fake_stronge() -> xr.Dataset:
     n_force = np.where(t <= 1.5, np.sin(np.pi * np.clip(t, 0, 1.5) / 1.5), np.nan)
     stick = np.where(t < 1.4, 1.0, np.where(t <= 1.5, 0.0, np.nan))
     tb = np.stack([t, t])
-    ds = xr.Dataset(
-        {
-            "eta2": ("ball", eta2, _attrs("1", "eta^2")),
-            "eta2_err": ("ball", [0.2, 0.3], _attrs("1", "se of eta^2")),
-            "eta2_ci_low": ("ball", eta2 - 0.4, _attrs("1", "low")),
-            "eta2_ci_high": ("ball", eta2 + 0.4, _attrs("1", "high")),
-            "e_y": ("ball", [0.5, 0.5], _attrs("1", "e_y")),
-            "mu": ("ball", [0.5, 0.5], _attrs("1", "mu")),
-            "omega_ratio": ("ball", [0.85, 0.76], _attrs("1", "Omega_t/Omega_n")),
-            "vtf_x_model": (("ball", "psi_grid"), vtf_x, _attrs("1", "x")),
-            "vtf_y_model": (("ball", "psi_grid"), (1 + e_x) * vtf_x, _attrs("1", "y")),
-            "e_x_model": (("ball", "psi_grid"), e_x, _attrs("1", "e_x")),
-            "vtf_y_published": (("ball", "psi_grid"), (1 + e_x_pub) * vtf_x, _attrs("1", "y pub")),
-            "e_x_published": (("ball", "psi_grid"), e_x_pub, _attrs("1", "e_x pub")),
-            "data_ball": ("impact_fit", data_ball, {"long_name": "ball"}),
-            "data_vtf_x": ("impact_fit", data_x, _attrs("1", "x")),
-            "data_vtf_y": ("impact_fit", data_y, _attrs("1", "y")),
-            "data_vtf_y_err": ("impact_fit", np.full(psi_d.size, 0.01), _attrs("1", "y err")),
-            "t_over_tc": ("sample", t, _attrs("1", "t/t_c")),
-            "normal_force": (("ball", "sample"), np.stack([n_force, n_force]), _attrs("1", "N/N_max")),
-            "tangential_force": (("ball", "sample"), 0.3 * np.sin(2 * tb) * np.stack([n_force] * 2), _attrs("1", "F")),
-            "tangential_velocity": (("ball", "sample"), 0.5 * np.cos(2.5 * tb), _attrs("1", "u")),
-            "spring_stretch": (("ball", "sample"), np.sin(tb), _attrs("1", "s")),
-            "stick": (("ball", "sample"), np.stack([stick, stick]), _attrs("1", "stick")),
-            "psi_stick_boundary": ("ball", np.radians([22.0, 25.0]), _attrs("rad", "stick boundary")),
-            "psi_gross_slip_boundary": ("ball", np.radians([58.0, 62.0]), _attrs("rad", "gross slip boundary")),
-        },
-        coords={
-            "ball": ("ball", np.array(BALLS), {"long_name": "ball"}),
-            "psi_grid": ("psi_grid", psi, _attrs("rad", "psi")),
-        },
-        attrs={"psi_history_deg": 30},
+    two = np.ones(2)
+    values = {
+        "eta2": eta2,
+        "eta2_err": [0.2, 0.3],
+        "eta2_ci_low": eta2 - 0.4,
+        "eta2_ci_high": eta2 + 0.4,
+        "eta2_n": n,
+        "eta2_redchi": [1.1, 0.9],
+        "eta2_published": [PUBLISHED_ETA2[b] for b in BALLS],
+        "e_y": 0.5 * two,
+        "e_y_err": np.nan * two,
+        "mu": 0.5 * two,
+        "mu_err": np.nan * two,
+        "omega_ratio": [0.85, 0.76],
+        "omega_ratio_bat": [0.88, 0.79],
+        "r_x_mean": r_x[:, 0],
+        "r_y_mean": [0.05, 0.04],
+        "psi_stick_boundary": np.radians([22.0, 25.0]),
+        "psi_gross_slip_boundary": np.radians([58.0, 62.0]),
+        "psi_stick_paper": np.radians([67.0, 72.0]),
+        "psi_gross_slip_paper": np.radians([69.0, 69.0]),
+        "t_stick_end": [1.4, 1.4],
+        "t_separation": [1.5, 1.5],
+        "t_stretch_max": [1.16, 1.33],
+        "regime_history": np.array([Regime.STICK_SLIP] * 2, dtype=np.int8),
+        "n_phases_history": [2, 2],
+        "vtf_x_model": vtf_x,
+        "vtf_y_model": (1 + e_x) * vtf_x,
+        "e_x_model": e_x,
+        "vtf_y_published": (1 + e_x_pub) * vtf_x,
+        "e_x_published": e_x_pub,
+        "normal_force": np.stack([n_force, n_force]),
+        "tangential_force": 0.3 * np.sin(2 * tb) * np.stack([n_force] * 2),
+        "tangential_velocity": 0.5 * np.cos(2.5 * tb),
+        "spring_stretch": np.sin(tb),
+        "stick": np.stack([stick, stick]),
+        "data_ball": data_ball,
+        "data_vtf_x": data_x,
+        "data_vtf_y": data_y,
+        "data_vtf_y_err": np.full(psi_d.size, 0.01),
+    }
+    coords = {
+        "ball": np.array(BALLS),
+        "psi_grid": psi,
+        "sample": np.arange(t.size),
+        "t_over_tc": t,
+        "impact_fit": np.arange(psi_d.size),
+    }
+    return build_dataset(
+        stronge_variables(),
+        values,
+        coords={name: (var, coords[name]) for name, var in STRONGE_COORDS.items()},
+        attrs={"psi_history_deg": 30.0, "frame": "bat (recoil factors r_x, r_y)"},
     )
-    return ds
-
-
-def test_fake_stronge_follows_the_declared_table():
-    """The hand-made stronge.nc above has the names and dimensions the fit_stronge job declares."""
-    from ballbat.stronge.analysis import STRONGE_COORDS, stronge_table
-
-    real = {**stronge_table(False, False), **STRONGE_COORDS}
-    fake = fake_stronge()
-    for name, var in {**fake.data_vars, **fake.coords}.items():
-        assert name in real, name
-        assert var.dims == real[name].dims, name
-    assert "psi_history_deg" in fake.attrs
 
 
 def test_stick_period():

@@ -19,7 +19,7 @@ from ballbat.properties import recoil_factors
 from ballbat.stronge.fit import Eta2FitError, fit_eta2
 from ballbat.stronge.model import omega_ratio, stronge_ex, stronge_solve
 from ballbat.stronge.reference import stronge_reference
-from ballbat.stronge.regimes import regime_boundaries
+from ballbat.stronge.regimes import Regime, regime_boundaries
 
 DEG = np.pi / 180
 #: Paper, Sec. V.A: fitted eta^2 with e_y = mu = 0.5.
@@ -81,6 +81,22 @@ def test_reference_event_times_match():
     assert sol.t_restick[1] == pytest.approx(ref["events"][1][0][0], abs=1e-9)
     assert sol.t_final_slip[1] == pytest.approx(ref["events"][1][1][0], abs=1e-9)
     assert ref["t_c"][0] == pytest.approx(np.pi / 2, abs=1e-10)
+
+
+def test_regime_codes_cover_the_solver():
+    """Every label the solver gives over a wide scan has a code that reads back as the label."""
+    psi = np.linspace(0.5, 89.0, 120) * DEG
+    labels = set()
+    for eta2 in (1.2, 2.0, 2.5, 3.5, 4.75, 10.0):
+        for e_y in (0.3, 0.5, 1.0):
+            labels |= set(map(str, stronge_solve(psi, eta2, e_y, 0.5).regime))
+    assert {"stick-slip", "slip-stick-slip", "gross-slip"} <= labels
+    for label in labels:
+        code = Regime.from_label(label)
+        assert code.label == label or (code is Regime.LONGER_SEQUENCE and label.count("-") >= 4)
+    for bad in ("slip", "stick-stick", "roll"):
+        with pytest.raises(ValueError, match="not a phase sequence"):
+            Regime.from_label(bad)
 
 
 def test_fast_path_matches_general_engine():
@@ -351,6 +367,17 @@ def test_histories_layout():
     assert np.all(np.isfinite(sol.u[1]))
     assert sol.u[1, -1] == pytest.approx(-sol.e_x[1] * np.tan(30 * DEG), abs=1e-12)
     assert stronge_solve(0.3, 4.75, 0.5, 0.5).t is None
+
+
+def test_histories_common_grid():
+    """t_max puts impacts solved apart on one grid; a grid ending before separation is refused."""
+    sol = stronge_solve(30.0 * DEG, 4.75, 0.5, 0.5, histories=True, n_time=181, t_max=1.8)
+    assert sol.t[-1] == 1.8 and np.all(np.isnan(sol.u[sol.t > 1.5 + 1e-9]))
+    same = stronge_solve(30.0 * DEG, 4.75, 0.5, 0.5, histories=True, n_time=181, t_max=1.5)
+    default = stronge_solve(30.0 * DEG, 4.75, 0.5, 0.5, histories=True, n_time=181)
+    assert np.array_equal(same.t, default.t) and np.array_equal(same.u, default.u, equal_nan=True)
+    with pytest.raises(ValueError, match="ends before separation"):
+        stronge_solve(30.0 * DEG, 4.75, 0.8, 0.5, histories=True, t_max=1.5)
 
 
 # ------------------------------------------------------------------------------------------

@@ -225,7 +225,11 @@ def write_table(
 
 
 def stronge_rows(stronge: xr.Dataset) -> list[dict]:
-    """Rows from ``stronge.nc``: eta2 (with its standard error) and Omega_t/Omega_n per ball (Sec. V.A)."""
+    """Rows from ``stronge.nc``: eta2 (with its standard error), Omega_t/Omega_n and the Fig. 10 times per ball.
+
+    The event times are named by the file's ``psi_history_deg`` (e.g. ``stick_end_time_psi30``),
+    so they meet the paper's values (Sec. V.A, psi = 30 deg) only when the histories are at that psi.
+    """
     rows = []
     at = f"_psi{stronge.attrs['psi_history_deg']:g}"  # the paper's timeline is at psi = 30 deg
     for b in map(str, stronge["ball"].values):

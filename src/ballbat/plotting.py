@@ -461,7 +461,7 @@ def fig10_time_history(stronge: xr.Dataset) -> Figure:
             ax.plot([start, end], [y, y], "-", color=c, lw=2.5, solid_capstyle="butt")
             ax.text(end, y, f"  initial stick ({ball})", color=c, fontsize=7, va="center")
     right.axhline(0, color="0.3", ls="--", lw=0.8)
-    psi = stronge.attrs.get("psi_history_deg", 30)
+    psi = stronge.attrs["psi_history_deg"]
     ax.set_xlabel("t / t_c")
     ax.set_ylabel("force / peak normal force (curves)")
     right.set_ylabel("tangential velocity / initial normal speed (points)")

@@ -87,7 +87,8 @@ PUBLISHED_IMPLICATIONS: tuple[Published, ...] = (
     Published("D_at_exit_speed_max", _BASE, "wood", 0.0, None, "in", "Sec. V.B: exit speed peaks at D ~ 0, Fig. 11a"),
 )
 
-#: Sec. V.A: "e_y = mu = 0.5 was assumed" for the published eta^2 (Stronge's model).
+#: Sec. V.A: the fixed normal COR and friction coefficient with which the paper fitted eta^2
+#: (4.75 baseball, 6.30 softball) and drew Figs. 9-10 ("e_y = mu = 0.5 was assumed").
 STRONGE_E_Y = 0.5
 STRONGE_MU = 0.5
 

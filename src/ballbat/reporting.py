@@ -167,7 +167,7 @@ def fig9_numbers(stronge: xr.Dataset) -> str:
 
 def fig10_numbers(stronge: xr.Dataset) -> str:
     """Frequency ratio and the stick period of the time histories (Fig. 10)."""
-    psi = stronge.attrs.get("psi_history_deg", 30)
+    psi = stronge.attrs["psi_history_deg"]
     lines = [f"At ψ = {_f(psi)}° with the fitted η²:", ""]
     t = stronge["t_over_tc"].values
     for ball in stronge["ball"].values.astype(str):

@@ -21,8 +21,9 @@ Dimensionless variables used throughout (``theta = Omega_n t``, so ``t_c`` is
 
 Every phase is linear with constant coefficients, so :func:`stronge_ex` and
 :func:`stronge_solve` evaluate each phase in closed form and find the phase-change times
-by vectorised root finding (no loop over impacts). :func:`ballbat.stronge.reference.stronge_reference` integrates
-the same model numerically with ``scipy.integrate.solve_ivp`` and is meant for tests.
+by vectorised root finding (no loop over impacts). The reference integrator
+(:mod:`.reference`, for tests) and the regime boundaries in psi (:mod:`.regimes`) live
+beside this module.
 
 References
 ----------
@@ -35,17 +36,14 @@ References
 
 from __future__ import annotations
 
-import enum
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
-    "Regime",
     "StrongeSolution",
     "omega_ratio",
-    "regime_code",
     "stronge_ex",
     "stronge_solve",
 ]
@@ -76,7 +74,9 @@ _PHASE_NAMES = {_STICK: "stick", _SLIP: "slip"}
 # --------------------------------------------------------------------------------------
 # parameters
 # --------------------------------------------------------------------------------------
-def omega_ratio(eta2: ArrayLike, r_x: ArrayLike = 0.0, r_y: ArrayLike = 0.0, alpha: ArrayLike = 0.4) -> np.ndarray:
+def omega_ratio(
+    eta2: ArrayLike, r_x: ArrayLike = 0.0, r_y: ArrayLike = 0.0, alpha: ArrayLike = 0.4
+) -> NDArray[np.float64] | float:
     """Ratio Omega_t / Omega_n of the tangential and normal vibration frequencies.
 
     Parameters
@@ -670,24 +670,6 @@ def _stretch_max(pc: _Pieces, rho, Lam, e, thf):
     return Cf[rows, k], S[rows, k]
 
 
-class Regime(enum.IntEnum):
-    """Phase sequences of an impact (the names :func:`stronge_solve` gives), as CF flag values."""
-
-    OTHER = 0
-    GROSS_SLIP = 1
-    STICK_SLIP = 2
-    SLIP_STICK_SLIP = 3
-    STICK = 4
-    SLIP_STICK = 5
-    STICK_SLIP_STICK = 6
-    STICK_SLIP_STICK_SLIP = 7
-
-
-def regime_code(name: str) -> Regime:
-    """Return the :class:`Regime` of a phase-sequence name such as ``"stick-slip"`` (OTHER if unlisted)."""
-    return Regime.__members__.get(name.upper().replace("-", "_"), Regime.OTHER)
-
-
 def _regimes(pc: _Pieces):
     n, P = pc.mode.shape
     valid = np.arange(P)[None, :] < pc.n[:, None]
@@ -721,6 +703,7 @@ def stronge_solve(
     alpha: ArrayLike = 0.4,
     histories: bool = False,
     n_time: int = 601,
+    t_max: float | None = None,
 ) -> StrongeSolution:
     """Solve Stronge's contact model: e_x, the phase sequence, event times and histories.
 
@@ -733,6 +716,10 @@ def stronge_solve(
         the largest 1 + e_y (values after an impact's separation are NaN).
     n_time : int
         Number of grid points of the histories.
+    t_max : float, optional
+        End of the time grid, t/t_c (default: the largest 1 + e_y, i.e. the last
+        separation). Must not end before that separation, so that impacts solved apart (with
+        different e_y) can share one grid.
 
     Returns
     -------
@@ -788,7 +775,10 @@ def stronge_solve(
         n_phases=nph.reshape(sh),
     )
     if histories:
-        t = np.linspace(0.0, float(np.max(1.0 + p.e, initial=1.0)), int(n_time))
+        t_sep = float(np.max(1.0 + p.e, initial=1.0))
+        if t_max is not None and not t_max >= t_sep:
+            raise ValueError(f"stronge_solve: t_max = {t_max:g} ends before separation at t/t_c = {t_sep:g}")
+        t = np.linspace(0.0, t_sep if t_max is None else float(t_max), int(n_time))
         th = np.broadcast_to(t * HALF_PI, (n, t.size))
         after = th > p.thf[:, None]
         thc = np.minimum(th, p.thf[:, None])

@@ -1,17 +1,25 @@
-"""Independent reference solution of Stronge's contact model by numerical integration.
+"""Reference solution of Stronge's contact model by numerical integration (for tests).
 
-For tests and benchmarks only: :func:`stronge_reference` integrates the equations of motion
-of PHYSICS.md (Sec. V.A) with ``scipy.integrate.solve_ivp`` and terminal events, impact by
-impact, so that the closed-form solver of :mod:`ballbat.stronge.model` can be checked
-against something that shares none of its algebra.
+:func:`stronge_reference` integrates the equations of motion of PHYSICS.md, Sec. V.A, with
+``scipy.integrate.solve_ivp`` and event detection, independently of the closed-form solver
+:mod:`ballbat.stronge.model`. It is slow (a Python loop over impacts) and simple by design:
+the tests and ``bench/bench_stronge.py`` compare the solver with it.
+
+References
+----------
+.. [1] J. R. Kensrud, A. M. Nathan and L. V. Smith, Am. J. Phys. 85, 503 (2017), Sec. V.A.
+.. [2] W. J. Stronge, *Impact Mechanics* (Cambridge University Press, 2000), Ch. 5.
 """
 
 from __future__ import annotations
 
 import itertools
+from typing import Any
 
 import numpy as np
 from numpy.typing import ArrayLike
+
+__all__ = ["stronge_reference"]
 
 
 def stronge_reference(
@@ -24,8 +32,8 @@ def stronge_reference(
     alpha: ArrayLike = 0.4,
     rtol: float = 1e-12,
     atol: float = 1e-14,
-) -> dict:
-    """Return the reference solution of the same model by numerical integration (for tests).
+) -> dict[str, Any]:
+    """Solve the same model by numerical integration, as a reference for tests.
 
     Integrates the equations of motion of PHYSICS.md, Sec. V.A, in physical form (unit
     ball mass, unit k_n, unit incident speed; normal compression and velocity are state
@@ -33,6 +41,13 @@ def stronge_reference(
     with ``scipy.integrate.solve_ivp`` (DOP853, tolerances ``rtol``/``atol``) and terminal
     events for maximum compression, separation, stick-to-slip (k_t|s| = mu N) and
     slip-to-stick (w = u - ds/dt = 0). A Python loop over impacts: slow, by design simple.
+
+    Parameters
+    ----------
+    psi, eta2, e_y, mu, r_x, r_y, alpha : array_like
+        As in :func:`ballbat.stronge.model.stronge_ex`; they broadcast against each other.
+    rtol, atol : float
+        Relative and absolute tolerances of ``solve_ivp``.
 
     Returns
     -------

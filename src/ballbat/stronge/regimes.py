@@ -1,18 +1,84 @@
-"""Regime boundaries of Stronge's contact model: where the phase sequence changes with psi.
+"""Regimes (phase sequences) of Stronge's contact model and their boundaries in psi.
 
-Found by bisection on the closed-form solver (:func:`ballbat.stronge.model.stronge_solve`),
-beside the boundaries the paper states (Sec. V.A), which the model does not always share
-(docs/stronge.md).
+The closed-form solver :func:`ballbat.stronge.model.stronge_solve` labels each impact with
+its phase sequence ("stick-slip", "gross-slip", ...). :class:`Regime` is the integer code of
+such a label for results files (CF ``flag_values``/``flag_meanings``);
+:func:`regime_boundaries` finds the incidence angles where the label changes and sets them
+beside the boundaries stated in Sec. V.A of Kensrud et al. (2017).
+
+References
+----------
+.. [1] J. R. Kensrud, A. M. Nathan and L. V. Smith, Am. J. Phys. 85, 503 (2017), Sec. V.A.
+.. [2] W. J. Stronge, "Planar impact of rough compliant bodies", Int. J. Impact Eng. 15,
+   435 (1994).
 """
 
 from __future__ import annotations
 
+import enum
+import itertools
 from dataclasses import dataclass
 
 import numpy as np
 from numpy.typing import NDArray
 
 from .model import omega_ratio, stronge_solve
+
+__all__ = ["Regime", "RegimeBoundaries", "regime_boundaries"]
+
+
+class Regime(enum.IntEnum):
+    """Integer code of a phase sequence of :func:`ballbat.stronge.model.stronge_solve`.
+
+    Phases alternate between stick and slip, so a sequence is fixed by its first phase and
+    its length. The codes cover every sequence of up to four phases; a longer one (possible
+    only when Omega_t > Omega_n) is ``LONGER_SEQUENCE``, and the file that stores the code
+    also stores the number of phases.
+    """
+
+    STICK = 1
+    STICK_SLIP = 2
+    STICK_SLIP_STICK = 3
+    STICK_SLIP_STICK_SLIP = 4
+    GROSS_SLIP = 5
+    SLIP_STICK = 6
+    SLIP_STICK_SLIP = 7
+    SLIP_STICK_SLIP_STICK = 8
+    LONGER_SEQUENCE = 9
+
+    @property
+    def label(self) -> str:
+        """The solver's label of the sequence ("stick-slip", "gross-slip", ...)."""
+        return self.name.lower().replace("_", "-")
+
+    @classmethod
+    def from_label(cls, label: str) -> Regime:
+        """Return the code of a solver label.
+
+        Parameters
+        ----------
+        label : str
+            A regime of :class:`ballbat.stronge.model.StrongeSolution`, e.g. ``"stick-slip"``.
+
+        Returns
+        -------
+        Regime
+            Its code; ``LONGER_SEQUENCE`` for a valid sequence of more than four phases.
+
+        Raises
+        ------
+        ValueError
+            ``label`` is not a "-"-joined alternating sequence of "stick" and "slip".
+        """
+        if label == "gross-slip":
+            return cls.GROSS_SLIP
+        phases = label.split("-")
+        alternating = all(a != b for a, b in itertools.pairwise(phases))
+        if not (phases and set(phases) <= {"stick", "slip"} and alternating) or phases == ["slip"]:
+            raise ValueError(f"Regime: {label!r} is not a phase sequence of Stronge's model")
+        if len(phases) > 4:
+            return cls.LONGER_SEQUENCE
+        return cls[label.upper().replace("-", "_")]
 
 
 @dataclass(frozen=True)
