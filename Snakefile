@@ -20,6 +20,7 @@ include: "workflow/rules/stronge.smk"
 include: "workflow/rules/compare.smk"
 include: "workflow/rules/implications.smk"
 include: "workflow/rules/plots.smk"
+include: "workflow/rules/workbook.smk"
 
 
 # All products of every dataset and scenario, intermediate files included (common.smk: final_targets).

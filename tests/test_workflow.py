@@ -128,6 +128,7 @@ def test_rerun_is_noop_and_byte_identical(run_dir):
     assert planned_jobs(run_dir) == {}
     files = sorted(res.glob("*.nc")) + sorted((run_dir / "results" / "implications").glob("*.nc"))
     files += sorted(run_dir.glob("results/*/figures/*.png"))  # figures too: no timestamps
+    files += sorted(run_dir.glob("results/*/results.xlsx"))  # workbooks: fixed metadata
     before = {p: sha256_file(p) for p in files}
     snakemake(run_dir, "-c2", "--forceall")
     after = {p: sha256_file(p) for p in files}
@@ -163,6 +164,8 @@ def test_code_edit_reruns_only_dependents(run_dir):
         **{k: v for k, v in DATASET_PLOTS.items() if k not in stronge_plots},
         "plot_fig11": 1,
         "comparison_html": 2,
+        "workbook": 1,
+        "implications_workbook": 1,
     }
     assert _jobs_after_edit(run_dir, pkg / "linefit.py") == {
         "fit_ex": 1,
@@ -173,6 +176,8 @@ def test_code_edit_reruns_only_dependents(run_dir):
         **DATASET_PLOTS,
         "plot_fig11": 1,
         "comparison_html": 2,
+        "workbook": 1,
+        "implications_workbook": 1,
     }
     assert _jobs_after_edit(run_dir, pkg / "kinematics.py") == {
         "simulate": 1,
@@ -187,6 +192,8 @@ def test_code_edit_reruns_only_dependents(run_dir):
         "plot_fig11": 1,
         "plot_launch": 1,  # captions quote D through the comparison code (Eq. D)
         "comparison_html": 2,
+        "workbook": 1,
+        "implications_workbook": 1,
     }
     assert _jobs_after_edit(run_dir, pkg / "flight.py") == {
         "implications": 2,
@@ -194,7 +201,9 @@ def test_code_edit_reruns_only_dependents(run_dir):
         "plot_fig11": 1,
         "plot_launch": 1,
         "comparison_html": 1,
+        "implications_workbook": 1,
     }
+    assert _jobs_after_edit(run_dir, pkg / "workbook.py") == {"workbook": 1, "implications_workbook": 1}
     assert planned_jobs(run_dir) == {}  # restoring the text restores the state
     (run_dir / "README.md").write_text("an unrelated edit\n")
     assert planned_jobs(run_dir) == {}
@@ -268,6 +277,66 @@ def test_results_pass_the_cf_checker(run_dir):
             if c["msgs"]
         ]
         assert cf["scored_points"] == cf["possible_points"] and not failed, (name, failed)
+
+
+def test_workbook_in_the_fields_units(run_dir):
+    """results.xlsx (issue 13): one sheet per table, names then units in the header, the values of
+    the NetCDF files in mph/deg/rpm/in, and the provenance of every file; read by two real readers.
+    """
+    import openpyxl
+    import pandas as pd
+
+    res = run_dir / "results" / "small"
+    book = openpyxl.load_workbook(res / "results.xlsx")
+    assert book.sheetnames == ["impacts", "e_x", "sec4", "eta2", "paper_comparison", "provenance"]
+    assert [c.value for c in book["impacts"][2]][3:5] == ["mph", "mph"]  # units in the second row
+    rec = xr.open_dataset(res / "reconstruct.nc")
+    fit = xr.open_dataset(res / "fit_ex.nc")
+    imp = pd.read_excel(res / "results.xlsx", sheet_name="impacts", header=[0, 1])
+    assert ("v_bat", "mph") in imp.columns and ("psi", "deg") in imp.columns and ("D", "in") in imp.columns
+    assert len(imp) == rec.sizes["impact"]
+    np.testing.assert_allclose(imp[("v_bat", "mph")], rec.v_bat.values / 0.44704, rtol=1e-12)
+    np.testing.assert_allclose(imp[("omega", "rpm")], rec.omega.values * 60 / (2 * np.pi), rtol=1e-12)
+    np.testing.assert_allclose(imp[("D", "in")], rec.D.values / 0.0254, rtol=1e-12)
+    assert set(imp.xs("flag_reason", axis=1, level=0).iloc[:, 0]) == {"ok"}  # text column: no unit
+    ex = pd.read_excel(res / "results.xlsx", sheet_name="e_x", header=[0, 1])
+    wood = ex[(ex.iloc[:, 0] == "baseball") & (ex.iloc[:, 1] == "wood")]
+    assert float(wood[("e_x value", "1")].iloc[0]) == pytest.approx(float(fit.e_x.sel(ball="baseball", bat="wood")))
+    pooled = ex[(ex.iloc[:, 0] == "softball") & (ex.iloc[:, 1] == "pooled")]
+    assert int(pooled[("e_x n", "1")].iloc[0]) == int(fit.e_x_pooled_n.sel(ball="softball"))
+    sec4 = pd.read_excel(res / "results.xlsx", sheet_name="sec4", header=[0, 1])
+    slope = float(fit.spin_theta_slope.sel(ball="baseball")) * 60 / (2 * np.pi) * np.pi / 180
+    assert float(sec4[("spin_theta_slope", "rpm/deg")].iloc[0]) == pytest.approx(slope, rel=1e-12)
+    prov = pd.read_excel(res / "results.xlsx", sheet_name="provenance", header=0).iloc[1:]
+    inputs = prov[prov["record"] == "input"]
+    normalize = inputs[inputs["key"].str.endswith("normalize.nc")]
+    assert normalize["value"].iloc[0] == sha256_file(res / "normalize.nc")
+    assert set(prov["record"]) >= {"title", "rule", "input", "config", "software", "git"}
+    paper = xr.open_dataset(run_dir / "results" / "implications" / "paper.nc")
+    sweep = pd.read_excel(run_dir / "results" / "implications" / "results.xlsx", sheet_name="paper", header=[0, 1])
+    np.testing.assert_allclose(sweep[("carry", "ft")], paper.carry.values / 0.3048, rtol=1e-12)
+    with pd.ExcelFile(run_dir / "results" / "implications" / "results.xlsx") as book:
+        assert set(book.sheet_names) == {"paper", "flyballs", "provenance"}
+
+
+def test_summary_command(run_dir):
+    """`ballbat summary` (issue 13) prints the dataset's e_x per bat and pooled, and eta^2, from its files."""
+    out = subprocess.run(
+        [str(Path(sys.executable).parent / "ballbat"), "summary", "results/small"],
+        cwd=run_dir,
+        capture_output=True,
+        text=True,
+        timeout=120,
+    )
+    assert out.returncode == 0, out.stderr
+    fit = xr.open_dataset(run_dir / "results" / "small" / "fit_ex.nc")
+    st = xr.open_dataset(run_dir / "results" / "small" / "stronge.nc")
+    e = float(fit.e_x.sel(ball="baseball", bat="wood"))
+    assert any(line.split()[:3] == ["baseball", "wood", f"{e:.3f}"] for line in out.stdout.splitlines())
+    p = float(fit.e_x_pooled.sel(ball="softball"))
+    assert any(line.split()[:3] == ["softball", "pooled", f"{p:.3f}"] for line in out.stdout.splitlines())
+    assert f"{float(st.eta2.sel(ball='baseball')):.3f}" in out.stdout
+    assert out.stdout.startswith("small: 36 impacts, 0 not used")
 
 
 def test_figures_drawn(run_dir):

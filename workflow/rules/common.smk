@@ -85,11 +85,12 @@ def final_targets():
     """Everything a default run makes: every dataset's intermediate files, fits, figures and tables, and
     every scenario's (rule all asks for these; an intermediate deleted by hand is therefore rebuilt)."""
     per_dataset = ["normalize.nc", "reconstruct.nc", "fit_ex.nc", "stronge.nc"]
-    per_dataset += ["paper_comparison.csv", "paper_comparison.html"]
+    per_dataset += ["paper_comparison.csv", "paper_comparison.html", "results.xlsx"]
     per_dataset += [f"figures/{fig}.png" for fig in ("fig3", "fig4", "fig5", "fig6", "fig9a", "fig9b", "fig10")]
     targets = [get_source(Namespace(dataset=d)) for d in DATASETS]
     targets += [f"results/{d}/{f}" for d in DATASETS for f in per_dataset]
     targets += [f"results/implications/{s}.nc" for s in SCENARIOS]
+    targets += ["results/implications/results.xlsx"] if SCENARIOS else []
     targets += [f"results/implications/figures/{s}_fig11{p}.png" for s in SWEEP_SCENARIOS for p in "ab"]
     targets += [f"results/implications/figures/{s}_launch.png" for s in LAUNCH_SCENARIOS]
     if "paper" in SWEEP_SCENARIOS:  # the paper's own scenario is compared with Sec. V.B
