@@ -370,6 +370,7 @@ def test_report_builds(run_dir):
     for name in ("fig3.png", "fig6.png", "fig9b.png", "fig10.png", "paper_fig11a.png", "flyballs_launch.png"):
         assert name in html, name
     assert "paper_comparison.html" in html
+    assert "results.xlsx" in html  # the workbooks are linked from the report (issue 13)
     e_x = float(xr.open_dataset(run_dir / "results" / "small" / "fit_ex.nc").e_x_pooled.sel(ball="baseball"))
     assert f"e_x = {e_x:.3f}" in html  # a caption quoting the fitted number
     assert "v_ref_mph" in html  # the run's config
