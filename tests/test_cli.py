@@ -141,4 +141,5 @@ def test_check_warns_of_unit_mistakes(tmp_path):
     path = tmp_path / "rads.csv"
     path.write_text("\n".join(",".join(r) for r in rows) + "\n")
     out = ballbat("check", str(path), "--bats", str(MAPLE_BATS))
-    assert "warning:" in out.stdout and "omega_rpm" in out.stdout
+    assert out.returncode == 1  # most rows implausible: not usable (issue 10), the column and rows named
+    assert "units are likely wrong" in out.stdout and "column omega_rpm" in out.stdout and "spin in rad/s" in out.stdout

@@ -260,7 +260,6 @@ def test_unit_mistakes_warn_naming_the_column(tmp_path, column, factor, expected
         w = csv.DictWriter(fh, list(rows[0]), lineterminator="\n")
         w.writeheader()
         w.writerows(rows)
-    ds, warnings = ingest.ingest(path, BALLS, MAPLE_BATS)
     hint = {
         ("omega_rpm", False): "spin in rad/s, not rpm",
         ("omega_rpm", True): "spin with the opposite sign",
@@ -268,6 +267,14 @@ def test_unit_mistakes_warn_naming_the_column(tmp_path, column, factor, expected
         ("v_ball_mph", False): "exit speed in m/s, not mph",
         ("theta_deg", False): "radians, not degrees",
     }[(column, factor < 0)]
+    try:
+        ds, warnings = ingest.ingest(path, BALLS, MAPLE_BATS)
+    except ingest.InputError as exc:  # most rows implausible: the dataset stops, the column named (issue 10)
+        assert "more than half: the file's units are likely wrong" in exc.problems[0]
+        one(exc.problems, "units.csv", expected, hint)
+        return
+    # a mistake most rows survive (the spin's sign, psi then negative but possible) is warned about,
+    # and the fit refuses the e_x it gives (tests/test_plausibility.py)
     one(warnings, "units.csv", expected, hint)
     assert hint in ds.attrs["ingest_warnings"] and ds.attrs["n_warnings"] == len(warnings)
 

@@ -313,9 +313,40 @@ def results_dataset(res: Sec4) -> xr.Dataset:
     )
 
 
+#: Physical bounds of a tangential COR: |u_final| <= |u_initial| (no tangential energy gain).
+E_X_BOUNDS = (-1.0, 1.0)
+
+
+class ImplausibleFit(ValueError):
+    """A fitted e_x no ball-bat collision can have: the dataset's numbers are not to be used."""
+
+
+def check_physical(res: Sec4, source: str = "fit_ex") -> None:
+    """Raise :class:`ImplausibleFit` naming every fitted e_x outside :data:`E_X_BOUNDS`."""
+    lo, hi = E_X_BOUNDS
+    bad = []
+    for name, grid in (("e_x", res.e_x), ("e_x_pooled", res.e_x_pooled)):
+        e_x = grid.field("slope", -1.0)
+        for idx in zip(*np.nonzero(np.isfinite(e_x) & ((e_x < lo) | (e_x > hi))), strict=True):
+            where = f"ball {res.balls[idx[0]]}" + (f", bat {res.bats[idx[1]]}" if len(idx) > 1 else "")
+            bad.append(f"{name} ({where}) = {e_x[idx]:.3f}")
+    if bad:
+        raise ImplausibleFit(
+            f"{source}: fitted e_x outside the physical range [{lo:g}, {hi:g}]: {'; '.join(bad)}. No ball-bat "
+            "collision gives such a value: check the units and the spin sign of the measurements (mph, deg, "
+            "rpm; omega > 0 is backspin)."
+        )
+
+
 def fit_dataset(impacts: xr.Dataset, mu_k_example: float) -> xr.Dataset:
-    """Return the Sec. IV fits of a reconstructed dataset, as a Dataset ready to write."""
-    ds = results_dataset(analyze_impacts(impacts, mu_k_example))
+    """Return the Sec. IV fits of a reconstructed dataset, as a Dataset ready to write.
+
+    Raises :class:`ImplausibleFit` when a fitted e_x lies outside [-1, 1] (an error for the
+    dataset, not a note: such a number is always a mistake in the data).
+    """
+    res = analyze_impacts(impacts, mu_k_example)
+    check_physical(res)
+    ds = results_dataset(res)
     ds.attrs["n_impacts"] = int(impacts.sizes["impact"])
     ds.attrs["n_excluded"] = int((impacts["flag"].values != 0).sum())
     ds.attrs["v_ref"] = float(impacts.attrs["v_ref"])

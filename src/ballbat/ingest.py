@@ -41,7 +41,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 import xarray as xr
 
-from .kinematics import FLAG_TEXT, ImpactFlag, angmom_argument, reconstruct_psi, spin_bracket
+from .kinematics import (
+    FLAG_TEXT,
+    ImpactFlag,
+    angmom_argument,
+    reconstruct_psi,
+    spin_bracket,
+)
 from .linefit import MIN_FIT_IMPACTS
 from .pipeline.products import flag_attrs, variable
 from .properties import Ball, Bat, InputError, load_balls, load_bats, recoil_factors
@@ -70,6 +76,18 @@ OPTIONAL = ("impact_id", *(f"{c}_err" for c in MEASURED_COLUMNS))
 
 #: Range of e_x (Eq. omega) that real ball-bat impacts can show; used only to spot unit mistakes.
 E_X_PLAUSIBLE = (-0.5, 1.0)
+#: Fastest bat (at the impact point) and batted ball, mph, that count as measured: swing
+#: machines and the fastest swings stay below 100 mph at the impact point and the hardest-hit
+#: balls below 125 mph, so faster values point to a unit mistake (km/h read as mph).
+SPEED_MAX_MPH = {"v_bat": 110.0, "v_ball": 140.0}
+#: Robust outliers: a spin residual (about its group's median) above this many 1.4826 MAD (a
+#: normal sigma) of the whole file's residuals. Spin in rad/s (z ~ 12) or of the wrong sign
+#: (z ~ 25) in some rows stands far above it.
+OUTLIER_Z = 6.0
+#: Fewest impacts of a bat x ball group for the robust comparison.
+OUTLIER_MIN_GROUP = 6
+#: A file with more implausible rows than this fraction is an error: a fit would rest on them.
+IMPLAUSIBLE_MAX_FRACTION = 0.5
 #: Impacts with |psi| below this are too head-on for an implied e_x (sin psi ~ 0).
 PSI_MIN_FOR_E_X = 10.0 * DEGREE
 #: A check that fails for more than this fraction of impacts triggers a unit warning ...
@@ -314,6 +332,95 @@ def implausible(
     }
 
 
+def implausible_rows(
+    v_bat: ArrayLike,
+    v_ball: ArrayLike,
+    theta: ArrayLike,
+    omega: ArrayLike,
+    r: ArrayLike,
+    alpha: ArrayLike,
+    r_x: ArrayLike,
+    r_y: ArrayLike,
+    groups: ArrayLike,
+) -> np.ndarray:
+    """Return, per impact, why its measurement is implausible ("" when it is not); SI inputs.
+
+    Row by row, so that a file with a unit mistake in some rows is caught where it is:
+
+    * a speed above :data:`SPEED_MAX_MPH` (km/h read as mph?);
+    * v_ball / v_bat above 2 / (1 + r_y) or below cos psi / (1 + r_y): beyond what any collision
+      of a ball at rest gives (Eqs. vballn, vxf with 0 <= e_y <= 1, e_x <= 1);
+    * the e_x the impact implies through Eq. omega outside :data:`E_X_PLAUSIBLE` (for |psi| >=
+      10 deg, where sin psi is not ~ 0): no tangential COR exceeds 1, and ball-bat impacts do
+      not reverse the contact point's slip by more than half;
+    * its spin an outlier of its bat x ball group (``groups``): the residual of Eq. omega,
+      omega - (1 + e_x) x with the group's median (1 + e_x), more than :data:`OUTLIER_Z` robust
+      standard deviations from the group's median residual, the spread (1.4826 MAD) taken over
+      the file's groups of at least :data:`OUTLIER_MIN_GROUP` impacts (spin in rad/s or of the
+      wrong sign in some rows).
+
+    Impacts psi cannot reconstruct are left to :func:`exclusions` ("" here).
+    """
+    v_bat, v_ball, theta, omega = (np.asarray(a, dtype=float) for a in (v_bat, v_ball, theta, omega))
+    groups = np.asarray(groups)
+    psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
+    ok = flag == ImpactFlag.OK
+    out = np.full(v_bat.shape, "", dtype=object)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = v_ball / v_bat
+        e_x = omega / spin_bracket(v_bat, psi, r, r_x, alpha) - 1.0
+        ratio_max = np.broadcast_to(2.0 / (1.0 + r_y), v_bat.shape)
+        ratio_min = np.broadcast_to(np.cos(psi) / (1.0 + r_y), v_bat.shape)
+    use_ex = ok & (np.abs(psi) >= PSI_MIN_FOR_E_X)
+    # Group outliers on the spin residual of Eq. omega, omega - (1 + e_x) x with x its bracket:
+    # spin noise is the same for every impact, so the residuals share one spread (the implied
+    # e_x does not: its noise grows as sin psi -> 0), and a robust spread (MAD) of the group
+    # is not pulled by the outliers themselves.
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x = spin_bracket(v_bat, psi, r, r_x, alpha)
+    # Two planes where a group's impacts lie close to a line through the origin: Eq. omega
+    # (spin against its bracket) and Fig. 3 (spin per bat speed against theta, the paper's
+    # "remarkably linear" relation). Rows in the wrong unit fall off at least one of them; the
+    # second also catches them at small psi, where the bracket itself follows the bad spin.
+    with np.errstate(invalid="ignore", divide="ignore"):
+        planes = {"spin vs its Eq. omega bracket": (omega, x), "spin vs theta (Fig. 3)": (omega / v_bat, theta)}
+    off = {}
+    for name, (y, xx) in planes.items():
+        dev = np.full(v_bat.shape, np.nan)
+        for g in np.unique(groups):
+            sel = ok & (groups == g)
+            fit = use_ex & (groups == g)
+            if sel.sum() < OUTLIER_MIN_GROUP or not fit.any():
+                continue
+            res = y[sel] - np.median(y[fit] / xx[fit]) * xx[sel]
+            dev[sel] = np.abs(res - np.median(res))
+        if np.isfinite(dev).any():  # one spread for the file: a MAD of a dozen impacts is too uncertain
+            spread = 1.4826 * np.median(dev[np.isfinite(dev)])
+            off[name] = np.isfinite(dev) & (dev > OUTLIER_Z * max(spread, 1e-12))
+    robust = np.any(list(off.values()), axis=0) if off else np.zeros(v_bat.shape, dtype=bool)
+    for i in np.flatnonzero(ok):
+        words = []
+        for k, top in SPEED_MAX_MPH.items():
+            speed = (v_bat if k == "v_bat" else v_ball)[i] / MPH
+            if speed > top:
+                words.append(f"{k} = {speed:.1f} mph is faster than any {k[2:]} reaches (above {top:g}; km/h?)")
+        if ratio[i] > ratio_max[i]:
+            words.append(f"v_ball/v_bat = {ratio[i]:.2f} exceeds 2/(1 + r_y), the most any collision gives")
+        elif ratio[i] < ratio_min[i]:
+            words.append(f"v_ball/v_bat = {ratio[i]:.2f} is below cos(psi)/(1 + r_y), the least any collision gives")
+        if use_ex[i] and not E_X_PLAUSIBLE[0] <= e_x[i] <= E_X_PLAUSIBLE[1]:
+            lo, hi = E_X_PLAUSIBLE
+            words.append(f"implied e_x = {e_x[i]:.2f} (Eq. omega) is outside [{lo:g}, {hi:g}], where impacts lie")
+        elif robust[i]:
+            planes_off = " and ".join(k for k, v in off.items() if v[i])
+            words.append(
+                f"{planes_off} far from its bat x ball group's line (spin {omega[i] / RPM:.0f} rpm, implied"
+                f" e_x = {e_x[i]:.2f}; robust z > {OUTLIER_Z:g})"
+            )
+        out[i] = "; ".join(words)
+    return out.astype(str)
+
+
 _CHECK_WORDS = {
     "psi": "psi cannot be reconstructed (Eq. angmom)",
     "ratio_high": "exit speed above 2/(1 + r_y) times the bat speed, more than any collision allows",
@@ -421,6 +528,22 @@ def ingest(
     r_x = np.array([rxy[(b, t)][0] for b, t in zip(ball_ids, bat_ids, strict=True)])
     r_y = np.array([rxy[(b, t)][1] for b, t in zip(ball_ids, bat_ids, strict=True)])
     flag, reason = exclusions(data["v_ball"], data["theta"], data["omega"], r, alpha)
+    why = implausible_rows(
+        data["v_bat"], data["v_ball"], data["theta"], data["omega"], r, alpha, r_x, r_y, np.char.add(ball_ids, bat_ids)
+    )
+    bad = why != ""
+    flag = np.where(bad, ImpactFlag.IMPLAUSIBLE, flag).astype(np.int8)
+    reason = np.where(bad, np.char.add("implausible: ", why.astype(str)), reason)
+    if bad.sum() > IMPLAUSIBLE_MAX_FRACTION * bad.size:
+        listing = [f"{impacts_path}: {lab}: {w}" for lab, w in zip(cols["label"][bad], why[bad], strict=True)][:10]
+        raise InputError(
+            [
+                f"{impacts_path}: {int(bad.sum())} of {bad.size} impacts are measurements no ball-bat collision "
+                "can produce, more than half: the file's units are likely wrong (mph, deg, rpm expected)",
+                *unit_warnings(impacts_path, data, r, alpha, r_x, r_y),
+                *listing,
+            ]
+        )
 
     warnings: list[str] = []
     usable = flag == 0

@@ -110,7 +110,9 @@ class ImpactFlag(enum.IntEnum):
     """Why an impact cannot be used (the ``flag`` of reconstruct.nc, ``ingest_flag`` of ingest.nc).
 
     One code list for every stage: Eq. angmom's failures (1-3), set wherever psi is
-    reconstructed, and the exclusions made when a measured file is read (4).
+    reconstructed, the exclusions made when a measured file is read (4, in reconstruct.nc),
+    and measurements no collision can produce (5, ``ingest_flag``: implied e_x outside
+    [-1, 1], an exit speed beyond the collision's bounds, an outlier of its bat x ball group).
     """
 
     OK = 0
@@ -118,6 +120,7 @@ class ImpactFlag(enum.IntEnum):
     BAD_SPEED = 2
     BAT_BEHIND_BALL = 3
     EXCLUDED_AT_INGEST = 4
+    IMPLAUSIBLE = 5
 
 
 #: A sentence per :class:`ImpactFlag`, for the readable ``*_reason`` variables.
@@ -127,6 +130,7 @@ FLAG_TEXT = {
     ImpactFlag.BAD_SPEED: "non-finite or non-positive measured speed",
     ImpactFlag.BAT_BEHIND_BALL: "reconstructed |psi| >= 90 deg: the bat cannot reach the ball there",
     ImpactFlag.EXCLUDED_AT_INGEST: "excluded when the measured file was read (see ingest_flag_reason)",
+    ImpactFlag.IMPLAUSIBLE: "a measurement no ball-bat collision can produce (a unit mistake?)",
 }
 
 
