@@ -342,8 +342,13 @@ def implausible_rows(
     r_x: ArrayLike,
     r_y: ArrayLike,
     groups: ArrayLike,
+    sigma: dict | None = None,
 ) -> np.ndarray:
     """Return, per impact, why its measurement is implausible ("" when it is not); SI inputs.
+
+    ``sigma`` maps ``v_bat``, ``theta`` and ``omega`` to their stated standard uncertainties
+    (SI, per impact) when the file gives them: the group outliers below are then judged
+    against each impact's own uncertainty, else against the file's robust spread.
 
     Row by row, so that a file with a unit mistake in some rows is caught where it is:
 
@@ -384,6 +389,11 @@ def implausible_rows(
     # second also catches them at small psi, where the bracket itself follows the bad spin.
     with np.errstate(invalid="ignore", divide="ignore"):
         planes = {"spin vs its Eq. omega bracket": (omega, x), "spin vs theta (Fig. 3)": (omega / v_bat, theta)}
+    if sigma is not None and all(k in sigma for k in ("v_bat", "theta", "omega")):
+        s_om, s_th, s_vb = (np.asarray(sigma[k], dtype=float) for k in ("omega", "theta", "v_bat"))
+        own = {"spin vs its Eq. omega bracket": s_om, "spin vs theta (Fig. 3)": None}
+    else:
+        own = {}
     off = {}
     for name, (y, xx) in planes.items():
         dev = np.full(v_bat.shape, np.nan)
@@ -392,9 +402,19 @@ def implausible_rows(
             fit = use_ex & (groups == g)
             if sel.sum() < OUTLIER_MIN_GROUP or not fit.any():
                 continue
-            res = y[sel] - np.median(y[fit] / xx[fit]) * xx[sel]
+            slope = np.median(y[fit] / xx[fit])
+            res = y[sel] - slope * xx[sel]
             dev[sel] = np.abs(res - np.median(res))
-        if np.isfinite(dev).any():  # one spread for the file: a MAD of a dozen impacts is too uncertain
+            if name in own:  # the residual's own standard uncertainty from the stated ones
+                sd = own[name]
+                if sd is None:
+                    sd = np.hypot(np.hypot(s_om / v_bat, omega * s_vb / v_bat**2), slope * s_th)
+                dev[sel] = dev[sel] / np.maximum(sd[sel], 1e-12)
+        if not np.isfinite(dev).any():
+            continue
+        if name in own:
+            off[name] = np.isfinite(dev) & (dev > OUTLIER_Z)
+        else:  # one spread for the file: a MAD of a dozen impacts is too uncertain
             spread = 1.4826 * np.median(dev[np.isfinite(dev)])
             off[name] = np.isfinite(dev) & (dev > OUTLIER_Z * max(spread, 1e-12))
     robust = np.any(list(off.values()), axis=0) if off else np.zeros(v_bat.shape, dtype=bool)
@@ -528,8 +548,18 @@ def ingest(
     r_x = np.array([rxy[(b, t)][0] for b, t in zip(ball_ids, bat_ids, strict=True)])
     r_y = np.array([rxy[(b, t)][1] for b, t in zip(ball_ids, bat_ids, strict=True)])
     flag, reason = exclusions(data["v_ball"], data["theta"], data["omega"], r, alpha)
+    sigma = {si: cols[f"{c}_err"] * factor for c, (si, factor, _) in MEASURED_COLUMNS.items() if f"{c}_err" in cols}
     why = implausible_rows(
-        data["v_bat"], data["v_ball"], data["theta"], data["omega"], r, alpha, r_x, r_y, np.char.add(ball_ids, bat_ids)
+        data["v_bat"],
+        data["v_ball"],
+        data["theta"],
+        data["omega"],
+        r,
+        alpha,
+        r_x,
+        r_y,
+        np.char.add(ball_ids, bat_ids),
+        sigma=sigma,
     )
     bad = why != ""
     flag = np.where(bad, ImpactFlag.IMPLAUSIBLE, flag).astype(np.int8)
