@@ -131,3 +131,37 @@ def test_no_false_alarms_on_clean_synthetic_experiments(tmp_path, config, balls,
         out, _ = ingest(path, BALLS, ROOT / "config" / "bats.csv")
         flagged += int((out.ingest_flag.values == ImpactFlag.IMPLAUSIBLE).sum())
     assert flagged == 0
+
+
+def test_rows_pasted_twice_are_an_error(tmp_path):
+    """The same rows twice without impact_id (accepted before, shrinking the errors by sqrt 2)."""
+    lines = [",".join(line.split(",")[1:]) for line in MAPLE.read_text().splitlines()]  # no impact_id
+    path = tmp_path / "twice.csv"
+    path.write_text("\n".join([*lines, *lines[1:4]]) + "\n")
+    with pytest.raises(InputError) as err:
+        ingest(path, BALLS, MAPLE_BATS)
+    dup = [p for p in err.value.problems if "the same measurement as" in p]
+    assert len(dup) == 3
+    assert dup[0].startswith(f"{path}: row 33: the same measurement as row 2")
+
+
+def test_netcdf_uncertainty_units_are_checked(tmp_path):
+    """omega_rpm_err in rad/s in a NetCDF file was accepted; it is named now."""
+    import xarray as xr
+
+    rows = [line.split(",") for line in MAPLE.read_text().splitlines()]
+    head, body = rows[0], rows[1:]
+    data = {}
+    for j, name in enumerate(head):
+        values = [r[j] for r in body]
+        unit = name.rsplit("_", 2)[-2] if name.endswith("_err") else name.rsplit("_", 1)[-1]
+        if name in ("impact_id", "bat", "ball"):
+            data[name] = ("impact", values)
+        else:
+            data[name] = ("impact", np.asarray(values, dtype=float), {"units": unit})
+    data["omega_rpm_err"][2]["units"] = "rad s-1"
+    path = tmp_path / "impacts.nc"
+    xr.Dataset(data).to_netcdf(path)
+    with pytest.raises(InputError) as err:
+        ingest(path, BALLS, MAPLE_BATS)
+    assert err.value.problems == [f"{path}: variable omega_rpm_err: units 'rad s-1', expected 'rpm'"]

@@ -143,11 +143,12 @@ def _read_netcdf(path: Path) -> tuple[list[str], list[tuple[str, dict]]]:
     dim = dims[0]
     header = [str(k) for k, v in ds.variables.items() if v.dims == (dim,) and k != dim]
     problems = []
-    for col, (_, _, _) in MEASURED_COLUMNS.items():
-        units = ds[col].attrs.get("units") if col in ds else None
+    for col in MEASURED_COLUMNS:
         expected = col.rsplit("_", 1)[1]
-        if units is not None and units != expected:
-            problems.append(f"{path}: variable {col}: units {units!r}, expected {expected!r}")
+        for name in (col, f"{col}_err"):  # an uncertainty has the unit of its value
+            units = ds[name].attrs.get("units") if name in ds else None
+            if units is not None and units != expected:
+                problems.append(f"{path}: variable {name}: units {units!r}, expected {expected!r}")
     if problems:
         raise InputError(problems)
     cols = {k: ds[k].values for k in header}
@@ -220,6 +221,7 @@ def check_rows(
     errs = [c for c in OPTIONAL if c.endswith("_err") and c in header]
     out: dict = {c: [] for c in ("label", "bat", "ball", "impact_id", *MEASURED_COLUMNS, *errs)}
     seen_ids: dict[str, str] = {}
+    seen_rows: dict[tuple, str] = {}
     for label, row in rows:
         at = f"{path}: {label}"
         if _EXTRA in row:
@@ -260,6 +262,18 @@ def check_rows(
                 seen_ids[iid] = label
         out["impact_id"].append(iid)
         out["label"].append(label)
+        # The same measurement twice (rows pasted twice) would shrink every standard error by
+        # sqrt(2): the bat, ball and every measured value and uncertainty, to the digit.
+        # (With an impact_id column, a pasted row repeats its id, which is reported above.)
+        key = tuple(row.get(c, "").strip() for c in ("bat", "ball", *MEASURED_COLUMNS, *errs))
+        if "impact_id" not in header and key in seen_rows:
+            problems.append(
+                f"{at}: the same measurement as {seen_rows[key]} (bat, ball and every value): "
+                "a row pasted twice? Remove one, or give the impacts an impact_id column if these really are "
+                "two impacts that measured alike"
+            )
+        else:
+            seen_rows[key] = label
     return {k: np.asarray(v) for k, v in out.items()}, problems
 
 
