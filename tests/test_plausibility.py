@@ -165,3 +165,57 @@ def test_netcdf_uncertainty_units_are_checked(tmp_path):
     with pytest.raises(InputError) as err:
         ingest(path, BALLS, MAPLE_BATS)
     assert err.value.problems == [f"{path}: variable omega_rpm_err: units 'rad s-1', expected 'rpm'"]
+
+
+# ---------------------------------------------------------------------------------------
+# CSV files as labs make them (issue 10, item 12)
+
+
+def _maple_values(path):
+    ds, _ = ingest(path, BALLS, MAPLE_BATS)
+    return ds
+
+
+def test_excel_utf8_bom_is_read(tmp_path):
+    path = tmp_path / "bom.csv"
+    path.write_bytes(b"\xef\xbb\xbf" + MAPLE.read_bytes())
+    np.testing.assert_array_equal(_maple_values(path).v_bat.values, _maple_values(MAPLE).v_bat.values)
+
+
+def test_semicolons_and_decimal_commas_are_read(tmp_path):
+    """European Excel: ';' between cells and ',' as the decimal mark; read as the same numbers."""
+    text = MAPLE.read_text().replace(",", ";").replace(".", ",")
+    path = tmp_path / "eu.csv"
+    path.write_text(text)
+    eu, ref = _maple_values(path), _maple_values(MAPLE)
+    for v in ("v_bat", "v_ball", "theta", "omega", "omega_err"):
+        np.testing.assert_array_equal(eu[v].values, ref[v].values)
+
+
+def test_latin1_file_is_named_not_utf8(tmp_path):
+    path = tmp_path / "latin1.csv"
+    text = MAPLE.read_text().replace("maple", "érable", 1)
+    path.write_bytes(text.encode("latin-1"))
+    with pytest.raises(InputError) as err:
+        ingest(path, BALLS, MAPLE_BATS)
+    assert err.value.problems == [
+        f"{path}: not UTF-8 text: byte 0xe9 on line 2 cannot be decoded (a Latin-1 or Windows export?); "
+        "save the file as 'CSV UTF-8'"
+    ]
+
+
+def test_trailing_empty_columns_are_ignored(tmp_path):
+    path = tmp_path / "trailing.csv"
+    path.write_text("\n".join(line + ",," for line in MAPLE.read_text().splitlines()) + "\n")
+    np.testing.assert_array_equal(_maple_values(path).omega.values, _maple_values(MAPLE).omega.values)
+    filled = tmp_path / "filled.csv"
+    lines = MAPLE.read_text().splitlines()
+    filled.write_text("\n".join([lines[0] + ",", *(line + ",7" for line in lines[1:])]) + "\n")
+    with pytest.raises(InputError, match=r"column 12 has values \(line 2, \.\.\.\) but no name in the header"):
+        ingest(filled, BALLS, MAPLE_BATS)
+
+
+def test_a_directory_is_named_as_such(tmp_path):
+    with pytest.raises(InputError) as err:
+        ingest(tmp_path, BALLS, MAPLE_BATS)
+    assert f"{tmp_path}: is a directory, not a CSV file" in err.value.problems

@@ -33,7 +33,6 @@ References
 
 from __future__ import annotations
 
-import csv
 import math
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -50,7 +49,7 @@ from .kinematics import (
 )
 from .linefit import MIN_FIT_IMPACTS
 from .pipeline.products import flag_attrs, variable
-from .properties import Ball, Bat, InputError, load_balls, load_bats, recoil_factors
+from .properties import Ball, Bat, InputError, load_balls, load_bats, read_csv_rows, recoil_factors
 from .units import DEGREE, MPH, RPM
 
 if TYPE_CHECKING:
@@ -103,21 +102,15 @@ _EXTRA = "\0extra"  # key of a row's surplus cells (cannot clash with a column n
 
 
 def _read_csv(path: Path) -> tuple[list[str], list[tuple[str, dict]]]:
-    with open(path, newline="") as fh:
-        reader = csv.reader(fh)
-        header = next(reader, None)
-        if header is None:
-            raise InputError([f"{path}: empty file (expected a header line with {', '.join(REQUIRED)})"])
-        header = [h.strip() for h in header]
-        rows = []
-        for cells in reader:
-            if not any(c.strip() for c in cells):
-                continue  # blank line
-            line = reader.line_num
-            row = {h: (cells[i].strip() if i < len(cells) else "") for i, h in enumerate(header)}
-            if len(cells) > len(header):
-                row[_EXTRA] = str(len(cells) - len(header))
-            rows.append((f"row {line}", row))
+    header, lines = read_csv_rows(path)
+    if not header:
+        raise InputError([f"{path}: empty file (expected a header line with {', '.join(REQUIRED)})"])
+    rows = []
+    for line, cells in lines:
+        row = {h: (cells[i] if i < len(cells) else "") for i, h in enumerate(header)}
+        if len(cells) > len(header):
+            row[_EXTRA] = str(len(cells) - len(header))
+        rows.append((f"row {line}", row))
     return header, rows
 
 
@@ -163,14 +156,9 @@ def read_impacts_table(path: str | os.PathLike[str]) -> tuple[list[str], list[tu
     is its index along the impact dimension (``impact 3``).
     """
     path = Path(path)
-    if not path.is_file():
-        raise InputError([f"{path}: file not found"])
-    if path.suffix.lower() in (".nc", ".nc4", ".netcdf"):
+    if path.suffix.lower() in (".nc", ".nc4", ".netcdf") and path.is_file():
         return _read_netcdf(path)
-    try:
-        return _read_csv(path)
-    except UnicodeDecodeError:
-        raise InputError([f"{path}: not a text (CSV) file; NetCDF files must end in .nc"]) from None
+    return _read_csv(path)
 
 
 # ---------------------------------------------------------------------------------------

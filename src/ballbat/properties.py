@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import csv
 import math
+import re
 from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -91,17 +92,70 @@ BAT_COLUMNS = {
 }
 
 
+#: A number written with a decimal comma (European spreadsheets), e.g. ``68,7`` or ``-1,5e3``.
+_DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$")
+
+
+def read_csv_rows(path: str | os.PathLike[str]) -> tuple[list[str], list[tuple[int, list[str]]]]:
+    """Return the header and the non-blank rows (line number, cells) of a CSV file as labs make them.
+
+    Accepted as they come from spreadsheets: a UTF-8 byte-order mark (Excel's "CSV UTF-8"),
+    semicolon-separated files with decimal commas (European Excel: the commas are read as
+    decimal points), and trailing columns with neither a name nor a value (Excel's stray
+    separators). Refused with one message that says what the file is: a directory, a file
+    that is not UTF-8 (naming the line and byte), a column with values but no name.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise InputError([f"{path}: is a directory, not a CSV file"])
+    if not path.is_file():
+        raise InputError([f"{path}: file not found"])
+    raw = path.read_bytes()
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise InputError(
+            [
+                f"{path}: not UTF-8 text: byte 0x{raw[exc.start]:02x} on line {line} cannot be decoded "
+                "(a Latin-1 or Windows export?); save the file as 'CSV UTF-8'"
+            ]
+        ) from None
+    lines = text.splitlines()
+    first = next((ln for ln in lines if ln.strip()), "")
+    semicolon = first.count(";") > first.count(",")
+    reader = csv.reader(lines, delimiter=";" if semicolon else ",")
+    header = None
+    rows: list[tuple[int, list[str]]] = []
+    for cells in reader:
+        if not any(c.strip() for c in cells):
+            continue
+        cells = [c.strip() for c in cells]
+        if semicolon:  # decimal commas: 68,7 -> 68.7
+            cells = [c.replace(",", ".") if _DECIMAL_COMMA.match(c) else c for c in cells]
+        if header is None:
+            header = cells
+            continue
+        rows.append((reader.line_num, cells))
+    if header is None:
+        return [], []
+    # Trailing columns without a name: dropped when they hold nothing, refused when they hold values.
+    while header and header[-1] == "":
+        k = len(header) - 1
+        filled = [line for line, cells in rows if k < len(cells) and cells[k] != ""]
+        if filled:
+            raise InputError([f"{path}: column {k + 1} has values (line {filled[0]}, ...) but no name in the header"])
+        header = header[:-1]
+        rows = [(line, cells[:k] if len(cells) > k else cells) for line, cells in rows]
+    return header, rows
+
+
 def _read_table(path: Path, columns: dict, key: str) -> list[dict]:
     """Read a property CSV, checking every row; raise one InputError listing all problems."""
     path = Path(path)
     problems: list[str] = []
-    try:
-        with open(path, newline="") as fh:
-            reader = csv.DictReader(fh)
-            header = [h.strip() for h in (reader.fieldnames or [])]
-            rows = [{(k or "").strip(): (v or "").strip() for k, v in row.items()} for row in reader]
-    except FileNotFoundError:
-        raise InputError([f"{path}: file not found"]) from None
+    header, lines = read_csv_rows(path)
+    rows = [dict(zip(header, cells, strict=False)) for _, cells in lines]
     missing = [c for c, (_, req, _) in columns.items() if req and c not in header]
     unknown = [c for c in header if c not in columns]
     if missing:
