@@ -5,12 +5,11 @@ from pathlib import Path
 import yaml
 
 from ballbat.pipeline.codedeps import module_files
-from ballbat.pipeline.config import validate_config
+from ballbat.pipeline.config import drop_nulls, validate_config
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
-# A dataset set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.
-if isinstance(config.get("datasets"), dict):
-    config["datasets"] = {k: v for k, v in config["datasets"].items() if v is not None}
+# A dataset or scenario set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.
+drop_nulls(config)
 with open(SCHEMA) as _fh:
     # the C loader (libyaml, shipped in the PyYAML wheel) parses the schema ~10x faster
     _schema = yaml.load(_fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))

@@ -8,6 +8,8 @@ is not of type 'integer'``). Missing keys that the schema gives a ``default`` ar
 from __future__ import annotations
 
 import copy
+import math
+import re
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -16,6 +18,107 @@ if TYPE_CHECKING:
 
 class ConfigError(ValueError):
     """The config does not match the schema."""
+
+
+#: Names the workflow uses for folders and files of its own under ``results/`` (and ``all``,
+#: the default rule): a dataset may not take them, nor, in ``results/implications/``, a scenario.
+RESERVED_DATASET_NAMES = ("all", "benchmarks", "figures", "implications", "logs", "report", "studies", "tracks")
+RESERVED_SCENARIO_NAMES = ("benchmarks", "figures", "logs", "paper_comparison", "results")
+
+#: What a dataset or scenario may be called: letters, digits, _ and - (a folder and file name).
+NAME = re.compile(r"[A-Za-z0-9_-]+")
+
+#: Bytes of memory one impact and one batted-ball case need. Measured peaks (ru_maxrss, default
+#: stack, 2026-11): simulate + normalize + reconstruct + fit_ex + fit_stronge of 10^5 impacts
+#: ~1.0 kB per impact (4 kB here leaves room for the NetCDF copies); a D sweep of 10^4 and
+#: 4 x 10^4 cases with 101 trajectory samples 59 and 52 kB per case.
+BYTES_PER_IMPACT = 4_000
+BYTES_PER_CASE = 60_000
+#: Share of the machine's available memory one job may plan to use.
+MEMORY_SHARE = 0.5
+
+
+def drop_nulls(config: dict) -> dict:
+    """Drop datasets and scenarios set to null (``datasets: {synthetic: null}`` in an override)."""
+    if isinstance(config.get("datasets"), dict):
+        config["datasets"] = {k: v for k, v in config["datasets"].items() if v is not None}
+    imp = config.get("implications")
+    if isinstance(imp, dict) and isinstance(imp.get("scenarios"), dict):
+        imp["scenarios"] = {k: v for k, v in imp["scenarios"].items() if v is not None}
+    return config
+
+
+def _names(config: dict) -> list[str]:
+    problems = []
+    groups = (
+        ("datasets", config.get("datasets") or {}, RESERVED_DATASET_NAMES, "results/{name}/"),
+        (
+            "implications.scenarios",
+            (config.get("implications") or {}).get("scenarios") or {},
+            RESERVED_SCENARIO_NAMES,
+            "results/implications/{name}.*",
+        ),
+    )
+    for where, table, reserved, folder in groups:
+        for name in table:
+            if not NAME.fullmatch(str(name)):
+                problems.append(f"{where}.{name!r}: a name may hold only letters, digits, _ and - (it names {folder})")
+            elif name in reserved:
+                problems.append(
+                    f"{where}.{name}: {name!r} is reserved for the workflow's own results "
+                    f"(reserved: {', '.join(reserved)}); choose another name"
+                )
+    return problems
+
+
+def _available_memory() -> int:
+    """Return the memory available to a job, bytes (psutil; /proc/meminfo as a fallback)."""
+    try:
+        import psutil
+
+        return int(psutil.virtual_memory().available)
+    except ImportError:  # pragma: no cover - psutil ships with snakemake
+        with open("/proc/meminfo") as fh:
+            info = dict(line.split(":", 1) for line in fh)
+        return int(info["MemAvailable"].split()[0]) * 1024
+
+
+def _sizes(config: dict, available: int) -> list[str]:
+    """Refuse counts the machine cannot hold, with the estimate; refuse empty datasets."""
+    problems = []
+    budget = MEMORY_SHARE * available
+
+    def check(where: str, count: int, per: int, what: str) -> None:
+        need = count * per
+        if need > budget:
+            problems.append(
+                f"{where}: {count:,} {what} need about {need / 2**30:.1f} GiB of memory (estimate: "
+                f"{per:,} bytes each), more than half the {available / 2**30:.1f} GiB this machine has "
+                "available; use fewer"
+            )
+
+    for name, ds in (config.get("datasets") or {}).items():
+        syn = ds.get("synthetic") if isinstance(ds, dict) else None
+        if not isinstance(syn, dict):
+            continue
+        total = sum(int(n) for bats in (syn.get("impacts") or {}).values() for n in (bats or {}).values())
+        if total == 0:
+            problems.append(f"datasets.{name}.synthetic.impacts: no impacts (every count is 0): nothing to fit")
+        check(f"datasets.{name}.synthetic.impacts", total, BYTES_PER_IMPACT, "impacts")
+    for name, sc in ((config.get("implications") or {}).get("scenarios") or {}).items():
+        if "sweep" in sc:
+            check(
+                f"implications.scenarios.{name}.sweep.D_in.num",
+                int(sc["sweep"]["D_in"]["num"]),
+                BYTES_PER_CASE,
+                "cases",
+            )
+        elif "launch" in sc:
+            sizes = [len(v) if isinstance(v, list) else 1 for k, v in sc["launch"].items() if k != "combine"]
+            grid = sc["launch"].get("combine", "grid") == "grid"
+            count = math.prod(sizes) if grid else max(sizes)
+            check(f"implications.scenarios.{name}.launch", count, BYTES_PER_CASE, "cases")
+    return problems
 
 
 def _path(error) -> str:
@@ -81,16 +184,22 @@ def fill_defaults(instance: object, schema: dict, root: dict | None = None) -> o
     return instance
 
 
-def validate_config(config: dict, schema: dict, source: str = "config") -> dict:
-    """Check ``config`` against ``schema``; fill defaults; raise :class:`ConfigError` listing all problems."""
+def validate_config(config: dict, schema: dict, source: str = "config", available: int | None = None) -> dict:
+    """Check ``config`` against ``schema``; fill defaults; raise :class:`ConfigError` listing all problems.
+
+    Beyond the schema: names of datasets and scenarios (the whole name, reserved names) and
+    counts the machine cannot hold (``available`` bytes of memory; default: what it has now).
+    """
     import jsonschema
 
     validator = jsonschema.Draft202012Validator(schema)
     errors = sorted(validator.iter_errors(config), key=lambda e: (list(map(str, e.absolute_path)), e.message))
-    if errors:
-        lines = [_message(e) for e in errors]
+    lines = [_message(e) for e in errors] + _names(config)
+    if not lines:
+        fill_defaults(config, schema)
+        lines = _sizes(config, _available_memory() if available is None else available)
+    if lines:
         raise ConfigError(f"{source} is not valid:\n  " + "\n  ".join(lines))
-    fill_defaults(config, schema)
     return config
 
 
