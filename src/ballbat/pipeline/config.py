@@ -168,11 +168,15 @@ def fill_defaults(instance: object, schema: dict, root: dict | None = None) -> o
     if not isinstance(instance, dict) or schema.get("type") != "object":
         return instance
     props = schema.get("properties", {})
+    # keys that choose one form of the object (oneOf/anyOf: synthetic | impacts) are never created
+    optional_forms = set(schema.get("required", ()))
+    for form in (*schema.get("oneOf", ()), *schema.get("anyOf", ())):
+        optional_forms.update(form.get("required", ()))
     for key, sub in props.items():
         sub = _resolve(sub, root)
         if key not in instance and "default" in sub:
             instance[key] = copy.deepcopy(sub["default"])
-        elif key not in instance and sub.get("type") == "object" and key not in schema.get("required", ()):
+        elif key not in instance and sub.get("type") == "object" and key not in optional_forms:
             if any("default" in _resolve(v, root) for v in sub.get("properties", {}).values()):
                 instance[key] = {}
         if key in instance:
