@@ -204,8 +204,15 @@ def write_comparison(
     """Build the comparison from ``fit_ex.nc`` and ``reconstruct.nc``; write CSV and Markdown."""
     from .pipeline.ncio import read_dataset
 
-    rows = fit_rows(read_dataset(fit)) + impact_rows(read_dataset(impacts)) + list(extra_rows)
-    return write_table(rows, csv_path, md_path, title)
+    rec = read_dataset(impacts)
+    warnings = [w for w in rec.attrs.get("ingest_warnings", "").split("\n") if w]
+    rows = [
+        *fit_rows(read_dataset(fit)),
+        *impact_rows(rec),
+        *extra_rows,
+        {"quantity": "n_warnings", "ball": "", "bat": "", "value": len(warnings), "unit": "1"},
+    ]
+    return write_table(rows, csv_path, md_path, title, warnings=warnings)
 
 
 def write_table(
@@ -214,13 +221,21 @@ def write_table(
     md_path: str | os.PathLike[str],
     title: str,
     published: Sequence[Published] = PUBLISHED,
+    warnings: Sequence[str] = (),
 ) -> list[dict]:
-    """Merge ``rows`` with the published values; write the CSV and its Markdown rendering."""
+    """Merge ``rows`` with the published values; write the CSV and its Markdown rendering.
+
+    ``warnings`` (those of the measured file, carried from ingest.nc) are listed under the
+    Markdown table; the CSV has their count as the row ``n_warnings``.
+    """
     from .pipeline.ncio import atomic_write_text
 
     table = comparison_table(rows, published)
     atomic_write_text(csv_path, to_csv(table))
-    atomic_write_text(md_path, to_markdown(table, title))
+    md = to_markdown(table, title)
+    if warnings:
+        md += "\n## Warnings\n\n" + "".join(f"- {w}\n" for w in warnings)
+    atomic_write_text(md_path, md)
     return table
 
 

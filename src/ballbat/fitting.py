@@ -33,7 +33,7 @@ import numpy as np
 from .designs import MEASURED, normalized_theta_design, spin_design, tan_ratio_design
 from .kinematics import e_y_from_tan_ratio_slope, gross_slip_onset, normalize_to_bat_speed
 from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, wls_slope
-from .pipeline.products import Var, build_dataset, estimate_vars, flag_attrs
+from .pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -350,6 +350,7 @@ def fit_dataset(impacts: xr.Dataset, mu_k_example: float) -> xr.Dataset:
     ds.attrs["n_impacts"] = int(impacts.sizes["impact"])
     ds.attrs["n_excluded"] = int((impacts["flag"].values != 0).sum())
     ds.attrs["v_ref"] = float(impacts.attrs["v_ref"])
+    ds.attrs.update(carried_warnings(impacts))
     return ds
 
 

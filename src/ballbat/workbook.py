@@ -237,7 +237,7 @@ def dataset_workbook(
     Sheets: ``impacts`` (one row per impact, flags and reasons kept), ``e_x`` (per bat and
     ball, then pooled per ball as bat ``pooled``), ``sec4`` (Eq. ratio, implied e_y, the mu_k
     bound, Figs. 3-4 slopes, the gross-slip example), ``eta2`` (Stronge's model),
-    ``paper_comparison`` and ``provenance``.
+    ``paper_comparison``, ``warnings`` (those of a measured file) and ``provenance``.
     """
     from openpyxl import Workbook
 
@@ -295,6 +295,11 @@ def dataset_workbook(
         ws.append(["" for _ in keys])
         for row in comparison:
             ws.append([_number_or_text(row[k]) for k in keys])
+    ws = wb.create_sheet("warnings")
+    ws.append(["warning"])
+    ws.append([""])
+    for text in (w for w in impacts.attrs.get("ingest_warnings", "").split("\n") if w):
+        ws.append([text])
     _provenance_sheet(wb, {"reconstruct.nc": impacts, "fit_ex.nc": fit, "stronge.nc": stronge})
     _write(wb, path)
 

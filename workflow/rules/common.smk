@@ -1,4 +1,5 @@
 # Config validation, input functions and code dependencies shared by all rules.
+import sys
 from argparse import Namespace
 from pathlib import Path
 
@@ -6,6 +7,8 @@ import yaml
 
 from ballbat.pipeline.codedeps import module_files
 from ballbat.pipeline.config import drop_nulls, validate_config
+from ballbat.pipeline.guards import remove_broken, remove_temporaries, warnings_summary
+from ballbat.pipeline.provenance import sha256_file
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 # A dataset or scenario set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.
@@ -16,6 +19,27 @@ with open(SCHEMA) as _fh:
     validate_config(config, _schema, source="config (config/config.yaml and --configfile/--config overrides)")
 
 DATASETS = sorted(config["datasets"])
+
+# A broken result (cut short by a full disk or a copy) would be kept by its timestamp and fail
+# every later job: remove it so that this run rebuilds it, and say so.
+for _message in remove_broken("results"):
+    print(f"ballbat: {_message}", file=sys.stderr)
+
+
+onstart:
+    # after Snakemake has locked the folder: no running job of ours can own these any more
+    for _message in remove_temporaries("results"):
+        print(f"ballbat: {_message}", file=sys.stderr)
+
+
+onsuccess:
+    print_warnings("results", DATASETS, SCENARIOS)
+
+
+onerror:
+    print_warnings("results", DATASETS, SCENARIOS)
+
+
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
 #: The software environment of every rule (requirements.lock as a conda file; `--sdm conda`).
 ENV = "../envs/ballbat.yaml"
@@ -23,6 +47,13 @@ ENV = "../envs/ballbat.yaml"
 
 wildcard_constraints:
     dataset="|".join(DATASETS),
+
+
+def print_warnings(results, datasets, scenarios):
+    """Print every warning of this run's jobs (from their logs) at its end, so no one has to open a log."""
+    lines = warnings_summary(results, datasets, ["implications"] if scenarios else [])
+    if lines:
+        print("\nballbat: warnings of this run (details in the logs named):", *lines, sep="\n  ", file=sys.stderr)
 
 
 def code(script):
@@ -40,12 +71,32 @@ def get_synthetic_settings(wildcards):
     return dataset_config(wildcards)["synthetic"]
 
 
+def data_files(wildcards):
+    """The dataset's data files as the config names them: impacts (measured), balls, bats."""
+    ds = dataset_config(wildcards)
+    files = {"balls": ds.get("balls", config["tables"]["balls"]), "bats": ds.get("bats", config["tables"]["bats"])}
+    if "impacts" in ds:
+        files["impacts"] = ds["impacts"]
+    return files
+
+
+def existing(path):
+    """``path`` as an input when it is a file; none when it is missing or not a file, so that only
+    this dataset's job fails, with a message that says what the path is (not the whole DAG)."""
+    return path if Path(path).is_file() else []
+
+
 def get_balls_table(wildcards):
-    return dataset_config(wildcards).get("balls", config["tables"]["balls"])
+    return existing(data_files(wildcards)["balls"])
 
 
 def get_bats_table(wildcards):
-    return dataset_config(wildcards).get("bats", config["tables"]["bats"])
+    return existing(data_files(wildcards)["bats"])
+
+
+def data_hashes(wildcards):
+    """sha256 of each data file (a rule param): a replaced file reruns its jobs whatever its timestamp."""
+    return {k: sha256_file(v) if Path(v).is_file() else "not a file" for k, v in data_files(wildcards).items()}
 
 
 def is_measured(name):
@@ -54,7 +105,7 @@ def is_measured(name):
 
 
 def get_measured_impacts(wildcards):
-    return dataset_config(wildcards)["impacts"]
+    return existing(dataset_config(wildcards)["impacts"])
 
 
 def get_source(wildcards):

@@ -13,5 +13,8 @@ rule reconstruct:
         "results/{dataset}/benchmarks/reconstruct.tsv"
     conda:
         ENV
+    params:
+        files=data_files,
+        sha256=data_hashes,
     script:
         "../scripts/reconstruct.py"

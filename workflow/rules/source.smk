@@ -14,6 +14,8 @@ rule simulate:
         ENV
     params:
         settings=get_synthetic_settings,
+        files=data_files,
+        sha256=data_hashes,
     script:
         "../scripts/simulate.py"
 
@@ -33,5 +35,8 @@ rule ingest:
         "results/{dataset}/benchmarks/ingest.tsv"
     conda:
         ENV
+    params:
+        files=data_files,
+        sha256=data_hashes,
     script:
         "../scripts/ingest.py"

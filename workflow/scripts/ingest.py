@@ -5,7 +5,8 @@ from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    ds, warnings = ingest(snakemake.input.impacts, balls_path=snakemake.input.balls, bats_path=snakemake.input.bats)
+    files = snakemake.params.files  # as the config names them: a missing one is reported by the ingest
+    ds, warnings = ingest(files["impacts"], balls_path=files["balls"], bats_path=files["bats"])
     for text in warnings:
         log.warning(text)
     excluded = excluded_listing(ds)
@@ -17,5 +18,5 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         snakemake,
         "impacts",
         f"Measured ball-bat impacts of dataset {snakemake.wildcards.dataset}, checked and in SI",
-        config={},
+        config={"sha256": snakemake.params.sha256},
     )

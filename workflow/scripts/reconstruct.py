@@ -8,8 +8,8 @@ from ballbat.properties import load_balls, load_bats
 with logged(snakemake.log[0], snakemake.rule) as log:
     ds = reconstruct(
         read_dataset(snakemake.input.impacts),
-        balls=load_balls(snakemake.input.balls),
-        bats=load_bats(snakemake.input.bats),
+        balls=load_balls(snakemake.params.files["balls"]),
+        bats=load_bats(snakemake.params.files["bats"]),
     )
     bad = int((ds["flag"] != 0).sum())
     log.info("%d of %d impacts not used (flagged, kept in the file)", bad, ds.sizes["impact"])
@@ -20,5 +20,4 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         snakemake,
         "impacts",
         f"Impacts of dataset {snakemake.wildcards.dataset} with the reconstructed geometry (Sec. III)",
-        config={},
     )

@@ -8,7 +8,7 @@ from ballbat.synthetic import SyntheticSettings, simulate_experiment
 with logged(snakemake.log[0], snakemake.rule):
     ds = simulate_experiment(
         SyntheticSettings(**snakemake.params.settings),
-        balls=load_balls(snakemake.input.balls),
-        bats=load_bats(snakemake.input.bats),
+        balls=load_balls(snakemake.params.files["balls"]),
+        bats=load_bats(snakemake.params.files["bats"]),
     )
     write_job_output(ds, snakemake, "impacts", f"Synthetic ball-bat impacts of dataset {snakemake.wildcards.dataset}")

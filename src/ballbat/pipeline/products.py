@@ -141,3 +141,12 @@ def add_variables(ds: xr.Dataset, table: Mapping[str, Var], values: Mapping[str,
         if name in values:
             out[name] = (var.dims, np.asarray(values[name]), var.attributes())
     return out
+
+
+#: Attributes that carry a measured dataset's warnings from ingest.nc to every later file.
+WARNING_ATTRS = ("ingest_warnings", "n_warnings")
+
+
+def carried_warnings(source: xr.Dataset) -> dict[str, Any]:
+    """Return the warning attributes of ``source`` (ingest.nc or a file made from it) to carry on."""
+    return {k: source.attrs[k] for k in WARNING_ATTRS if k in source.attrs}

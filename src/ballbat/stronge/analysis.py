@@ -29,7 +29,7 @@ from numpy.typing import NDArray
 
 from ..designs import MEASURED, vtf_design
 from ..linefit import MIN_FIT_IMPACTS, effective_sigma, wls_slope
-from ..pipeline.products import Var, build_dataset, estimate_vars, flag_attrs
+from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 from ..published import STRONGE_E_Y, STRONGE_MU, per_ball
 from .fit import Eta2Fit, fit_eta2
 from .model import omega_ratio, stronge_ex, stronge_solve
@@ -521,7 +521,11 @@ def stronge_dataset(
         "t_over_tc": t,
         "impact_fit": np.arange(values["data_ball"].size, dtype=np.int64),
     }
-    attrs = {"psi_history_deg": float(psi_history_deg), "frame": "bat (recoil factors r_x, r_y)"}
+    attrs = {
+        "psi_history_deg": float(psi_history_deg),
+        "frame": "bat (recoil factors r_x, r_y)",
+        **carried_warnings(rec),
+    }
     if skipped:
         attrs["balls_not_fitted"] = "; ".join(
             f"{b}: {n} usable impacts (< {MIN_FIT_IMPACTS})" for b, n in sorted(skipped.items())
