@@ -23,6 +23,20 @@ include: "workflow/rules/plots.smk"
 include: "workflow/rules/workbook.smk"
 
 
+# Once Snakemake holds the folder's lock, no running job of ours owns a temporary file any more.
+onstart:
+    remove_stale_temporaries()
+
+
+# Every warning of the run's jobs, printed at its end, success or not.
+onsuccess:
+    print_warnings("results", DATASETS, SCENARIOS)
+
+
+onerror:
+    print_warnings("results", DATASETS, SCENARIOS)
+
+
 # All products of every dataset and scenario, intermediate files included (common.smk: final_targets).
 rule all:
     default_target: True

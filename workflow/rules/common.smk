@@ -20,25 +20,6 @@ with open(SCHEMA) as _fh:
 
 DATASETS = sorted(config["datasets"])
 
-# A broken result (cut short by a full disk or a copy) would be kept by its timestamp and fail
-# every later job: remove it so that this run rebuilds it, and say so.
-for _message in remove_broken("results"):
-    print(f"ballbat: {_message}", file=sys.stderr)
-
-
-onstart:
-    # after Snakemake has locked the folder: no running job of ours can own these any more
-    for _message in remove_temporaries("results"):
-        print(f"ballbat: {_message}", file=sys.stderr)
-
-
-onsuccess:
-    print_warnings("results", DATASETS, SCENARIOS)
-
-
-onerror:
-    print_warnings("results", DATASETS, SCENARIOS)
-
 
 SCRIPTS = Path(workflow.basedir) / "workflow" / "scripts"
 #: The software environment of every rule (requirements.lock as a conda file; `--sdm conda`).
@@ -49,11 +30,28 @@ wildcard_constraints:
     dataset="|".join(DATASETS),
 
 
+def report_broken_results():
+    """Remove broken results (so that this run rebuilds them) and say which."""
+    for message in remove_broken("results"):
+        print(f"ballbat: {message}", file=sys.stderr)
+
+
+def remove_stale_temporaries():
+    """Remove the temporary files of jobs that were killed (call once Snakemake holds the lock)."""
+    for message in remove_temporaries("results"):
+        print(f"ballbat: {message}", file=sys.stderr)
+
+
 def print_warnings(results, datasets, scenarios):
     """Print every warning of this run's jobs (from their logs) at its end, so no one has to open a log."""
     lines = warnings_summary(results, datasets, ["implications"] if scenarios else [])
     if lines:
         print("\nballbat: warnings of this run (details in the logs named):", *lines, sep="\n  ", file=sys.stderr)
+
+
+# A broken result (cut short by a full disk or a copy) would be kept by its timestamp and fail
+# every later job: remove it so that this run rebuilds it, and say so.
+report_broken_results()
 
 
 def code(script):
@@ -95,7 +93,7 @@ def get_bats_table(wildcards):
 
 
 def data_hashes(wildcards):
-    """sha256 of each data file (a rule param): a replaced file reruns its jobs whatever its timestamp."""
+    """Return the sha256 of each data file, a param of the rules that read them (reruns follow content)."""
     return {k: sha256_file(v) if Path(v).is_file() else "not a file" for k, v in data_files(wildcards).items()}
 
 
