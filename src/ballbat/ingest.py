@@ -34,6 +34,7 @@ References
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -315,23 +316,49 @@ def implausible(
     * ``e_x``: the e_x each impact implies through Eq. omega lies in :data:`E_X_PLAUSIBLE`
       (impacts with |psi| >= :data:`PSI_MIN_FOR_E_X` only).
     """
+    c = _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y)
+    n = c.psi.size
+    return {
+        "psi": (int((~c.ok).sum()), n),
+        "ratio_high": (int(c.ratio_high.sum()), n),
+        "ratio_low": (int(c.ratio_low.sum()), int(c.ok.sum())),
+        "e_x": (int(c.e_x_out.sum()), int(c.use_ex.sum())),
+    }
+
+
+@dataclass(frozen=True)
+class _Checks:
+    """Per impact: reconstructed psi, implied e_x and the collision's bounds (SI)."""
+
+    psi: np.ndarray
+    ok: np.ndarray  # psi reconstructed (Eq. angmom)
+    ratio: np.ndarray  # v_ball / v_bat
+    e_x: np.ndarray  # implied through Eq. omega
+    use_ex: np.ndarray  # ok and |psi| >= PSI_MIN_FOR_E_X
+    ratio_high: np.ndarray  # v_ball / v_bat > 2 / (1 + r_y)
+    ratio_low: np.ndarray  # ok and v_ball / v_bat < cos psi / (1 + r_y)
+    e_x_out: np.ndarray  # use_ex and implied e_x outside E_X_PLAUSIBLE
+
+
+def _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y) -> _Checks:
+    """Return the bounds a collision of a ball at rest sets (:func:`implausible`), impact by impact."""
+    v_bat, v_ball, theta, omega = (np.asarray(a, dtype=float) for a in (v_bat, v_ball, theta, omega))
     psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
-    psi_ok = flag == ImpactFlag.OK
+    ok = flag == ImpactFlag.OK
     with np.errstate(invalid="ignore", divide="ignore"):
         ratio = v_ball / v_bat
         e_x = omega / spin_bracket(v_bat, psi, r, r_x, alpha) - 1.0
-        use_ex = psi_ok & (np.abs(psi) >= PSI_MIN_FOR_E_X)
-        ratio_low = psi_ok & (ratio < np.cos(psi) / (1.0 + r_y))
-    n = psi.size
-    return {
-        "psi": (int((~psi_ok).sum()), n),
-        "ratio_high": (int((ratio > 2.0 / (1.0 + r_y)).sum()), n),
-        "ratio_low": (int(ratio_low.sum()), int(psi_ok.sum())),
-        "e_x": (
-            int((use_ex & ~((e_x >= E_X_PLAUSIBLE[0]) & (e_x <= E_X_PLAUSIBLE[1]))).sum()),
-            int(use_ex.sum()),
-        ),
-    }
+        use_ex = ok & (np.abs(psi) >= PSI_MIN_FOR_E_X)
+        return _Checks(
+            psi=psi,
+            ok=ok,
+            ratio=ratio,
+            e_x=e_x,
+            use_ex=use_ex,
+            ratio_high=np.broadcast_to(ratio > 2.0 / (1.0 + r_y), psi.shape),
+            ratio_low=np.broadcast_to(ok & (ratio < np.cos(psi) / (1.0 + r_y)), psi.shape),
+            e_x_out=use_ex & ~((e_x >= E_X_PLAUSIBLE[0]) & (e_x <= E_X_PLAUSIBLE[1])),
+        )
 
 
 def implausible_rows(
@@ -370,15 +397,9 @@ def implausible_rows(
     """
     v_bat, v_ball, theta, omega = (np.asarray(a, dtype=float) for a in (v_bat, v_ball, theta, omega))
     groups = np.asarray(groups)
-    psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
-    ok = flag == ImpactFlag.OK
+    c = _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y)
+    psi, ok, ratio, e_x, use_ex = c.psi, c.ok, c.ratio, c.e_x, c.use_ex
     out = np.full(v_bat.shape, "", dtype=object)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ratio = v_ball / v_bat
-        e_x = omega / spin_bracket(v_bat, psi, r, r_x, alpha) - 1.0
-        ratio_max = np.broadcast_to(2.0 / (1.0 + r_y), v_bat.shape)
-        ratio_min = np.broadcast_to(np.cos(psi) / (1.0 + r_y), v_bat.shape)
-    use_ex = ok & (np.abs(psi) >= PSI_MIN_FOR_E_X)
     # Group outliers on the spin residual of Eq. omega, omega - (1 + e_x) x with x its bracket:
     # spin noise is the same for every impact, so the residuals share one spread (the implied
     # e_x does not: its noise grows as sin psi -> 0), and a robust spread (MAD) of the group
@@ -426,11 +447,11 @@ def implausible_rows(
             speed = (v_bat if k == "v_bat" else v_ball)[i] / MPH
             if speed > top:
                 words.append(f"{k} = {speed:.1f} mph is faster than any {k[2:]} reaches (above {top:g}; km/h?)")
-        if ratio[i] > ratio_max[i]:
+        if c.ratio_high[i]:
             words.append(f"v_ball/v_bat = {ratio[i]:.2f} exceeds 2/(1 + r_y), the most any collision gives")
-        elif ratio[i] < ratio_min[i]:
+        elif c.ratio_low[i]:
             words.append(f"v_ball/v_bat = {ratio[i]:.2f} is below cos(psi)/(1 + r_y), the least any collision gives")
-        if use_ex[i] and not E_X_PLAUSIBLE[0] <= e_x[i] <= E_X_PLAUSIBLE[1]:
+        if c.e_x_out[i]:
             lo, hi = E_X_PLAUSIBLE
             words.append(f"implied e_x = {e_x[i]:.2f} (Eq. omega) is outside [{lo:g}, {hi:g}], where impacts lie")
         elif robust[i]:
