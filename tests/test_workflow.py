@@ -301,9 +301,9 @@ def test_workbook_in_the_fields_units(run_dir):
     assert set(imp.xs("flag_reason", axis=1, level=0).iloc[:, 0]) == {"ok"}  # text column: no unit
     ex = pd.read_excel(res / "results.xlsx", sheet_name="e_x", header=[0, 1])
     wood = ex[(ex.iloc[:, 0] == "baseball") & (ex.iloc[:, 1] == "wood")]
-    assert float(wood[("e_x value", "1")].iloc[0]) == pytest.approx(float(fit.e_x.sel(ball="baseball", bat="wood")))
+    assert float(wood[("e_x", "1")].iloc[0]) == pytest.approx(float(fit.e_x.sel(ball="baseball", bat="wood")))
     pooled = ex[(ex.iloc[:, 0] == "softball") & (ex.iloc[:, 1] == "pooled")]
-    assert int(pooled[("e_x n", "1")].iloc[0]) == int(fit.e_x_pooled_n.sel(ball="softball"))
+    assert int(pooled[("e_x_n", "1")].iloc[0]) == int(fit.e_x_pooled_n.sel(ball="softball"))
     sec4 = pd.read_excel(res / "results.xlsx", sheet_name="sec4", header=[0, 1])
     slope = float(fit.spin_theta_slope.sel(ball="baseball")) * 60 / (2 * np.pi) * np.pi / 180
     assert float(sec4[("spin_theta_slope", "rpm/deg")].iloc[0]) == pytest.approx(slope, rel=1e-12)

@@ -77,14 +77,15 @@ IMPACT_COLUMNS = (
     Column("flag_reason", ""),
 )
 
-#: e_x per bat x ball and pooled (fit_ex.nc): the fields of each fit.
+#: e_x per bat x ball and pooled (fit_ex.nc): the fields of each fit (value, standard error,
+#: 95 % interval, impacts, reduced chi-square), headed by their names in fit_ex.nc.
 FIT_FIELDS = (
-    Column("", "1", "value"),
-    Column("_err", "1", "standard error"),
-    Column("_ci_low", "1", "95 % low"),
-    Column("_ci_high", "1", "95 % high"),
-    Column("_n", "1", "n"),
-    Column("_redchi", "1", "reduced chi2"),
+    Column("", "1", "e_x"),
+    Column("_err", "1", "e_x_err"),
+    Column("_ci_low", "1", "e_x_ci_low"),
+    Column("_ci_high", "1", "e_x_ci_high"),
+    Column("_n", "1", "e_x_n"),
+    Column("_redchi", "1", "e_x_redchi"),
 )
 
 #: Sec. IV quantities per ball (fit_ex.nc): (variable, unit, its standard error or None).
@@ -246,9 +247,7 @@ def dataset_workbook(
     _table_sheet(wb, "impacts", impacts, IMPACT_COLUMNS, "impact")
 
     ws = wb.create_sheet("e_x")
-    _header(
-        ws, ["ball", "bat", *(f"e_x {c.name}" for c in FIT_FIELDS), "status"], ["", "", *("1" for _ in FIT_FIELDS), "1"]
-    )
+    _header(ws, ["ball", "bat", *(c.name for c in FIT_FIELDS), "e_x_status"], ["", "", *("1" for _ in FIT_FIELDS), "1"])
     for ball in fit["ball"].values.astype(str):
         for bat in fit["bat"].values.astype(str):
             f = fit.sel(ball=ball, bat=bat)
