@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.ballbat-installed
 CORES ?= 2
 
-.PHONY: install run test report bench lint lock clean
+.PHONY: install run test test-slurm report bench lint lock clean
 
 # Create the virtual environment and install the pinned stack plus ballbat (editable).
 $(STAMP): pyproject.toml requirements.lock
@@ -21,6 +21,11 @@ run: install
 
 test: install
 	$(BIN)/python -m pytest
+
+# The default workflow through a real single-node SLURM set up on this machine (Debian's
+# packages; root needed), compared byte for byte with a local run; the daemons are stopped after.
+test-slurm: install
+	tests/slurm/run.sh
 
 report: run
 	$(BIN)/snakemake -c$(CORES) --report results/report.html

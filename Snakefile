@@ -23,6 +23,24 @@ include: "workflow/rules/plots.smk"
 include: "workflow/rules/workbook.smk"
 
 
+# Cheap jobs (drawing, tabulating) run where Snakemake runs, never as cluster jobs.
+localrules:
+    all,
+    compare,
+    comparison_html,
+    implications_compare,
+    workbook,
+    implications_workbook,
+    plot_fig3,
+    plot_fig4,
+    plot_fig5,
+    plot_fig6,
+    plot_fig9,
+    plot_fig10,
+    plot_fig11,
+    plot_launch,
+
+
 # Once Snakemake holds the folder's lock, no running job of ours owns a temporary file any more.
 onstart:
     remove_stale_temporaries()

@@ -1,4 +1,5 @@
 # Config validation, input functions and code dependencies shared by all rules.
+import math
 import sys
 from argparse import Namespace
 from pathlib import Path
@@ -6,7 +7,7 @@ from pathlib import Path
 import yaml
 
 from ballbat.pipeline.codedeps import module_files
-from ballbat.pipeline.config import drop_nulls, validate_config
+from ballbat.pipeline.config import BYTES_PER_CASE, BYTES_PER_IMPACT, drop_nulls, validate_config
 from ballbat.pipeline.guards import remove_broken, remove_temporaries, warnings_summary
 from ballbat.pipeline.provenance import sha256_file
 
@@ -104,6 +105,24 @@ def is_measured(name):
 
 def get_measured_impacts(wildcards):
     return existing(dataset_config(wildcards)["impacts"])
+
+
+def dataset_mem_mb(wildcards):
+    """Return the memory a dataset's job may need, MB: 4 kB per impact (measured ~1 kB) over a 500 MB base."""
+    syn = dataset_config(wildcards).get("synthetic")
+    n = sum(sum(bats.values()) for bats in syn["impacts"].values()) if syn else 10_000
+    return 500 + n * BYTES_PER_IMPACT // 1_000_000
+
+
+def scenario_mem_mb(wildcards):
+    """Return the memory a scenario's job may need, MB: 60 kB per case (measured 52-59 kB) over 500 MB."""
+    sc = get_scenario(wildcards)
+    if "sweep" in sc:
+        n = int(sc["sweep"]["D_in"]["num"])
+    else:
+        sizes = [len(v) if isinstance(v, list) else 1 for k, v in sc["launch"].items() if k != "combine"]
+        n = math.prod(sizes) if sc["launch"].get("combine", "grid") == "grid" else max(sizes)
+    return 500 + n * BYTES_PER_CASE // 1_000_000
 
 
 def get_source(wildcards):

@@ -9,8 +9,14 @@ rule fit_ex:
         "results/{dataset}/logs/fit_ex.log",
     benchmark:
         "results/{dataset}/benchmarks/fit_ex.tsv"
+    group:
+        "dataset"
     conda:
         ENV
+    threads: 1
+    resources:
+        mem_mb=dataset_mem_mb,
+        runtime=10,
     params:
         mu_k_example=config["analysis"]["mu_k_example"],
     script:

@@ -13,6 +13,10 @@ rule implications:
         "results/implications/benchmarks/{scenario}.tsv"
     conda:
         ENV
+    threads: 1
+    resources:
+        mem_mb=scenario_mem_mb,
+        runtime=20,
     params:
         scenario=get_scenario,
         air=config["implications"]["air"],

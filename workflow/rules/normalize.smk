@@ -9,8 +9,14 @@ rule normalize:
         "results/{dataset}/logs/normalize.log",
     benchmark:
         "results/{dataset}/benchmarks/normalize.tsv"
+    group:
+        "dataset"
     conda:
         ENV
+    threads: 1
+    resources:
+        mem_mb=dataset_mem_mb,
+        runtime=10,
     params:
         v_ref_mph=config["normalize"]["v_ref_mph"],
     script:

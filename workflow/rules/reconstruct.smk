@@ -11,8 +11,14 @@ rule reconstruct:
         "results/{dataset}/logs/reconstruct.log",
     benchmark:
         "results/{dataset}/benchmarks/reconstruct.tsv"
+    group:
+        "dataset"
     conda:
         ENV
+    threads: 1
+    resources:
+        mem_mb=dataset_mem_mb,
+        runtime=10,
     params:
         files=data_files,
         sha256=data_hashes,

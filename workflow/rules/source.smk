@@ -10,8 +10,14 @@ rule simulate:
         "results/{dataset}/logs/simulate.log",
     benchmark:
         "results/{dataset}/benchmarks/simulate.tsv"
+    group:
+        "dataset"
     conda:
         ENV
+    threads: 1
+    resources:
+        mem_mb=dataset_mem_mb,
+        runtime=10,
     params:
         settings=get_synthetic_settings,
         files=data_files,
@@ -33,8 +39,14 @@ rule ingest:
         "results/{dataset}/logs/ingest.log",
     benchmark:
         "results/{dataset}/benchmarks/ingest.tsv"
+    group:
+        "dataset"
     conda:
         ENV
+    threads: 1
+    resources:
+        mem_mb=dataset_mem_mb,
+        runtime=10,
     params:
         files=data_files,
         sha256=data_hashes,

@@ -9,8 +9,14 @@ rule fit_stronge:
         "results/{dataset}/logs/fit_stronge.log",
     benchmark:
         "results/{dataset}/benchmarks/fit_stronge.tsv"
+    group:
+        "dataset"
     conda:
         ENV
+    threads: 1
+    resources:
+        mem_mb=dataset_mem_mb,
+        runtime=20,
     params:
         stronge=config["stronge"],
     script:
