@@ -47,7 +47,7 @@ G = 9.80665
 #: Frames at rest whose median is the ball's rest position.
 N_REST = 5
 #: Motion threshold in pixels: at least this, and THRESHOLD_SIGMA times the rest scatter.
-THRESHOLD_FLOOR_PX = 2.0
+THRESHOLD_FLOOR_PX = 3.0
 THRESHOLD_SIGMA = 8.0
 #: Longest contact (s): "under a millisecond" (Sec. II).
 CONTACT_MAX = 1.0e-3
@@ -63,7 +63,7 @@ UNWRAP_LIMIT = 0.75 * np.pi
 #: RADIUS_TOLERANCE x its mean radius and RADIUS_SIGMA x the tracking noise ... or below
 #: the larger of the two.
 RADIUS_TOLERANCE = 0.05
-RADIUS_SIGMA = 4.0
+RADIUS_SIGMA = 2.5
 
 
 class ReduceFlag(enum.IntEnum):
@@ -157,8 +157,11 @@ def find_onset(x: np.ndarray, y: np.ndarray) -> Onset:
     onset = _first(moving & stays)
     cols = np.arange(x.shape[1])[None, :]
     rest = _last(valid & ~moving & (cols < np.where(onset < 0, 0, onset)[:, None]))
-    n_rest = np.sum(valid & (cols < onset[:, None]), axis=1)
-    found = (onset > 0) & (rest >= 0) & (n_rest >= 2)
+    before = cols < onset[:, None]
+    n_rest = np.sum(valid & ~moving & before, axis=1)
+    n_moving_before = np.sum(moving & before, axis=1)
+    # a real rest: at least two frames at rest and none away from rest before the impact
+    found = (onset > 0) & (rest >= 0) & (n_rest >= 2) & (n_moving_before == 0)
     return Onset(np.where(found, onset, -1), np.where(found, rest, -1), x0, y0, found)
 
 
@@ -201,7 +204,7 @@ def _line_fit(u, X, Y, w):
         ry = Yc - ay[:, None] - by[:, None] * u
         ss = _msum(rx**2 + ry**2, w)
         sigma = np.sqrt(ss / (2 * n - 4))
-    return ax, bx, ay, by, sigma, sigma**2 / sxx, n, np.hypot(rx, ry), um, sxx
+        return ax, bx, ay, by, sigma, sigma**2 / sxx, n, np.hypot(rx, ry), um, sxx
 
 
 def fit_flight(X, Y, t, onset: Onset, fps: float) -> Flight:
@@ -302,7 +305,8 @@ def fit_swing(X, Y, t, onset: Onset, fps: float, L: float) -> Swing:
         perp = -dx * uy[:, None] + dy * ux[:, None]
         beta = np.arctan2(uy, ux)
         s_perp = np.sqrt(_msum(perp**2, w) / (n - 2))
-        beta_err = s_perp / np.sqrt(_msum(along**2, w))
+        # Student-t: with few frames the scatter estimate is itself uncertain (sd of t with n - 2 dof)
+        beta_err = s_perp / np.sqrt(_msum(along**2, w)) * np.sqrt((n - 2) / np.maximum(n - 4, 1))
 
         tau0 = _take(t, onset.rest) - 0.5 / fps
         st = tm - tau0
@@ -342,7 +346,7 @@ def fit_swing(X, Y, t, onset: Onset, fps: float, L: float) -> Swing:
         A[:, 2, 2] += s2 / sigma_tau**2
         A[~(n >= 4)] = np.eye(3)
         cov = np.linalg.inv(A) * s2[:, None, None]
-        omega_err = np.sqrt(cov[:, 1, 1])
+        omega_err = np.sqrt(cov[:, 1, 1] * (n - 3) / np.maximum(n - 5, 1))  # Student-t, as for beta
         rms = np.sqrt(np.sum(rr**2, axis=1) / n)
     return Swing(om, omega_err, beta, beta_err, tau, a, ux, uy, cx, cy, rms, n.astype(int), mask)
 
