@@ -13,6 +13,7 @@ report: "workflow/report/workflow.rst"
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/source.smk"
+include: "workflow/rules/tracks.smk"
 include: "workflow/rules/normalize.smk"
 include: "workflow/rules/reconstruct.smk"
 include: "workflow/rules/fit_ex.smk"

@@ -57,6 +57,8 @@ def get_measured_impacts(wildcards):
 
 def get_source(wildcards):
     """The first stage of a dataset: its synthetic experiment or its measured impacts, checked."""
+    if uses_tracks(wildcards.dataset):  # raw camera tracks: workflow/rules/tracks.smk
+        return f"results/{wildcards.dataset}/reduce.nc"
     stage = "ingest" if is_measured(wildcards.dataset) else "simulate"
     return f"results/{wildcards.dataset}/{stage}.nc"
 

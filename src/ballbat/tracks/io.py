@@ -20,7 +20,7 @@ import xarray as xr
 
 from ..pipeline.products import Var, build_dataset
 from ..properties import InputError
-from .data import Camera, Rig, Tracks, to_dense, to_long
+from .data import POINTS, Camera, Rig, Tracks, to_dense, to_long
 from .validate import (
     EXTRA,
     IMPACT_COLUMNS,
@@ -169,6 +169,10 @@ def load_tracks(tracks_path, impacts_path=None, balls: dict | None = None, bats:
             problems += rp
     except InputError as exc:
         problems += exc.problems
+    if not problems and impacts is not None and tracks_path.suffix.lower() in _NC:
+        fast = _fast_nc(tracks_path, impacts)
+        if fast is not None:  # well-formed: skip the row-by-row checks (they would find nothing)
+            return _assemble(fast, irows, ipath if impacts_path is None else None)
     try:
         header, rows = read_table(tracks_path, TRACK_COLUMNS, "row")
     except InputError as exc:
@@ -181,19 +185,58 @@ def load_tracks(tracks_path, impacts_path=None, balls: dict | None = None, bats:
     problems += rp
     if problems:
         raise InputError(problems)
+    return _assemble({k: np.asarray(cols[k]) for k in TRACK_COLUMNS}, irows, ipath if impacts_path is None else None)
+
+
+def _fast_nc(path: Path, impacts: dict) -> dict | None:
+    """The long columns of a NetCDF tracks file when every vectorised check passes, else None."""
+    try:
+        with xr.open_dataset(path) as ds:
+            if "row" not in ds.dims or any(c not in ds or ds[c].dims != ("row",) for c in TRACK_COLUMNS):
+                return None
+            cols = {c: ds[c].values for c in TRACK_COLUMNS}
+    except (OSError, ValueError):
+        return None
+    cam, point, iid = (cols[c].astype(str) for c in ("camera", "point", "impact_id"))
+    frame = cols["frame"].astype(float)
+    ok = np.isfinite(frame) & (frame == np.round(frame)) & np.isfinite(cols["x_px"].astype(float))
+    ok &= np.isfinite(cols["y_px"].astype(float))
+    pairs = {(c, p) for c, pts in POINTS.items() for p in pts}
+    ok &= np.isin(np.char.add(np.char.add(cam, "/"), point), [f"{c}/{p}" for c, p in pairs])
+    ok &= np.isin(iid, list(impacts))
+    if not ok.all():
+        return None
+    key = np.char.add(np.char.add(np.char.add(iid, "/"), np.char.add(cam, "/")), np.char.add(point, "/"))
+    full = np.char.add(key, frame.astype(np.int64).astype(str))
+    if np.unique(full).size != full.size:
+        return None
+    if set(np.unique(key)) != {f"{i}/{c}/{p}/" for i in impacts for c, p in pairs}:
+        return None  # a camera or point missing somewhere: the row checks say where
+    return {
+        "impact_id": iid,
+        "camera": cam,
+        "point": point,
+        "frame": frame.astype(np.int64),
+        "x_px": cols["x_px"].astype(float),
+        "y_px": cols["y_px"].astype(float),
+    }
+
+
+def _assemble(cols: dict, irows, truth_path) -> Tracks:
     ids = [row["impact_id"] for _, row in irows]
     index = {iid: i for i, iid in enumerate(ids)}
     n = len(ids)
+    uniq, inv = np.unique(np.asarray(cols["impact_id"]).astype(str), return_inverse=True)
     cams = to_dense(
-        np.array([index[i] for i in cols["impact_id"]], dtype=np.int64),
-        np.array(cols["camera"]),
-        np.array(cols["point"]),
-        np.array(cols["frame"], dtype=np.int64),
-        np.array(cols["x_px"], dtype=float),
-        np.array(cols["y_px"], dtype=float),
+        np.array([index[u] for u in uniq], dtype=np.int64)[inv],
+        np.asarray(cols["camera"]).astype(str),
+        np.asarray(cols["point"]).astype(str),
+        np.asarray(cols["frame"], dtype=np.int64),
+        np.asarray(cols["x_px"], dtype=float),
+        np.asarray(cols["y_px"], dtype=float),
         n,
     )
-    truth = _truth_from_nc(ipath) if impacts_path is None else {}
+    truth = _truth_from_nc(truth_path) if truth_path is not None else {}
     return Tracks(
         impact_id=np.array(ids, dtype=str),
         ball=np.array([row["ball"] for _, row in irows], dtype=str),

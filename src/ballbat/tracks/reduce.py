@@ -682,6 +682,18 @@ def reduction_table(truth_names=()) -> dict[str, Var]:
     table["bat_alignment_time"] = _v(
         "s", "fitted time the bat is aligned with the swing camera, from its frame origin (tau)"
     )
+    for cam in ("swing", "spin"):
+        table[f"frame0_{cam}"] = _v("1", f"{cam}-camera frame number of time 0 of the fitted motions")
+        table[f"flight_t_ref_{cam}"] = _v("s", f"separation time in the {cam} camera (reference of its flight fit)")
+        for c, what in (("x", "along the swing"), ("y", "upward")):
+            table[f"flight_{c}0_{cam}"] = _v("m", f"fitted ball position {what} at separation, {cam} camera")
+            table[f"flight_v{c}_{cam}"] = _v("m s-1", f"fitted ball velocity {what} at separation, {cam} camera")
+    table["tip_offset"] = _v("m", "fitted tip position along the swing at the alignment time (from the tip centroid)")
+    table["tip_centroid_x"] = _v("m", "centroid of the fitted tip positions along the image x (swing-positive)")
+    table["tip_centroid_y"] = _v("m", "centroid of the fitted tip positions, upward")
+    table["bat_angular_speed"] = _v("rad s-1", "fitted angular speed of the bat about the pivot before impact")
+    for p in ("dot_a", "dot_b"):
+        table[f"{p}_phase"] = _v("rad", f"fitted angle of {p} about the ball's centre at time 0 (unwrapped)")
     table["n_frames_spin"] = _v("1", "spin-camera dot frames in the spin fit (both dots)")
     table["dot_angle_rms"] = _v("rad", "rms residual of the dot angles about the fitted spin")
     for p in ("dot_a", "dot_b"):
@@ -735,6 +747,17 @@ def reduction_dataset(red: Reduction) -> xr.Dataset:
         values[f"flight_rms_{cam}"] = red.flight[cam].sigma * np.sqrt(
             2 * np.maximum(red.flight[cam].n - 2, 0) / np.maximum(red.flight[cam].n, 1)
         )
+    for cam in ("swing", "spin"):
+        fl = red.flight[cam]
+        values[f"frame0_{cam}"] = tr.cameras[cam].frame0.astype(np.int64)
+        values[f"flight_t_ref_{cam}"] = fl.t_ref
+        values[f"flight_x0_{cam}"], values[f"flight_y0_{cam}"] = fl.x0, fl.y0
+        values[f"flight_vx_{cam}"], values[f"flight_vy_{cam}"] = fl.vx, fl.vy
+    values["tip_offset"] = red.swing.a
+    values["tip_centroid_x"], values["tip_centroid_y"] = red.swing.cx, red.swing.cy
+    values["bat_angular_speed"] = red.swing.omega
+    for p in ("dot_a", "dot_b"):
+        values[f"{p}_phase"] = red.spin.intercept[p]
     values["n_frames_tip"] = red.swing.n
     values["tip_rms"] = red.swing.rms
     values["bat_alignment_time"] = red.swing.tau
