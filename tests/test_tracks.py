@@ -238,3 +238,26 @@ def test_bat_slows_only_pre_impact_frames_used(swing_fps):
     z = zscores(red, tr)["v_bat"]
     assert np.mean(np.abs(z) < 2) >= 0.9
     assert abs(np.mean(z)) < 0.6
+
+
+def test_qa_figures_draw_the_fits(tmp_path):
+    """The QA figure shows usable and excluded impacts with fitted lines through the tracked points."""
+    from ballbat.tracks.qa import impacts_figure, pick_impacts, save_figure, summary_figure
+
+    tr, s = render(experiment(11, per_bat=3), render_cfg(tilted_fraction=0.3))
+    red = reduction_dataset(reduce(tr, s))
+    idx = pick_impacts(red)
+    assert [red[FLAG_VAR].values[i] == 0 for i in idx] == [True, True, False]
+    fig = impacts_figure(red, tr, idx)
+    assert len(fig.axes) == 9
+    # the ball's fitted flight passes through its tracked points (swing camera, first impact)
+    line = [ln for ln in fig.axes[0].lines if ln.get_label() == "ball flight fit"][0]
+    x, y = line.get_xdata(), line.get_ydata()
+    ct = tr.cameras["swing"]
+    ok = np.isfinite(x) & np.isfinite(ct.x["ball"][idx[0]])
+    assert ok.sum() > 10
+    assert np.max(np.hypot(x[ok] - ct.x["ball"][idx[0]][ok], y[ok] - ct.y["ball"][idx[0]][ok])) < 3.0
+    a = save_figure(fig, tmp_path / "a.png").read_bytes()
+    b = save_figure(impacts_figure(red, tr, idx), tmp_path / "b.png").read_bytes()
+    assert a == b  # deterministic
+    assert len(summary_figure(red).axes) == 5

@@ -71,3 +71,33 @@ rule reduce:
         "results/{dataset}/benchmarks/reduce.tsv"
     script:
         "../scripts/reduce.py"
+
+
+TARGETS += expand("results/{dataset}/figures/tracks_{fig}.png", dataset=TRACKED, fig=["impacts", "summary"])
+
+
+rule tracks_qa:
+    """QA figures of the reduction: a few impacts' camera views and spin fits; residuals and flags."""
+    input:
+        unpack(get_tracks_inputs),
+        reduced=rules.reduce.output.impacts,
+        code=code("tracks_qa.py"),
+    output:
+        impacts=report(
+            "results/{dataset}/figures/tracks_impacts.png",
+            caption="../report/tracks_impacts.rst",
+            category="Dataset {dataset}",
+            subcategory="Camera tracks",
+            labels={"figure": "tracks QA", "shows": "camera views and spin fits of a few impacts"},
+        ),
+        summary=report(
+            "results/{dataset}/figures/tracks_summary.png",
+            caption="../report/tracks_summary.rst",
+            category="Dataset {dataset}",
+            subcategory="Camera tracks",
+            labels={"figure": "tracks summary", "shows": "fit residuals and exclusions"},
+        ),
+    log:
+        "results/{dataset}/logs/tracks_qa.log",
+    script:
+        "../scripts/tracks_qa.py"

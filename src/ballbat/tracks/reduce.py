@@ -676,7 +676,9 @@ def reduction_table(truth_names=()) -> dict[str, Var]:
         table[f"impact_frame_{cam}"] = _v("1", f"first {cam}-camera frame with the ball moving (-1: none)")
         table[f"separation_frame_{cam}"] = _v("1", f"first {cam}-camera frame of the ball's free flight (-1: none)")
         table[f"n_frames_flight_{cam}"] = _v("1", f"{cam}-camera frames in the ball's free-flight fit")
-        table[f"flight_rms_{cam}"] = _v("m", f"rms residual of the ball's free-flight fit in the {cam} camera")
+        table[f"flight_rms_{cam}"] = _v(
+            "m", f"rms distance of the ball's tracked centre from its fitted free flight, {cam} camera"
+        )
     table["n_frames_tip"] = _v("1", "swing-camera frames before impact in the bat-tip fit")
     table["tip_rms"] = _v("m", "rms residual of the bat-tip fit along the swing")
     table["bat_alignment_time"] = _v(
