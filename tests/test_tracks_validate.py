@@ -153,3 +153,18 @@ def test_camera_settings_good():
     )
     assert cams["swing"].sign == -1 and cams["swing"].m_per_px_err == 0.005
     assert rig.pivot_to_impact == pytest.approx(28 * 0.0254)
+
+
+def test_shipped_example_reduces():
+    """config/examples/tracked.yaml: 12 impacts, the one with a tilted spin axis (W04) excluded."""
+    import yaml
+
+    from ballbat.tracks.stage import reduce_stage
+
+    with open("config/examples/tracked.yaml") as fh:
+        cfg = yaml.safe_load(fh)["datasets"]["tracked"]["tracks"]
+    ds = reduce_stage(cfg["file"], cfg["impacts"], cfg, "config/balls.csv", "config/bats.csv", "tracked")
+    flagged = ds["impact_id"].values[ds["ingest_flag"].values != 0]
+    assert list(flagged) == ["W04"]
+    assert ds.sizes["impact"] == 12
+    assert ds["v_bat_err_scale"].values[0] == pytest.approx(0.005 * ds["v_bat"].values[0])
