@@ -13,6 +13,7 @@ report: "workflow/report/workflow.rst"
 
 include: "workflow/rules/common.smk"
 include: "workflow/rules/source.smk"
+include: "workflow/rules/tracks.smk"
 include: "workflow/rules/normalize.smk"
 include: "workflow/rules/reconstruct.smk"
 include: "workflow/rules/fit_ex.smk"
@@ -39,6 +40,7 @@ localrules:
     plot_fig10,
     plot_fig11,
     plot_launch,
+    tracks_qa,
 
 
 # Once Snakemake holds the folder's lock, no running job of ours owns a temporary file any more.

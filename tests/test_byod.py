@@ -143,4 +143,4 @@ def test_override_file_merges_and_null_drops(run):
     (wd / "clash.yaml").write_text("datasets:\n  tiny:\n    impacts: bad.csv\n")
     out = snakemake(wd, "-n", "--configfile", "clash.yaml", check=False)
     assert out.returncode != 0
-    assert "datasets.tiny: give exactly one of synthetic, impacts, not several" in out.stdout + out.stderr
+    assert "datasets.tiny: give exactly one of synthetic, impacts, tracks, not several" in out.stdout + out.stderr

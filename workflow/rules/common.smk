@@ -10,6 +10,7 @@ from ballbat.pipeline.codedeps import module_files
 from ballbat.pipeline.config import BYTES_PER_CASE, BYTES_PER_IMPACT, drop_nulls, validate_config
 from ballbat.pipeline.guards import remove_broken, remove_temporaries, warnings_summary
 from ballbat.pipeline.provenance import sha256_file
+from ballbat.tracks.stage import camera_block
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 # A dataset or scenario set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.
@@ -76,6 +77,9 @@ def data_files(wildcards):
     files = {"balls": ds.get("balls", config["tables"]["balls"]), "bats": ds.get("bats", config["tables"]["bats"])}
     if "impacts" in ds:
         files["impacts"] = ds["impacts"]
+    if "tracks" in ds:
+        files["tracks"] = ds["tracks"]["file"]
+        files["tracks_impacts"] = ds["tracks"]["impacts"]
     return files
 
 
@@ -125,8 +129,41 @@ def scenario_mem_mb(wildcards):
     return 500 + n * BYTES_PER_CASE // 1_000_000
 
 
+def uses_tracks(name):
+    """Whether a dataset starts from raw camera tracks (reduce.nc is its source)."""
+    d = config["datasets"][name]
+    return "tracks" in d or bool((d.get("render") or {}).get("enabled", False))
+
+
+TRACKED = [d for d in DATASETS if uses_tracks(d)]
+
+
+def get_render_settings(wildcards):
+    return dataset_config(wildcards)["render"]
+
+
+def get_tracks_inputs(wildcards):
+    """A lab's tracks and impacts files, or the rendered tracks.nc (which holds its impact table)."""
+    d = dataset_config(wildcards)
+    if "tracks" in d:
+        return {"tracks": d["tracks"]["file"], "impacts": d["tracks"]["impacts"]}
+    return {"tracks": f"results/{wildcards.dataset}/tracks.nc"}
+
+
+def get_reduce_settings(wildcards):
+    d = dataset_config(wildcards)
+    return camera_block(d["tracks"] if "tracks" in d else d["render"])
+
+
+def get_reduce_where(wildcards):
+    key = "tracks" if "tracks" in dataset_config(wildcards) else "render"
+    return f"config datasets.{wildcards.dataset}.{key}"
+
+
 def get_source(wildcards):
     """The first stage of a dataset: its synthetic experiment or its measured impacts, checked."""
+    if uses_tracks(wildcards.dataset):  # raw camera tracks: workflow/rules/tracks.smk
+        return f"results/{wildcards.dataset}/reduce.nc"
     stage = "ingest" if is_measured(wildcards.dataset) else "simulate"
     return f"results/{wildcards.dataset}/{stage}.nc"
 
@@ -155,6 +192,7 @@ def final_targets():
     per_dataset += ["paper_comparison.csv", "paper_comparison.html", "results.xlsx"]
     per_dataset += [f"figures/{fig}.png" for fig in ("fig3", "fig4", "fig5", "fig6", "fig9a", "fig9b", "fig10")]
     targets = [get_source(Namespace(dataset=d)) for d in DATASETS]
+    targets += [f"results/{d}/figures/tracks_{fig}.png" for d in TRACKED for fig in ("impacts", "summary")]
     targets += [f"results/{d}/{f}" for d in DATASETS for f in per_dataset]
     targets += [f"results/implications/{s}.nc" for s in SCENARIOS]
     targets += ["results/implications/results.xlsx"] if SCENARIOS else []

@@ -176,7 +176,12 @@ def fill_defaults(instance: object, schema: dict, root: dict | None = None) -> o
         sub = _resolve(sub, root)
         if key not in instance and "default" in sub:
             instance[key] = copy.deepcopy(sub["default"])
-        elif key not in instance and sub.get("type") == "object" and key not in optional_forms:
+        elif (
+            key not in instance
+            and sub.get("type") == "object"
+            and key not in optional_forms
+            and not sub.get("required")  # an object with required keys is the user's to give
+        ):
             if any("default" in _resolve(v, root) for v in sub.get("properties", {}).values()):
                 instance[key] = {}
         if key in instance:

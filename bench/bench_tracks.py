@@ -1,0 +1,58 @@
+"""Speed of the raw-track chain: render and reduce 10^4 impacts (targets: each under 10 s).
+
+    .venv/bin/python bench/bench_tracks.py [n_impacts]
+
+Prints the frames and points per impact, and the wall time of rendering, of reducing, and of
+the long <-> dense conversion a lab's file goes through.
+"""
+
+import sys
+import time
+
+import numpy as np
+
+from ballbat.tracks.data import POINTS, to_dense, to_long
+from ballbat.tracks.reduce import reduce_tracks
+from ballbat.tracks.render import render_tracks, settings_from_config
+from ballbat.units import DEGREE, MPH, RPM
+
+N = int(sys.argv[1]) if len(sys.argv) > 1 else 10_000
+CFG = {
+    "cameras": {
+        "swing": {"fps": 3000, "m_per_px": 0.00074, "tee_px": [540, 480]},
+        "spin": {"fps": 1000, "m_per_px": 0.00125, "tee_px": [600, 480], "pre_impact_frames": 5},
+    },
+    "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
+    "seed": 1,
+}
+
+rng = np.random.default_rng(0)
+truth = {
+    "v_bat": rng.uniform(63, 88, N) * MPH,
+    "v_ball": rng.uniform(55, 100, N) * MPH,
+    "theta": rng.uniform(0, 30, N) * DEGREE,
+    "omega": rng.uniform(0, 3500, N) * RPM,
+    "psi": rng.uniform(0, 35, N) * DEGREE,
+}
+r = np.full(N, 0.0366)
+ids = np.arange(N).astype(str)
+s = settings_from_config(CFG)
+
+t0 = time.perf_counter()
+tracks = render_tracks(truth, r, s, ids, np.full(N, "baseball"), np.full(N, "wood"))
+t1 = time.perf_counter()
+red = reduce_tracks(tracks, {"swing": s.swing.camera, "spin": s.spin.camera}, s.rig)
+t2 = time.perf_counter()
+rows = to_long(tracks)
+t3 = time.perf_counter()
+index = rows["impact_id"].astype(np.int64)
+to_dense(index, rows["camera"], rows["point"], rows["frame"], rows["x_px"], rows["y_px"], N)
+t4 = time.perf_counter()
+
+frames = {c: np.isfinite(tracks.cameras[c].x["ball"]).sum(axis=1).mean() for c in POINTS}
+points = rows["frame"].size / N
+print(f"impacts: {N}; tracked frames per impact (ball): swing {frames['swing']:.0f}, spin {frames['spin']:.0f}")
+print(f"tracked points per impact (all cameras and points): {points:.0f}; excluded: {int((red.flag != 0).sum())}")
+print(f"render: {t1 - t0:.2f} s   (target < 10 s)")
+print(f"reduce: {t2 - t1:.2f} s   (target < 10 s)")
+print(f"dense -> long rows: {t3 - t2:.2f} s; long rows -> dense: {t4 - t3:.2f} s")

@@ -1,0 +1,170 @@
+"""A lab's tracks, impacts and camera settings: every problem reported at once, with file, row and column."""
+
+from __future__ import annotations
+
+import pytest
+
+from ballbat.properties import InputError, load_balls, load_bats
+from ballbat.tracks.io import cameras_from_config, load_tracks
+
+BALLS = load_balls("config/balls.csv")
+BATS = load_bats("config/bats.csv")
+HEADER = "impact_id,camera,point,frame,x_px,y_px\n"
+
+
+def good_rows(iid="A1"):
+    rows = []
+    for cam, pts in (("swing", ("bat_tip", "ball")), ("spin", ("ball", "dot_a", "dot_b"))):
+        for p in pts:
+            for f in range(3):
+                rows.append(f"{iid},{cam},{p},{100 + f},{10.0 + f},{20.0}\n")
+    return rows
+
+
+def write(tmp_path, rows, impacts="impact_id,bat,ball\nA1,wood,baseball\n"):
+    t = tmp_path / "tracks.csv"
+    t.write_text(HEADER + "".join(rows))
+    i = tmp_path / "impacts.csv"
+    i.write_text(impacts)
+    return t, i
+
+
+def problems(t, i):
+    with pytest.raises(InputError) as exc:
+        load_tracks(t, i, BALLS, BATS)
+    return exc.value.problems
+
+
+def test_good_file_reads(tmp_path):
+    tr = load_tracks(*write(tmp_path, good_rows()), BALLS, BATS)
+    assert tr.n == 1 and tr.cameras["swing"].frame0[0] == 100
+    assert tr.cameras["spin"].x["dot_b"].shape == (1, 3)
+
+
+def test_unknown_point_name(tmp_path):
+    rows = good_rows()
+    rows[0] = "A1,swing,dot_a,100,10.0,20.0\n"  # dot_a is a spin-camera point
+    (p,) = [p for p in problems(*write(tmp_path, rows)) if "unknown point" in p]
+    assert "tracks.csv: row 2, column point: unknown point 'dot_a' for the swing camera (known: bat_tip, ball)" in p
+
+
+def test_unknown_camera(tmp_path):
+    rows = [*good_rows(), "A1,camera3,ball,100,1,2\n"]
+    ps = problems(*write(tmp_path, rows))
+    assert any("row 17, column camera: unknown camera 'camera3' (known: swing, spin)" in p for p in ps)
+
+
+def test_frame_twice(tmp_path):
+    rows = [*good_rows(), "A1,spin,dot_a,101,5,5\n"]
+    ps = problems(*write(tmp_path, rows))
+    assert any(
+        "row 17, column frame: frame 101 of dot_a in the spin camera of impact 'A1' appears twice (also row 12)" in p
+        for p in ps
+    )
+
+
+def test_impact_with_no_tracks(tmp_path):
+    ps = problems(*write(tmp_path, good_rows(), "impact_id,bat,ball\nA1,wood,baseball\nA2,wood,baseball\n"))
+    assert any("impacts.csv: row 3: impact 'A2' has no tracks in" in p for p in ps)
+
+
+def test_camera_missing(tmp_path):
+    rows = [r for r in good_rows() if ",spin," not in r]
+    ps = problems(*write(tmp_path, rows))
+    assert any("impact 'A1'" in p and "the spin camera is missing" in p for p in ps)
+
+
+def test_point_missing(tmp_path):
+    rows = [r for r in good_rows() if "bat_tip" not in r]
+    ps = problems(*write(tmp_path, rows))
+    assert any("the swing camera has no rows of point(s) bat_tip" in p for p in ps)
+
+
+def test_bad_cells_and_unknown_impact(tmp_path):
+    rows = [*good_rows(), "A1,swing,ball,1.5,1,2\n", "A1,swing,ball,200,abc,2\n", "A9,swing,ball,300,1,2\n"]
+    ps = problems(*write(tmp_path, rows))
+    assert any("row 17, column frame: '1.5' is not a whole frame number" in p for p in ps)
+    assert any("row 18, column x_px: 'abc' is not a number" in p for p in ps)
+    assert any("row 19, column impact_id: impact 'A9' is not in" in p for p in ps)
+
+
+def test_impacts_file_problems(tmp_path):
+    impacts = "impact_id,bat,ball\nA1,wood,baseball\nA1,wood,baseball\nA3,oak,cricket\n"
+    ps = problems(*write(tmp_path, good_rows(), impacts))
+    assert any("impacts.csv: row 3, column impact_id: 'A1' duplicates row 2" in p for p in ps)
+    assert any("impacts.csv: row 4, column bat: bat 'oak' is not in the bat table" in p for p in ps)
+    assert any("impacts.csv: row 4, column ball: ball 'cricket' is not in the ball table" in p for p in ps)
+
+
+def test_columns(tmp_path):
+    t = tmp_path / "tracks.csv"
+    t.write_text("impact_id,camera,point,frame,x,y_px\n")
+    i = tmp_path / "impacts.csv"
+    i.write_text("impact_id,bat,ball\nA1,wood,baseball\n")
+    ps = problems(t, i)
+    assert any("missing column(s) x_px" in p for p in ps)
+    assert any("unknown column(s) 'x'" in p for p in ps)
+
+
+def test_every_problem_at_once(tmp_path):
+    rows = good_rows()
+    rows[0] = "A1,swing,dot_z,100,10.0,20.0\n"
+    rows.append("A1,spin,dot_a,101,5,5\n")
+    ps = problems(*write(tmp_path, rows, "impact_id,bat,ball\nA1,wood,baseball\nA2,oak,baseball\n"))
+    kinds = ("unknown point", "appears twice", "has no tracks", "not in the bat table")
+    assert all(any(k in p for p in ps) for k in kinds), ps
+
+
+def test_missing_file(tmp_path):
+    ps = problems(tmp_path / "nope.csv", tmp_path / "nope_impacts.csv")
+    assert any("nope_impacts.csv: file not found" in p for p in ps)
+    assert any("nope.csv: file not found" in p for p in ps)
+
+
+def test_camera_settings():
+    cfg = {
+        "cameras": {"swing": {"fps": -3000, "m_per_px": 0.00074, "mirror": "no", "zoom": 2}, "side": {}},
+        "rig": {"pivot_to_tip_in": 28.0, "pivot_to_impact_in": 34.0},
+    }
+    with pytest.raises(InputError) as exc:
+        cameras_from_config(cfg, "datasets.lab.tracks")
+    ps = exc.value.problems
+    expected = (
+        "datasets.lab.tracks.cameras.spin: camera missing",
+        "datasets.lab.tracks.cameras.side: unknown camera",
+        "datasets.lab.tracks.cameras.swing.fps: -3000 must be a positive number",
+        "datasets.lab.tracks.cameras.swing.mirror: 'no' must be true or false",
+        "datasets.lab.tracks.cameras.swing.zoom: unknown setting",
+        "datasets.lab.tracks.rig: pivot_to_impact_in 34.0 is beyond pivot_to_tip_in 28.0",
+    )
+    for e in expected:
+        assert any(e in p for p in ps), (e, ps)
+
+
+def test_camera_settings_good():
+    cams, rig = cameras_from_config(
+        {
+            "cameras": {
+                "swing": {"fps": 3000, "m_per_px": 0.00074, "mirror": True, "m_per_px_err": 0.005},
+                "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False},
+            },
+            "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
+        }
+    )
+    assert cams["swing"].sign == -1 and cams["swing"].m_per_px_err == 0.005
+    assert rig.pivot_to_impact == pytest.approx(28 * 0.0254)
+
+
+def test_shipped_example_reduces():
+    """config/examples/tracked.yaml: 12 impacts, the one with a tilted spin axis (W04) excluded."""
+    import yaml
+
+    from ballbat.tracks.stage import reduce_stage
+
+    with open("config/examples/tracked.yaml") as fh:
+        cfg = yaml.safe_load(fh)["datasets"]["tracked"]["tracks"]
+    ds = reduce_stage(cfg["file"], cfg["impacts"], cfg, "config/balls.csv", "config/bats.csv", "tracked")
+    flagged = ds["impact_id"].values[ds["ingest_flag"].values != 0]
+    assert list(flagged) == ["W04"]
+    assert ds.sizes["impact"] == 12
+    assert ds["v_bat_err_scale"].values[0] == pytest.approx(0.005 * ds["v_bat"].values[0])

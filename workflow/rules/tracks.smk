@@ -1,0 +1,87 @@
+# Raw camera tracks (Sec. II): a dataset that names `tracks` (a lab's tracked points), or a
+# synthetic dataset with `render: {enabled: true}`, starts from camera tracks; `reduce`
+# turns them into the impacts every later stage reads (get_source in common.smk).
+
+
+rule render_tracks:
+    """Render both cameras' raw tracks of a synthetic experiment (Sec. II rig)."""
+    input:
+        truth="results/{dataset}/simulate.nc",
+        balls=get_balls_table,
+        code=code("render_tracks.py"),
+    output:
+        tracks="results/{dataset}/tracks.nc",
+    log:
+        "results/{dataset}/logs/render_tracks.log",
+    benchmark:
+        "results/{dataset}/benchmarks/render_tracks.tsv"
+    group:
+        "dataset"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=dataset_mem_mb,
+        runtime=10,
+    params:
+        settings=get_render_settings,
+    script:
+        "../scripts/render_tracks.py"
+
+
+rule reduce:
+    """Reduce camera tracks to v_bat, v_ball, theta, omega per impact, with fitted uncertainties."""
+    input:
+        unpack(get_tracks_inputs),
+        balls=get_balls_table,
+        bats=get_bats_table,
+        code=code("reduce.py"),
+    output:
+        impacts="results/{dataset}/reduce.nc",
+    log:
+        "results/{dataset}/logs/reduce.log",
+    benchmark:
+        "results/{dataset}/benchmarks/reduce.tsv"
+    group:
+        "dataset"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=dataset_mem_mb,
+        runtime=10,
+    params:
+        settings=get_reduce_settings,
+        where=get_reduce_where,
+        sha256=data_hashes,
+    script:
+        "../scripts/reduce.py"
+
+
+rule tracks_qa:
+    """QA figures of the reduction: a few impacts' camera views and spin fits; residuals and flags."""
+    input:
+        unpack(get_tracks_inputs),
+        reduced=rules.reduce.output.impacts,
+        code=code("tracks_qa.py"),
+    output:
+        impacts=report(
+            "results/{dataset}/figures/tracks_impacts.png",
+            caption="../report/tracks_impacts.rst",
+            category="Dataset {dataset}",
+            subcategory="Camera tracks",
+            labels={"figure": "tracks QA", "shows": "camera views and spin fits of a few impacts"},
+        ),
+        summary=report(
+            "results/{dataset}/figures/tracks_summary.png",
+            caption="../report/tracks_summary.rst",
+            category="Dataset {dataset}",
+            subcategory="Camera tracks",
+            labels={"figure": "tracks summary", "shows": "fit residuals and exclusions"},
+        ),
+    log:
+        "results/{dataset}/logs/tracks_qa.log",
+    conda:
+        ENV
+    script:
+        "../scripts/tracks_qa.py"
