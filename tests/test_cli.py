@@ -82,7 +82,8 @@ def test_fly_many_balls_from_csv(tmp_path):
         (["fly", "--csv", "nothere.csv"], "argument --csv: nothere.csv: no such file"),
         (["check", "nothere.csv"], "argument file: nothere.csv: no such file"),
         (["check", "config"], "argument file: config is a directory"),
-        (["check", "x.csv", "--kind", "tracks"], "argument --kind: raw camera tracks are not supported"),
+        (["check", "config/examples/tracked_tracks.csv", "--kind", "tracks"], "argument --impacts: required"),
+        (["check", str(MAPLE), "--impacts", "x.csv"], "argument --impacts: only with --kind tracks"),
         (["summary", "results/none"], "argument folder: results/none: not a directory"),
         (["bake"], "argument command: invalid choice: 'bake'"),
     ],
@@ -143,3 +144,26 @@ def test_check_warns_of_unit_mistakes(tmp_path):
     out = ballbat("check", str(path), "--bats", str(MAPLE_BATS))
     assert out.returncode == 1  # most rows implausible: not usable (issue 10), the column and rows named
     assert "units are likely wrong" in out.stdout and "column omega_rpm" in out.stdout and "spin in rad/s" in out.stdout
+
+
+def test_check_raw_tracks():
+    """`--kind tracks` checks a tracks file as the reduce rule reads it (issue 11's format)."""
+    tracks = ROOT / "config" / "examples" / "tracked_tracks.csv"
+    impacts = ROOT / "config" / "examples" / "tracked_impacts.csv"
+    out = ballbat("check", str(tracks), "--kind", "tracks", "--impacts", str(impacts))
+    assert out.returncode == 0, out.stdout + out.stderr
+    assert "usable: 12 impacts tracked by the cameras spin, swing" in out.stdout
+
+
+def test_check_raw_tracks_lists_every_problem(tmp_path):
+    lines = (ROOT / "config" / "examples" / "tracked_tracks.csv").read_text().splitlines()
+    cells = lines[5].split(",")
+    cells[1] = "side"  # an unknown camera
+    lines[5] = ",".join(cells)
+    path = tmp_path / "tracks.csv"
+    path.write_text("\n".join([*lines, lines[2]]) + "\n")  # and a frame twice
+    impacts = ROOT / "config" / "examples" / "tracked_impacts.csv"
+    out = ballbat("check", str(path), "--kind", "tracks", "--impacts", str(impacts))
+    assert out.returncode == 1
+    assert "row 6, column camera: unknown camera 'side'" in out.stdout and "appears twice" in out.stdout
+    assert "not usable: 2 problem(s)" in out.stderr

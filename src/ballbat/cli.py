@@ -28,7 +28,8 @@ EXAMPLES = {
     "check": """examples:
   ballbat check data/mylab/impacts.csv
   ballbat check data/mylab/impacts.csv --bats data/mylab/bats.csv
-  ballbat check config/examples/maple_impacts.csv --bats config/examples/maple_bats.csv""",
+  ballbat check config/examples/maple_impacts.csv --bats config/examples/maple_bats.csv
+  ballbat check config/examples/tracked_tracks.csv --kind tracks --impacts config/examples/tracked_impacts.csv""",
     "fly": """examples:
   ballbat fly --speed 103 --angle 27.5 --backspin 2500
   ballbat fly --speed 103 --angle 27.5 --backspin 2500 --method calculator --json
@@ -76,14 +77,16 @@ def cmd_check(args: argparse.Namespace) -> int:
     from .ingest import excluded_listing, ingest
     from .properties import InputError
 
-    if args.kind == "tracks":
-        raise UsageError("argument --kind: raw camera tracks are not supported by this version (impacts only)")
     path = Path(args.file)
     if path.is_dir():
         raise UsageError(f"argument file: {path} is a directory, not an impacts file")
     if not path.exists():
         raise UsageError(f"argument file: {path}: no such file")
     defaults = _schema_defaults()["tables"]
+    if args.kind == "tracks":
+        return _check_tracks(path, args, defaults)
+    if args.impacts:
+        raise UsageError("argument --impacts: only with --kind tracks (the impact table of a tracks file)")
     try:
         ds, warnings = ingest(path, balls_path=args.balls or defaults["balls"], bats_path=args.bats or defaults["bats"])
     except InputError as exc:
@@ -99,6 +102,27 @@ def cmd_check(args: argparse.Namespace) -> int:
         f"{path}: usable: {ds.sizes['impact']} impacts, {int(ds.attrs['n_excluded'])} excluded, "
         f"{len(warnings)} warning(s)"
     )
+    return 0
+
+
+def _check_tracks(path: Path, args: argparse.Namespace, defaults: dict) -> int:
+    """Validate a raw-tracks file and its impact table as the workflow's reduce rule reads them."""
+    from .properties import InputError, load_balls, load_bats
+    from .tracks.io import load_tracks
+
+    if path.suffix.lower() != ".nc" and not args.impacts:
+        raise UsageError("argument --impacts: required with --kind tracks for a CSV tracks file (impact_id,bat,ball)")
+    try:
+        balls = load_balls(args.balls or defaults["balls"])
+        bats = load_bats(args.bats or defaults["bats"])
+        tracks = load_tracks(path, args.impacts, balls, bats)
+    except InputError as exc:
+        for problem in exc.problems:
+            print(problem)
+        print(f"{path}: not usable: {len(exc.problems)} problem(s)", file=sys.stderr)
+        return 1
+    cams = ", ".join(sorted(tracks.cameras))
+    print(f"{path}: usable: {tracks.n} impacts tracked by the cameras {cams}")
     return 0
 
 
@@ -287,6 +311,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--bats", help="bat table (default: the workflow's config/bats.csv)")
     p.add_argument("--balls", help="ball table (default: the workflow's config/balls.csv)")
     p.add_argument("--kind", choices=("impacts", "tracks"), default="impacts", help="what the file holds")
+    p.add_argument("--impacts", metavar="FILE", help="with --kind tracks: the impact table (impact_id,bat,ball)")
     p.set_defaults(func=cmd_check)
 
     p = sub.add_parser(
