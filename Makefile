@@ -24,8 +24,17 @@ test: install
 
 # The default workflow through a real single-node SLURM set up on this machine (Debian's
 # packages; root needed), compared byte for byte with a local run; the daemons are stopped after.
-test-slurm: install
-	tests/slurm/run.sh
+# The executor plugin lives in its own environment: imported by every Snakemake start, it asks
+# SLURM for its status commands, which costs seconds wherever SLURM is installed but not running.
+SLURM_VENV ?= .venv-slurm
+$(SLURM_VENV)/.installed: pyproject.toml requirements.lock requirements-slurm.lock
+	test -x $(SLURM_VENV)/bin/python || $(PYTHON) -m venv $(SLURM_VENV)
+	$(SLURM_VENV)/bin/python -m pip install --quiet --disable-pip-version-check -r requirements.lock -r requirements-slurm.lock
+	$(SLURM_VENV)/bin/python -m pip install --quiet --disable-pip-version-check --no-deps -e .
+	touch $@
+
+test-slurm: $(SLURM_VENV)/.installed
+	BIN=$(CURDIR)/$(SLURM_VENV)/bin tests/slurm/run.sh
 
 report: run
 	$(BIN)/snakemake -c$(CORES) --report results/report.html

@@ -4,7 +4,7 @@
 set -euo pipefail
 cd "$(dirname "$0")/../.."
 ROOT=$(pwd)
-BIN="$ROOT/.venv/bin"
+BIN="${BIN:-$ROOT/.venv-slurm/bin}"  # an environment with the executor plugin (make test-slurm)
 HERE="$ROOT/tests/slurm"
 
 trap '"$HERE/cluster.sh" down' EXIT INT TERM
