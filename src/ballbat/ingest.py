@@ -50,7 +50,17 @@ from .kinematics import (
 )
 from .linefit import MIN_FIT_IMPACTS
 from .pipeline.products import flag_attrs, variable
-from .properties import Ball, Bat, InputError, load_balls, load_bats, read_csv_rows, recoil_factors
+from .properties import (
+    EXTRA,
+    Ball,
+    Bat,
+    InputError,
+    cell_text,
+    load_balls,
+    load_bats,
+    read_csv_table,
+    recoil_factors,
+)
 from .units import DEGREE, MPH, RPM
 
 if TYPE_CHECKING:
@@ -99,31 +109,6 @@ UNIT_FIX_FRACTION = 0.2
 # ---------------------------------------------------------------------------------------
 # Reading: every cell as text, with the label of its row
 
-_EXTRA = "\0extra"  # key of a row's surplus cells (cannot clash with a column name)
-
-
-def _read_csv(path: Path) -> tuple[list[str], list[tuple[str, dict]]]:
-    header, lines = read_csv_rows(path)
-    if not header:
-        raise InputError([f"{path}: empty file (expected a header line with {', '.join(REQUIRED)})"])
-    rows = []
-    for line, cells in lines:
-        row = {h: (cells[i] if i < len(cells) else "") for i, h in enumerate(header)}
-        if len(cells) > len(header):
-            row[_EXTRA] = str(len(cells) - len(header))
-        rows.append((f"row {line}", row))
-    return header, rows
-
-
-def _cell_text(v) -> str:
-    if isinstance(v, bytes):
-        v = v.decode()
-    if isinstance(v, str):
-        return v.strip()
-    if v is None or (isinstance(v, float | np.floating) and math.isnan(v)):
-        return ""
-    return repr(float(v)) if isinstance(v, float | np.floating) else str(v)
-
 
 def _read_netcdf(path: Path) -> tuple[list[str], list[tuple[str, dict]]]:
     try:
@@ -146,7 +131,7 @@ def _read_netcdf(path: Path) -> tuple[list[str], list[tuple[str, dict]]]:
     if problems:
         raise InputError(problems)
     cols = {k: ds[k].values for k in header}
-    rows = [(f"impact {i}", {k: _cell_text(cols[k][i]) for k in header}) for i in range(ds.sizes[dim])]
+    rows = [(f"impact {i}", {k: cell_text(cols[k][i]) for k in header}) for i in range(ds.sizes[dim])]
     return header, rows
 
 
@@ -159,7 +144,7 @@ def read_impacts_table(path: str | os.PathLike[str]) -> tuple[list[str], list[tu
     path = Path(path)
     if path.suffix.lower() in (".nc", ".nc4", ".netcdf") and path.is_file():
         return _read_netcdf(path)
-    return _read_csv(path)
+    return read_csv_table(path, REQUIRED)
 
 
 # ---------------------------------------------------------------------------------------
@@ -213,8 +198,8 @@ def check_rows(
     seen_rows: dict[tuple, str] = {}
     for label, row in rows:
         at = f"{path}: {label}"
-        if _EXTRA in row:
-            problems.append(f"{at}: {row[_EXTRA]} more cell(s) than the header has columns")
+        if EXTRA in row:
+            problems.append(f"{at}: {row[EXTRA]} more cell(s) than the header has columns")
         for key, table, what in (("bat", bats, "bat"), ("ball", balls, "ball")):
             name = row.get(key, "")
             if not name:

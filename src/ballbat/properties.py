@@ -20,10 +20,13 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from .units import INCH, OUNCE, OZ_IN2
 
 if TYPE_CHECKING:
     import os
+    from collections.abc import Sequence
 
     import numpy as np
     from numpy.typing import ArrayLike
@@ -148,6 +151,42 @@ def read_csv_rows(path: str | os.PathLike[str]) -> tuple[list[str], list[tuple[i
         header = header[:-1]
         rows = [(line, cells[:k] if len(cells) > k else cells) for line, cells in rows]
     return header, rows
+
+
+#: Key of a row's surplus cells in :func:`read_csv_table` (cannot clash with a column name).
+EXTRA = "\0extra"
+
+
+def read_csv_table(path: str | os.PathLike[str], required: Sequence[str]) -> tuple[list[str], list[tuple[str, dict]]]:
+    """Return the header and the rows (``"row N"``, {column: text}) of a CSV file as labs make them.
+
+    :func:`read_csv_rows` reads the file; a row with more cells than the header has columns
+    keeps their number under :data:`EXTRA`. An empty file is an :class:`InputError` that names
+    the ``required`` columns.
+    """
+    header, lines = read_csv_rows(path)
+    if not header:
+        raise InputError([f"{path}: empty file (expected a header line with {', '.join(required)})"])
+    rows = []
+    for line, cells in lines:
+        row = {h: (cells[i] if i < len(cells) else "") for i, h in enumerate(header)}
+        if len(cells) > len(header):
+            row[EXTRA] = str(len(cells) - len(header))
+        rows.append((f"row {line}", row))
+    return header, rows
+
+
+def cell_text(v: object) -> str:
+    """Return a NetCDF cell as the text a CSV cell would hold (NaN and None as empty)."""
+    if isinstance(v, bytes):
+        v = v.decode()
+    if isinstance(v, str):
+        return v.strip()
+    if v is None or (isinstance(v, float | np.floating) and math.isnan(v)):
+        return ""
+    if isinstance(v, np.integer | int):
+        return str(int(v))
+    return repr(float(v))
 
 
 def _read_table(path: Path, columns: dict, key: str) -> list[dict]:

@@ -11,8 +11,6 @@ anything is computed, and every problem is reported at once
 
 from __future__ import annotations
 
-import csv
-import math
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -20,10 +18,9 @@ import numpy as np
 import xarray as xr
 
 from ..pipeline.products import Var, build_dataset
-from ..properties import InputError
+from ..properties import InputError, cell_text, read_csv_table
 from .data import POINTS, Camera, Rig, Tracks, to_dense, to_long
 from .validate import (
-    EXTRA,
     IMPACT_COLUMNS,
     TRACK_COLUMNS,
     check_cameras,
@@ -39,39 +36,6 @@ if TYPE_CHECKING:
 _NC = (".nc", ".nc4", ".netcdf")
 
 
-def _read_csv(path: Path, required) -> tuple[list[str], list[tuple[str, dict]]]:
-    try:
-        with open(path, newline="") as fh:
-            reader = csv.reader(fh)
-            header = next(reader, None)
-            if header is None:
-                raise InputError([f"{path}: empty file (expected a header line with {','.join(required)})"])
-            header = [h.strip() for h in header]
-            rows = []
-            for cells in reader:
-                if not any(c.strip() for c in cells):
-                    continue
-                row = {h: (cells[i].strip() if i < len(cells) else "") for i, h in enumerate(header)}
-                if len(cells) > len(header):
-                    row[EXTRA] = str(len(cells) - len(header))
-                rows.append((f"row {reader.line_num}", row))
-    except UnicodeDecodeError:
-        raise InputError([f"{path}: not a text (CSV) file; NetCDF files must end in .nc"]) from None
-    return header, rows
-
-
-def _text(v) -> str:
-    if isinstance(v, bytes):
-        v = v.decode()
-    if isinstance(v, str):
-        return v.strip()
-    if v is None or (isinstance(v, float | np.floating) and math.isnan(v)):
-        return ""
-    if isinstance(v, np.integer | int):
-        return str(int(v))
-    return repr(float(v))
-
-
 def _read_nc(path: Path, dim: str, columns) -> tuple[list[str], list[tuple[str, dict]]]:
     try:
         with xr.open_dataset(path) as ds:
@@ -85,7 +49,7 @@ def _read_nc(path: Path, dim: str, columns) -> tuple[list[str], list[tuple[str, 
     if dim == "impact" and "impact_id" not in header and "impact" in ds.coords:
         header.insert(0, "impact_id")  # rendered tracks: the impact ids are the dimension's coordinate
         cols["impact_id"] = ds["impact"].values
-    rows = [(f"{dim} {i}", {k: _text(v[i]) for k, v in cols.items()}) for i in range(ds.sizes[dim])]
+    rows = [(f"{dim} {i}", {k: cell_text(v[i]) for k, v in cols.items()}) for i in range(ds.sizes[dim])]
     return header, rows
 
 
@@ -98,7 +62,7 @@ def read_table(
         raise InputError([f"{path}: file not found"])
     if path.suffix.lower() in _NC:
         return _read_nc(path, dim, required)
-    return _read_csv(path, required)
+    return read_csv_table(path, required)
 
 
 def _truth_from_nc(path: Path) -> dict[str, np.ndarray]:

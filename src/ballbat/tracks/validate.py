@@ -11,6 +11,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
+from ..properties import EXTRA
 from .data import CAMERAS, POINTS
 
 if TYPE_CHECKING:
@@ -24,7 +25,6 @@ IMPACT_COLUMNS = ("impact_id", "bat", "ball")
 CAMERA_KEYS = {"fps", "m_per_px", "mirror", "m_per_px_err"}
 CAMERA_REQUIRED = ("fps", "m_per_px", "mirror")
 RIG_KEYS = ("pivot_to_tip_in", "pivot_to_impact_in")
-EXTRA = "\0extra"
 
 
 def check_header(path: str | os.PathLike[str], header: list[str], required: tuple[str, ...]) -> list[str]:
