@@ -86,6 +86,7 @@ def test_outputs_content(run_dir):
         "paper_uncertainty",
         "value",
         "uncertainty",
+        "systematic",
         "truth",
         "unit",
     ]

@@ -1,7 +1,9 @@
 """The paper-comparison table: every published number beside ours (and the truth).
 
-Columns: ``quantity, ball, bat, paper, paper_uncertainty, value, uncertainty, truth, unit``,
-in the paper's units. One row per published number (``ballbat.published``) and one per
+Columns: ``quantity, ball, bat, paper, paper_uncertainty, value, uncertainty, systematic,
+truth, unit``, in the paper's units. ``uncertainty`` is the statistical standard error;
+``systematic`` a systematic error reported apart from it (e_x of a dataset reduced from
+camera tracks with a pixel-scale uncertainty). One row per published number (``ballbat.published``) and one per
 result of ours that the paper does not publish (e.g. e_x of a bat not in the paper, or
 e_y implied by Eq. ratio). Cells that do not apply are empty.
 """
@@ -27,7 +29,18 @@ if TYPE_CHECKING:
 
     from .published import Published
 
-COLUMNS = ("quantity", "ball", "bat", "paper", "paper_uncertainty", "value", "uncertainty", "truth", "unit")
+COLUMNS = (
+    "quantity",
+    "ball",
+    "bat",
+    "paper",
+    "paper_uncertainty",
+    "value",
+    "uncertainty",
+    "systematic",
+    "truth",
+    "unit",
+)
 
 #: quantity -> (variable in fit_ex.nc, unit of the table); value's error is ``<var>_err``.
 FIT_QUANTITIES = {
@@ -80,6 +93,7 @@ def fit_rows(fit: xr.Dataset) -> list[dict]:
                     continue
                 err = _pick(fit, f"{var}_err", ball, bat or None)
                 tru = _pick(fit, f"truth_{var}", ball, bat or None)
+                sys_ = _pick(fit, f"{var}_err_scale", ball, bat or None)
                 conv = (lambda x, unit=unit: None if x is None else from_si(x, unit)) if unit != "1" else (lambda x: x)
                 rows.append(
                     {
@@ -88,6 +102,7 @@ def fit_rows(fit: xr.Dataset) -> list[dict]:
                         "bat": bat,
                         "value": conv(val),
                         "uncertainty": conv(err),
+                        "systematic": conv(sys_),
                         "truth": conv(tru),
                         "unit": unit,
                     }

@@ -91,6 +91,7 @@ class Sec4:
     spin_theta_slope: FitGrid
     speed_theta_slope: FitGrid
     per_ball: dict[str, np.ndarray] = field(default_factory=dict)
+    systematic: dict[str, np.ndarray] | None = None  # pixel-scale systematic of e_x (scale_systematic)
 
 
 #: Per-ball quantities that are not line fits (values of :attr:`Sec4.per_ball`).
@@ -125,6 +126,92 @@ def _weights(jx, jy, sigma, slope):
     return 1.0 / np.sqrt(var) if np.all(var > 0) else None
 
 
+def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool) -> tuple[FitGrid, FitGrid]:
+    """Fit Eq. omega per bat and ball and pooled per ball (usable impacts, ``flag == 0``).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Reconstructed impacts.
+    balls, bats : list of str
+        The grid's labels.
+    with_truth : bool
+        Also apply the estimator to the noise-free ``truth_*`` (same weights).
+
+    Returns
+    -------
+    (FitGrid, FitGrid)
+        Per bat and ball (ball x bat; the slope is 1 + e_x), pooled per ball.
+    """
+    usable = ds["flag"].values == 0
+    ball_of = ds["ball"].values.astype(str)
+    bat_of = ds["bat"].values.astype(str)
+    per_bat, pooled = FitGrid.empty((len(balls), len(bats))), FitGrid.empty((len(balls),))
+
+    def spin_fit(sel):
+        n = int(np.sum(sel))
+        if n < MIN_FIT_IMPACTS:  # too few for a slope and its error: report, do not fit
+            return LineFit.not_fitted(n), np.nan
+        r, r_x, alpha = (ds[k].values[sel] for k in ("r", "r_x", "alpha"))
+        x, y, jx, jy = spin_design(*_measured(ds, sel), r, r_x, alpha)
+        sig = _sigma(ds, sel)
+        fit = fit_line(x, y, jx, jy, sig)
+        t = np.nan
+        if with_truth and fit.success:
+            xt, yt, _, _ = spin_design(*_measured(ds, sel, "truth_"), r, r_x, alpha)
+            t = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope))[0] - 1.0
+        return fit, t
+
+    for i, ball in enumerate(balls):
+        in_ball = usable & (ball_of == ball)
+        for bat in sorted(set(bat_of[ball_of == ball])):
+            j = bats.index(bat)
+            per_bat.fits[i, j], per_bat.truth[i, j] = spin_fit(in_ball & (bat_of == bat))
+        pooled.fits[i], pooled.truth[i] = spin_fit(in_ball)
+    return per_bat, pooled
+
+
+#: Per-impact systematic uncertainties of the speeds from a camera's pixel scale (reduce.nc).
+SCALE_VARS = ("v_bat_err_scale", "v_ball_err_scale")
+
+
+def scale_systematic(ds: xr.Dataset, res: Sec4) -> dict[str, np.ndarray] | None:
+    """Systematic error of e_x from the swing camera's pixel-scale uncertainty.
+
+    The pixel scale is shared by every impact of a camera, so its uncertainty does not
+    average out: every v_bat and v_ball is scaled by (1 +- its relative uncertainty) at once
+    and e_x refitted; half the difference of the two fits is the systematic error. It is
+    reported beside the statistical error, never added into it.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Reconstructed impacts with ``v_bat_err_scale`` and ``v_ball_err_scale`` (datasets
+        reduced from camera tracks).
+    res : Sec4
+        The fits of ``ds`` (for its labels).
+
+    Returns
+    -------
+    dict or None
+        ``e_x_err_scale`` (ball x bat) and ``e_x_pooled_err_scale`` (ball); None when the
+        dataset has no pixel-scale uncertainty.
+    """
+    if not all(k in ds for k in SCALE_VARS):
+        return None
+    fits = []
+    for sign in (1.0, -1.0):
+        scaled = ds.copy()
+        for k in ("v_bat", "v_ball"):
+            rel = np.divide(ds[f"{k}_err_scale"].values, np.abs(ds[k].values))
+            scaled[k] = ds[k] * (1.0 + sign * np.nan_to_num(rel))
+        fits.append(fit_e_x(scaled, res.balls, res.bats, with_truth=False))
+    return {
+        "e_x_err_scale": 0.5 * np.abs(fits[0][0].field("slope") - fits[1][0].field("slope")),
+        "e_x_pooled_err_scale": 0.5 * np.abs(fits[0][1].field("slope") - fits[1][1].field("slope")),
+    }
+
+
 def analyze_impacts(ds: xr.Dataset, mu_k_example: float) -> Sec4:
     """Sec. IV analysis of a normalised and reconstructed dataset (output of ``reconstruct``).
 
@@ -156,27 +243,10 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float) -> Sec4:
     )
     res.per_ball["mu_k_lower_bound_impact"] = np.full(nb, -1, dtype=np.int64)
 
-    def spin_fit(sel):
-        n = int(np.sum(sel))
-        if n < MIN_FIT_IMPACTS:  # too few for a slope and its error: report, do not fit
-            return LineFit.not_fitted(n), np.nan
-        r, r_x, alpha = (ds[k].values[sel] for k in ("r", "r_x", "alpha"))
-        x, y, jx, jy = spin_design(*_measured(ds, sel), r, r_x, alpha)
-        sig = _sigma(ds, sel)
-        fit = fit_line(x, y, jx, jy, sig)
-        t = np.nan
-        if has_truth and fit.success:
-            xt, yt, _, _ = spin_design(*_measured(ds, sel, "truth_"), r, r_x, alpha)
-            t = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope))[0] - 1.0
-        return fit, t
-
+    res.e_x, res.e_x_pooled = fit_e_x(ds, ball_list, bat_list, with_truth=has_truth)
     pb = res.per_ball
     for i, ball in enumerate(ball_list):
         in_ball = usable & (balls == ball)
-        for bat in sorted(set(bats[balls == ball])):
-            j = bat_list.index(bat)
-            res.e_x.fits[i, j], res.e_x.truth[i, j] = spin_fit(in_ball & (bats == bat))
-        res.e_x_pooled.fits[i], res.e_x_pooled.truth[i] = spin_fit(in_ball)
         n_ball = int(in_ball.sum())
         if n_ball < MIN_FIT_IMPACTS:  # per-ball fits need the same minimum: report NaN
             for grid in (res.tan_ratio_slope, res.spin_theta_slope, res.speed_theta_slope):
@@ -220,6 +290,7 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float) -> Sec4:
                 yt_norm = normalize_to_bat_speed(tv[MEASURED.index(which)], tv[0], v_ref)
                 xt, yt, _, _ = normalized_theta_design(tv[0], yt_norm, tv[2], which, v_ref)
                 grid.truth[i] = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope), through_origin=False)[0]
+    res.systematic = scale_systematic(ds, res)
     return res
 
 
@@ -239,11 +310,22 @@ FIT_FAMILIES = {
 _SLOPE_IS_ONE_PLUS = ("e_x", "e_x_pooled")
 
 
-def fit_ex_table(has_truth: bool, mu_k_example: float) -> dict[str, Var]:
-    """Return the variables of fit_ex.nc, declared once (name -> :class:`Var`)."""
+def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) -> dict[str, Var]:
+    """Return the variables of fit_ex.nc, declared once (name -> :class:`Var`).
+
+    ``has_scale``: the dataset carries a pixel-scale uncertainty (reduced from camera
+    tracks), so e_x gets a systematic error (``*_err_scale``).
+    """
     table: dict[str, Var] = {}
     for name, (dims, units, what) in FIT_FAMILIES.items():
         table.update(estimate_vars(name, dims, units, what))
+        if has_scale and name in _SLOPE_IS_ONE_PLUS:
+            table[f"{name}_err_scale"] = Var(
+                dims,
+                units,
+                f"systematic error of {name} from the pixel-scale uncertainty of the swing camera "
+                "(shared by every impact; not included in the standard error)",
+            )
         if has_truth:
             table[f"truth_{name}"] = Var(
                 dims, units, f"true {what} (same estimator on the noise-free truth)", {"ballbat_role": "truth"}
@@ -304,12 +386,17 @@ def results_dataset(res: Sec4) -> xr.Dataset:
     for name in _SLOPE_IS_ONE_PLUS:
         values[f"{name}_status"] = np.vectorize(lambda f: int(fit_status(f)), otypes=[np.int8])(getattr(res, name).fits)
     values.update({k: v for k, v in res.per_ball.items() if res.has_truth or not k.startswith("truth_")})
+    if res.systematic is not None:
+        values.update(res.systematic)
     coords = {
         "ball": (Var(("ball",), None, "ball type"), np.array(res.balls, dtype=str)),
         "bat": (Var(("bat",), None, "bat"), np.array(res.bats, dtype=str)),
     }
     return build_dataset(
-        fit_ex_table(res.has_truth, res.mu_k_example), values, coords, {"mu_k_example": res.mu_k_example}
+        fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None),
+        values,
+        coords,
+        {"mu_k_example": res.mu_k_example},
     )
 
 

@@ -35,6 +35,7 @@ rate to unwrap. Exclude, never drop.
 from __future__ import annotations
 
 import enum
+import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -57,6 +58,9 @@ THRESHOLD_FLOOR_PX = 3.0
 THRESHOLD_SIGMA = 8.0
 #: Longest contact (s): "under a millisecond" (Sec. II).
 CONTACT_MAX = 1.0e-3
+#: Typical ball-bat contact time (s), 0.6-0.9 ms: places the contact's start before the
+#: time the free flight extrapolates back to the rest position (its midpoint).
+CONTACT_TYPICAL = 0.75e-3
 #: A frame within this many sigma of the flight fit is already in free flight.
 SEPARATION_SIGMA = 4.0
 #: Sd of the prior on the bat's alignment time tau, in frames (the rest frame is its centre).
@@ -65,11 +69,11 @@ TAU_PRIOR_FRAMES = 0.6
 GN_ITERATIONS = 6
 #: Apparent spin per frame beyond which unwrapping is ambiguous (rad per frame).
 UNWRAP_LIMIT = 0.75 * np.pi
-#: A dot rotates about the centre when the rms of its radius is below both
-#: RADIUS_TOLERANCE x its mean radius and RADIUS_SIGMA x the tracking noise ... or below
-#: the larger of the two.
+#: A dot rotates about the centre when the scatter of its distance from the centre is
+#: what the tracking noise alone gives (F test, false-alarm probability
+#: RADIUS_FALSE_ALARM per dot), or below RADIUS_TOLERANCE x its mean radius.
 RADIUS_TOLERANCE = 0.05
-RADIUS_SIGMA = 2.5
+RADIUS_FALSE_ALARM = 1e-3
 
 
 class ReduceFlag(enum.IntEnum):
@@ -129,6 +133,25 @@ class Onset:
     found: np.ndarray
 
 
+def _rest_scatter(x: np.ndarray, y: np.ndarray, rest: np.ndarray) -> np.ndarray:
+    """Tracking scatter per coordinate (px) from successive differences of the frames at rest.
+
+    Differences of neighbouring rest frames do not depend on the rest position, so a few
+    frames give an unbiased estimate (the deviations from a median of five frames include
+    exact zeros and underestimate it). Their mean is removed, so a track that is already
+    moving steadily (no rest filmed) shows a small scatter and no rest.
+    """
+    pair = rest[:, 1:] & rest[:, :-1]
+    n = pair.sum(axis=1)
+    with np.errstate(all="ignore"):
+        dx = np.where(pair, np.diff(x, axis=1), 0.0)
+        dy = np.where(pair, np.diff(y, axis=1), 0.0)
+        mx = dx.sum(axis=1) / np.maximum(n, 1)
+        my = dy.sum(axis=1) / np.maximum(n, 1)
+        ss = np.sum(np.where(pair, (dx - mx[:, None]) ** 2 + (dy - my[:, None]) ** 2, 0.0), axis=1)
+        return np.where(n > 1, np.sqrt(ss / (4 * np.maximum(n - 1, 1))), np.nan)
+
+
 def find_onset(x: np.ndarray, y: np.ndarray) -> Onset:
     """First column from which the ball stays away from its rest position (pixels).
 
@@ -144,26 +167,25 @@ def find_onset(x: np.ndarray, y: np.ndarray) -> Onset:
     valid = np.isfinite(x) & np.isfinite(y)
     rank = np.cumsum(valid, axis=1)
     early = valid & (rank <= N_REST)
-    with np.errstate(all="ignore"):
-        import warnings
-
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore", RuntimeWarning)
-            x0 = np.nanmedian(np.where(early, x, np.nan), axis=1)
-            y0 = np.nanmedian(np.where(early, y, np.nan), axis=1)
-            dev = np.concatenate(
-                [np.where(early, x - x0[:, None], np.nan), np.where(early, y - y0[:, None], np.nan)], 1
-            )
-            sig = 1.4826 * np.nanmedian(np.abs(dev), axis=1)
-    thr = np.maximum(THRESHOLD_FLOOR_PX, THRESHOLD_SIGMA * np.nan_to_num(sig))
-    d = np.hypot(x - x0[:, None], y - y0[:, None])
-    moving = valid & (d > thr[:, None])
-    ok_after = moving | ~valid
-    stays = np.flip(np.cumprod(np.flip(ok_after, axis=1), axis=1), axis=1).astype(bool)
-    onset = _first(moving & stays)
     cols = np.arange(x.shape[1])[None, :]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        x0 = np.nanmedian(np.where(early, x, np.nan), axis=1)
+        y0 = np.nanmedian(np.where(early, y, np.nan), axis=1)
+    # Two passes: the tracking scatter from the first frames, then from every frame at rest
+    # before the impact that pass found (more frames, a steadier threshold).
+    rest_frames = early
+    for _ in range(2):
+        sig = _rest_scatter(x, y, rest_frames)
+        thr = np.maximum(THRESHOLD_FLOOR_PX, THRESHOLD_SIGMA * np.nan_to_num(sig))
+        d = np.hypot(x - x0[:, None], y - y0[:, None])
+        moving = valid & (d > thr[:, None])
+        ok_after = moving | ~valid
+        stays = np.flip(np.cumprod(np.flip(ok_after, axis=1), axis=1), axis=1).astype(bool)
+        onset = _first(moving & stays)
+        before = cols < onset[:, None]
+        rest_frames = np.where((onset > 0)[:, None], valid & ~moving & before, early)
     rest = _last(valid & ~moving & (cols < np.where(onset < 0, 0, onset)[:, None]))
-    before = cols < onset[:, None]
     n_rest = np.sum(valid & ~moving & before, axis=1)
     n_moving_before = np.sum(moving & before, axis=1)
     # a real rest: at least two frames at rest and none away from rest before the impact
@@ -272,7 +294,80 @@ class Swing:
     mask: np.ndarray
 
 
-def fit_swing(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: float, L: float) -> Swing:
+def radius_scatter_limit(noise: ArrayLike, noise_dof: ArrayLike, n: ArrayLike) -> np.ndarray:
+    """Largest rms of a dot's distance from the ball's centre that tracking noise explains.
+
+    The distance's scatter over ``n`` frames is the tracking noise (per coordinate, estimated
+    from the free-flight fit with ``noise_dof`` degrees of freedom) plus the fitted centre's
+    own error (about noise x sqrt(2 / n)). The ratio of its sample variance (``n - 1``
+    degrees of freedom) to the estimated noise variance follows an F distribution; it
+    exceeds the returned limit squared with probability :data:`RADIUS_FALSE_ALARM`.
+
+    Parameters
+    ----------
+    noise : ndarray
+        Tracking noise (m) per impact.
+    noise_dof : ndarray
+        Degrees of freedom of that estimate.
+    n : ndarray
+        Frames of the dot.
+
+    Returns
+    -------
+    ndarray
+        NaN where ``n`` < 2 or the noise has no degree of freedom.
+    """
+    from scipy import stats
+
+    n = np.asarray(n, dtype=float)
+    dof2 = np.asarray(noise_dof, dtype=float)
+    ok = (n >= 2) & (dof2 >= 1)
+    q = stats.f.isf(RADIUS_FALSE_ALARM, np.maximum(n - 1, 1), np.maximum(dof2, 1))
+    with np.errstate(all="ignore"):
+        lim = np.asarray(noise, dtype=float) * np.sqrt((1 + 2 / np.maximum(n, 1)) * q)
+    return np.where(ok, lim, np.nan)
+
+
+def contact_start(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, flight: Flight) -> np.ndarray:
+    """Time the contact began (s), from the ball's rest position and its free flight.
+
+    The free flight extrapolated back passes the rest position at the impulse-weighted mean
+    time of the contact, its midpoint for a symmetric force pulse; the contact began half a
+    typical contact time (:data:`CONTACT_TYPICAL`) earlier. This is steadier than the last
+    frame at rest, which lags behind the impact by up to a frame or two when the tracking
+    is noisy (the ball must first move clear of the noise).
+
+    Parameters
+    ----------
+    X, Y : ndarray
+        Ball centre (m), physical frame, NaN untracked.
+    t : ndarray
+        Time of each column (s).
+    onset : Onset
+        The impact found in this camera.
+    flight : Flight
+        Its free-flight fit.
+
+    Returns
+    -------
+    ndarray
+        NaN where no impact was found.
+    """
+    X = np.asarray(X, dtype=float)
+    Y = np.asarray(Y, dtype=float)
+    cols = np.arange(X.shape[1])[None, :]
+    at_rest = np.isfinite(X) & np.isfinite(Y) & (cols <= onset.rest[:, None]) & onset.found[:, None]
+    w = at_rest.astype(float)
+    with np.errstate(all="ignore"):
+        n = w.sum(axis=1)
+        xr, yr = _msum(X, w) / n, _msum(Y, w) / n
+        u = ((xr - flight.x0) * flight.vx + (yr - flight.y0) * flight.vy) / (flight.vx**2 + flight.vy**2)
+    return np.where(onset.found & (n > 0), flight.t_ref + u - 0.5 * CONTACT_TYPICAL, np.nan)
+
+
+def fit_swing(
+    X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: float, L: float, t_contact: ArrayLike
+) -> Swing:
     """Fit the tip dot's pre-impact motion (a circle of radius L about the pivot, seen edge-on).
 
     Parameters
@@ -287,14 +382,19 @@ def fit_swing(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: float
         Frame rate.
     L : float
         Pivot-to-tip distance (m).
+    t_contact : ndarray
+        Start of the contact (:func:`contact_start`): only earlier frames are fitted (the
+        bat slows in the collision), and the tip is aligned with the impact then (the prior
+        of the alignment time tau).
 
     Returns
     -------
     Swing
     """
     valid = np.isfinite(X) & np.isfinite(Y)
-    cols = np.arange(X.shape[1])[None, :]
-    mask = valid & onset.found[:, None] & (cols <= onset.rest[:, None] - 1)
+    t_contact = np.asarray(t_contact, dtype=float)
+    found = onset.found & np.isfinite(t_contact)
+    mask = valid & found[:, None] & (t < np.where(found, t_contact, -np.inf)[:, None])
     w = mask.astype(float)
     n = _msum(np.ones_like(X), w)
     with np.errstate(all="ignore"):
@@ -314,7 +414,7 @@ def fit_swing(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: float
         # Student-t: with few frames the scatter estimate is itself uncertain (sd of t with n - 2 dof)
         beta_err = s_perp / np.sqrt(_msum(along**2, w)) * np.sqrt((n - 2) / np.maximum(n - 4, 1))
 
-        tau0 = _take(t, onset.rest) - 0.5 / fps
+        tau0 = np.where(found, t_contact, 0.0)
         st = tm - tau0
         slope = _msum((t - tm[:, None]) * along, w) / _msum((t - tm[:, None]) ** 2, w)
         om = slope / L
@@ -535,7 +635,8 @@ def reduce_tracks(
         flight[name] = fit_flight(X, Y, t, onset[name], cam.fps)
     Xt, Yt = physical(tracks.cameras["swing"], cameras["swing"], "bat_tip")
     phys[("swing", "bat_tip")] = (Xt, Yt)
-    swing = fit_swing(Xt, Yt, times["swing"], onset["swing"], cameras["swing"].fps, rig.pivot_to_tip)
+    t_contact = contact_start(*phys[("swing", "ball")], times["swing"], onset["swing"], flight["swing"])
+    swing = fit_swing(Xt, Yt, times["swing"], onset["swing"], cameras["swing"].fps, rig.pivot_to_tip, t_contact)
     dots = {p: physical(tracks.cameras["spin"], cameras["spin"], p) for p in ("dot_a", "dot_b")}
     for p, v in dots.items():
         phys[("spin", p)] = v
@@ -619,8 +720,11 @@ def reduce_tracks(
             ),
         )
     noise = flight["spin"].sigma
+    noise_dof = 2 * flight["spin"].n - 4  # two coordinates, four fitted parameters
     for p in ("dot_a", "dot_b"):
-        allowed = np.maximum(RADIUS_TOLERANCE * spin.radius[p], RADIUS_SIGMA * noise)
+        allowed = np.maximum(
+            RADIUS_TOLERANCE * spin.radius[p], radius_scatter_limit(noise, noise_dof, spin.mask[p].sum(axis=1))
+        )
         mark(
             spin.radius_sd[p] > allowed,
             ReduceFlag.DOT_NOT_ROTATING_ABOUT_CENTRE,

@@ -60,7 +60,7 @@ class RenderCamera:
     width_px: int = 1200
     height_px: int = 800
     tee_px: tuple[float, float] = (540.0, 480.0)
-    pixel_noise_px: float = 0.5
+    pixel_noise_px: float = 2.0
     pre_impact_frames: int = 20
     max_frames: int = 200
 
@@ -107,7 +107,7 @@ def settings_from_config(cfg: dict) -> RenderSettings:
             width_px=int(c.get("width_px", 1200)),
             height_px=int(c.get("height_px", 800)),
             tee_px=tuple(float(v) for v in c.get("tee_px", (540.0, 480.0))),
-            pixel_noise_px=float(c.get("pixel_noise_px", 0.5)),
+            pixel_noise_px=float(c.get("pixel_noise_px", 2.0)),
             pre_impact_frames=int(c.get("pre_impact_frames", 20)),
             max_frames=int(c.get("max_frames", 200)),
         )
