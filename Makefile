@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.ballbat-installed
 CORES ?= 2
 
-.PHONY: install run test test-slurm report bench lint lock clean
+.PHONY: install run test test-slurm study report bench lint lock clean
 
 # Create the virtual environment and install the pinned stack plus ballbat (editable).
 $(STAMP): pyproject.toml requirements.lock
@@ -35,6 +35,12 @@ $(SLURM_VENV)/.installed: pyproject.toml requirements.lock requirements-slurm.lo
 
 test-slurm: $(SLURM_VENV)/.installed
 	BIN=$(CURDIR)/$(SLURM_VENV)/bin tests/slurm/run.sh
+
+# Replicate studies (config `studies`: calibration and design; docs/studies.md), then the
+# report with their figures. Not part of `make run`.
+study: install
+	$(BIN)/snakemake -c$(CORES) all studies
+	$(BIN)/snakemake -c$(CORES) --report results/report.html all studies
 
 report: run
 	$(BIN)/snakemake -c$(CORES) --report results/report.html

@@ -22,6 +22,7 @@ include: "workflow/rules/compare.smk"
 include: "workflow/rules/implications.smk"
 include: "workflow/rules/plots.smk"
 include: "workflow/rules/workbook.smk"
+include: "workflow/rules/studies.smk"
 
 
 # Cheap jobs (drawing, tabulating) run where Snakemake runs, never as cluster jobs.
@@ -41,6 +42,8 @@ localrules:
     plot_fig11,
     plot_launch,
     tracks_qa,
+    studies,
+    study_design,
 
 
 # Once Snakemake holds the folder's lock, no running job of ours owns a temporary file any more.

@@ -40,6 +40,7 @@ def run(tmp_path_factory):
     wd = make_workdir(tmp_path_factory.mktemp("byod"))
     cfg = yaml.safe_load((wd / "config" / "config.yaml").read_text())
     cfg["datasets"] = TINY
+    cfg["studies"] = {}
     cfg["implications"]["scenarios"] = {}
     (wd / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
     (wd / "bad.csv").write_text(BAD_CSV)

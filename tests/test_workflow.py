@@ -37,6 +37,7 @@ def run_dir(tmp_path_factory):
     wd = make_workdir(tmp_path_factory.mktemp("wf"), copy_package=True)
     cfg = yaml.safe_load((wd / "config" / "config.yaml").read_text())
     cfg["datasets"] = SMALL["datasets"]
+    cfg["studies"] = {}
     paper = cfg["implications"]["scenarios"]["paper"]
     paper["sweep"]["D_in"]["num"] = 26
     paper["e_x_from_dataset"] = "small"

@@ -64,6 +64,7 @@ def fit_line(
     sigma: ArrayLike = None,
     through_origin: bool = True,
     iterations: int = 3,
+    robust: bool = False,
 ) -> LineFit:
     """Fit y = slope x (+ intercept) with lmfit, weighting by the effective variance.
 
@@ -73,6 +74,11 @@ def fit_line(
     jx, jy : (n, k) partial derivatives of x and y with respect to the k measured
         quantities; ``sigma`` (n, k) their standard uncertainties. All three or none.
     through_origin : fit y = slope x (Eq. omega, Eq. ratio) or a line with intercept.
+    robust : standard errors from the sandwich (HC3, :func:`sandwich_cov`) instead of the
+        covariance scaled by the reduced chi-square: for lines that summarise data the
+        model does not describe impact by impact (Figs. 3-4: bats of different e_x, spin
+        and speed not exactly linear in theta), whose scatter about the line is not the
+        same everywhere.
     """
     import lmfit
     from scipy import stats
@@ -115,6 +121,12 @@ def fit_line(
     tq = float(stats.t.ppf(0.975, n - p))
     icpt = 0.0 if through_origin else float(result.params["intercept"].value)
     icpt_err = 0.0 if through_origin else float(result.params["intercept"].stderr)
+    if robust:
+        X = x[:, None] if through_origin else np.stack([x, np.ones_like(x)], axis=1)
+        w = np.ones(n) if weights is None else np.asarray(weights, dtype=float)
+        cov = sandwich_cov(X * w[:, None], (y - slope * x - icpt) * w)
+        err = float(np.sqrt(cov[0, 0]))
+        icpt_err = 0.0 if through_origin else float(np.sqrt(cov[1, 1]))
     return LineFit(
         slope=slope,
         slope_err=err,
@@ -126,6 +138,29 @@ def fit_line(
         redchi=float(result.redchi) if weighted else np.nan,
         success=True,
     )
+
+
+def sandwich_cov(J: ArrayLike, r: ArrayLike) -> np.ndarray:
+    """Heteroscedasticity-consistent (HC3) covariance of least-squares parameters.
+
+    ``J`` (n, p) is the Jacobian of the weighted model (for a line, the weighted design
+    matrix) and ``r`` (n,) the weighted residuals at the fit. The covariance is
+    (J'J)^-1 J' diag(r_i^2 / (1 - h_i)^2) J (J'J)^-1 with the leverages h_i (MacKinnon and
+    White 1985): it holds whether or not the scatter about the model is the same for every
+    point, and whether or not the stated uncertainties explain it.
+
+    Returns
+    -------
+    ndarray
+        (p, p).
+    """
+    J = np.asarray(J, dtype=float)
+    r = np.asarray(r, dtype=float)
+    A = np.linalg.inv(J.T @ J)
+    h = np.einsum("ij,jk,ik->i", J, A, J)
+    u = r / (1.0 - np.minimum(h, 1.0 - 1e-12))
+    B = J.T @ (u[:, None] ** 2 * J)
+    return A @ B @ A
 
 
 def wls_slope(
@@ -148,3 +183,29 @@ def effective_sigma(jx: ArrayLike, jy: ArrayLike, sigma: ArrayLike, slope: Array
     if sigma is None:
         return None
     return np.sqrt(np.sum((jy - slope * jx) ** 2 * sigma**2, axis=1))
+
+
+def slope_correlation(
+    a: tuple[ArrayLike, ArrayLike, ArrayLike | None, float], b: tuple[ArrayLike, ArrayLike, ArrayLike | None, float]
+) -> float:
+    """Correlation of two weighted slopes through the origin fitted to the same impacts.
+
+    Each fit is given as ``(x, y, weights, slope)`` (weights 1/sigma as in :func:`fit_line`,
+    None for unweighted). A slope s = sum(w^2 x y) / sum(w^2 x^2) moves with impact i by its
+    influence w_i^2 x_i (y_i - s x_i) / sum(w^2 x^2); the correlation of the two slopes is
+    that of their influences (the sandwich estimate), which holds whatever the noise is.
+
+    Returns
+    -------
+    float
+        In [-1, 1]; 0 when either fit has no scatter.
+    """
+
+    def influence(x, y, w, s):
+        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
+        w2 = np.ones_like(x) if w is None else np.asarray(w, dtype=float) ** 2
+        return w2 * x * (y - s * x) / np.sum(w2 * x * x)
+
+    ia, ib = influence(*a), influence(*b)
+    den = np.sqrt(np.sum(ia * ia) * np.sum(ib * ib))
+    return float(np.clip(np.sum(ia * ib) / den, -1.0, 1.0)) if den > 0 else 0.0

@@ -589,6 +589,86 @@ FIGURES = {
 }
 
 
+def coverage_figure(cov: xr.Dataset, point: int = 0) -> Figure:
+    """Coverage of a replicate study at one sweep point: 68 % and 95 % coverage and spread / SE per quantity.
+
+    Parameters
+    ----------
+    cov : xarray.Dataset
+        ``results/studies/{name}/coverage.nc``.
+    point : int
+        Sweep point to draw.
+
+    Returns
+    -------
+    Figure
+    """
+    labels = [
+        f"{q} {b} {t}".strip()
+        for q, b, t in zip(cov["quantity_name"].values, cov["ball"].values, cov["bat"].values, strict=True)
+    ]
+    y = np.arange(len(labels))[::-1]
+    fig = Figure(figsize=(10.0, 0.28 * len(labels) + 1.6), dpi=DPI, layout="constrained")
+    axes = fig.subplots(1, 3, sharey=True)
+    c = cov.isel(point=point)
+    panels = (
+        ("coverage_95", 0.95, (0.93, 0.97), "95 % intervals covering the truth"),
+        ("coverage_68", 0.6827, (0.6627, 0.7027), "68 % intervals covering the truth"),
+        ("spread_over_se", 1.0, (0.9, 1.1), "spread / mean standard error"),
+    )
+    for ax, (var, target, band, title) in zip(axes, panels, strict=True):
+        ax.axvspan(*band, color="0.9", zorder=0)
+        ax.axvline(target, color="0.4", lw=0.8, ls=":")
+        ax.errorbar(c[var].values, y, xerr=c[f"{var}_err"].values, fmt="o", ms=4, color="#1f3b73", capsize=2)
+        ax.set_title(title, fontsize=9)
+        ax.grid(axis="x", alpha=0.3)
+    axes[0].set_yticks(y, labels, fontsize=7)
+    n = int(np.nanmax(c["n_replicates"].values)) if c["n_replicates"].size else 0
+    setting = float(c["setting"])
+    where = "" if not np.isfinite(setting) else f", {cov.attrs.get('sweep_parameter', '')} = {setting:g}"
+    fig.suptitle(f"Replicate study: {n} replicates{where} (grey: target)", fontsize=10)
+    return fig
+
+
+def design_figure(des: xr.Dataset) -> Figure:
+    """Draw a sweep's spread of e_x per bat and ball against the swept setting, and the impacts needed.
+
+    Parameters
+    ----------
+    des : xarray.Dataset
+        ``results/studies/{name}/design.nc``.
+
+    Returns
+    -------
+    Figure
+    """
+    fig = Figure(figsize=(10.0, 4.4), dpi=DPI, layout="constrained")
+    ax1, ax2 = fig.subplots(1, 2)
+    x = des["setting"].values
+    balls = list(dict.fromkeys(des["ball"].values.astype(str)))
+    bats = list(dict.fromkeys(des["bat"].values.astype(str)))
+    param = des.attrs.get("sweep_parameter", "setting")
+    for j, (ball, bat) in enumerate(zip(des["ball"].values.astype(str), des["bat"].values.astype(str), strict=True)):
+        kw = {**_marker_kw(ball, bat, balls, bats, size=5), "linestyle": "-", "lw": 0.8}
+        s = des["sigma_e_x"].values[:, j]
+        ax1.errorbar(x, s, yerr=des["sigma_e_x_err"].values[:, j], label=f"{ball}, {bat}", **kw)
+        ax2.plot(x, des["impacts_required"].values[:, j], **kw)
+    if param == "impacts_per_bat":
+        ax1.set_xscale("log")
+        ax1.set_yscale("log")
+        ax2.set_xscale("log")
+    ax1.set_xlabel(param)
+    ax1.set_ylabel("standard deviation of e_x over replicates")
+    ax1.grid(alpha=0.3, which="both")
+    ax1.legend(fontsize=7)
+    delta, conf, power = (des.attrs[k] for k in ("delta_e_x", "confidence", "power"))
+    ax2.set_xlabel(param)
+    ax2.set_ylabel("impacts per bat needed")
+    ax2.set_title(f"to tell two bats {delta:g} apart in e_x ({conf:.0%} confidence, {power:.0%} power)", fontsize=9)
+    ax2.grid(alpha=0.3, which="both")
+    return fig
+
+
 def save_figure(fig: Figure, path: str | os.PathLike[str]) -> Path:
     """Save ``fig`` as PNG atomically, without timestamp or software metadata (same data, same bytes)."""
     path = Path(path)

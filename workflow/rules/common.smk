@@ -211,3 +211,70 @@ def get_scenario_fit(wildcards):
     """fit_ex.nc of the dataset whose pooled e_x the scenario uses (none by default)."""
     name = get_scenario(wildcards).get("e_x_from_dataset")
     return {"fit": f"results/{name}/fit_ex.nc"} if name else {}
+
+
+# Replicate studies (studies.smk).
+STUDIES = sorted(config.get("studies") or {})
+
+
+wildcard_constraints:
+    study="|".join(STUDIES) or "^$",
+    batch=r"\d+",
+
+
+def study_settings(name):
+    from ballbat.studies import StudySettings
+
+    return StudySettings.from_config(config, name)
+
+
+def get_study_config(wildcards):
+    """Everything a study's results depend on: its settings, its dataset's and the chain's."""
+    s = config["studies"][wildcards.study]
+    return {
+        "study": s,
+        "dataset": config["datasets"][s["dataset"]],
+        "normalize": config["normalize"],
+        "analysis": config["analysis"],
+        "stronge": config["stronge"],
+    }
+
+
+def _study_dataset(wildcards):
+    return Namespace(dataset=config["studies"][wildcards.study]["dataset"])
+
+
+def get_study_balls(wildcards):
+    return get_balls_table(_study_dataset(wildcards))
+
+
+def get_study_bats(wildcards):
+    return get_bats_table(_study_dataset(wildcards))
+
+
+def get_study_batches(wildcards):
+    n = study_settings(wildcards.study).n_batches
+    return [f"results/studies/{wildcards.study}/batches/batch{b}.nc" for b in range(n)]
+
+
+def study_mem_mb(wildcards):
+    """A batch holds one replicate at a time (and the aggregate the design's large noise-free experiment)."""
+    s = study_settings(wildcards.study)
+    pairs = sum(len(v) for v in s.dataset["synthetic"]["impacts"].values())
+    impacts = s.truth_impacts * pairs * 2
+    return max(1000, math.ceil(impacts * BYTES_PER_IMPACT / 1e6) + 500)
+
+
+def study_batch_runtime(wildcards):
+    """Minutes: about a second per replicate of the paper's size, with room."""
+    s = study_settings(wildcards.study)
+    return max(10, math.ceil(s.batch_size * 2 / 60) + 5)
+
+
+def study_targets():
+    targets = []
+    for name in STUDIES:
+        targets += [f"results/studies/{name}/coverage.{ext}" for ext in ("nc", "csv", "png")]
+        if config["studies"][name].get("sweep"):
+            targets += [f"results/studies/{name}/design.{ext}" for ext in ("nc", "csv", "png")]
+    return targets

@@ -39,9 +39,20 @@ MEMORY_SHARE = 0.5
 
 
 def drop_nulls(config: dict) -> dict:
-    """Drop datasets and scenarios set to null (``datasets: {synthetic: null}`` in an override)."""
+    """Drop datasets, scenarios and studies set to null (``datasets: {synthetic: null}`` in an override).
+
+    A study of a dataset dropped this way is dropped with it (it has nothing to replicate).
+    """
+    dropped = set()
     if isinstance(config.get("datasets"), dict):
+        dropped = {k for k, v in config["datasets"].items() if v is None}
         config["datasets"] = {k: v for k, v in config["datasets"].items() if v is not None}
+    if isinstance(config.get("studies"), dict):
+        config["studies"] = {
+            k: v
+            for k, v in config["studies"].items()
+            if v is not None and not (isinstance(v, dict) and v.get("dataset") in dropped)
+        }
     imp = config.get("implications")
     if isinstance(imp, dict) and isinstance(imp.get("scenarios"), dict):
         imp["scenarios"] = {k: v for k, v in imp["scenarios"].items() if v is not None}
@@ -68,6 +79,30 @@ def _names(config: dict) -> list[str]:
                     f"{where}.{name}: {name!r} is reserved for the workflow's own results "
                     f"(reserved: {', '.join(reserved)}); choose another name"
                 )
+    return problems
+
+
+def _studies(config: dict) -> list[str]:
+    """Check that each study names a synthetic dataset and that its sweep suits that dataset."""
+    from ..studies import check_sweep
+
+    problems = []
+    datasets = config.get("datasets") or {}
+    for name, study in (config.get("studies") or {}).items():
+        where = f"studies.{name}"
+        ds = datasets.get(study["dataset"])
+        if ds is None:
+            problems.append(
+                f"{where}.dataset: no dataset {study['dataset']!r} (datasets: {', '.join(datasets)}); "
+                f"name one, or drop the study with {where}: null"
+            )
+        elif "synthetic" not in ds:
+            problems.append(
+                f"{where}.dataset: {study['dataset']!r} is not synthetic (a study replicates a synthetic experiment)"
+            )
+        else:
+            sweep = study.get("sweep") or {}
+            problems += check_sweep(ds, sweep.get("parameter"), sweep.get("values", ()), where)
     return problems
 
 
@@ -206,7 +241,7 @@ def validate_config(config: dict, schema: dict, source: str = "config", availabl
     lines = [_message(e) for e in errors] + _names(config)
     if not lines:
         fill_defaults(config, schema)
-        lines = _sizes(config, _available_memory() if available is None else available)
+        lines = _studies(config) + _sizes(config, _available_memory() if available is None else available)
     if lines:
         raise ConfigError(f"{source} is not valid:\n  " + "\n  ".join(lines))
     return config

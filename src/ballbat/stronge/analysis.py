@@ -44,6 +44,7 @@ __all__ = [
     "VtfData",
     "analyse_ball",
     "boundaries",
+    "fit_ball",
     "model_curves",
     "stronge_dataset",
     "stronge_variables",
@@ -273,6 +274,49 @@ class BallAnalysis:
         return (self.fit.eta2, self.fit.e_y, self.fit.mu, self.r_x_mean, self.r_y_mean, self.alpha_mean)
 
 
+def fit_ball(
+    data: VtfData,
+    *,
+    e_y: float,
+    mu: float,
+    vary_e_y: bool,
+    vary_mu: bool,
+    sigma: NDArray[np.float64] | None = None,
+) -> Eta2Fit:
+    """Fit eta^2 to one ball's Eq. vtf data as the workflow does (the workflow and the replicate studies).
+
+    Parameters
+    ----------
+    data : VtfData
+        The ball's data (:func:`vtf_data`).
+    e_y, mu : float
+        Fixed values, or starting values when ``vary_e_y``/``vary_mu``.
+    vary_e_y, vary_mu : bool
+        Fit e_y and/or mu along with eta^2.
+    sigma : ndarray, optional
+        Weights' uncertainties in place of ``data.sigma`` (the truth of a replicate study
+        is fitted with the measured data's weights).
+
+    Returns
+    -------
+    Eta2Fit
+    """
+    d = data
+    return fit_eta2(
+        d.psi,
+        d.x,
+        d.y,
+        d.r_x,
+        d.r_y,
+        sigma=d.sigma if sigma is None else sigma,
+        e_y=e_y,
+        mu=mu,
+        alpha=d.alpha,
+        vary_e_y=vary_e_y,
+        vary_mu=vary_mu,
+    )
+
+
 def analyse_ball(
     data: VtfData,
     eta2_published: float | None,
@@ -305,9 +349,7 @@ def analyse_ball(
         (bat frame) and the mean alpha.
     """
     d = data
-    fit = fit_eta2(
-        d.psi, d.x, d.y, d.r_x, d.r_y, sigma=d.sigma, e_y=e_y, mu=mu, alpha=d.alpha, vary_e_y=vary_e_y, vary_mu=vary_mu
-    )
+    fit = fit_ball(d, e_y=e_y, mu=mu, vary_e_y=vary_e_y, vary_mu=vary_mu)
     a = float(np.mean(d.alpha))
     rxm, rym = float(np.mean(d.r_x)), float(np.mean(d.r_y))
     params = (fit.eta2, fit.e_y, fit.mu, rxm, rym, a)

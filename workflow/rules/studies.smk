@@ -1,0 +1,91 @@
+# Replicate studies (docs/studies.md): the whole chain on many replicates of a synthetic
+# dataset, one job per batch of replicates, then the coverage of every uncertainty and, for a
+# sweep, the design table. Not part of `rule all`: `make study` (or `snakemake studies`).
+
+
+rule study_batch:
+    """Run one batch of a study's replicate experiments through the chain (in memory)."""
+    input:
+        balls=get_study_balls,
+        bats=get_study_bats,
+        code=code("study_batch.py"),
+    output:
+        batch="results/studies/{study}/batches/batch{batch}.nc",
+    log:
+        "results/studies/{study}/logs/batch{batch}.log",
+    benchmark:
+        "results/studies/{study}/benchmarks/batch{batch}.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=study_mem_mb,
+        runtime=study_batch_runtime,
+    params:
+        study=get_study_config,
+    script:
+        "../scripts/study_batch.py"
+
+
+rule study_aggregate:
+    """Coverage of every quantity with an uncertainty and a truth, over all batches of a study."""
+    input:
+        batches=get_study_batches,
+        balls=get_study_balls,
+        bats=get_study_bats,
+        code=code("study_aggregate.py"),
+    output:
+        coverage="results/studies/{study}/coverage.nc",
+        csv="results/studies/{study}/coverage.csv",
+        png=report(
+            "results/studies/{study}/coverage.png",
+            caption="../report/study_coverage.rst",
+            category="Studies",
+            subcategory="{study}",
+            labels={"figure": "coverage", "shows": "coverage of every reported uncertainty"},
+        ),
+    log:
+        "results/studies/{study}/logs/aggregate.log",
+    benchmark:
+        "results/studies/{study}/benchmarks/aggregate.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=study_mem_mb,
+        runtime=30,
+    params:
+        study=get_study_config,
+    script:
+        "../scripts/study_aggregate.py"
+
+
+rule study_design:
+    """A sweep's spread of e_x and the impacts per bat an experiment needs (table and figure)."""
+    input:
+        coverage=rules.study_aggregate.output.coverage,
+        code=code("study_design.py"),
+    output:
+        design="results/studies/{study}/design.nc",
+        csv="results/studies/{study}/design.csv",
+        png=report(
+            "results/studies/{study}/design.png",
+            caption="../report/study_design.rst",
+            category="Studies",
+            subcategory="{study}",
+            labels={"figure": "design", "shows": "spread of e_x and impacts needed"},
+        ),
+    log:
+        "results/studies/{study}/logs/design.log",
+    conda:
+        ENV
+    params:
+        study=get_study_config,
+    script:
+        "../scripts/study_design.py"
+
+
+rule studies:
+    """Every study of the config (`make study`)."""
+    input:
+        study_targets(),
