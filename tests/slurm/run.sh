@@ -18,10 +18,14 @@ for side in local slurm; do
 done
 
 export PATH="$BIN:$PATH"
-TARGETS=(all studies --configfile tests/slurm/study.yaml)
-(cd "$WORK/local" && snakemake -c2 --quiet "${TARGETS[@]}") >"$WORK/local.log" 2>&1 || { tail -n 40 "$WORK/local.log"; exit 1; }
+TARGETS=(all studies)
+CONFIG=(--configfile "$HERE/study.yaml")  # last: --configfile takes every word after it
+(cd "$WORK/local" && snakemake "${TARGETS[@]}" -c2 --quiet "${CONFIG[@]}") >"$WORK/local.log" 2>&1 || {
+    tail -n 40 "$WORK/local.log"
+    exit 1
+}
 start=$(date +%s)
-(cd "$WORK/slurm" && snakemake --workflow-profile workflow/profiles/slurm "${TARGETS[@]}") >"$WORK/slurm.log" 2>&1 || {
+(cd "$WORK/slurm" && snakemake "${TARGETS[@]}" --workflow-profile workflow/profiles/slurm "${CONFIG[@]}") >"$WORK/slurm.log" 2>&1 || {
     tail -n 60 "$WORK/slurm.log"
     exit 1
 }
