@@ -197,7 +197,7 @@ def test_study_rules_through_snakemake(tmp_path):
     """`snakemake studies`: batches, coverage and design files with units and provenance; `all` runs none."""
     import csv
 
-    from workflow_helpers import assert_not_blank, make_workdir, planned_jobs, snakemake
+    from workflow_helpers import assert_cf, assert_not_blank, make_workdir, planned_jobs, snakemake
 
     wd = make_workdir(tmp_path)
     small = wd / "small.yaml"
@@ -225,6 +225,7 @@ def test_study_rules_through_snakemake(tmp_path):
     assert all(float(r["impacts_required"]) >= 3 for r in design)
     for png in ("calibration/coverage.png", "design/coverage.png", "design/design.png"):
         assert_not_blank(res / png)
+    assert_cf(sorted(str(p) for p in res.rglob("*.nc")), tmp_path / "cf.json")
     # replicates are the same experiments whatever the batch size
     b = xr.concat([xr.open_dataset(res / "calibration" / "batches" / f"batch{i}.nc") for i in (0, 1)], "replicate")
     small.write_text(small.read_text().replace("batch_size: 3", "batch_size: 4"))

@@ -69,3 +69,30 @@ def planned_jobs(workdir: Path, *args: str) -> dict[str, int]:
         if len(cells) == len(header) and cells[col["plan"]] == "update pending":
             jobs.setdefault(cells[col["rule"]], set()).add(cells[col["log-file(s)"]])
     return {rule: len(logs) for rule, logs in jobs.items()}
+
+
+def assert_cf(files: list[str], report: Path) -> None:
+    """Every file passes the IOOS compliance-checker's CF 1.10 suite (all points, no message).
+
+    The checker raises inside its own monotonicity check on string-valued coordinates (ball,
+    bat); that check is then not scored, so it cannot hide a failure of another.
+    """
+    import json
+
+    checker = Path(sys.executable).parent / "compliance-checker"
+    subprocess.run(
+        [str(checker), "--test", "cf:1.10", "-f", "json_new", "-o", str(report), *files],
+        capture_output=True,
+        timeout=600,
+    )
+    results = json.loads(report.read_text())
+    assert sorted(results) == sorted(files)
+    for name, res in results.items():
+        cf = res["cf:1.10"]
+        failed = [
+            f"{c['name']}: {c['msgs']}"
+            for level in ("high_priorities", "medium_priorities", "low_priorities")
+            for c in cf[level]
+            if c["msgs"]
+        ]
+        assert cf["scored_points"] == cf["possible_points"] and not failed, (name, failed)

@@ -193,12 +193,36 @@ def to_csv(table: list[dict]) -> str:
     return buf.getvalue()
 
 
+#: What an ``uncertainty`` is where it is not the standard error of a fit (notes under the Markdown table).
+UNCERTAINTY_NOTES = {
+    "mu_k_lower_bound": (
+        "the measurement uncertainty of the largest tan(psi - theta), not a standard error of a sample "
+        "maximum: it says how well the largest value of these impacts is measured (docs/studies.md)"
+    ),
+    "e_y_implied": "propagated from the Eq. ratio slope and the pooled e_x, with their correlation",
+    "spin_theta_slope": "a sandwich (HC3) standard error",
+    "speed_theta_slope": "a sandwich (HC3) standard error",
+}
+
+
 def to_markdown(table: list[dict], title: str) -> str:
-    """Return the comparison table as a Markdown table under the heading ``title``."""
+    """Return the comparison table as a Markdown table under the heading ``title``, with notes on the uncertainties."""
     lines = [f"# {title}", "", "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     for r in table:
         cells = [r[c] or "" if c in ("quantity", "ball", "bat", "unit") else _num(r[c]) for c in COLUMNS]
         lines.append("| " + " | ".join(cells) + " |")
+    present = {r["quantity"] for r in table if r.get("uncertainty") is not None}
+    notes = [f"- `{q}`: uncertainty is {UNCERTAINTY_NOTES[q]}" for q in UNCERTAINTY_NOTES if q in present]
+    if any(r.get("systematic") is not None for r in table):
+        notes.append("- `systematic`: from the swing camera's pixel-scale uncertainty, apart from the standard error")
+    if notes:
+        lines += [
+            "",
+            "Uncertainties are standard errors of the fits (covariance scaled by the reduced chi-square; "
+            "95 % intervals with Student's t), except:",
+            "",
+            *notes,
+        ]
     return "\n".join(lines) + "\n"
 
 
