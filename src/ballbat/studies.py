@@ -37,21 +37,12 @@ import numpy as np
 import xarray as xr
 
 from .pipeline.products import Var, build_dataset
+from .sweeps import point_dataset
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterable, Sequence
 
     from .properties import Ball, Bat
-
-#: What a sweep may vary: name -> what it sets in the dataset's settings.
-SWEEP_PARAMETERS = {
-    "impacts_per_bat": "impacts of every ball on every bat it is swung with",
-    "pixel_noise_px": "tracking noise of both cameras (pixels; datasets that render tracks)",
-    "swing_fps": "frame rate of the swing camera (datasets that render tracks)",
-    "spin_fps": "frame rate of the spin camera (datasets that render tracks)",
-    "noise_scale": "factor on every direct measurement noise (datasets that do not render tracks)",
-    "e_x": "true e_x of every bat and ball",
-}
 
 #: The quantities of paper_comparison.csv a study records (those with an uncertainty and a truth).
 STUDY_QUANTITIES = (
@@ -180,48 +171,6 @@ def study_config(params: dict) -> dict:
     }
 
 
-def check_sweep(dataset: dict, parameter: str | None, values: Sequence[float], where: str) -> list[str]:
-    """Problems of a study's sweep against its dataset (empty when fine), each naming ``where``."""
-    if parameter is None:
-        return []
-    problems = []
-    renders = bool(dataset.get("render", {}).get("enabled", False))
-    if parameter in ("pixel_noise_px", "swing_fps", "spin_fps") and not renders:
-        problems.append(f"{where}.sweep.parameter: {parameter} needs a dataset that renders camera tracks")
-    if parameter == "noise_scale" and renders:
-        problems.append(f"{where}.sweep.parameter: noise_scale scales the direct noise, but the dataset renders tracks")
-    for i, v in enumerate(values):
-        if parameter == "impacts_per_bat" and (v != int(v) or v < 3):
-            problems.append(f"{where}.sweep.values[{i}]: impacts per bat must be a whole number >= 3, not {v:g}")
-        elif parameter in ("swing_fps", "spin_fps", "pixel_noise_px", "noise_scale") and v <= 0:
-            problems.append(f"{where}.sweep.values[{i}]: {parameter} must be positive, not {v:g}")
-        elif parameter == "e_x" and not -1.0 < v < 1.0:
-            problems.append(f"{where}.sweep.values[{i}]: e_x must lie in (-1, 1), not {v:g}")
-    return problems
-
-
-def point_dataset(dataset: dict, parameter: str | None, value: float) -> dict:
-    """Return the dataset's config block with the swept setting at ``value`` (a copy)."""
-    ds = copy.deepcopy(dataset)
-    if parameter is None:
-        return ds
-    syn = ds["synthetic"]
-    if parameter == "impacts_per_bat":
-        syn["impacts"] = {b: {t: int(value) for t in bats} for b, bats in syn["impacts"].items()}
-    elif parameter == "e_x":
-        syn["e_x"] = {b: {t: float(value) for t in bats} for b, bats in syn["e_x"].items()}
-    elif parameter == "noise_scale":
-        syn["noise"] = {k: float(v) * value for k, v in syn["noise"].items()}
-    elif parameter == "pixel_noise_px":
-        for cam in ds["render"]["cameras"].values():
-            cam["pixel_noise_px"] = float(value)
-    elif parameter in ("swing_fps", "spin_fps"):
-        ds["render"]["cameras"][parameter.split("_")[0]]["fps"] = float(value)
-    else:
-        raise ValueError(f"unknown sweep parameter {parameter!r} (known: {', '.join(SWEEP_PARAMETERS)})")
-    return ds
-
-
 def replicate_seeds(seed: int, replicate: int) -> tuple[int, int]:
     """Seeds of one replicate's experiment and tracks, independent streams of the study's seed."""
     state = np.random.SeedSequence(seed, spawn_key=(replicate,)).generate_state(2, dtype=np.uint32)
@@ -240,10 +189,11 @@ def _source(dataset: dict, seeds: tuple[int, int], balls: dict[str, Ball], bats:
     render = dataset.get("render") or {}
     if not render.get("enabled", False):
         return sim
+    from .tracks.data import camera_block
     from .tracks.io import cameras_from_config
     from .tracks.reduce import reduce_tracks, reduction_dataset
     from .tracks.render import render_tracks, settings_from_config
-    from .tracks.stage import SIMULATED_TRUTH, camera_block
+    from .tracks.stage import SIMULATED_TRUTH
 
     cfg = {**render, "seed": seeds[1]}
     truth = {k: sim[f"truth_{k}"].values for k in SIMULATED_TRUTH if f"truth_{k}" in sim}

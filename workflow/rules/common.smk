@@ -10,7 +10,7 @@ from ballbat.pipeline.codedeps import module_files
 from ballbat.pipeline.config import BYTES_PER_CASE, BYTES_PER_IMPACT, drop_nulls, validate_config
 from ballbat.pipeline.guards import remove_broken, remove_temporaries, warnings_summary
 from ballbat.pipeline.provenance import sha256_file
-from ballbat.tracks.stage import camera_block
+from ballbat.tracks.data import camera_block
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 # A dataset or scenario set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.

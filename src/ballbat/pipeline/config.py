@@ -84,7 +84,7 @@ def _names(config: dict) -> list[str]:
 
 def _studies(config: dict) -> list[str]:
     """Check that each study names a synthetic dataset and that its sweep suits that dataset."""
-    from ..studies import check_sweep
+    from ..sweeps import check_sweep
 
     problems = []
     datasets = config.get("datasets") or {}

@@ -152,3 +152,13 @@ def to_dense(
             ys[p][ii[ps], col[ps]] = y[sel][ps]
         out[cam] = CameraTracks(frame0, xs, ys)
     return out
+
+
+def camera_block(cfg: dict) -> dict:
+    """``cameras`` and ``rig`` of a ``tracks`` or ``render`` block, with only the reduction's settings."""
+    keep = ("fps", "m_per_px", "mirror", "m_per_px_err")
+    return {
+        "cameras": {n: {k: v for k, v in c.items() if k in keep} for n, c in cfg["cameras"].items()},
+        "rig": dict(cfg["rig"]),
+        **({"min_frames": cfg["min_frames"]} if "min_frames" in cfg else {}),
+    }

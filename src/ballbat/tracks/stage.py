@@ -50,16 +50,6 @@ def render_stage(simulated: xr.Dataset, balls_path: str | os.PathLike[str], rend
     return tracks_dataset(tracks)
 
 
-def camera_block(cfg: dict) -> dict:
-    """``cameras`` and ``rig`` of a ``tracks`` or ``render`` block, with only the reduction's settings."""
-    keep = ("fps", "m_per_px", "mirror", "m_per_px_err")
-    return {
-        "cameras": {n: {k: v for k, v in c.items() if k in keep} for n, c in cfg["cameras"].items()},
-        "rig": dict(cfg["rig"]),
-        **({"min_frames": cfg["min_frames"]} if "min_frames" in cfg else {}),
-    }
-
-
 def reduce_stage(
     tracks_path: str | os.PathLike[str],
     impacts_path: str | os.PathLike[str] | None,
