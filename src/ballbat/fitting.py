@@ -16,10 +16,11 @@ measurement uncertainties explain that scatter. The Figs. 3-4 lines summarise da
 model does not describe impact by impact (bats of different e_x, spin and speed not exactly
 linear in theta): their scatter is not the same everywhere, and their standard errors are
 the sandwich (HC3) ones, which the replicate studies (:mod:`ballbat.studies`) find
-calibrated where the scaled covariance was 10-20 % small. e_y implied by Eq. ratio takes the
-correlation of the two slopes it combines (fitted to the same impacts) from their influence
-functions. 95 % intervals use Student's t with n - p degrees of freedom. Without
-uncertainties the fit is unweighted and the reduced chi-square is undefined (NaN).
+calibrated where the scaled covariance was 10-20 % small. e_y implied by Eq. ratio inverts
+the slope with each impact's recoil factors and its bat's e_x, weighted as the fit weighs the
+impacts (:func:`implied_e_y`), with a sandwich standard error. 95 % intervals use Student's
+t with n - p degrees of freedom. Without uncertainties the fit is unweighted and the
+reduced chi-square is undefined (NaN).
 
 References
 ----------
@@ -37,8 +38,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .designs import MEASURED, normalized_theta_design, spin_design, tan_ratio_design
-from .kinematics import e_y_from_tan_ratio_slope, gross_slip_onset, normalize_to_bat_speed
-from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, slope_correlation, wls_slope
+from .kinematics import gross_slip_onset, normalize_to_bat_speed
+from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, wls_slope
 from .pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 
 if TYPE_CHECKING:
@@ -218,6 +219,85 @@ def scale_systematic(ds: xr.Dataset, res: Sec4) -> dict[str, np.ndarray] | None:
     }
 
 
+def implied_e_y(
+    ds: xr.Dataset, sel: np.ndarray, res: Sec4, i: int, ratio_design: tuple, rfit: LineFit
+) -> tuple[float, float]:
+    """Return e_y implied by the Eq. ratio slope of one ball, and its standard error.
+
+    Eq. ratio holds impact by impact: tan(psi - theta) = c_i (1 + e_x) / (1 + e_y) tan psi,
+    with c_i = alpha/(1 + alpha) (1 + r_y)/(1 + r_x) of the impact's bat and ball and e_x of
+    its bat. The fitted slope is the weighted mean of the impacts' slopes, so it is inverted
+    with the same weighted mean of c_i (1 + e_x): 1 + e_y = sum(W x^2 c_i (1 + e_x,bat(i)))
+    / sum(W x y), with the fit's weights W. (Inverting with the mean recoil factors
+    and the pooled e_x instead, as a first version did, is biased by 0.3-0.6 of its error once
+    the weights differ between bats: found by the replicate studies, docs/studies.md.)
+
+    The standard error comes from the impacts' influences on ln(1 + e_y): through the e_x fit
+    of the impact's bat and through sum(W x y), each impact about its own slope (the bats'
+    differences are structure, not scatter; the same spin measurement enters both), a
+    sandwich estimate with n / (n - k) for the k fitted slopes.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Reconstructed impacts.
+    sel : ndarray of bool
+        The ball's usable impacts.
+    res : Sec4
+        The fits so far (e_x per bat and pooled).
+    i : int
+        The ball's index in ``res.balls``.
+    ratio_design : tuple
+        ``(x, y, jx, jy, sigma)`` of the Eq. ratio fit.
+    rfit : LineFit
+        The Eq. ratio fit.
+
+    Returns
+    -------
+    (float, float)
+    """
+    x, y, jx, jy, sig = ratio_design
+    r, r_x, r_y, alpha = (ds[k].values[sel] for k in ("r", "r_x", "r_y", "alpha"))
+    bat_of = ds["bat"].values.astype(str)[sel]
+    n = x.size
+    w_r = _weights(jx, jy, sig, rfit.slope)
+    W = np.ones(n) if w_r is None else w_r**2
+    # each impact's e_x (its bat's; the pooled one where the bat has no fit) and its influence
+    xs, ys, jxs, jys = spin_design(*_measured(ds, sel), r, r_x, alpha)
+    one_plus = np.empty(n)
+    influence_ex = np.empty(n)
+    groups = {}
+    for bat in sorted(set(bat_of)):
+        m = bat_of == bat
+        fit = res.e_x.fits[i, res.bats.index(bat)]
+        if not (fit.success and np.isfinite(fit.slope)):
+            fit, m_fit = res.e_x_pooled.fits[i], np.ones(n, dtype=bool)
+        else:
+            m_fit = m
+        sig_m = None if sig is None else sig[m_fit]
+        w = _weights(jxs[m_fit], jys[m_fit], sig_m, fit.slope)
+        ws = np.ones(int(m_fit.sum())) if w is None else w**2
+        infl = ws * xs[m_fit] * (ys[m_fit] - fit.slope * xs[m_fit]) / np.sum(ws * xs[m_fit] ** 2)
+        one_plus[m] = fit.slope
+        influence_ex[m] = infl[m[m_fit]] if m_fit is not m else infl
+        groups[bat] = m
+    c = alpha / (1.0 + alpha) * (1.0 + r_y) / (1.0 + r_x)
+    # 1 + e_y = D / T with D = sum(W x^2 c (1 + e_x,bat)) and T = sum(W x y) (= slope sum(W x^2))
+    d = float(np.sum(W * x * x * c * one_plus))
+    t = float(np.sum(W * x * y))
+    e_y = d / t - 1.0
+    # influences on ln D (through each bat's e_x) and on ln T (each impact about its own
+    # slope c_i (1 + e_x,bat) / (1 + e_y): the bats' differences are structure, not scatter)
+    share = np.zeros(n)
+    for m in groups.values():
+        share[m] = np.sum((W * x * x * c)[m])
+    infl_t = W * x * (y - c * one_plus / (1.0 + e_y) * x)
+    infl = share * influence_ex / d - infl_t / t
+    k = len(groups) + 1
+    var = np.sum(infl**2) * n / max(n - k, 1)
+    return float(e_y), float((1.0 + e_y) * np.sqrt(var))
+
+
 def analyze_impacts(ds: xr.Dataset, mu_k_example: float) -> Sec4:
     """Sec. IV analysis of a normalised and reconstructed dataset (output of ``reconstruct``).
 
@@ -259,25 +339,15 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float) -> Sec4:
                 grid.fits[i] = LineFit.not_fitted(n_ball)
             continue
 
-        r, r_x, r_y, alpha = (ds[k].values[in_ball] for k in ("r", "r_x", "r_y", "alpha"))
+        r, r_x, alpha = (ds[k].values[in_ball] for k in ("r", "r_x", "alpha"))
         x, y, jx, jy = tan_ratio_design(*_measured(ds, in_ball), r, alpha)
         sig = _sigma(ds, in_ball)
         rfit = fit_line(x, y, jx, jy, sig)
         res.tan_ratio_slope.fits[i] = rfit
-        # Eq. ratio inverted with the pooled e_x and the mean recoil factors of the impacts.
         exf = res.e_x_pooled.fits[i]
         a = float(np.mean(alpha))
-        e_y = e_y_from_tan_ratio_slope(rfit.slope, exf.slope - 1.0, np.mean(r_x), np.mean(r_y), a)
-        pb["e_y_implied"][i] = float(e_y)
-        # ln(1 + e_y) = const + ln(1 + e_x) - ln(slope): both fits see the same impacts (the same
-        # spin noise), so their errors are correlated; the correlation from their influence functions.
-        xs, ys, jxs, jys = spin_design(*_measured(ds, in_ball), r, r_x, alpha)
-        rho = slope_correlation(
-            (xs, ys, _weights(jxs, jys, sig, exf.slope), exf.slope),
-            (x, y, _weights(jx, jy, sig, rfit.slope), rfit.slope),
-        )
-        da, db = exf.slope_err / exf.slope, rfit.slope_err / rfit.slope
-        pb["e_y_implied_err"][i] = float((1.0 + e_y) * np.sqrt(max(da * da + db * db - 2.0 * rho * da * db, 0.0)))
+        e_y, e_y_err = implied_e_y(ds, in_ball, res, i, (x, y, jx, jy, sig), rfit)
+        pb["e_y_implied"][i], pb["e_y_implied_err"][i] = e_y, e_y_err
         # Eq. muk: the largest measured tan(psi - theta) bounds mu_k from below.
         k = int(np.nanargmax(y))
         pb["mu_k_lower_bound"][i] = float(y[k])
@@ -355,11 +425,11 @@ def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) 
     table["e_y_implied"] = Var(
         ("ball",),
         "1",
-        "normal COR e_y implied by the Eq. ratio slope and pooled e_x (mean r_x, r_y)",
+        "normal COR e_y implied by the Eq. ratio slope (each impact's r_x, r_y and its bat's e_x)",
         {"ancillary_variables": "e_y_implied_err"},
     )
     table["e_y_implied_err"] = Var(
-        ("ball",), "1", "standard error of e_y implied (slope and e_x errors with their correlation)"
+        ("ball",), "1", "standard error of e_y implied (sandwich: the impacts' influences via the slope and e_x)"
     )
     table["mu_k_lower_bound"] = Var(
         ("ball",),

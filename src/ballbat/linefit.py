@@ -183,29 +183,3 @@ def effective_sigma(jx: ArrayLike, jy: ArrayLike, sigma: ArrayLike, slope: Array
     if sigma is None:
         return None
     return np.sqrt(np.sum((jy - slope * jx) ** 2 * sigma**2, axis=1))
-
-
-def slope_correlation(
-    a: tuple[ArrayLike, ArrayLike, ArrayLike | None, float], b: tuple[ArrayLike, ArrayLike, ArrayLike | None, float]
-) -> float:
-    """Correlation of two weighted slopes through the origin fitted to the same impacts.
-
-    Each fit is given as ``(x, y, weights, slope)`` (weights 1/sigma as in :func:`fit_line`,
-    None for unweighted). A slope s = sum(w^2 x y) / sum(w^2 x^2) moves with impact i by its
-    influence w_i^2 x_i (y_i - s x_i) / sum(w^2 x^2); the correlation of the two slopes is
-    that of their influences (the sandwich estimate), which holds whatever the noise is.
-
-    Returns
-    -------
-    float
-        In [-1, 1]; 0 when either fit has no scatter.
-    """
-
-    def influence(x, y, w, s):
-        x, y = np.asarray(x, dtype=float), np.asarray(y, dtype=float)
-        w2 = np.ones_like(x) if w is None else np.asarray(w, dtype=float) ** 2
-        return w2 * x * (y - s * x) / np.sum(w2 * x * x)
-
-    ia, ib = influence(*a), influence(*b)
-    den = np.sqrt(np.sum(ia * ia) * np.sum(ib * ib))
-    return float(np.clip(np.sum(ia * ib) / den, -1.0, 1.0)) if den > 0 else 0.0

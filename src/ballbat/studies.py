@@ -63,7 +63,7 @@ ERROR_KIND = {
     "spin_theta_slope": "standard error (sandwich, t interval)",
     "speed_theta_slope": "standard error (sandwich, t interval)",
     "tan_ratio_slope": "standard error (t interval)",
-    "e_y_implied": "standard error (propagated, correlation of slope and e_x included)",
+    "e_y_implied": "standard error (sandwich, t interval)",
     "mu_k_lower_bound": "measurement uncertainty of the largest tan(psi - theta); judged against the same impacts",
     "eta2": "standard error (t interval)",
 }
