@@ -80,6 +80,10 @@ def schema(root):
             "studies.design.sweep.parameter: noise_scale scales the direct noise, but the dataset renders tracks",
         ),
         (lambda c: c["studies"]["calibration"].update(replicates=1), "studies.calibration.replicates"),
+        (
+            lambda c: c["studies"]["calibration"].update(truth_impacts=10**7),
+            "studies.calibration.truth_impacts: 70,000,000 impacts need about",
+        ),
         (lambda c: c["studies"]["calibration"].update(colour=1), "studies.calibration"),
     ],
 )

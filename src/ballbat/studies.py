@@ -105,7 +105,7 @@ class StudySettings:
     v_ref_mph: float
     mu_k_example: float
     stronge: dict
-    truth_impacts: int = 3000
+    truth_impacts: int = 10000
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> StudySettings:

@@ -7,7 +7,7 @@ from pathlib import Path
 import yaml
 
 from ballbat.pipeline.codedeps import module_files
-from ballbat.pipeline.config import BYTES_PER_CASE, BYTES_PER_IMPACT, drop_nulls, validate_config
+from ballbat.pipeline.config import BYTES_PER_CASE, drop_nulls, impact_bytes, validate_config
 from ballbat.pipeline.guards import remove_broken, remove_temporaries, warnings_summary
 from ballbat.pipeline.provenance import sha256_file
 from ballbat.tracks.data import camera_block
@@ -112,10 +112,12 @@ def get_measured_impacts(wildcards):
 
 
 def dataset_mem_mb(wildcards):
-    """Return the memory a dataset's job may need, MB: 4 kB per impact (measured ~1 kB) over a 500 MB base."""
-    syn = dataset_config(wildcards).get("synthetic")
+    """Return the memory a dataset's job may need, MB: over a 500 MB base, 4 kB per impact (measured ~1 kB),
+    50 kB per impact rendered as camera tracks (measured 35 kB)."""
+    d = dataset_config(wildcards)
+    syn = d.get("synthetic")
     n = sum(sum(bats.values()) for bats in syn["impacts"].values()) if syn else 10_000
-    return 500 + n * BYTES_PER_IMPACT // 1_000_000
+    return 500 + n * impact_bytes(d) // 1_000_000
 
 
 def scenario_mem_mb(wildcards):
@@ -257,12 +259,25 @@ def get_study_batches(wildcards):
     return [f"results/studies/{wildcards.study}/batches/batch{b}.nc" for b in range(n)]
 
 
-def study_mem_mb(wildcards):
-    """A batch holds one replicate at a time (and the aggregate the design's large noise-free experiment)."""
-    s = study_settings(wildcards.study)
+def _study_impacts(s):
+    """Impacts of the largest replicate of a study, and of its noise-free design (per point)."""
     pairs = sum(len(v) for v in s.dataset["synthetic"]["impacts"].values())
-    impacts = s.truth_impacts * pairs * 2
-    return max(1000, math.ceil(impacts * BYTES_PER_IMPACT / 1e6) + 500)
+    most = max(max(v.values()) for v in s.dataset["synthetic"]["impacts"].values())
+    counts = [int(v) for v in s.values] if s.parameter == "impacts_per_bat" else [most]
+    return pairs * max(counts), pairs * max(s.truth_impacts, max(counts))
+
+
+def study_batch_mem_mb(wildcards):
+    """A batch holds one replicate at a time (measured ~180 MB for the paper-sized experiment)."""
+    s = study_settings(wildcards.study)
+    return 500 + math.ceil(_study_impacts(s)[0] * impact_bytes(s.dataset) / 1e6)
+
+
+def study_aggregate_mem_mb(wildcards):
+    """The aggregate holds the design's large noise-free experiment (truth_impacts per ball and bat:
+    measured 2.7 GB for the calibration study's 70000 rendered impacts)."""
+    s = study_settings(wildcards.study)
+    return 500 + math.ceil(_study_impacts(s)[1] * impact_bytes(s.dataset) / 1e6)
 
 
 def study_batch_runtime(wildcards):

@@ -19,7 +19,7 @@ rule study_batch:
         ENV
     threads: 1
     resources:
-        mem_mb=study_mem_mb,
+        mem_mb=study_batch_mem_mb,
         runtime=study_batch_runtime,
     params:
         study=get_study_config,
@@ -52,7 +52,7 @@ rule study_aggregate:
         ENV
     threads: 1
     resources:
-        mem_mb=study_mem_mb,
+        mem_mb=study_aggregate_mem_mb,
         runtime=30,
     params:
         study=get_study_config,

@@ -34,6 +34,18 @@ NAME = re.compile(r"[A-Za-z0-9_-]+")
 #: 4 x 10^4 cases with 101 trajectory samples 59 and 52 kB per case.
 BYTES_PER_IMPACT = 4_000
 BYTES_PER_CASE = 60_000
+#: An impact rendered as camera tracks and reduced (dense tracks of both cameras, the fits'
+#: arrays): 34-35 kB measured (2026-11, 7000 and 28000 impacts through render, reduce and the
+#: Sec. IV fits); 50 kB leaves room.
+BYTES_PER_TRACKED_IMPACT = 50_000
+
+
+def impact_bytes(dataset: dict) -> int:
+    """Return the memory one impact of a dataset's chain may need (bytes): more when it renders tracks."""
+    renders = bool((dataset.get("render") or {}).get("enabled", False)) or "tracks" in dataset
+    return BYTES_PER_TRACKED_IMPACT if renders else BYTES_PER_IMPACT
+
+
 #: Share of the machine's available memory one job may plan to use.
 MEMORY_SHARE = 0.5
 
@@ -139,7 +151,13 @@ def _sizes(config: dict, available: int) -> list[str]:
         total = sum(int(n) for bats in (syn.get("impacts") or {}).values() for n in (bats or {}).values())
         if total == 0:
             problems.append(f"datasets.{name}.synthetic.impacts: no impacts (every count is 0): nothing to fit")
-        check(f"datasets.{name}.synthetic.impacts", total, BYTES_PER_IMPACT, "impacts")
+        check(f"datasets.{name}.synthetic.impacts", total, impact_bytes(ds), "impacts")
+    datasets = config.get("datasets") or {}
+    for name, st in (config.get("studies") or {}).items():
+        ds = datasets.get(st.get("dataset")) if isinstance(st, dict) else None
+        if isinstance(ds, dict) and isinstance(ds.get("synthetic"), dict):
+            pairs = sum(len(b or {}) for b in (ds["synthetic"].get("impacts") or {}).values())
+            check(f"studies.{name}.truth_impacts", pairs * int(st.get("truth_impacts", 0)), impact_bytes(ds), "impacts")
     for name, sc in ((config.get("implications") or {}).get("scenarios") or {}).items():
         if "sweep" in sc:
             check(
