@@ -14,14 +14,13 @@ Run: ``.venv/bin/python bench/bench_study.py`` (about 5 minutes on 2 cores). Pri
 from __future__ import annotations
 
 import csv
-import shutil
 import subprocess
 import sys
 import tempfile
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parents[1]
+from bench_workflow import ROOT, fresh_copy  # bench/ is on the path when run as a script
 
 CHILD = """
 import resource, sys, time
@@ -44,11 +43,7 @@ print(dt, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, ds.sizes["replicat
 def workflow_time() -> tuple[float, float, int, list[dict]]:
     """Wall time of the calibration study through Snakemake (-c2), the largest job's RSS (MB), batches, coverage."""
     with tempfile.TemporaryDirectory() as tmp:
-        wd = Path(tmp) / "wf"
-        wd.mkdir()
-        shutil.copy(ROOT / "Snakefile", wd)
-        shutil.copytree(ROOT / "workflow", wd / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
-        shutil.copytree(ROOT / "config", wd / "config")
+        wd = fresh_copy(Path(tmp))
         cmd = [sys.executable, "-m", "snakemake", "-c2", "results/studies/calibration/coverage.csv"]
         t0 = time.perf_counter()
         subprocess.run(cmd, cwd=wd, check=True, capture_output=True)

@@ -30,15 +30,21 @@ def timed(cmd, cwd) -> float:
     return time.perf_counter() - t0
 
 
+def fresh_copy(tmp: Path) -> Path:
+    """Copy the workflow (Snakefile, workflow/, config/) into ``tmp``/wf; return that folder."""
+    wd = tmp / "wf"
+    wd.mkdir()
+    shutil.copy(ROOT / "Snakefile", wd)
+    shutil.copytree(ROOT / "workflow", wd / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
+    shutil.copytree(ROOT / "config", wd / "config")
+    return wd
+
+
 def snakemake_times(repeats: int = 5) -> dict:
     """Return the times of a cold run and of no-op reruns of the default workflow."""
     sm = [sys.executable, "-m", "snakemake", "-c2"]
     with tempfile.TemporaryDirectory() as tmp:
-        wd = Path(tmp) / "wf"
-        wd.mkdir()
-        shutil.copy(ROOT / "Snakefile", wd)
-        shutil.copytree(ROOT / "workflow", wd / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
-        shutil.copytree(ROOT / "config", wd / "config")
+        wd = fresh_copy(Path(tmp))
         cold = timed(sm, wd)
         noop = statistics.median(timed(sm, wd) for _ in range(repeats))
         one = Path(tmp) / "one"

@@ -57,7 +57,8 @@ FIT_QUANTITIES = {
 }
 
 
-def _num(x) -> str:
+def format_number(x: float | None) -> str:
+    """Return a number as the tables print it (6 significant digits; empty for None, NaN or inf)."""
     if x is None:
         return ""
     x = float(x)
@@ -189,11 +190,13 @@ def to_csv(table: list[dict]) -> str:
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(COLUMNS)
     for r in table:
-        w.writerow([r[c] if c in ("quantity", "ball", "bat", "unit") else _num(r[c]) for c in COLUMNS])
+        w.writerow([r[c] if c in ("quantity", "ball", "bat", "unit") else format_number(r[c]) for c in COLUMNS])
     return buf.getvalue()
 
 
-#: What an ``uncertainty`` is where it is not the standard error of a fit (notes under the Markdown table).
+#: What an ``uncertainty`` is where it is not the standard error of a fit (notes under the Markdown
+#: table; the replicate studies' ``error_kind``). Every other uncertainty is :data:`STANDARD_ERROR`.
+STANDARD_ERROR = "a standard error of the fit (covariance scaled by the reduced chi-square)"
 UNCERTAINTY_NOTES = {
     "mu_k_lower_bound": (
         "the measurement uncertainty of the largest tan(psi - theta), not a standard error of a sample "
@@ -209,7 +212,7 @@ def to_markdown(table: list[dict], title: str) -> str:
     """Return the comparison table as a Markdown table under the heading ``title``, with notes on the uncertainties."""
     lines = [f"# {title}", "", "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     for r in table:
-        cells = [r[c] or "" if c in ("quantity", "ball", "bat", "unit") else _num(r[c]) for c in COLUMNS]
+        cells = [r[c] or "" if c in ("quantity", "ball", "bat", "unit") else format_number(r[c]) for c in COLUMNS]
         lines.append("| " + " | ".join(cells) + " |")
     present = {r["quantity"] for r in table if r.get("uncertainty") is not None}
     notes = [f"- `{q}`: uncertainty is {UNCERTAINTY_NOTES[q]}" for q in UNCERTAINTY_NOTES if q in present]
@@ -218,8 +221,7 @@ def to_markdown(table: list[dict], title: str) -> str:
     if notes:
         lines += [
             "",
-            "Uncertainties are standard errors of the fits (covariance scaled by the reduced chi-square; "
-            "95 % intervals with Student's t), except:",
+            f"Every uncertainty is {STANDARD_ERROR} (95 % intervals with Student's t), except:",
             "",
             *notes,
         ]

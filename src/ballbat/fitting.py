@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .designs import MEASURED, normalized_theta_design, spin_design, tan_ratio_design
-from .kinematics import gross_slip_onset, normalize_to_bat_speed
+from .kinematics import gross_slip_onset, normalize_to_bat_speed, tan_ratio_slope_model
 from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, wls_slope
 from .pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 
@@ -266,32 +266,30 @@ def implied_e_y(
     xs, ys, jxs, jys = spin_design(*_measured(ds, sel), r, r_x, alpha)
     one_plus = np.empty(n)
     influence_ex = np.empty(n)
-    groups = {}
+    groups = []
     for bat in sorted(set(bat_of)):
         m = bat_of == bat
-        fit = res.e_x.fits[i, res.bats.index(bat)]
-        if not (fit.success and np.isfinite(fit.slope)):
+        fit, m_fit = res.e_x.fits[i, res.bats.index(bat)], m
+        if not (fit.success and np.isfinite(fit.slope)):  # no fit of its own: the pooled one
             fit, m_fit = res.e_x_pooled.fits[i], np.ones(n, dtype=bool)
-        else:
-            m_fit = m
-        sig_m = None if sig is None else sig[m_fit]
-        w = _weights(jxs[m_fit], jys[m_fit], sig_m, fit.slope)
+        w = _weights(jxs[m_fit], jys[m_fit], None if sig is None else sig[m_fit], fit.slope)
         ws = np.ones(int(m_fit.sum())) if w is None else w**2
-        infl = ws * xs[m_fit] * (ys[m_fit] - fit.slope * xs[m_fit]) / np.sum(ws * xs[m_fit] ** 2)
-        one_plus[m] = fit.slope
-        influence_ex[m] = infl[m[m_fit]] if m_fit is not m else infl
-        groups[bat] = m
-    c = alpha / (1.0 + alpha) * (1.0 + r_y) / (1.0 + r_x)
-    # 1 + e_y = D / T with D = sum(W x^2 c (1 + e_x,bat)) and T = sum(W x y) (= slope sum(W x^2))
-    d = float(np.sum(W * x * x * c * one_plus))
+        infl = np.zeros(n)
+        infl[m_fit] = ws * xs[m_fit] * (ys[m_fit] - fit.slope * xs[m_fit]) / np.sum(ws * xs[m_fit] ** 2)
+        one_plus[m], influence_ex[m] = fit.slope, infl[m]
+        groups.append(m)
+    # each impact's Eq. ratio slope times (1 + e_y): its recoil factors and its bat's e_x
+    k_i = tan_ratio_slope_model(one_plus - 1.0, 0.0, r_x, r_y, alpha)
+    # 1 + e_y = D / T with D = sum(W x^2 k_i) and T = sum(W x y) (= slope sum(W x^2))
+    d = float(np.sum(W * x * x * k_i))
     t = float(np.sum(W * x * y))
     e_y = d / t - 1.0
     # influences on ln D (through each bat's e_x) and on ln T (each impact about its own
-    # slope c_i (1 + e_x,bat) / (1 + e_y): the bats' differences are structure, not scatter)
+    # slope k_i / (1 + e_y): the bats' differences are structure, not scatter)
     share = np.zeros(n)
-    for m in groups.values():
-        share[m] = np.sum((W * x * x * c)[m])
-    infl_t = W * x * (y - c * one_plus / (1.0 + e_y) * x)
+    for m in groups:
+        share[m] = np.sum((W * x * x * k_i / one_plus)[m])
+    infl_t = W * x * (y - k_i / (1.0 + e_y) * x)
     infl = share * influence_ex / d - infl_t / t
     k = len(groups) + 1
     var = np.sum(infl**2) * n / max(n - k, 1)

@@ -56,18 +56,6 @@ STUDY_QUANTITIES = (
     "eta2",
 )
 
-#: How each quantity's uncertainty is to be read (the coverage table's ``error_kind``).
-ERROR_KIND = {
-    "e_x": "standard error (t interval)",
-    "e_x_pooled": "standard error (t interval)",
-    "spin_theta_slope": "standard error (sandwich, t interval)",
-    "speed_theta_slope": "standard error (sandwich, t interval)",
-    "tan_ratio_slope": "standard error (t interval)",
-    "e_y_implied": "standard error (sandwich, t interval)",
-    "mu_k_lower_bound": "measurement uncertainty of the largest tan(psi - theta); judged against the same impacts",
-    "eta2": "standard error (t interval)",
-}
-
 
 @dataclass(frozen=True)
 class StudySettings:
@@ -84,7 +72,7 @@ class StudySettings:
     batch_size : int
         Replicates per batch job.
     parameter : str or None
-        Swept setting (a key of :data:`SWEEP_PARAMETERS`), None for no sweep.
+        Swept setting (a key of :data:`ballbat.sweeps.SWEEP_PARAMETERS`), None for no sweep.
     values : tuple of float
         Its values (one point, NaN, without a sweep).
     v_ref_mph, mu_k_example : float
@@ -105,7 +93,7 @@ class StudySettings:
     v_ref_mph: float
     mu_k_example: float
     stronge: dict
-    truth_impacts: int = 10000
+    truth_impacts: int
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> StudySettings:
@@ -512,7 +500,9 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
     out["setting"] = values
     coords = {k: _copy_coord(rep, k) for k in ("quantity", "quantity_name", "ball", "bat", "table_unit")}
     coords["point"] = (Var(("point",), "1", "sweep point"), np.arange(npt, dtype=np.int64))
-    kinds = np.array([ERROR_KIND.get(str(q), "") for q in rep["quantity_name"].values])
+    from .compare import STANDARD_ERROR, UNCERTAINTY_NOTES
+
+    kinds = np.array([UNCERTAINTY_NOTES.get(str(q), STANDARD_ERROR) for q in rep["quantity_name"].values])
     coords["error_kind"] = (Var(("quantity",), None, "what the quantity's uncertainty is"), kinds)
     attrs = {k: rep.attrs[k] for k in ("study_seed", "replicates_per_point", "sweep_parameter") if k in rep.attrs}
     return build_dataset(COVERAGE_TABLE, out, coords, attrs)
@@ -545,36 +535,42 @@ COVERAGE_COLUMNS = (
 )
 
 
-def _fmt(x) -> str:
-    if isinstance(x, str):
-        return x
-    x = float(x)
-    return "" if not math.isfinite(x) else f"{x:.6g}"
+def _csv_text(header: Sequence[str], rows: Iterable[Sequence]) -> str:
+    """Return CSV text: strings as they are, numbers as in paper_comparison.csv (empty when not finite)."""
+    import csv
+    import io
+
+    from .compare import format_number
+
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(header)
+    for row in rows:
+        w.writerow([x if isinstance(x, str) else format_number(x) for x in row])
+    return buf.getvalue()
 
 
 def coverage_csv(cov: xr.Dataset) -> str:
     """Return the coverage table as CSV text (one row per sweep point and quantity)."""
-    import csv
-    import io
+    labels = {
+        "quantity": "quantity_name",
+        "ball": "ball",
+        "bat": "bat",
+        "unit": "table_unit",
+        "error_kind": "error_kind",
+    }
 
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(COVERAGE_COLUMNS)
-    for p in range(cov.sizes["point"]):
-        for j in range(cov.sizes["quantity"]):
-            row = {
-                "setting": cov["setting"].values[p],
-                "quantity": str(cov["quantity_name"].values[j]),
-                "ball": str(cov["ball"].values[j]),
-                "bat": str(cov["bat"].values[j]),
-                "unit": str(cov["table_unit"].values[j]),
-                "error_kind": str(cov["error_kind"].values[j]),
-            }
-            for k in COVERAGE_COLUMNS:
-                if k not in row:
-                    row[k] = cov[k].values[p, j]
-            w.writerow([_fmt(row[k]) for k in COVERAGE_COLUMNS])
-    return buf.getvalue()
+    def row(p, j):
+        for k in COVERAGE_COLUMNS:
+            if k == "setting":
+                yield cov["setting"].values[p]
+            elif k in labels:
+                yield str(cov[labels[k]].values[j])
+            else:
+                yield cov[k].values[p, j]
+
+    points, quantities = range(cov.sizes["point"]), range(cov.sizes["quantity"])
+    return _csv_text(COVERAGE_COLUMNS, (list(row(p, j)) for p in points for j in quantities))
 
 
 # ---------------------------------------------------------------------------------------
@@ -694,15 +690,9 @@ DESIGN_COLUMNS = (
 
 def design_csv(des: xr.Dataset) -> str:
     """Return the design table as CSV text (one row per sweep point, ball and bat)."""
-    import csv
-    import io
 
-    buf = io.StringIO()
-    w = csv.writer(buf, lineterminator="\n")
-    w.writerow(DESIGN_COLUMNS)
-    for p in range(des.sizes["point"]):
-        for j in range(des.sizes["pair"]):
-            row = [des.attrs["sweep_parameter"], des["setting"].values[p], str(des["ball"].values[j])]
-            row += [str(des["bat"].values[j])] + [des[k].values[p, j] for k in DESIGN_COLUMNS[4:]]
-            w.writerow([_fmt(x) for x in row])
-    return buf.getvalue()
+    def row(p, j):
+        head = [des.attrs["sweep_parameter"], des["setting"].values[p], str(des["ball"].values[j])]
+        return head + [str(des["bat"].values[j])] + [des[k].values[p, j] for k in DESIGN_COLUMNS[4:]]
+
+    return _csv_text(DESIGN_COLUMNS, (row(p, j) for p in range(des.sizes["point"]) for j in range(des.sizes["pair"])))

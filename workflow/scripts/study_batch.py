@@ -3,19 +3,17 @@
 from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
-from ballbat.studies import StudySettings, study_config
+from ballbat.studies import StudySettings, run_batch, study_config
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     study, batch = snakemake.wildcards.study, int(snakemake.wildcards.batch)
     settings = StudySettings.from_config(study_config(snakemake.params.study), study)
-    from ballbat.studies import run_batch
-
     step = max(1, settings.batch_size // 10)
-    ds = run_batch(
-        settings,
-        batch,
-        load_balls(snakemake.input.balls),
-        load_bats(snakemake.input.bats),
-        progress=lambda done, n: (done % step == 0 or done == n) and log.info("%d of %d replicates", done, n),
-    )
+
+    def progress(done, n):
+        """Log every tenth of the batch."""
+        if done % step == 0 or done == n:
+            log.info("%d of %d replicates", done, n)
+
+    ds = run_batch(settings, batch, load_balls(snakemake.input.balls), load_bats(snakemake.input.bats), progress)
     write_job_output(ds, snakemake, "batch", f"Study {study}, batch {batch}: replicate estimates, errors and truths")

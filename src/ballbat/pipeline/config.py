@@ -157,7 +157,7 @@ def _sizes(config: dict, available: int) -> list[str]:
         ds = datasets.get(st.get("dataset")) if isinstance(st, dict) else None
         if isinstance(ds, dict) and isinstance(ds.get("synthetic"), dict):
             pairs = sum(len(b or {}) for b in (ds["synthetic"].get("impacts") or {}).values())
-            check(f"studies.{name}.truth_impacts", pairs * int(st.get("truth_impacts", 0)), impact_bytes(ds), "impacts")
+            check(f"studies.{name}.truth_impacts", pairs * int(st["truth_impacts"]), impact_bytes(ds), "impacts")
     for name, sc in ((config.get("implications") or {}).get("scenarios") or {}).items():
         if "sweep" in sc:
             check(
