@@ -6,7 +6,7 @@ import yaml
 
 from ballbat.analysis import normalize, reconstruct
 from ballbat.fitting import fit_dataset
-from ballbat.linefit import fit_line, wls_slope
+from ballbat.linefit import fit_line, sandwich_cov, sandwich_dof, wls_slope
 from ballbat.synthetic import SyntheticSettings, simulate_experiment
 from ballbat.units import MPH
 
@@ -193,3 +193,66 @@ def test_implied_e_y_is_exact_for_bats_of_different_e_x(default_settings, balls,
         float(f.tan_ratio_slope), float(f.e_x_pooled), *(float(rec[k].mean()) for k in ("r_x", "r_y", "alpha"))
     )
     assert abs(naive - 0.45) > 10 * abs(float(f.e_y_implied) - 0.45)
+
+
+# ------------------------------------------------------------------------------------------
+# sandwich standard errors: strata and Bell-McCaffrey degrees of freedom
+# ------------------------------------------------------------------------------------------
+def _dense_bm_dof(J, strata, column):
+    """Bell-McCaffrey nu = (tr W)^2 / tr(W^2) with W = M D C D M built densely (the definition)."""
+    n = J.shape[0]
+    A = np.linalg.inv(J.T @ J)
+    h = np.einsum("ij,jk,ik->i", J, A, J)
+    d = J @ A[:, column] / (1 - h)
+    C = np.zeros((n, n))
+    labels = np.asarray(strata)
+    for b in np.unique(labels):
+        k = np.flatnonzero(labels == b)
+        C[np.ix_(k, k)] = len(k) / (len(k) - 1) * (np.eye(len(k)) - 1.0 / len(k))
+    M = np.eye(n) - J @ A @ J.T
+    W = M @ np.diag(d) @ C @ np.diag(d) @ M
+    return np.trace(W) ** 2 / np.trace(W @ W), W
+
+
+def test_sandwich_dof_textbook_cases():
+    """Equal leverage: nu = n - 1 unstratified, n - S with S equal strata (the classical dof)."""
+    J = np.ones((30, 1))
+    assert sandwich_dof(J) == pytest.approx(29, rel=1e-12)
+    assert sandwich_dof(J, np.repeat(list("abc"), 10)) == pytest.approx(27, rel=1e-12)
+
+
+@pytest.mark.parametrize("p", [1, 2, 3])
+def test_sandwich_dof_and_cov_match_their_definition(p):
+    """The O(n p^2) nu equals the dense (tr W)^2/tr(W^2), and r'Wr equals the sandwich variance."""
+    rng = np.random.default_rng(p)
+    J = rng.normal(size=(40, p)) * rng.uniform(0.2, 3.0, size=(40, 1))
+    strata = rng.choice(list("abcd"), size=40)
+    r = rng.normal(size=40)
+    r -= J @ np.linalg.lstsq(J, r, rcond=None)[0]  # residuals at a least-squares fit
+    cov = sandwich_cov(J, r, strata)
+    for col in range(p):
+        nu, W = _dense_bm_dof(J, strata, col)
+        assert sandwich_dof(J, strata, col) == pytest.approx(nu, rel=1e-9)
+        assert r @ W @ r == pytest.approx(cov[col, col], rel=1e-9)
+        assert 1.0 < nu < 40 - p
+
+
+def test_sandwich_strata_ignore_a_misfit_common_to_a_stratum():
+    """A residual shared by every point of a stratum is the same in every repetition of a
+    stratified design: it does not enter the stratified sandwich, but does the plain one.
+    A stratum of one point is pooled with the other single points.
+    """
+    rng = np.random.default_rng(7)
+    J = np.ones((24, 1))
+    strata = np.repeat(list("abc"), 8)
+    r = rng.normal(size=24)
+    shifted = r + np.repeat([1.0, -2.0, 1.0], 8)
+    assert sandwich_cov(J, shifted, strata)[0, 0] == pytest.approx(sandwich_cov(J, r, strata)[0, 0], rel=1e-12)
+    assert sandwich_cov(J, shifted)[0, 0] > 2.0 * sandwich_cov(J, r)[0, 0]
+    lonely = strata.copy()
+    lonely[[0, 8]] = ["x", "y"]  # two single-point strata: pooled into one of two points
+    pooled = lonely.copy()
+    pooled[[0, 8]] = "z"
+    assert sandwich_cov(J, r, lonely)[0, 0] == pytest.approx(sandwich_cov(J, r, pooled)[0, 0], rel=1e-12)
+    with pytest.raises(ValueError, match="one label per row"):
+        sandwich_cov(J, r, strata[:-1])

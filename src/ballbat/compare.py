@@ -205,6 +205,10 @@ UNCERTAINTY_NOTES = {
     "e_y_implied": "a sandwich standard error (the impacts' influences through the Eq. ratio slope and e_x per bat)",
     "spin_theta_slope": "a sandwich (HC3) standard error",
     "speed_theta_slope": "a sandwich (HC3) standard error",
+    "eta2": (
+        "a sandwich (HC3) standard error centred within bats, with Bell-McCaffrey degrees of freedom "
+        "(eta2_dof in stronge.nc) for its Student's t interval"
+    ),
 }
 
 

@@ -140,14 +140,51 @@ def fit_line(
     )
 
 
-def sandwich_cov(J: ArrayLike, r: ArrayLike) -> np.ndarray:
+def _strata_blocks(n: int, strata: ArrayLike | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Stratum index of each row, and per stratum the factor f_b and the centering switch c_b.
+
+    Without strata every row is one uncentred block (f = 1, c = 0): the plain sandwich. With
+    strata, each stratum's scores are centred on their mean (c = 1) and scaled by
+    f_b = n_b/(n_b - 1). Strata of one row cannot be centred; they are pooled into one
+    stratum, which stays uncentred (f = 1, c = 0) if it holds a single row.
+    """
+    if strata is None:
+        return np.zeros(n, dtype=np.int64), np.ones(1), np.zeros(1)
+    labels = np.asarray(strata)
+    if labels.shape != (n,):
+        raise ValueError(f"sandwich: strata must have one label per row ({n}); got shape {labels.shape}")
+    _, idx, counts = np.unique(labels, return_inverse=True, return_counts=True)
+    single = counts[idx] == 1
+    idx = np.where(single, counts.size, idx)  # pool the single-row strata
+    _, idx = np.unique(idx, return_inverse=True)
+    nb = np.bincount(idx).astype(float)
+    centred = nb > 1
+    f = np.where(centred, nb / np.maximum(nb - 1.0, 1.0), 1.0)
+    return idx, f, centred.astype(float)
+
+
+def _hc3_parts(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(J'J)^-1 and the leverages h_i = J_i (J'J)^-1 J_i'."""
+    A = np.linalg.inv(J.T @ J)
+    h = np.einsum("ij,jk,ik->i", J, A, J)
+    return A, np.minimum(h, 1.0 - 1e-12)
+
+
+def sandwich_cov(J: ArrayLike, r: ArrayLike, strata: ArrayLike | None = None) -> np.ndarray:
     """Heteroscedasticity-consistent (HC3) covariance of least-squares parameters.
 
     ``J`` (n, p) is the Jacobian of the weighted model (for a line, the weighted design
     matrix) and ``r`` (n,) the weighted residuals at the fit. The covariance is
-    (J'J)^-1 J' diag(r_i^2 / (1 - h_i)^2) J (J'J)^-1 with the leverages h_i (MacKinnon and
-    White 1985): it holds whether or not the scatter about the model is the same for every
-    point, and whether or not the stated uncertainties explain it.
+    (J'J)^-1 M (J'J)^-1 with the scores u_i = J_i r_i / (1 - h_i) and the leverages h_i
+    (MacKinnon and White 1985): it holds whether or not the scatter about the model is the
+    same for every point, and whether or not the stated uncertainties explain it.
+
+    Without ``strata``, M = sum_i u_i u_i'. With ``strata`` (one label per row: the fixed
+    groups of a stratified design, such as the bats of an experiment whose number of impacts
+    per bat is chosen), M = sum_b n_b/(n_b - 1) sum_{i in b} (u_i - u_b)(u_i - u_b)' with u_b
+    the stratum's mean score: a misfit common to a stratum is the same in every repetition
+    of the design and is not counted as scatter (the stratified variance of survey sampling,
+    e.g. Cochran, *Sampling Techniques*, 3rd ed., Sec. 5.3). Strata of one row are pooled.
 
     Returns
     -------
@@ -156,11 +193,65 @@ def sandwich_cov(J: ArrayLike, r: ArrayLike) -> np.ndarray:
     """
     J = np.asarray(J, dtype=float)
     r = np.asarray(r, dtype=float)
-    A = np.linalg.inv(J.T @ J)
-    h = np.einsum("ij,jk,ik->i", J, A, J)
-    u = r / (1.0 - np.minimum(h, 1.0 - 1e-12))
-    B = J.T @ (u[:, None] ** 2 * J)
+    A, h = _hc3_parts(J)
+    if strata is None:
+        u = r / (1.0 - h)
+        return A @ (J.T @ (u[:, None] ** 2 * J)) @ A
+    u = J * (r / (1.0 - h))[:, None]
+    idx, f, c = _strata_blocks(J.shape[0], strata)
+    nb = np.bincount(idx).astype(float)
+    mean = np.zeros((f.size, u.shape[1]))
+    np.add.at(mean, idx, u)
+    u = u - (c / nb)[idx, None] * mean[idx]
+    B = (u * f[idx, None]).T @ u
     return A @ B @ A
+
+
+def sandwich_dof(J: ArrayLike, strata: ArrayLike | None = None, column: int = 0) -> float:
+    """Bell-McCaffrey degrees of freedom of one parameter's :func:`sandwich_cov` variance.
+
+    The sandwich variance of parameter ``column`` is a quadratic form r'Wr in the residuals.
+    If the errors were independent with equal variance, it would be distributed as a
+    multiple of chi^2 with nu = (tr W)^2 / tr(W^2) degrees of freedom (Satterthwaite); the
+    interval uses Student's t with nu (Bell and McCaffrey, Survey Methodology 28, 169 (2002);
+    Imbens and Kolesar, Rev. Econ. Stat. 98, 701 (2016)). nu depends on the design only, not
+    on the residuals, and is smaller than n - p when a few points carry the fit: the variance
+    estimate then rests on few of them. Computed in O(n p^2) from the low-rank structure of W.
+
+    Parameters
+    ----------
+    J : (n, p) Jacobian of the weighted model at the fit.
+    strata : labels as for :func:`sandwich_cov`, or None.
+    column : the parameter.
+
+    Returns
+    -------
+    float
+    """
+    J = np.asarray(J, dtype=float)
+    n = J.shape[0]
+    A, h = _hc3_parts(J)
+    a = (J @ A[:, column]) / (1.0 - h)  # the diagonal of D: the parameter's score weights
+    idx, f, c = _strata_blocks(n, strata)
+    nb = np.bincount(idx).astype(float)
+    K = J @ A  # the projection onto the model is P = K J'
+
+    def apply_b(X: np.ndarray) -> np.ndarray:
+        """B X with B = D C D: per stratum f_b (diag(a^2) - c_b a a'/n_b)."""
+        s = np.zeros((f.size, X.shape[1]))
+        np.add.at(s, idx, a[:, None] * X)
+        return f[idx, None] * (a[:, None] ** 2 * X - (c / nb)[idx, None] * a[:, None] * s[idx])
+
+    a2 = np.bincount(idx, weights=a**2, minlength=f.size)
+    a4 = np.bincount(idx, weights=a**4, minlength=f.size)
+    tr_b = float(np.sum(f * (1.0 - c / nb) * a2))
+    tr_bb = float(np.sum(f**2 * (a4 - 2.0 * c * a4 / nb + c * a2**2 / nb**2)))
+    BK = apply_b(K)
+    Q = J.T @ BK  # tr(B P) = tr(Q)
+    tr_bbp = float(np.trace(J.T @ apply_b(BK)))
+    tr_w = tr_b - float(np.trace(Q))
+    tr_ww = tr_bb - 2.0 * tr_bbp + float(np.trace(Q @ Q))
+    return tr_w**2 / tr_ww
 
 
 def wls_slope(

@@ -203,7 +203,7 @@ def _truth_source(src: xr.Dataset) -> xr.Dataset:
     return out
 
 
-def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> tuple[float, float, float, int]:
+def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> tuple[float, float, float, float]:
     """eta^2 of one ball (value, standard error, truth, degrees of freedom); NaN if not fitted."""
     from .linefit import MIN_FIT_IMPACTS
     from .stronge.analysis import fit_ball, vtf_data
@@ -218,7 +218,7 @@ def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> t
         truth = fit_ball(vtf_data(rec_truth, sel), sigma=d.sigma, **kw).eta2
     except (ValueError, RuntimeError):
         return math.nan, math.nan, math.nan, 0
-    return fit.eta2, fit.eta2_err, truth, int(fit.nfree)
+    return fit.eta2, fit.eta2_err, truth, fit.dof
 
 
 def run_replicate(

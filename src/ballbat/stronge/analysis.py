@@ -78,6 +78,7 @@ class VtfData:
     x, y : ``tan(psi)/(1 + r_x)`` and ``(v_ball,t + r omega)/v_bat,n`` (Eq. vtf).
     sigma : effective standard uncertainty of y, or None when the file gives none.
     r_x, r_y, alpha : recoil factors of each impact's bat and I/(m r^2) of the ball.
+    bat : each impact's bat (the strata of the standard error).
     """
 
     psi: NDArray[np.float64]
@@ -87,6 +88,7 @@ class VtfData:
     r_x: NDArray[np.float64]
     r_y: NDArray[np.float64]
     alpha: NDArray[np.float64]
+    bat: NDArray[np.str_]
 
 
 def vtf_data(rec: xr.Dataset, sel: NDArray[np.bool_]) -> VtfData:
@@ -113,7 +115,7 @@ def vtf_data(rec: xr.Dataset, sel: NDArray[np.bool_]) -> VtfData:
     if all(f"{k}_err" in rec for k in MEASURED):
         sig = np.stack([rec[f"{k}_err"].values[sel] for k in MEASURED], axis=1).astype(float)
         sigma = effective_sigma(jx, jy, sig, wls_slope(x, y)[0])
-    return VtfData(rec["psi"].values[sel], x, y, sigma, r_x, r_y, alpha)
+    return VtfData(rec["psi"].values[sel], x, y, sigma, r_x, r_y, alpha, rec["bat"].values[sel].astype(str))
 
 
 @dataclass(frozen=True)
@@ -285,6 +287,11 @@ def fit_ball(
 ) -> Eta2Fit:
     """Fit eta^2 to one ball's Eq. vtf data as the workflow does (the workflow and the replicate studies).
 
+    The standard error is the sandwich centred within bats, with Bell-McCaffrey degrees of
+    freedom (:func:`ballbat.stronge.fit.fit_eta2` with ``robust=True``, ``strata`` the bats):
+    a lab chooses its bats and the impacts per bat, so the misfit of one eta^2 to a bat's own
+    e_x is the same in every repetition of the experiment; only the scatter within a bat is.
+
     Parameters
     ----------
     data : VtfData
@@ -314,6 +321,8 @@ def fit_ball(
         alpha=d.alpha,
         vary_e_y=vary_e_y,
         vary_mu=vary_mu,
+        robust=True,
+        strata=d.bat,
     )
 
 
@@ -399,14 +408,14 @@ def stronge_variables(vary_e_y: bool = False, vary_mu: bool = False) -> dict[str
     """
     b, bg, bs, fi = ("ball",), ("ball", "psi_grid"), ("ball", "sample"), ("impact_fit",)
     eta2 = estimate_vars("eta2", b, "1", "eta^2 = k_n/k_t fitted to Eq. vtf (Sec. V.A)")
-    eta2["eta2_err"] = replace(
-        eta2["eta2_err"], long_name="standard error of eta^2 (covariance scaled by reduced chi^2)"
-    )
+    eta2["eta2_err"] = replace(eta2["eta2_err"], long_name="standard error of eta^2 (HC3 sandwich centred within bats)")
     for end in ("low", "high"):
         v = eta2[f"eta2_ci_{end}"]
         eta2[f"eta2_ci_{end}"] = replace(
             v, long_name=f"{'lower' if end == 'low' else 'upper'} end of the 95 % profile-likelihood interval of eta^2"
         )
+    eta2["eta2_dof"] = Var(b, "1", "degrees of freedom of eta2_err (Bell-McCaffrey), for Student's t intervals")
+    eta2["eta2"] = _with(eta2["eta2"], ancillary_variables=eta2["eta2"].attrs["ancillary_variables"] + " eta2_dof")
     e_y = estimate_vars("e_y", b, "1", "normal COR e_y of the model (fixed unless fitted)", fit=False, interval=False)
     e_y["e_y"] = _with(e_y["e_y"], vary=int(vary_e_y))
     e_y["e_y_err"] = replace(e_y["e_y_err"], long_name="standard error of e_y (NaN when fixed)")
@@ -532,6 +541,7 @@ def stronge_dataset(
         **{k: _column(res, f"fit.{k}") for k in ("eta2", "eta2_err", "eta2_ci_low", "eta2_ci_high")},
         "eta2_n": _column(res, "fit.n").astype(np.int64),
         "eta2_redchi": _column(res, "fit.redchi"),
+        "eta2_dof": _column(res, "fit.dof"),
         "eta2_published": _column(res, "eta2_published"),
         **{k: _column(res, f"fit.{k}") for k in ("e_y", "e_y_err", "mu", "mu_err")},
         **{k: _column(res, k) for k in ("omega_ratio", "omega_ratio_bat", "r_x_mean", "r_y_mean")},

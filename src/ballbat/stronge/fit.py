@@ -7,15 +7,23 @@ factors. The paper fitted eta^2 = 4.75 (baseball) and 6.30 (softball) with e_y =
 
 Uncertainties (documented in docs/stronge.md, "The eta^2 fit"):
 
-* The standard error is lmfit's, from the covariance of the least-squares fit. With
-  ``scale_covar=True`` (default) the covariance is scaled by the reduced chi-square, as the
-  paper's error bars are "estimates based on the fluctuation of the data about a smooth
-  line"; with ``sigma=None`` this is the only meaningful choice.
+* ``robust=False`` (default): the standard error is lmfit's, from the covariance of the
+  least-squares fit. With ``scale_covar=True`` (default) the covariance is scaled by the
+  reduced chi-square, as the paper's error bars are "estimates based on the fluctuation of
+  the data about a smooth line"; with ``sigma=None`` this is the only meaningful choice.
+* ``robust=True`` (the workflow's fit, :func:`ballbat.stronge.analysis.fit_ball`): the
+  standard error is the HC3 sandwich, centred within ``strata`` (the bats:
+  :func:`ballbat.linefit.sandwich_cov`), with Bell-McCaffrey degrees of freedom
+  (:func:`ballbat.linefit.sandwich_dof`). One eta^2 does not describe bats of different e_x
+  exactly, so the scatter about the curve is neither the same for every impact nor noise
+  alone: the part common to a bat is the same whenever its impacts are repeated.
 * The profile-likelihood interval is where chi^2(eta2) (minimised over the free nuisance
-  parameters, if any) exceeds its minimum by ``chi2.ppf(level, 1)`` (3.84 for 95 %),
-  multiplied by the reduced chi-square of the best fit when ``scale_covar=True``. The same
-  scaling as the covariance makes the interval equal to +-1.96 standard errors for a model
-  linear in eta2.
+  parameters, if any) exceeds its minimum by Delta. Not robust: ``chi2.ppf(level, 1)``
+  (3.84 for 95 %), multiplied by the reduced chi-square of the best fit when
+  ``scale_covar=True``, the same scaling as the covariance. Robust: t_nu^2 (quantile of
+  Student's t with the Bell-McCaffrey nu) times the ratio of the robust to the unscaled
+  variance. Either way the interval is +-(quantile) standard errors for a model linear in
+  eta2, and follows the curvature of chi^2 otherwise.
 
 lmfit and scipy.stats are imported inside :func:`fit_eta2` only.
 """
@@ -52,6 +60,8 @@ class Eta2Fit:
     redchi: float
     n: int
     nfree: int
+    dof: float  # degrees of freedom of eta2_err (nfree, or Bell-McCaffrey's when robust)
+    robust: bool
     level: float
     delta_chi2: float  # the chi^2 rise that defines the interval (after scaling)
     scale_covar: bool
@@ -69,6 +79,20 @@ def _describe(psi, e_y, mu, vary_e_y, vary_mu) -> str:
     )
 
 
+def _jacobian(residual, at: dict[str, float], names: list[str]) -> np.ndarray:
+    """Central-difference Jacobian (n, len(names)) of ``residual(eta2, e_y, mu)`` at ``at``."""
+    cols = []
+    for k in names:
+        h = 1e-6 * max(abs(at[k]), 1e-3)
+        up, down = dict(at), dict(at)
+        up[k] += h
+        down[k] -= h
+        cols.append(
+            (residual(up["eta2"], up["e_y"], up["mu"]) - residual(down["eta2"], down["e_y"], down["mu"])) / (2 * h)
+        )
+    return np.stack(cols, axis=1)
+
+
 def fit_eta2(
     psi: ArrayLike,
     x: ArrayLike,
@@ -84,6 +108,8 @@ def fit_eta2(
     eta2_bounds: tuple[float, float] = (1.0, 30.0),
     scale_covar: bool = True,
     level: float = 0.95,
+    robust: bool = False,
+    strata: ArrayLike | None = None,
 ) -> Eta2Fit:
     """Fit eta^2 (and optionally e_y, mu) of Stronge's model to Eq. (vtf) data.
 
@@ -98,8 +124,12 @@ def fit_eta2(
     alpha : I_ball/(m r^2).
     eta2_bounds : search range of eta^2. The scan that picks the starting value and the
         profile interval are confined to it.
-    scale_covar : scale the covariance (and the profile threshold) by the reduced chi^2.
+    scale_covar : scale the covariance (and the profile threshold) by the reduced chi^2
+        (not robust).
     level : confidence level of the profile-likelihood interval.
+    robust : standard errors from the sandwich centred within ``strata``, with
+        Bell-McCaffrey degrees of freedom (module docstring).
+    strata : a label per impact (its bat) for ``robust``; None: one uncentred stratum.
 
     Returns
     -------
@@ -123,6 +153,9 @@ def fit_eta2(
     import lmfit
     from scipy.optimize import brentq
     from scipy.stats import chi2
+    from scipy.stats import t as t_dist
+
+    from ..linefit import sandwich_cov, sandwich_dof
 
     psi = np.asarray(psi, dtype=float).ravel()
     what = _describe(psi, e_y, mu, vary_e_y, vary_mu)
@@ -179,8 +212,21 @@ def fit_eta2(
     chi_min = float(res.chisqr)
     nfree = int(res.nfree)
     redchi = chi_min / nfree
-    delta = float(chi2.ppf(level, 1)) * (redchi if scale_covar else 1.0)
     e_best, mu_best = res.params["e_y"].value, res.params["mu"].value
+    errs = {k: err(k) for k in ("eta2", "e_y", "mu")}
+    dof = float(nfree)
+    if robust:
+        if strata is not None and np.shape(strata) != psi.shape:
+            raise ValueError(f"fit_eta2: strata must have one label per impact ({what})")
+        names = [k for k in ("eta2", "e_y", "mu") if res.params[k].vary]
+        J = _jacobian(residual, {k: res.params[k].value for k in ("eta2", "e_y", "mu")}, names)
+        cov = sandwich_cov(J, residual(best, e_best, mu_best), strata)
+        errs.update({k: float(np.sqrt(cov[i, i])) for i, k in enumerate(names)})
+        dof = sandwich_dof(J, strata, 0)
+        var_unscaled = float(np.linalg.inv(J.T @ J)[0, 0])
+        delta = float(t_dist.ppf(0.5 + level / 2.0, dof)) ** 2 * errs["eta2"] ** 2 / var_unscaled
+    else:
+        delta = float(chi2.ppf(level, 1)) * (redchi if scale_covar else 1.0)
 
     if vary_e_y or vary_mu:
 
@@ -195,7 +241,7 @@ def fit_eta2(
             return chisq(h, e_best, mu_best)
 
     def crossing(direction):
-        step = err("eta2")
+        step = errs["eta2"]
         step = step if np.isfinite(step) and step > 0 else 0.05 * best
         inner = best
         for _ in range(40):
@@ -212,17 +258,19 @@ def fit_eta2(
     ci_low, ci_high = crossing(-1.0), crossing(+1.0)
     return Eta2Fit(
         eta2=float(best),
-        eta2_err=err("eta2"),
+        eta2_err=errs["eta2"],
         eta2_ci_low=float(ci_low),
         eta2_ci_high=float(ci_high),
         e_y=float(e_best),
-        e_y_err=err("e_y"),
+        e_y_err=errs["e_y"],
         mu=float(mu_best),
-        mu_err=err("mu"),
+        mu_err=errs["mu"],
         chisqr=chi_min,
         redchi=redchi,
         n=n,
         nfree=nfree,
+        dof=dof,
+        robust=bool(robust),
         level=float(level),
         delta_chi2=delta,
         scale_covar=bool(scale_covar),
