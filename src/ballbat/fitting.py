@@ -296,14 +296,16 @@ def implied_e_y(
     return float(e_y), float((1.0 + e_y) * np.sqrt(var))
 
 
-def analyze_impacts(ds: xr.Dataset, mu_k_example: float) -> Sec4:
+def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True) -> Sec4:
     """Sec. IV analysis of a normalised and reconstructed dataset (output of ``reconstruct``).
 
     Uses only impacts with ``flag == 0``. The Figs. 3-4 fits read the normalised spin and
     exit speed that ``normalize`` wrote (``omega_norm``, ``v_ball_norm``) and its reference
     bat speed (attribute ``v_ref``). When the dataset holds ``truth_*`` variables
     (synthetic), each quantity also gets a truth value: the same estimator applied to the
-    noise-free truth with the same weights.
+    noise-free truth with the same weights. ``systematic=False`` skips the pixel-scale
+    systematic (:func:`scale_systematic`, two more e_x fits), which the replicate studies do
+    not judge.
     """
     usable = ds["flag"].values == 0
     balls = ds["ball"].values.astype(str)
@@ -372,7 +374,7 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float) -> Sec4:
                 yt_norm = normalize_to_bat_speed(tv[MEASURED.index(which)], tv[0], v_ref)
                 xt, yt, _, _ = normalized_theta_design(tv[0], yt_norm, tv[2], which, v_ref)
                 grid.truth[i] = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope), through_origin=False)[0]
-    res.systematic = scale_systematic(ds, res)
+    res.systematic = scale_systematic(ds, res) if systematic else None
     return res
 
 

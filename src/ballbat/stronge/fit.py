@@ -187,7 +187,10 @@ def fit_eta2(
 
     lo_b, hi_b = (float(b) for b in eta2_bounds)
     scan = np.geomspace(lo_b, hi_b, 48)
-    start = scan[int(np.argmin([chisq(h, e_y, mu) for h in scan]))]
+    # one call of the closed-form model for the whole scan (elementwise: the same numbers as one call per value)
+    ex_scan = stronge_ex(psi, scan[:, None], e_y, mu, r_x, r_y, alpha)
+    res_scan = (y - (1.0 + ex_scan) * x) / sig
+    start = scan[int(np.argmin([float(r @ r) for r in res_scan]))]
 
     params = lmfit.Parameters()
     params.add("eta2", value=start, min=lo_b, max=hi_b)
