@@ -54,6 +54,7 @@ def fake_stronge() -> xr.Dataset:
         "eta2_ci_high": eta2 + 0.4,
         "eta2_n": n,
         "eta2_redchi": [1.1, 0.9],
+        "eta2_dof": [21.5, 25.0],
         "eta2_published": [PUBLISHED_ETA2[b] for b in BALLS],
         "e_y": 0.5 * two,
         "e_y_err": np.nan * two,

@@ -195,6 +195,10 @@ def test_replicates_cover_the_truth(config, balls, bats):
     assert set(cov.quantity_name.values) == set(studies.STUDY_QUANTITIES)
     assert np.all(cov.n_replicates.values == 40)
     assert all(cov.error_kind.values)
+    # eta^2's interval uses the Bell-McCaffrey degrees of freedom of its bat-stratified sandwich
+    eta = batch.dof.isel(quantity=np.flatnonzero(batch.quantity_name.values == "eta2")).values
+    assert eta.size == 80 and np.all((eta > 5) & (eta < 60)) and not np.all(eta == np.round(eta))
+    assert "centred within bats" in str(cov.error_kind.values[list(cov.quantity_name.values).index("eta2")])
 
 
 def test_study_rules_through_snakemake(tmp_path):

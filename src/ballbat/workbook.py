@@ -106,6 +106,7 @@ STRONGE_COLUMNS = (
     Column("eta2_err", "1"),
     Column("eta2_ci_low", "1"),
     Column("eta2_ci_high", "1"),
+    Column("eta2_dof", "1"),
     Column("eta2_n", "1"),
     Column("eta2_redchi", "1"),
     Column("e_y", "1"),

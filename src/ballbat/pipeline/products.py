@@ -136,7 +136,9 @@ def add_variables(ds: xr.Dataset, table: Mapping[str, Var], values: Mapping[str,
     undeclared = sorted(set(values) - set(table))
     if undeclared:
         raise KeyError(f"values not declared in the table: {undeclared}")
-    new = {name: (var.dims, np.asarray(values[name]), var.attributes()) for name, var in table.items() if name in values}
+    new = {
+        name: (var.dims, np.asarray(values[name]), var.attributes()) for name, var in table.items() if name in values
+    }
     out = ds.copy()
     out.update(new)  # one merge for all of them (one per variable is most of a replicate study's time)
     return out
