@@ -223,6 +223,13 @@ def test_study_rules_through_snakemake(tmp_path):
     assert cov.sizes == {"point": 1, "quantity": 21}
     assert all("units" in cov[v].attrs for v in cov.data_vars)
     assert cov.attrs["provenance_rule"] == "study_aggregate"
+    truth = xr.open_dataset(res / "calibration" / "truth.nc")
+    assert truth.attrs["provenance_rule"] == "study_truth" and truth.attrs["truth_impacts"] == 60
+    assert set(truth.quantity.values) == set(cov.quantity.values)
+    judged = cov.quantity.values[cov.quantity_name.values != "mu_k_lower_bound"]  # the others: the design's truth
+    assert np.allclose(
+        truth.truth.sel(quantity=judged).values, cov.mean_truth.sel(quantity=judged).values, rtol=1e-12, equal_nan=True
+    )
     assert int(cov.n_replicates.max()) == 4
     with open(res / "calibration" / "coverage.csv") as fh:
         rows = list(csv.DictReader(fh))

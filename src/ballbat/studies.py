@@ -410,6 +410,42 @@ def population_truth(settings: StudySettings, point: int, balls: dict[str, Ball]
     return dict(zip(_labels(rows), (r["truth"] for r in rows), strict=True))
 
 
+#: The truth file of a study (``results/{study}/truth.nc``; dims point x quantity).
+TRUTH_TABLE = {
+    "truth": Var(
+        ("point", "quantity"),
+        "1",
+        "the estimator on the design's large noise-free experiment (unit of its quantity; NaN: not fitted)",
+    ),
+    "setting": Var(("point",), "1", "value of the swept setting (NaN: no sweep)"),
+}
+
+
+def truth_dataset(settings: StudySettings, balls: dict[str, Ball], bats: dict[str, Bat]) -> xr.Dataset:
+    """:func:`population_truth` of every sweep point, as a dataset (its own job: it runs beside the batches).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``truth`` (point x quantity, labels as the batches'), ``setting``.
+    """
+    truths = [population_truth(settings, p, balls, bats) for p in range(settings.n_points)]
+    labels = list(dict.fromkeys(lab for t in truths for lab in t))
+    values = {
+        "truth": np.array([[np.nan if t.get(lab) is None else float(t[lab]) for lab in labels] for t in truths]),
+        "setting": np.asarray(settings.values, dtype=float),
+    }
+    coords = _coords(settings, labels, [lab.split(":") for lab in labels])
+    coords["point"] = (Var(("point",), "1", "sweep point"), np.arange(settings.n_points, dtype=np.int64))
+    return build_dataset(TRUTH_TABLE, values, coords, {**_attrs(settings), "truth_impacts": settings.truth_impacts})
+
+
+def truths_from_dataset(ds: xr.Dataset) -> list[dict]:
+    """The per-point ``label -> truth`` mappings of :func:`truth_dataset` (what :func:`coverage` takes)."""
+    labels = ds["quantity"].values.astype(str)
+    return [dict(zip(labels, map(float, row), strict=True)) for row in ds["truth"].values]
+
+
 # ---------------------------------------------------------------------------------------
 # aggregation
 

@@ -273,11 +273,17 @@ def study_batch_mem_mb(wildcards):
     return 500 + math.ceil(_study_impacts(s)[0] * impact_bytes(s.dataset) / 1e6)
 
 
-def study_aggregate_mem_mb(wildcards):
-    """The aggregate holds the design's large noise-free experiment (truth_impacts per ball and bat:
-    measured 2.7 GB for the calibration study's 70000 rendered impacts)."""
+def study_truth_mem_mb(wildcards):
+    """The truth job holds the design's large noise-free experiment (truth_impacts per ball and bat:
+    measured 1.8 GB for the calibration study's 70000 rendered impacts)."""
     s = study_settings(wildcards.study)
     return 500 + math.ceil(_study_impacts(s)[1] * impact_bytes(s.dataset) / 1e6)
+
+
+def study_aggregate_mem_mb(wildcards):
+    """The aggregate holds every replicate's table: 4 numbers per replicate and quantity (kilobytes)."""
+    s = study_settings(wildcards.study)
+    return 500 + math.ceil(s.total * 64 * 4 * 8 / 1e6)
 
 
 def study_batch_runtime(wildcards):

@@ -27,12 +27,38 @@ rule study_batch:
         "../scripts/study_batch.py"
 
 
+rule study_truth:
+    """The design's truth of every quantity: the estimators on a large noise-free experiment per sweep point.
+
+    Its own job, so that it runs beside the batches rather than after them.
+    """
+    input:
+        balls=get_study_balls,
+        bats=get_study_bats,
+        code=code("study_truth.py"),
+    output:
+        truth="results/studies/{study}/truth.nc",
+    log:
+        "results/studies/{study}/logs/truth.log",
+    benchmark:
+        "results/studies/{study}/benchmarks/truth.tsv"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=study_truth_mem_mb,
+        runtime=30,
+    params:
+        study=get_study_config,
+    script:
+        "../scripts/study_truth.py"
+
+
 rule study_aggregate:
     """Coverage of every quantity with an uncertainty and a truth, over all batches of a study."""
     input:
         batches=get_study_batches,
-        balls=get_study_balls,
-        bats=get_study_bats,
+        truth=rules.study_truth.output.truth,
         code=code("study_aggregate.py"),
     output:
         coverage="results/studies/{study}/coverage.nc",
@@ -53,7 +79,7 @@ rule study_aggregate:
     threads: 1
     resources:
         mem_mb=study_aggregate_mem_mb,
-        runtime=30,
+        runtime=10,
     params:
         study=get_study_config,
     script:
