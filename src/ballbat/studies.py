@@ -441,7 +441,7 @@ def truth_dataset(settings: StudySettings, balls: dict[str, Ball], bats: dict[st
 
 
 def truths_from_dataset(ds: xr.Dataset) -> list[dict]:
-    """The per-point ``label -> truth`` mappings of :func:`truth_dataset` (what :func:`coverage` takes)."""
+    """Return the per-point ``label -> truth`` mappings of :func:`truth_dataset` (what :func:`coverage` takes)."""
     labels = ds["quantity"].values.astype(str)
     return [dict(zip(labels, map(float, row), strict=True)) for row in ds["truth"].values]
 
