@@ -434,6 +434,8 @@ def test_robust_fit_interval_and_dof(balls, bats):
     tq = stats.t.ppf(0.975, g.dof)
     assert (g.eta2_ci_high - g.eta2_ci_low) / 2 == pytest.approx(tq * g.eta2_err, rel=0.1)
     assert g.eta2_err == pytest.approx(f.eta2_err, rel=0.5)  # same data, homoscedastic noise
+    h = fit_eta2(psi, x, y, r_x, r_y, robust=True, strata=strata, interval=False)
+    assert h.eta2 == g.eta2 and h.eta2_err == g.eta2_err and np.isnan(h.eta2_ci_low) and np.isnan(h.eta2_ci_high)
     with pytest.raises(ValueError, match="strata must have one label per impact"):
         fit_eta2(psi, x, y, r_x, r_y, robust=True, strata=strata[:-1])
 

@@ -284,6 +284,7 @@ def fit_ball(
     vary_e_y: bool,
     vary_mu: bool,
     sigma: NDArray[np.float64] | None = None,
+    interval: bool = True,
 ) -> Eta2Fit:
     """Fit eta^2 to one ball's Eq. vtf data as the workflow does (the workflow and the replicate studies).
 
@@ -303,6 +304,7 @@ def fit_ball(
     sigma : ndarray, optional
         Weights' uncertainties in place of ``data.sigma`` (the truth of a replicate study
         is fitted with the measured data's weights).
+    interval : compute the profile-likelihood interval (the truth of a study needs the value only).
 
     Returns
     -------
@@ -323,6 +325,7 @@ def fit_ball(
         vary_mu=vary_mu,
         robust=True,
         strata=d.bat,
+        interval=interval,
     )
 
 

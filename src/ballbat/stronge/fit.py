@@ -110,6 +110,7 @@ def fit_eta2(
     level: float = 0.95,
     robust: bool = False,
     strata: ArrayLike | None = None,
+    interval: bool = True,
 ) -> Eta2Fit:
     """Fit eta^2 (and optionally e_y, mu) of Stronge's model to Eq. (vtf) data.
 
@@ -130,6 +131,8 @@ def fit_eta2(
     robust : standard errors from the sandwich centred within ``strata``, with
         Bell-McCaffrey degrees of freedom (module docstring).
     strata : a label per impact (its bat) for ``robust``; None: one uncentred stratum.
+    interval : compute the profile-likelihood interval (False: NaN, for fits whose value
+        alone is wanted, such as a replicate study's noise-free truth).
 
     Returns
     -------
@@ -258,7 +261,7 @@ def fit_eta2(
             inner, step = outer, 2.0 * step
         return np.nan
 
-    ci_low, ci_high = crossing(-1.0), crossing(+1.0)
+    ci_low, ci_high = (crossing(-1.0), crossing(+1.0)) if interval else (np.nan, np.nan)
     return Eta2Fit(
         eta2=float(best),
         eta2_err=errs["eta2"],
