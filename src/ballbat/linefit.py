@@ -140,8 +140,8 @@ def fit_line(
     )
 
 
-def _strata_blocks(n: int, strata: ArrayLike | None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Stratum index of each row, and per stratum the factor f_b and the centering switch c_b.
+def _strata_blocks(n: int, strata: ArrayLike | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Stratum index of each row, and per stratum its size n_b, the factor f_b and the centering switch c_b.
 
     Without strata every row is one uncentred block (f = 1, c = 0): the plain sandwich. With
     strata, each stratum's scores are centred on their mean (c = 1) and scaled by
@@ -149,7 +149,7 @@ def _strata_blocks(n: int, strata: ArrayLike | None) -> tuple[np.ndarray, np.nda
     stratum, which stays uncentred (f = 1, c = 0) if it holds a single row.
     """
     if strata is None:
-        return np.zeros(n, dtype=np.int64), np.ones(1), np.zeros(1)
+        return np.zeros(n, dtype=np.int64), np.array([float(n)]), np.ones(1), np.zeros(1)
     labels = np.asarray(strata)
     if labels.shape != (n,):
         raise ValueError(f"sandwich: strata must have one label per row ({n}); got shape {labels.shape}")
@@ -160,7 +160,7 @@ def _strata_blocks(n: int, strata: ArrayLike | None) -> tuple[np.ndarray, np.nda
     nb = np.bincount(idx).astype(float)
     centred = nb > 1
     f = np.where(centred, nb / np.maximum(nb - 1.0, 1.0), 1.0)
-    return idx, f, centred.astype(float)
+    return idx, nb, f, centred.astype(float)
 
 
 def _hc3_parts(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -198,8 +198,7 @@ def sandwich_cov(J: ArrayLike, r: ArrayLike, strata: ArrayLike | None = None) ->
         u = r / (1.0 - h)
         return A @ (J.T @ (u[:, None] ** 2 * J)) @ A
     u = J * (r / (1.0 - h))[:, None]
-    idx, f, c = _strata_blocks(J.shape[0], strata)
-    nb = np.bincount(idx).astype(float)
+    idx, nb, f, c = _strata_blocks(J.shape[0], strata)
     mean = np.zeros((f.size, u.shape[1]))
     np.add.at(mean, idx, u)
     u = u - (c / nb)[idx, None] * mean[idx]
@@ -232,8 +231,7 @@ def sandwich_dof(J: ArrayLike, strata: ArrayLike | None = None, column: int = 0)
     n = J.shape[0]
     A, h = _hc3_parts(J)
     a = (J @ A[:, column]) / (1.0 - h)  # the diagonal of D: the parameter's score weights
-    idx, f, c = _strata_blocks(n, strata)
-    nb = np.bincount(idx).astype(float)
+    idx, nb, f, c = _strata_blocks(n, strata)
     K = J @ A  # the projection onto the model is P = K J'
 
     def apply_b(X: np.ndarray) -> np.ndarray:
