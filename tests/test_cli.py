@@ -32,7 +32,7 @@ def test_help_has_examples(command):
 
 
 def test_fly_reproduces_the_calculator():
-    """Nathan's trajectory calculator (PHYSICS.md, Sec. V.B): 103 mph, 27.5 deg, 2500 rpm, tau 30 s
+    """Nathan's trajectory calculator (docs/model.md, "Flight"): 103 mph, 27.5 deg, 2500 rpm, tau 30 s
     lands at 421.5 ft after 5.52 s with apex 92.0 ft with its own fixed-step scheme.
     """
     out = ballbat("fly", "--speed", "103", "--angle", "27.5", "--backspin", "2500", "--method", "calculator", "--json")
@@ -42,7 +42,7 @@ def test_fly_reproduces_the_calculator():
     assert r["hang_time_s"] == pytest.approx(5.52, abs=0.005)
     assert r["apex_ft"] == pytest.approx(92.0, abs=0.05)
     assert r["bearing_deg"] == pytest.approx(0.0, abs=1e-9)
-    # the accurate integrator lands about 0.8 ft further (PHYSICS.md; docs/flight.md: 422.6 ft)
+    # the accurate integrator lands about 0.8 ft further (docs/model.md; docs/flight.md: 422.6 ft)
     acc = json.loads(ballbat("fly", "--speed", "103", "--angle", "27.5", "--backspin", "2500", "--json").stdout)
     assert 0.5 < acc["carry_ft"] - r["carry_ft"] < 1.5
     text = ballbat("fly", "--speed", "103", "--angle", "27.5", "--backspin", "2500", "--method", "calculator").stdout

@@ -19,7 +19,7 @@ WOOD = BATS["wood"]
 
 # Sec. V.B inputs (paper): pitch 85 mph descending 6 deg with 2000 rpm backspin (topspin
 # relative to the batted ball, hence the minus sign), bat 73 mph swinging up at 6 deg,
-# e_x = 0.4; e_y = 0.50 and the wood bat are PHYSICS.md's defaults.
+# e_x = 0.4; e_y = 0.50 and the wood bat are the defaults of docs/model.md.
 PAPER = dict(
     v_pitch=85 * MPH,
     pitch_descent=6 * DEGREE,
@@ -35,7 +35,7 @@ PAPER = dict(
 
 def sec3_ball_at_rest(D, v_bat, e_x, e_y, ball, bat):
     """Sec. III of Kensrud et al. 2017 written out directly: Eqs. (D), (vballn), (vxf),
-    (omega) and theta = psi - atan(v_t / v_n) (PHYSICS.md, Sec. III forward model).
+    (omega) and theta = psi - atan(v_t / v_n) (docs/model.md, "The forward model").
     """
     r_x, r_y = recoil_factors(ball, bat)
     alpha, r = ball.alpha, ball.r

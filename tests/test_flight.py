@@ -1,4 +1,4 @@
-"""Tests of ballbat.flight: Nathan's trajectory-calculator model (PHYSICS.md, Sec. V.B)."""
+"""Tests of ballbat.flight: Nathan's trajectory-calculator model (docs/model.md, "Flight")."""
 
 from __future__ import annotations
 
@@ -23,13 +23,13 @@ from ballbat.flight import (
 )
 from ballbat.units import DEGREE, FOOT, INHG_IN_MMHG, MPH, RPM, fahrenheit_to_celsius
 
-# The calculator's published case (PHYSICS.md): 5.125 oz, 9.125 in, start (0, 2, 3) ft,
+# The calculator's published case (docs/model.md, "Flight"): 5.125 oz, 9.125 in, start (0, 2, 3) ft,
 # 103 mph at 27.5 deg with 2500 rpm backspin, tau = 30 s, dt = 0.01 s, default air.
 CASE = dict(v0=103 * MPH, launch_angle=27.5 * DEGREE, spray_angle=0.0, backspin=2500 * RPM, sidespin=0.0)
 
 
 def test_air_density_default_conditions():
-    """PHYSICS.md: 70 F, 15 ft, 50 %, 29.92 inHg give rho ~ 1.1938 kg/m^3."""
+    """docs/model.md, "Flight": 70 F, 15 ft, 50 %, 29.92 inHg give rho ~ 1.1938 kg/m^3."""
     rho = air_density(float(fahrenheit_to_celsius(70.0)), 29.92 * INHG_IN_MMHG, 15 * FOOT, 50.0)
     assert rho == pytest.approx(1.1938, abs=5e-5)
     assert air_density() == rho == DEFAULT_RHO
@@ -44,7 +44,7 @@ def test_air_density_dry_standard_air():
 
 
 def test_calculator_reproduces_published_case():
-    """Published (PHYSICS.md, Nathan's calculator): 421.5 ft, 5.52 s, apex 92.0 ft.
+    """Published (docs/model.md, Nathan's calculator): 421.5 ft, 5.52 s, apex 92.0 ft.
 
     The published numbers are rounded to 0.1 ft and 0.01 s, hence half-unit tolerances.
     """
@@ -57,7 +57,7 @@ def test_calculator_reproduces_published_case():
 
 def test_calculator_with_exact_units_and_accurate_integrator():
     """Exact unit factors move the calculator's landing by +0.3 ft (docs/flight.md); the
-    accurate integrator lands ~0.8 ft beyond the fixed-step scheme (PHYSICS.md) and within
+    accurate integrator lands ~0.8 ft beyond the fixed-step scheme (docs/model.md) and within
     2 ft of the published 421.5 ft.
     """
     exact = fly(**CASE, method="calculator", calculator_rounding=False)
@@ -70,7 +70,7 @@ def test_calculator_with_exact_units_and_accurate_integrator():
 
 
 def _reference_ivp(v0, la, sa, wb, ws, wind=(0.0, 0.0), rho=DEFAULT_RHO, tau=30.0):
-    """Independent scalar implementation of the PHYSICS.md model with scipy's DOP853."""
+    """Independent scalar implementation of the docs/model.md model with scipy's DOP853."""
     r = DEFAULT_BALL_CIRCUMFERENCE / (2 * np.pi)
     k = rho * np.pi * r**2 / (2 * DEFAULT_BALL_MASS)
     ct, st, cp, sp = np.cos(la), np.sin(la), np.cos(sa), np.sin(sa)

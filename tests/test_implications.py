@@ -35,7 +35,7 @@ def paper(cfg, balls, bats):
 
 
 def test_default_air_density(cfg):
-    # PHYSICS.md: 70 F, 15 ft, 50 %, 29.92 inHg give rho ~ 1.1938 kg/m^3.
+    # docs/model.md, "Flight": 70 F, 15 ft, 50 %, 29.92 inHg give rho ~ 1.1938 kg/m^3.
     assert density_from_conditions(cfg["air"]) == pytest.approx(1.1938, abs=5e-4)
 
 

@@ -5,7 +5,7 @@ from a ball at rest to a moving, spinning ball. Everything happens in the vertic
 that holds the pitch and the swing. The step-by-step derivation, and its reduction to the
 Sec. III equations for a ball at rest, is in ``docs/collision.md``.
 
-Frame and sign conventions (PHYSICS.md, "Conventions"):
+Frame and sign conventions (docs/model.md, "Conventions"):
 
 * Lab axes: X horizontal, pointing from home plate towards the field (the direction the
   batted ball goes), Z vertically up. The pitch moves towards -X.
@@ -140,7 +140,7 @@ def pitched_ball_collision(
     point, ``m r v_t - I omega``, is conserved. For ``v_pitch = 0`` and ``omega_i = 0`` this
     is exactly Eqs. (vballn), (omega) and (vxf) of Kensrud et al. 2017 with
     ``theta = psi - atan(v_t / v_n)``; the derivation is in ``docs/collision.md``
-    (PHYSICS.md, Sec. V.B).
+    (docs/model.md, "Collision of a pitched, spinning ball").
     """
     D, v_pitch, descent, spin_i, v_bat, attack, e_x, e_y = (
         np.asarray(a, dtype=float)

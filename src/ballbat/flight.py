@@ -1,6 +1,6 @@
 """Flight of a batted baseball: the drag and lift model of Nathan's trajectory calculator.
 
-The model (PHYSICS.md, Sec. V.B "Flight"; Nathan's TrajectoryCalculator spreadsheet [1]_):
+The model (docs/model.md, "Flight"; Nathan's TrajectoryCalculator spreadsheet [1]_):
 
     a = -k C_D |v| v + k C_L |v| (omega_hat x v) - g z_hat,     k = rho A / (2 m),
 
@@ -58,17 +58,17 @@ __all__ = [
     "fly",
 ]
 
-#: Drag coefficient without spin (Nathan's calculator, PHYSICS.md).
+#: Drag coefficient without spin (Nathan's calculator, docs/model.md).
 CD0 = 0.3008
-#: Spin term of the drag coefficient, per 1000 rpm (Nathan's calculator, PHYSICS.md).
+#: Spin term of the drag coefficient, per 1000 rpm (Nathan's calculator, docs/model.md).
 CD_SPIN = 0.0292
-#: Lift coefficient C_L = CL2 S / (CL0 + CL1 S) (Nathan's calculator, PHYSICS.md).
+#: Lift coefficient C_L = CL2 S / (CL0 + CL1 S) (Nathan's calculator, docs/model.md).
 CL2, CL0, CL1 = 1.120, 0.583, 2.333
 #: Reference speed of the spin-decay law, 100 mph in m/s.
 V100 = 100.0 * MPH
 #: Gravitational acceleration, m/s^2 (standard gravity; the calculator's 32.174 ft/s^2).
 G = 9.80665
-#: Pressure scale of the air-density formula, 1/m (PHYSICS.md).
+#: Pressure scale of the air-density formula, 1/m (docs/model.md, "Flight").
 BETA = 0.0001217
 
 #: The spreadsheet's own rounded unit factors, used by ``method="calculator"`` when
@@ -115,7 +115,7 @@ def air_density(
     -----
     ``rho = 1.2929 (273/(T + 273)) (P exp(-beta h) - 0.3783 RH SVP/100) / 760`` with
     ``beta = 0.0001217 /m`` and the saturation vapour pressure (mmHg)
-    ``SVP = 4.5841 exp((18.687 - T/234.5) T/(257.14 + T))`` (PHYSICS.md, Sec. V.B; Nathan's
+    ``SVP = 4.5841 exp((18.687 - T/234.5) T/(257.14 + T))`` (docs/model.md, "Flight"; Nathan's
     calculator).
     """
     T = np.asarray(temp_C, dtype=float)
@@ -503,7 +503,7 @@ def fly(
 
     Notes
     -----
-    Acceleration, coefficients and spin decay exactly as PHYSICS.md (Sec. V.B "Flight"):
+    Acceleration, coefficients and spin decay exactly as docs/model.md ("Flight"):
     ``a = -k C_D |v| v + k C_L |v| (omega_hat x v) - g z``, ``k = rho A/(2 m)``,
     ``C_D = 0.3008 + 0.0292 (spin_rpm/1000) f``, ``S = (r omega/|v|) f``,
     ``C_L = 1.120 S/(0.583 + 2.333 S)``, ``f = exp(-t/(tau v_100/|v|))``. The spin vector is
@@ -518,7 +518,7 @@ def fly(
     The calculator scheme is ``x_{n+1} = x_n + v_n dt + a_n dt^2/2``,
     ``v_{n+1} = v_n + a_n dt`` with the landing by linear interpolation in z between the
     last two points, as in the spreadsheet; its published case (103 mph, 27.5 deg,
-    2500 rpm) lands at 421.5 ft after 5.52 s with apex 92.0 ft (PHYSICS.md). Those numbers
+    2500 rpm) lands at 421.5 ft after 5.52 s with apex 92.0 ft (docs/model.md). Those numbers
     need the spreadsheet's rounded unit factors too (``calculator_rounding``): its drag
     constant is 0.29 % above the exact ``rho A/(2 m)`` and its launch speed 0.023 % above
     the exact mph conversion; with exact factors the same scheme gives 421.8 ft, 5.52 s and

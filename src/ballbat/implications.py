@@ -9,7 +9,7 @@ converted to SI here, once.
 References
 ----------
 .. [1] J. R. Kensrud, A. M. Nathan and L. V. Smith, Am. J. Phys. 85, 503 (2017), Sec. V.B.
-.. [2] A. M. Nathan, trajectory calculator (drag, lift and spin decay; PHYSICS.md).
+.. [2] A. M. Nathan, trajectory calculator (drag, lift and spin decay; docs/model.md, "Flight").
 """
 
 from __future__ import annotations

@@ -4,7 +4,7 @@ Forward model (used to make synthetic experiments) and its inverse (the reconstr
 the impact geometry psi from measured exit speed, angle and spin). All inputs and outputs
 are SI: m, m s-1, rad, rad s-1. Functions broadcast over numpy arrays of impacts.
 
-Conventions (PHYSICS.md): n-hat points from the bat's centre to the ball's centre; the bat
+Conventions (docs/model.md, "Conventions"): n-hat points from the bat's centre to the ball's centre; the bat
 velocity is v_bat (cos psi n-hat + sin psi t-hat); omega > 0 is the spin of the paper's
 Fig. 2 (backspin when the bat undercuts the ball); theta is the ball's angle from the bat's
 direction of travel.
@@ -197,7 +197,7 @@ def normalize_to_bat_speed(value: ArrayLike, v_bat: ArrayLike, v_ref: float) -> 
 
     Both scale linearly with bat speed (Eqs. vballn, vxf, omega), so the normalised value
     is value * v_ref / v_bat. The paper's text prints the ratio upside down; only
-    v_ref / v_bat normalises (PHYSICS.md).
+    v_ref / v_bat normalises (docs/model.md, "Normalisation to 77 mph").
     """
     return np.asarray(value, dtype=float) * (v_ref / np.asarray(v_bat, dtype=float))
 

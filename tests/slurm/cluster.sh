@@ -3,7 +3,7 @@
 #   tests/slurm/cluster.sh up     install what is missing, write /etc/slurm/slurm.conf, start
 #                                 munged, slurmctld and slurmd, wait until the node is idle
 #   tests/slurm/cluster.sh down   stop the daemons this script started
-# Facts it rests on (shared/SLURM.md): SLURM 22.05 from bookworm; no systemd, so the daemons run
+# Facts it rests on: SLURM 22.05 from bookworm; no systemd, so the daemons run
 # as background processes; the config must be at /etc/slurm/slurm.conf (the executor's job step
 # does not pass SLURM_CONF on); no accounting database, so job status comes from squeue.
 set -euo pipefail

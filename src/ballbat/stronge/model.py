@@ -4,7 +4,7 @@ A sphere meets a surface through a massless contact point C and two linear sprin
 normal spring (stiffness k_n while loading, k_n / e_y**2 while unloading, which gives the
 normal coefficient of restitution e_y) and an elastic tangential spring k_t = k_n / eta2
 between the ball and C. C either sticks to the surface or slips on it with Coulomb friction
-of coefficient mu. The binding specification is PHYSICS.md, "Sec. V.A"; the equations,
+of coefficient mu. The specification is docs/model.md, "Stronge's contact model"; the equations,
 their closed-form solutions and the comparison with the paper's numbers are in
 ``docs/stronge.md``.
 
@@ -96,7 +96,7 @@ def omega_ratio(
     Sec. V.A of Kensrud et al. 2017 gives Omega_t = Omega_n sqrt(3.5/eta^2) for a rigid
     surface (m_n = m, m_t = alpha m/(1 + alpha), alpha = 0.4). In the bat's frame the
     effective masses are m_n = m/(1 + r_y) and m_t = alpha m/((1 + alpha)(1 + r_x))
-    (PHYSICS.md, Sec. V.A), which multiplies the ratio by sqrt((1 + r_x)/(1 + r_y)).
+    (docs/model.md, "Effective masses"), which multiplies the ratio by sqrt((1 + r_x)/(1 + r_y)).
     """
     eta2, r_x, r_y, alpha = (np.asarray(a, dtype=float) for a in (eta2, r_x, r_y, alpha))
     out = np.sqrt((1.0 + alpha) * (1.0 + r_x) / (alpha * (1.0 + r_y) * eta2))
@@ -546,7 +546,7 @@ def stronge_ex(
     Notes
     -----
     Sec. V.A of Kensrud et al. (2017), after Stronge (1994, 2000); the model is
-    specified in PHYSICS.md and derived in docs/stronge.md. For Omega_t <= Omega_n
+    specified in docs/model.md and derived in docs/stronge.md. For Omega_t <= Omega_n
     (eta2 >= 3.5 (1 + r_x)/(1 + r_y) when alpha = 0.4) the result is
     ``e_x = rho^2 mu eta2 (1 + e_y)/tan(psi) - 1`` when ``tan(psi) >= mu eta2`` (gross
     slip) and otherwise ``e_x = -cos(rho theta_1) + rho^2 (mu eta2/tan psi) (1 + e_y -

@@ -1,6 +1,6 @@
 """Reference solution of Stronge's contact model by numerical integration (for tests).
 
-:func:`stronge_reference` integrates the equations of motion of PHYSICS.md, Sec. V.A, with
+:func:`stronge_reference` integrates the equations of motion of docs/model.md, "Stronge's contact model", with
 ``scipy.integrate.solve_ivp`` and event detection, independently of the closed-form solver
 :mod:`ballbat.stronge.model`. It is slow (a Python loop over impacts) and simple by design:
 the tests and ``bench/bench_stronge.py`` compare the solver with it.
@@ -35,7 +35,7 @@ def stronge_reference(
 ) -> dict[str, Any]:
     """Solve the same model by numerical integration, as a reference for tests.
 
-    Integrates the equations of motion of PHYSICS.md, Sec. V.A, in physical form (unit
+    Integrates the equations of motion of docs/model.md ("Stronge's contact model") in physical form (unit
     ball mass, unit k_n, unit incident speed; normal compression and velocity are state
     variables, so the normal force law is integrated rather than evaluated in closed form)
     with ``scipy.integrate.solve_ivp`` (DOP853, tolerances ``rtol``/``atol``) and terminal
