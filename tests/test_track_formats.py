@@ -26,7 +26,7 @@ from ballbat.tracks.formats.tables import read_kinovea_table, read_tracker_table
 from ballbat.tracks.formats.tracker import read_trk, read_trz
 
 sys.path.insert(0, str(Path(__file__).parent))
-from track_files import (  # noqa: E402
+from track_files import (
     TOOL_NAMES,
     kinovea_csv_text,
     kva_text,
@@ -125,7 +125,7 @@ def test_trz_holds_exactly_one_project(tmp_path, rows):
 
 
 def test_kva_timestamps_calibration(tmp_path, rows):
-    """Kinovea: frame = (t - FirstTimeStamp) / AverageTimeStampsPerFrame; fps = CaptureFramerate; scale from the line."""
+    """Kinovea: frame = (t - FirstTimeStamp) / AverageTimeStampsPerFrame; fps = CaptureFramerate; scale: a line."""
     tracks = rows[("W04", "spin")]
     p = tmp_path / "W04_spin.kva"
     p.write_text(kva_text(tracks, 1000.0, 0.00125, per_frame=1001, first=123456, video_fps=29.97))
@@ -290,7 +290,7 @@ BALLBAT = Path(sys.executable).parent / "ballbat"
 
 
 def test_cli_import_tracks(tmp_path, rows):
-    """ballbat import-tracks writes the long CSV (the example's rows) and prints the settings found as YAML."""
+    """The command import-tracks writes the long CSV (the example's rows) and prints the settings found as YAML."""
     lab = write_lab_folder(tmp_path / "lab", EXAMPLE / "tracked_tracks.csv", "trk", CAMS)
     out = tmp_path / "tracks.csv"
     pts = "--points=ball=ball,bat_tip=tip,dot_a=A,dot_b=B"
@@ -338,10 +338,11 @@ def test_cli_import_tracks(tmp_path, rows):
 @pytest.mark.slow
 def test_tool_files_run_end_to_end_with_the_long_csvs_e_x(tmp_path):
     """A Tracker project (.trk, and the same in .trz), a Kinovea file (.kva) and its CSV export, each a
-    folder of one file per impact and camera, run through snakemake and give the long CSV's e_x."""
-    from workflow_helpers import make_workdir, snakemake
-
+    folder of one file per impact and camera, run through snakemake and give the long CSV's e_x.
+    """
     import xarray as xr
+
+    from workflow_helpers import make_workdir, snakemake
 
     work = make_workdir(tmp_path)
     for fmt in ("trk", "trz", "kva", "kinovea_csv"):
