@@ -200,6 +200,8 @@ def test_config_that_contradicts_a_file_names_both(tmp_path):
     )
     assert f"tracks.cameras.spin.fps: the config says 500 but {tmp_path / 'W01_spin.trk'} says 1000" in msg
     assert "tracks.cameras.swing.fps" not in msg  # agrees
+    with pytest.raises(FormatError, match=r"tracks.units: given, but only a table .* needs it"):
+        import_files([tmp_path], POINTS, units={"time": "s", "length": "m", "y": "up"})
 
 
 def test_files_of_one_camera_calibrated_apart_share_one_scale(tmp_path, rows):
@@ -282,6 +284,9 @@ def test_schema_takes_a_folder_and_still_wants_settings_of_a_long_file():
     }
     with pytest.raises(ConfigError, match="fps"):
         validate_config({"datasets": {"lab": {"tracks": long}}}, schema, available=10**12)
+    no_points = {k: v for k, v in lab.items() if k != "points"}
+    with pytest.raises(ConfigError, match="datasets.lab.tracks: 'points' is a required property"):
+        validate_config({"datasets": {"lab": {"tracks": no_points}}}, schema, available=10**12)
     with pytest.raises(ConfigError, match="units"):
         validate_config({"datasets": {"lab": {"tracks": {**lab, "units": {"time": "ms"}}}}}, schema, available=10**12)
 

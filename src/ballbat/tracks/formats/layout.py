@@ -187,6 +187,11 @@ def import_files(
     if fmt is not None and fmt not in FORMATS:
         problems.append(f"{where}.format: {fmt!r} is not one of {', '.join(FORMATS)}")
         fmt = None
+    if units is not None and fmt not in TABLES:
+        problems.append(
+            f"{where}.units: given, but only a table (format tracker_table or kinovea_table) needs it: "
+            "the tools' own files say their units"
+        )
     if fmt in TABLES:
         problems += check_units(units, f"{where}.units")
         for c in CAMERAS:
