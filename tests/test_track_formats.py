@@ -285,7 +285,7 @@ def test_schema_takes_a_folder_and_still_wants_settings_of_a_long_file():
     with pytest.raises(ConfigError, match="fps"):
         validate_config({"datasets": {"lab": {"tracks": long}}}, schema, available=10**12)
     no_points = {k: v for k, v in lab.items() if k != "points"}
-    with pytest.raises(ConfigError, match="datasets.lab.tracks: 'points' is a required property"):
+    with pytest.raises(ConfigError, match=r"datasets\.lab\.tracks: 'points' is a required property"):
         validate_config({"datasets": {"lab": {"tracks": no_points}}}, schema, available=10**12)
     with pytest.raises(ConfigError, match="units"):
         validate_config({"datasets": {"lab": {"tracks": {**lab, "units": {"time": "ms"}}}}}, schema, available=10**12)

@@ -264,6 +264,8 @@ def _camera_settings(cam: str, files: list[FileTracks], config: dict, where: str
                 problems.append(
                     f"{where}.{key}: the config says {given:g} but {p} says {v:.6g} ({_src(files, p, key)})"
                 )
+            if len(bad) > 5:
+                problems.append(f"{where}.{key}: ... and {len(bad) - 5} more {cam} files say otherwise than the config")
             out[key] = float(given)
             out[f"{key}_from"] = "config" + (f", agrees with {len(vals)} file(s)" if vals else "")
         elif vals:
