@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..data import CAMERAS, POINTS
+from ..data import CAMERAS, POINTS, Tracks
 from . import FileTracks, FormatError, close
 from .kinovea import read_kva
 from .tables import check_units, read_kinovea_table, read_tracker_table
@@ -302,7 +302,7 @@ def _src(files: list[FileTracks], path: str, key: str) -> str:
     return ft.source.get(key, key)
 
 
-def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | None = None):
+def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | None = None) -> tuple[Tracks, Imported]:
     """Read a dataset's ``tracks`` block that names a folder (``dir``): return (Tracks, Imported).
 
     The impacts file (``impacts``) gives each impact's bat and ball; every impact must have a
