@@ -19,9 +19,10 @@ import yaml
 
 from ballbat.pipeline.config import ConfigError, validate_config
 from ballbat.properties import InputError
+from ballbat.tracks.data import with_found_settings
 from ballbat.tracks.formats import FormatError
 from ballbat.tracks.formats.kinovea import read_kva
-from ballbat.tracks.formats.layout import import_block, import_files, with_found_settings
+from ballbat.tracks.formats.layout import import_block, import_files
 from ballbat.tracks.formats.tables import read_kinovea_table, read_tracker_table
 from ballbat.tracks.formats.tracker import read_trk, read_trz
 

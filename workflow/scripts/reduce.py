@@ -5,7 +5,7 @@ import yaml
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import logged
-from ballbat.tracks.formats.layout import with_found_settings
+from ballbat.tracks.data import with_found_settings
 from ballbat.tracks.stage import excluded_listing, reduce_stage
 
 with logged(snakemake.log[0], snakemake.rule) as log:

@@ -358,16 +358,6 @@ def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | 
     return _assemble(imp.columns, irows, None), imp
 
 
-def with_found_settings(block: dict, found: dict) -> dict:
-    """Return the reduce rule's settings block with the frame rates and pixel scales found in the files."""
-    out = {**block, "cameras": {c: dict(v) for c, v in block["cameras"].items()}}
-    for cam, vals in found["cameras"].items():
-        for key in ("fps", "m_per_px"):
-            if key in vals:
-                out["cameras"].setdefault(cam, {})[key] = vals[key]
-    return out
-
-
 def tool_file_extensions(fmt: str | None) -> tuple[str, ...]:
     """Extensions of the files a ``dir`` of format ``fmt`` holds (None: the tools' own files)."""
     return FORMATS[fmt] if fmt else tuple(BY_EXTENSION)
