@@ -182,11 +182,11 @@ def read_kinovea_table(path: str | os.PathLike[str], units: dict, fps: float, m_
     blocks: dict[str, list] = {}
     for c, h in enumerate(head[1:], start=1):
         parts = h.rsplit("/", 2)
-        if len(parts) != 3 or parts[2] not in ("X", "Y"):
+        if len(parts) < 2 or parts[-1] not in ("X", "Y"):
             problems.append(f"{path}: line 1, column {c + 1}: {h!r} is not '<track>/<point>/X' or '.../Y'")
             continue
-        key = parts[0] if parts[1] == "0" else f"{parts[0]}/{parts[1]}"
-        blocks.setdefault(key, [None, None])[0 if parts[2] == "X" else 1] = c
+        key = parts[0] if len(parts) == 2 or parts[1] == "0" else f"{parts[0]}/{parts[1]}"
+        blocks.setdefault(key, [None, None])[0 if parts[-1] == "X" else 1] = c
     for k, (cx, cy) in blocks.items():
         if cx is None or cy is None:
             problems.append(f"{path}: line 1: track {k!r} lacks its {'X' if cx is None else 'Y'} column")
