@@ -74,6 +74,25 @@ def test_trk_gives_the_marks_frames_and_settings(tmp_path, rows):
     assert "delta_t" in ft.source["fps"] and "px/cm" in ft.source["m_per_px"]
 
 
+def test_trk_clip_with_a_step_size(tmp_path, rows):
+    """Marks on every other frame of a clip with step size 2 keep their video frame numbers."""
+    tracks = {n: tuple(a[::2] for a in t) for n, t in rows[("W01", "swing")].items()}
+    f0 = min(t[0][0] for t in tracks.values())
+    tracks = {n: t for n, t in tracks.items() if ((t[0] - f0) % 2 == 0).all()}
+    assert tracks
+    p = tmp_path / "W01_swing.trk"
+    p.write_text(trk_text(tracks, 3000.0, 0.00074, step=2))
+    ft = read_trk(p)
+    for name, (f, x, _) in tracks.items():
+        np.testing.assert_array_equal(ft.tracks[name][0], f)
+        np.testing.assert_array_equal(ft.tracks[name][1], x)
+    p.write_text(trk_text(tracks, 3000.0, 0.00074, step=2, extra_mark=int(f0) + 1))
+    with pytest.raises(
+        FormatError, match=rf"frame {int(f0) + 1}: the mark is not on a step of the clip \(frames {int(f0)}, "
+    ):
+        read_trk(p)
+
+
 def test_trk_turned_axes_are_undone(tmp_path, rows):
     """A coordinate system turned by 7 deg: ballbat's x-axis is the lab's, as set in Tracker."""
     tracks = rows[("W02", "spin")]
@@ -162,6 +181,16 @@ def test_exported_tables_become_pixels(tmp_path, rows):
     flipped = read_tracker_table(t, {"time": "s", "length": "m", "y": "down"}, 3000.0, 0.00074).tracks
     dy = flipped["ball"][2] - flipped["ball"][2][0]
     np.testing.assert_allclose(dy, -(tracks["ball"][2] - tracks["ball"][2][0]), atol=1e-3)
+
+
+def test_tracker_table_with_a_decimal_comma(tmp_path, rows):
+    """A European locale: semicolons and decimal commas, as Tracker writes them there."""
+    tracks = rows[("W06", "spin")]
+    text = tracker_table_text(tracks, 1000.0, 0.00125, delim=";").replace(".", ",")
+    t = tmp_path / "W06_spin.txt"
+    t.write_text(text)
+    got = read_tracker_table(t, {"time": "s", "length": "m", "y": "up"}, 1000.0, 0.00125).tracks
+    _same(got, tracks, tol=1e-3)
 
 
 def test_table_at_the_wrong_frame_rate_names_rows(tmp_path, rows):

@@ -58,11 +58,12 @@ def trk_text(
     origin=(600.0, 400.0),
     video: str = "clip.mp4",
     extra_mark: int | None = None,
+    step: int = 1,
 ) -> str:
-    """A Tracker project (.trk) holding ``tracks`` as point masses (image pixels)."""
+    """A Tracker project (.trk) holding ``tracks`` as point masses (image pixels); clip step size ``step``."""
     frames = np.concatenate([t[0] for t in tracks.values()])
-    start = max(int(frames.min()) - 3, 0)
-    count = int(frames.max()) - start + 4
+    start = int(frames.min())
+    count = (int(frames.max()) - start) // step + 4
     to_m = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254}[unit]
     scale = to_m / m_per_px  # px per unit
     i1, i2, i3, i4 = "    ", "        ", "            ", "                "
@@ -86,7 +87,7 @@ def trk_text(
         f"{i2}</property>",
         _prop("video_framecount", "int", str(start + count + 20), i2),
         _prop("startframe", "int", str(start), i2),
-        _prop("stepsize", "int", "1", i2),
+        _prop("stepsize", "int", str(step), i2),
         _prop("stepcount", "int", str(count), i2),
         _prop("starttime", "double", "0.0", i2),
         _prop("readout", "string", "frame", i2),
