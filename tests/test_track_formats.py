@@ -368,6 +368,10 @@ def test_cli_import_tracks(tmp_path, rows):
         [BALLBAT, "import-tracks", lab, "--points", "ball", "-o", out2], capture_output=True, text=True
     )
     assert res.returncode == 2 and "argument --points: 'ball' is not NAME=VALUE" in res.stderr
+    res = subprocess.run(
+        [BALLBAT, "import-tracks", lab, pts, "-o", out2, "--camera", "cam1:fps=3000"], capture_output=True, text=True
+    )
+    assert res.returncode == 2 and "argument --camera: unknown camera 'cam1' (known: swing, spin)" in res.stderr
 
 
 @pytest.mark.slow

@@ -172,6 +172,8 @@ def cmd_import_tracks(args: argparse.Namespace) -> int:
         cam, sep, rest = spec.partition(":")
         if not sep:
             raise UsageError(f"argument --camera: {spec!r} is not CAMERA:fps=...,m_per_px=...")
+        if cam not in ("swing", "spin"):
+            raise UsageError(f"argument --camera: unknown camera {cam!r} (known: swing, spin)")
         cameras[cam] = {k: _number_arg(v, f"--camera {cam}:{k}") for k, v in _pairs(rest, "--camera").items()}
     try:
         imp = import_files(
