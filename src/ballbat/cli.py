@@ -3,7 +3,8 @@
 ``ballbat check FILE`` validates a measured impacts file exactly as the workflow's ``ingest``
 rule does (the same function, :func:`ballbat.ingest.ingest`); ``ballbat fly`` flies batted
 balls with Nathan's trajectory model (:func:`ballbat.flight.fly`), one from options or many
-from a CSV file; ``ballbat summary results/{dataset}`` prints a dataset's headline numbers.
+from a CSV file; ``ballbat summary results/{dataset}`` prints a dataset's headline numbers; ``ballbat import-tracks``
+reads Tracker or Kinovea files into the long tracks CSV (:mod:`ballbat.tracks.formats`).
 Defaults (air, spin decay, integrator, property tables) are the config schema's, the one
 place the workflow's defaults live. Errors are one line naming the bad argument (exit 2);
 ``check`` exits 1 when the file is not usable.
@@ -35,6 +36,13 @@ EXAMPLES = {
   ballbat fly --speed 103 --angle 27.5 --backspin 2500 --method calculator --json
   ballbat fly --speed 95 --angle 30 --backspin 2200 --sidespin -500 --spray 15 --wind 0,10
   ballbat fly --csv balls.csv        (columns named like the options: speed, angle, backspin, ...)""",
+    "import-tracks": """examples:
+  ballbat import-tracks data/mylab/trk/ --points ball=ball,bat_tip=tip,dot_a=A,dot_b=B -o tracks.csv
+  ballbat import-tracks W01_swing.trk W01_spin.kva --points ball=ball,bat_tip=tip,dot_a=A,dot_b=B -o W01.csv
+  ballbat import-tracks data/mylab/tables/ --format tracker_table --units time=s,length=m,y=up \\
+      --camera swing:fps=3000,m_per_px=0.00074 --camera spin:fps=1000,m_per_px=0.00125 --points ... -o tracks.csv
+Files are named {impact_id}_{camera}.{ext} (camera: swing or spin; --pattern to change it).
+Prints the camera settings found in the files as YAML; exits 1 when a file cannot be read.""",
     "summary": """examples:
   ballbat summary results/synthetic
   ballbat summary results/maple""",
@@ -123,6 +131,76 @@ def _check_tracks(path: Path, args: argparse.Namespace, defaults: dict) -> int:
         return 1
     cams = ", ".join(sorted(tracks.cameras))
     print(f"{path}: usable: {tracks.n} impacts tracked by the cameras {cams}")
+    return 0
+
+
+# --------------------------------------------------------------------------------------
+# import-tracks
+
+
+def _pairs(text: str, what: str) -> dict[str, str]:
+    """``a=1,b=2`` -> {a: "1", b: "2"}; a UsageError naming ``what`` when malformed."""
+    out = {}
+    for part in filter(None, (p.strip() for p in text.split(","))):
+        key, sep, val = part.partition("=")
+        if not sep or not key.strip() or not val.strip():
+            raise UsageError(f"argument {what}: {part!r} is not NAME=VALUE")
+        out[key.strip()] = val.strip()
+    return out
+
+
+def _number_arg(text: str, what: str) -> float:
+    try:
+        return float(text)
+    except ValueError:
+        raise UsageError(f"argument {what}: {text!r} is not a number") from None
+
+
+def cmd_import_tracks(args: argparse.Namespace) -> int:
+    """Read tracking-tool files into ballbat's long tracks CSV; print the camera settings found as YAML."""
+    import numpy as np
+    import yaml
+
+    from .pipeline.ncio import atomic_write_text
+    from .tracks.formats import FormatError
+    from .tracks.formats.layout import DEFAULT_PATTERN, import_files
+
+    points = _pairs(args.points, "--points")
+    units = _pairs(args.units, "--units") if args.units else None
+    cameras: dict[str, dict] = {}
+    for spec in args.camera or []:
+        cam, sep, rest = spec.partition(":")
+        if not sep:
+            raise UsageError(f"argument --camera: {spec!r} is not CAMERA:fps=...,m_per_px=...")
+        if cam not in ("swing", "spin"):
+            raise UsageError(f"argument --camera: unknown camera {cam!r} (known: swing, spin)")
+        cameras[cam] = {k: _number_arg(v, f"--camera {cam}:{k}") for k, v in _pairs(rest, "--camera").items()}
+    try:
+        imp = import_files(
+            args.paths,
+            points,
+            pattern=args.pattern or DEFAULT_PATTERN,
+            fmt=args.format,
+            units=units,
+            cameras=cameras,
+            where="import-tracks",
+        )
+    except FormatError as exc:
+        for problem in exc.problems:
+            print(problem, file=sys.stderr)
+        print(f"ballbat import-tracks: {len(exc.problems)} problem(s); nothing written", file=sys.stderr)
+        return 1
+    c = imp.columns
+    order = np.lexsort((c["frame"], c["point"], c["camera"], c["impact_id"]))
+    lines = ["impact_id,camera,point,frame,x_px,y_px"]
+    lines += [
+        f"{c['impact_id'][i]},{c['camera'][i]},{c['point'][i]},{int(c['frame'][i])},{float(c['x_px'][i])!r},{float(c['y_px'][i])!r}"
+        for i in order
+    ]
+    atomic_write_text(args.output, "\n".join(lines) + "\n")
+    found = imp.settings_yaml()
+    found["written"] = str(args.output)
+    print(yaml.safe_dump(found, sort_keys=False), end="")
     return 0
 
 
@@ -344,6 +422,30 @@ def parser() -> argparse.ArgumentParser:
     )
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=cmd_fly)
+
+    p = sub.add_parser(
+        "import-tracks",
+        help="read Tracker or Kinovea files into ballbat's long tracks CSV",
+        epilog=EXAMPLES["import-tracks"],
+        formatter_class=fmt,
+    )
+    p.add_argument("paths", nargs="+", metavar="FILE_OR_DIR", help="tool files, or folders of them")
+    p.add_argument("--points", required=True, help="ballbat point=the tool's track name, e.g. ball=ball,bat_tip=tip")
+    p.add_argument("-o", "--output", required=True, help="long tracks CSV to write")
+    p.add_argument("--pattern", help="file names (default {impact_id}_{camera}.{ext})")
+    p.add_argument(
+        "--format",
+        choices=("tracker", "kinovea", "tracker_table", "kinovea_table"),
+        help="format of the files (default: from the extension, .trk/.trz/.kva; tables need it)",
+    )
+    p.add_argument("--units", help="tables only: time=s|ms|us|frames,length=m|cm|mm|in|ft|px,y=up|down")
+    p.add_argument(
+        "--camera",
+        action="append",
+        metavar="CAMERA:fps=..,m_per_px=..",
+        help="a camera's settings the files lack (tables), or to check against theirs; repeat per camera",
+    )
+    p.set_defaults(func=cmd_import_tracks)
 
     p = sub.add_parser("summary", help="a dataset's headline numbers", epilog=EXAMPLES["summary"], formatter_class=fmt)
     p.add_argument("folder", help="a results folder, e.g. results/synthetic")

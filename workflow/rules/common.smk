@@ -11,6 +11,7 @@ from ballbat.pipeline.config import BYTES_PER_CASE, drop_nulls, impact_bytes, va
 from ballbat.pipeline.guards import remove_broken, remove_temporaries, warnings_summary
 from ballbat.pipeline.provenance import sha256_file
 from ballbat.tracks.data import camera_block
+from ballbat.tracks.formats.layout import tool_file_extensions
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 # A dataset or scenario set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.
@@ -78,7 +79,8 @@ def data_files(wildcards):
     if "impacts" in ds:
         files["impacts"] = ds["impacts"]
     if "tracks" in ds:
-        files["tracks"] = ds["tracks"]["file"]
+        if "file" in ds["tracks"]:
+            files["tracks"] = ds["tracks"]["file"]
         files["tracks_impacts"] = ds["tracks"]["impacts"]
     return files
 
@@ -145,11 +147,27 @@ def get_render_settings(wildcards):
 
 
 def get_tracks_inputs(wildcards):
-    """A lab's tracks and impacts files, or the rendered tracks.nc (which holds its impact table)."""
+    """A lab's tracks and impacts files, its imported tool files (imported_tracks.nc and the camera
+    settings found in them), or the rendered tracks.nc (both .nc hold their impact table)."""
     d = dataset_config(wildcards)
+    if "tracks" in d and "dir" in d["tracks"]:
+        out = f"results/{wildcards.dataset}/imported"
+        return {"tracks": f"{out}_tracks.nc", "cameras": f"{out}_cameras.yaml"}
     if "tracks" in d:
         return {"tracks": d["tracks"]["file"], "impacts": d["tracks"]["impacts"]}
     return {"tracks": f"results/{wildcards.dataset}/tracks.nc"}
+
+
+def get_tool_files(wildcards):
+    """The tool files of a dataset whose tracks block names a folder (dir), and its impacts file."""
+    t = dataset_config(wildcards)["tracks"]
+    exts = tool_file_extensions(t.get("format"))
+    found = sorted(str(p) for p in Path(t["dir"]).glob("*") if p.is_file() and p.suffix.lower() in exts)
+    return {"files": found, "impacts": existing(t["impacts"])}
+
+
+def get_import_settings(wildcards):
+    return dataset_config(wildcards)["tracks"]
 
 
 def get_reduce_settings(wildcards):

@@ -29,6 +29,33 @@ rule render_tracks:
         "../scripts/render_tracks.py"
 
 
+rule import_tracks:
+    """Read a lab's tracking-tool files (Tracker, Kinovea; one per impact and camera) into long tracks."""
+    input:
+        unpack(get_tool_files),
+        balls=get_balls_table,
+        bats=get_bats_table,
+        code=code("import_tracks.py"),
+    output:
+        tracks="results/{dataset}/imported_tracks.nc",
+        cameras="results/{dataset}/imported_cameras.yaml",
+    log:
+        "results/{dataset}/logs/import_tracks.log",
+    group:
+        "dataset"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=dataset_mem_mb,
+        runtime=10,
+    params:
+        settings=get_import_settings,
+        where=get_reduce_where,
+    script:
+        "../scripts/import_tracks.py"
+
+
 rule reduce:
     """Reduce camera tracks to v_bat, v_ball, theta, omega per impact, with fitted uncertainties."""
     input:

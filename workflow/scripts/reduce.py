@@ -1,16 +1,22 @@
 """Rule reduce: adapter around ballbat.tracks.stage.reduce_stage."""
 
+import yaml
+
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import logged
+from ballbat.tracks.data import with_found_settings
 from ballbat.tracks.stage import excluded_listing, reduce_stage
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     inp = snakemake.input
+    settings = snakemake.params.settings
+    if "cameras" in inp.keys():  # a folder of tool files: the camera settings found in them
+        settings = with_found_settings(settings, yaml.safe_load(open(inp.cameras)))
     ds = reduce_stage(
         inp.tracks,
         inp.get("impacts"),
-        snakemake.params.settings,
+        settings,
         inp.balls,
         inp.bats,
         where=snakemake.params.where,

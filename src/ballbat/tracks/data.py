@@ -162,3 +162,13 @@ def camera_block(cfg: dict) -> dict:
         "rig": dict(cfg["rig"]),
         **({"min_frames": cfg["min_frames"]} if "min_frames" in cfg else {}),
     }
+
+
+def with_found_settings(block: dict, found: dict) -> dict:
+    """Return the reduce rule's settings block with the frame rates and pixel scales found in the files."""
+    out = {**block, "cameras": {c: dict(v) for c, v in block["cameras"].items()}}
+    for cam, vals in found["cameras"].items():
+        for key in ("fps", "m_per_px"):
+            if key in vals:
+                out["cameras"].setdefault(cam, {})[key] = vals[key]
+    return out

@@ -1,0 +1,91 @@
+"""Read the files tracking tools write: Tracker (.trk, .trz, data tables) and Kinovea (.kva, exports).
+
+Each reader returns a :class:`FileTracks`: every named track of one file as frame numbers and
+pixel coordinates in ballbat's convention (x to the right, y downward, one pixel scale for
+both axes), with the camera settings the file holds (frame rate, pixel scale) and a note of
+where each came from. :mod:`.layout` lays a lab's folder of such files (one per impact and
+camera) out as ballbat's long tracks. See docs/tracks.md ("Files of tracking tools").
+
+* :mod:`.tracker` -- Tracker project files (``.trk``, XML) and archives (``.trz``).
+* :mod:`.kinovea` -- Kinovea annotation files (``.kva``, XML).
+* :mod:`.tables` -- Tracker's exported data tables and Kinovea's CSV exports (no settings:
+  the config states the units, the axis direction, the frame rate and the pixel scale).
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: Metres per length unit, by every name the tools (and a config) use for it.
+LENGTH_UNITS = {
+    "m": 1.0,
+    "meter": 1.0,
+    "meters": 1.0,
+    "metre": 1.0,
+    "metres": 1.0,
+    "cm": 0.01,
+    "centimeters": 0.01,
+    "mm": 0.001,
+    "millimeters": 0.001,
+    "in": 0.0254,
+    "inch": 0.0254,
+    "inches": 0.0254,
+    "ft": 0.3048,
+    "feet": 0.3048,
+    "yd": 0.9144,
+    "yards": 0.9144,
+}
+#: Seconds per time unit of a table (``frames``: the time column counts frames).
+TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6}
+
+
+class FormatError(Exception):
+    """Problems of one file (each naming the file, the track or row, and what is wrong)."""
+
+    def __init__(self, problems: list[str]):
+        super().__init__("\n".join(problems))
+        self.problems = list(problems)
+
+
+@dataclass
+class FileTracks:
+    """The tracks of one file, in ballbat's pixel convention, and the settings the file holds.
+
+    ``tracks`` maps the tool's track name to ``(frame, x_px, y_px)`` arrays (frames whole,
+    coordinates finite). ``fps`` and ``m_per_px`` are None when the file does not hold them;
+    ``source`` says where each setting came from (for the import report).
+    """
+
+    path: str
+    tracks: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]
+    fps: float | None = None
+    m_per_px: float | None = None
+    source: dict[str, str] = field(default_factory=dict)
+
+
+def whole_frames(values: np.ndarray, what: str, labels: list[str], tol: float = 0.05) -> tuple[np.ndarray, list[str]]:
+    """Round ``values`` to whole frame numbers; a value further than ``tol`` from one is a problem per label."""
+    values = np.asarray(values, dtype=float)
+    rounded = np.round(values)
+    bad = ~np.isfinite(values) | (np.abs(values - rounded) > tol)
+    problems = [f"{labels[i]}: {what} is {values[i]:.3f} frames, not a whole frame" for i in np.flatnonzero(bad)[:5]]
+    if bad.sum() > 5:
+        problems.append(f"... and {int(bad.sum()) - 5} more such rows")
+    out = np.where(bad, 0, rounded).astype(np.int64)
+    return out, problems
+
+
+def length_to_m(unit: str, where: str) -> float:
+    """Metres per ``unit``; a ValueError naming ``where`` when the unit is unknown."""
+    key = str(unit).strip().lower()
+    if key not in LENGTH_UNITS:
+        raise ValueError(f"{where}: unknown length unit {unit!r} (known: m, cm, mm, in, ft, yd)")
+    return LENGTH_UNITS[key]
+
+
+def close(a: float, b: float, rel: float = 1e-3) -> bool:
+    """Whether two settings agree to ``rel`` (relative)."""
+    return math.isclose(a, b, rel_tol=rel)

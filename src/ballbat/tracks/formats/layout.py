@@ -1,0 +1,363 @@
+"""A lab's folder of tool files -> ballbat's long tracks and the camera settings found in them.
+
+One file per impact and camera, named by a pattern (default ``{impact_id}_{camera}.{ext}``;
+``camera`` is ``swing`` or ``spin``). ``points`` maps ballbat's points to the tool's track names
+(``{ball: ball, bat_tip: tip, dot_a: A, dot_b: B}``); other tracks of a file are left out and
+listed. The frame rate and the pixel scale come from the files wherever they hold them; a config
+value that contradicts a file is an error naming both; where no file holds one, the config must
+give it. Files of one camera calibrated apart (slightly different scales) are brought to one
+scale (the config's, or the median of the files'), and the range is reported.
+"""
+
+from __future__ import annotations
+
+import re
+import statistics
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..data import CAMERAS, POINTS, Tracks
+from . import FileTracks, FormatError, close
+from .kinovea import read_kva
+from .tables import check_units, read_kinovea_table, read_tracker_table
+from .tracker import read_trk, read_trz
+
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Iterable
+
+#: Formats and the file extensions each reads.
+FORMATS = {
+    "tracker": (".trk", ".trz"),
+    "kinovea": (".kva",),
+    "tracker_table": (".txt", ".csv", ".tsv"),
+    "kinovea_table": (".csv", ".txt"),
+}
+#: Formats known from the extension alone.
+BY_EXTENSION = {".trk": "tracker", ".trz": "tracker", ".kva": "kinovea"}
+#: Formats whose files hold no settings (the config states units, fps, m_per_px).
+TABLES = ("tracker_table", "kinovea_table")
+DEFAULT_PATTERN = "{impact_id}_{camera}.{ext}"
+BALLBAT_POINTS = tuple(dict.fromkeys(p for pts in POINTS.values() for p in pts))
+
+
+@dataclass
+class Imported:
+    """Long track rows of every file, the camera settings found and what was left out."""
+
+    columns: dict[str, np.ndarray]
+    cameras: dict[str, dict]
+    files: list[tuple[str, str, str]]  # (impact_id, camera, path)
+    ignored: dict[str, list[str]] = field(default_factory=dict)  # path -> tracks left out
+
+    def settings_yaml(self) -> dict:
+        """Return the camera settings found, as ``ballbat import-tracks`` prints them and the workflow writes them."""
+        out: dict = {"cameras": self.cameras, "files": len(self.files)}
+        out["impacts"] = len({f[0] for f in self.files})
+        out["rows"] = int(self.columns["frame"].size)
+        if self.ignored:
+            out["tracks_left_out"] = {p: sorted(t) for p, t in self.ignored.items()}
+        return out
+
+
+def pattern_regex(pattern: str, exts: Iterable[str]) -> re.Pattern:
+    """Return the regular expression of a file-name pattern (``{impact_id}``, ``{camera}``, ``{ext}``)."""
+    for key in ("{impact_id}", "{camera}"):
+        if key not in pattern:
+            raise ValueError(f"pattern {pattern!r} lacks {key}")
+    out = re.escape(pattern)
+    out = out.replace(re.escape("{impact_id}"), r"(?P<impact_id>.+?)")
+    out = out.replace(re.escape("{camera}"), "(?P<camera>" + "|".join(CAMERAS) + ")")
+    ext_alt = "|".join(re.escape(e.lstrip(".")) for e in sorted(set(exts)))
+    out = out.replace(re.escape("{ext}"), f"(?P<ext>{ext_alt})")
+    return re.compile(out + r"\Z", re.IGNORECASE)
+
+
+def find_files(
+    paths: Iterable[str | os.PathLike[str]], pattern: str = DEFAULT_PATTERN, fmt: str | None = None
+) -> tuple[list[tuple[str, str, Path]], list[str]]:
+    """Files of ``paths`` (files, or folders of them) as (impact_id, camera, path); problems listed.
+
+    In a folder, files with a track-file extension must match the pattern; others (videos,
+    notes) are left alone. A file named directly must match.
+    """
+    exts = tool_file_extensions(fmt)
+    try:
+        rx = pattern_regex(pattern, [*exts, *(e for f in FORMATS.values() for e in f)])
+    except ValueError as exc:
+        return [], [str(exc)]
+    problems: list[str] = []
+    found: dict[tuple[str, str], Path] = {}
+    for p in map(Path, paths):
+        if p.is_dir():
+            cands = sorted(
+                q for q in p.iterdir() if q.is_file() and q.suffix.lower() in exts and not q.name.startswith(".")
+            )
+            if not cands:
+                problems.append(f"{p}: no {' or '.join(exts)} files in this folder")
+        elif p.is_file():
+            cands = [p]
+        else:
+            problems.append(f"{p}: no such file or folder")
+            continue
+        for q in cands:
+            m = rx.match(q.name)
+            if m is None:
+                problems.append(
+                    f"{q}: the name does not match the pattern {pattern!r} (camera: {' or '.join(CAMERAS)})"
+                )
+                continue
+            if q.suffix.lower() not in exts:
+                problems.append(
+                    f"{q}: a {q.suffix} file is not read as {fmt or 'a tool file'} (expected {', '.join(exts)})"
+                )
+                continue
+            key = (m["impact_id"], m["camera"].lower())
+            if key in found:
+                problems.append(f"{q}: impact {key[0]!r}, camera {key[1]} already read from {found[key]}")
+                continue
+            found[key] = q
+    return [(i, c, p) for (i, c), p in sorted(found.items())], problems
+
+
+def check_points(points: object, where: str) -> list[str]:
+    """Problems of a ``points`` map (ballbat point -> the tool's track name)."""
+    if not isinstance(points, dict):
+        return [
+            f"{where}: missing (map ballbat's points to the tool's track names, "
+            "e.g. {ball: ball, bat_tip: tip, dot_a: A, dot_b: B})"
+        ]
+    problems = [
+        f"{where}.{k}: unknown point (known: {', '.join(BALLBAT_POINTS)})" for k in points if k not in BALLBAT_POINTS
+    ]
+    names = [str(v) for v in points.values()]
+    problems += [
+        f"{where}: track name {n!r} is given to several points"
+        for n in sorted({n for n in names if names.count(n) > 1})
+    ]
+    return problems
+
+
+def _read(path: Path, fmt: str, units: dict | None, cam: dict) -> FileTracks:
+    if fmt == "tracker":
+        return read_trz(path) if path.suffix.lower() == ".trz" else read_trk(path)
+    if fmt == "kinovea":
+        return read_kva(path)
+    reader = read_tracker_table if fmt == "tracker_table" else read_kinovea_table
+    return reader(path, units, float(cam["fps"]), float(cam["m_per_px"]))
+
+
+def import_files(
+    paths: Iterable[str | os.PathLike[str]],
+    points: dict,
+    *,
+    pattern: str = DEFAULT_PATTERN,
+    fmt: str | None = None,
+    units: dict | None = None,
+    cameras: dict | None = None,
+    where: str = "tracks",
+) -> Imported:
+    """Read a lab's tool files into long rows; camera settings from the files, checked against ``cameras``.
+
+    Parameters
+    ----------
+    paths : iterable of path-like
+        Files, or folders of files, one per impact and camera.
+    points : dict
+        ballbat point -> the tool's track name.
+    pattern, fmt : str
+        File-name pattern; format (None: from each file's extension, .trk/.trz/.kva).
+    units : dict, optional
+        ``time``, ``length``, ``y`` of a table format (required for tables).
+    cameras : dict, optional
+        Config camera settings (``fps``, ``m_per_px``, ...) per camera, to check and complete.
+    where : str
+        Config key of the block, for messages.
+
+    Raises
+    ------
+    FormatError
+        Every problem of every file at once.
+    """
+    cameras = cameras or {}
+    problems = check_points(points, f"{where}.points")
+    if fmt is not None and fmt not in FORMATS:
+        problems.append(f"{where}.format: {fmt!r} is not one of {', '.join(FORMATS)}")
+        fmt = None
+    if units is not None and fmt not in TABLES:
+        problems.append(
+            f"{where}.units: given, but only a table (format tracker_table or kinovea_table) needs it: "
+            "the tools' own files say their units"
+        )
+    if fmt in TABLES:
+        problems += check_units(units, f"{where}.units")
+        for c in CAMERAS:
+            for k in ("fps", "m_per_px"):
+                if k not in (cameras.get(c) or {}):
+                    problems.append(f"{where}.cameras.{c}.{k}: missing (a {fmt} holds no {k}; no default)")
+    if problems:
+        raise FormatError(problems)
+    files, problems = find_files(paths, pattern, fmt)
+    read: list[tuple[str, str, FileTracks]] = []
+    for iid, cam, path in files:
+        f = fmt or BY_EXTENSION[path.suffix.lower()]
+        try:
+            read.append((iid, cam, _read(path, f, units, cameras.get(cam) or {})))
+        except FormatError as exc:
+            problems += exc.problems
+    settings: dict[str, dict] = {}
+    for cam in CAMERAS:
+        these = [ft for _, c, ft in read if c == cam]
+        settings[cam], sp = _camera_settings(cam, these, cameras.get(cam) or {}, f"{where}.cameras.{cam}")
+        problems += sp
+    cols: dict[str, list] = {k: [] for k in ("impact_id", "camera", "point", "frame", "x_px", "y_px")}
+    ignored: dict[str, list[str]] = {}
+    wanted = {str(v): k for k, v in points.items()}
+    for iid, cam, ft in read:
+        m = settings[cam].get("m_per_px")
+        factor = ft.m_per_px / m if ft.m_per_px is not None and m else 1.0
+        left = [n for n in ft.tracks if n not in wanted or wanted[n] not in POINTS[cam]]
+        if left:
+            ignored[ft.path] = left
+        for p in POINTS[cam]:
+            if p not in points:
+                problems.append(
+                    f"{ft.path}: no track name given for {p} ({cam} camera): add {p}: <the tool's name> to points"
+                )
+                continue
+            name = str(points[p])
+            if name not in ft.tracks or ft.tracks[name][0].size == 0:
+                have = ", ".join(repr(n) for n in ft.tracks) or "none"
+                why = "has no marks" if name in ft.tracks else "is not in the file"
+                problems.append(f"{ft.path}: track {name!r} (ballbat's {p}, {cam} camera) {why} (tracks: {have})")
+                continue
+            fr, x, y = ft.tracks[name]
+            if np.unique(fr).size != fr.size:
+                u, n = np.unique(fr, return_counts=True)
+                problems.append(f"{ft.path}: track {name!r}: frame(s) {', '.join(map(str, u[n > 1][:5]))} appear twice")
+                continue
+            cols["impact_id"].append(np.full(fr.size, iid))
+            cols["camera"].append(np.full(fr.size, cam))
+            cols["point"].append(np.full(fr.size, p))
+            cols["frame"].append(fr)
+            cols["x_px"].append(x * factor if factor != 1.0 else x)
+            cols["y_px"].append(y * factor if factor != 1.0 else y)
+    if problems:
+        raise FormatError(problems)
+    out = {k: np.concatenate(v) if v else np.array([]) for k, v in cols.items()}
+    return Imported(out, settings, [(i, c, ft.path) for i, c, ft in read], ignored)
+
+
+def _camera_settings(cam: str, files: list[FileTracks], config: dict, where: str) -> tuple[dict, list[str]]:
+    """Return the frame rate and pixel scale of one camera: from its files, checked against the config."""
+    problems: list[str] = []
+    out: dict = {"files": len(files)}
+    for key in ("fps", "m_per_px"):
+        vals = [(ft.path, getattr(ft, key)) for ft in files if getattr(ft, key) is not None]
+        given = config.get(key)
+        if given is not None:
+            bad = [(p, v) for p, v in vals if not close(v, float(given))]
+            for p, v in bad[:5]:
+                problems.append(
+                    f"{where}.{key}: the config says {given:g} but {p} says {v:.6g} ({_src(files, p, key)})"
+                )
+            if len(bad) > 5:
+                problems.append(f"{where}.{key}: ... and {len(bad) - 5} more {cam} files say otherwise than the config")
+            out[key] = float(given)
+            out[f"{key}_from"] = "config" + (f", agrees with {len(vals)} file(s)" if vals else "")
+        elif vals:
+            if key == "fps":
+                ref = vals[0]
+                bad = [(p, v) for p, v in vals if not close(v, ref[1])]
+                for p, v in bad[:5]:
+                    problems.append(
+                        f"{p}: frame rate {v:.6g} fps differs from {ref[1]:.6g} fps of {ref[0]} (same {cam} camera)"
+                    )
+                out[key] = float(statistics.median(v for _, v in vals))
+            else:
+                out[key] = float(statistics.median(v for _, v in vals))
+                lo, hi = min(v for _, v in vals), max(v for _, v in vals)
+                if lo != hi:
+                    out["m_per_px_range"] = [lo, hi]
+            out[f"{key}_from"] = f"{len(vals)} file(s): {_src(files, vals[0][0], key)}"
+            if len(vals) < len(files):
+                miss = [ft.path for ft in files if getattr(ft, key) is None]
+                problems.append(
+                    f"{where}.{key}: {len(miss)} file(s) of the {cam} camera hold no {key} ({miss[0]}...) and the "
+                    f"config gives none"
+                )
+        elif files:
+            problems.append(
+                f"{where}.{key}: missing: the {cam} camera's files do not hold it ({files[0].path}); "
+                "give it in the config"
+            )
+    return out, problems
+
+
+def _src(files: list[FileTracks], path: str, key: str) -> str:
+    ft = next(f for f in files if f.path == path)
+    return ft.source.get(key, key)
+
+
+def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | None = None) -> tuple[Tracks, Imported]:
+    """Read a dataset's ``tracks`` block that names a folder (``dir``): return (Tracks, Imported).
+
+    The impacts file (``impacts``) gives each impact's bat and ball; every impact must have a
+    file of each camera and every file an impact. Every problem is raised at once as an
+    :class:`~ballbat.properties.InputError`.
+    """
+    from ...properties import InputError
+    from ..io import _assemble, read_table
+    from ..validate import IMPACT_COLUMNS, check_header, check_impact_rows
+
+    problems: list[str] = []
+    ipath = Path(cfg["impacts"])
+    irows: list = []
+    impacts: dict[str, str] = {}
+    try:
+        header, irows = read_table(ipath, IMPACT_COLUMNS, "impact")
+        hp = check_header(ipath, header, IMPACT_COLUMNS)
+        problems += hp
+        if not hp:
+            impacts, rp = check_impact_rows(ipath, irows, balls, bats)
+            problems += rp
+    except InputError as exc:
+        problems += exc.problems
+    try:
+        imp = import_files(
+            [cfg["dir"]],
+            cfg.get("points"),
+            pattern=cfg.get("pattern", DEFAULT_PATTERN),
+            fmt=cfg.get("format"),
+            units=cfg.get("units"),
+            cameras=cfg.get("cameras"),
+            where=where,
+        )
+    except FormatError as exc:
+        raise InputError(problems + exc.problems) from None
+    have: dict[str, set] = {}
+    for iid, cam, path in imp.files:
+        have.setdefault(iid, set()).add(cam)
+        if impacts and iid not in impacts:
+            problems.append(f"{path}: impact {iid!r} is not in {ipath} (add a row impact_id,bat,ball)")
+    for iid, label in impacts.items():
+        miss = [c for c in CAMERAS if c not in have.get(iid, set())]
+        if miss:
+            names = " and ".join(
+                cfg.get("pattern", DEFAULT_PATTERN).replace("{impact_id}", iid).replace("{camera}", c) for c in miss
+            )
+            problems.append(
+                f"{ipath}: {label}: impact {iid!r} has no file of the {' and '.join(miss)} camera "
+                f"in {cfg['dir']} ({names})"
+            )
+    if problems:
+        raise InputError(problems)
+    return _assemble(imp.columns, irows, None), imp
+
+
+def tool_file_extensions(fmt: str | None) -> tuple[str, ...]:
+    """Extensions of the files a ``dir`` of format ``fmt`` holds (None: the tools' own files)."""
+    return FORMATS[fmt] if fmt else tuple(BY_EXTENSION)
