@@ -170,8 +170,10 @@ def test_single_frame_glitches_are_removed_and_counted(rendered):
         for p in ct.x:
             for i in range(tr.n):
                 ok = np.isfinite(ct.x[p][i])
-                # interior frames with both neighbours tracked
+                # interior frames with both neighbours tracked, and (ball and dots) after the contact
                 cand = np.flatnonzero(ok[1:-1] & ok[:-2] & ok[2:]) + 1
+                if p != "bat_tip":
+                    cand = cand[cand > clean.onset[name].onset[i] + 5]
                 if cand.size < 12 or rng.uniform() > 0.5:
                     continue
                 k = rng.choice(cand[2:-2])

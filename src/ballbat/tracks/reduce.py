@@ -603,17 +603,23 @@ class Reduction:
     agreement: object = None
 
 
-def remove_glitches(tracks: Tracks) -> tuple[Tracks, dict[str, np.ndarray]]:
+def remove_glitches(tracks: Tracks, cameras: dict[str, Camera]) -> tuple[Tracks, dict[str, np.ndarray]]:
     """Return the tracks without their single-frame glitches (:func:`.checks.glitch_mask`), and the count per impact.
 
-    The input is not changed. Counts are per camera (all its points), shape (impact,).
+    The ball's and the dots' frames from the last at rest to the end of the longest contact
+    (:data:`CONTACT_MAX`) after the impact frame (:func:`find_onset` on the raw track) are
+    not tested. The input is not changed. Counts are per camera (all its points), shape (impact,).
     """
     cams, counts = {}, {}
     for name, ct in tracks.cameras.items():
         xs, ys = {}, {}
         count = np.zeros(tracks.n, dtype=np.int64)
+        on = find_onset(ct.x["ball"], ct.y["ball"])
+        n_c = int(np.ceil(CONTACT_MAX * cameras[name].fps - 1e-9))
+        cols = np.arange(ct.n_columns)[None, :]
+        kink = on.found[:, None] & (cols >= on.rest[:, None] - 1) & (cols <= on.onset[:, None] + n_c + 1)
         for p in POINTS[name]:
-            bad = glitch_mask(ct.x[p], ct.y[p])
+            bad = glitch_mask(ct.x[p], ct.y[p], None if p == "bat_tip" else kink)
             xs[p], ys[p] = np.where(bad, np.nan, ct.x[p]), np.where(bad, np.nan, ct.y[p])
             count += bad.sum(axis=1)
         cams[name] = CameraTracks(ct.frame0, xs, ys)
@@ -649,7 +655,7 @@ def reduce_tracks(
     """
     opt = options or ReduceOptions()
     n = tracks.n
-    tracks, n_outliers = remove_glitches(tracks)
+    tracks, n_outliers = remove_glitches(tracks, cameras)
     onset, flight, times, phys = {}, {}, {}, {}
     for name in ("swing", "spin"):
         ct, cam = tracks.cameras[name], cameras[name]
