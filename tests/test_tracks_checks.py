@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -220,3 +221,66 @@ def test_every_impact_excluded_stops_with_a_count(rendered):
     msg = stopped(few, s)
     assert f"0 of {tr.n} impacts usable" in msg and f"too_few_frames: {tr.n}" in msg, msg
     assert "impact 0: reduce: " in msg
+
+
+# --------------------------------------------------------------------------------------
+# ballbat check --kind tracks: the reduce rule's own reading, reduction and cross-checks
+
+
+def check(capsys, *argv):
+    from ballbat.cli import main
+
+    rc = main(["check", "--kind", "tracks", *argv])
+    out = capsys.readouterr()
+    return rc, out.out, out.err
+
+
+def test_check_tracks_says_what_the_workflow_does_with_every_impact(capsys):
+    rc, out, err = check(capsys, "--config", "config/examples/tracked.yaml")
+    assert rc == 0, out + err
+    assert out.count("impact W") == 12 and "impact W01: used" in out
+    assert "impact W04: excluded: reduce: dot_a's distance from the ball's centre varies" in out
+    assert "cross-check: the ball's speed in swing / in spin" in out
+    assert "11 of 12 impacts usable (per ball: baseball 11), 1 excluded, 0 tracking glitch(es) removed" in out
+
+
+def _tracked_config(tmp_path, edit=None, keep=None):
+    import yaml
+
+    cfg = yaml.safe_load(Path("config/examples/tracked.yaml").read_text())
+    block = cfg["datasets"]["tracked"]["tracks"]
+    if keep is not None:  # a subset of the impacts
+        lines = Path(block["file"]).read_text().splitlines()
+        t = tmp_path / "tracks.csv"
+        t.write_text("\n".join([lines[0], *[ln for ln in lines[1:] if ln.split(",")[0] in keep]]) + "\n")
+        lines = Path(block["impacts"]).read_text().splitlines()
+        i = tmp_path / "impacts.csv"
+        i.write_text("\n".join([lines[0], *[ln for ln in lines[1:] if ln.split(",")[0] in keep]]) + "\n")
+        block["file"], block["impacts"] = str(t), str(i)
+    if edit:
+        edit(block)
+    path = tmp_path / "config.yaml"
+    path.write_text(yaml.safe_dump(cfg))
+    return path
+
+
+def test_check_tracks_exits_1_when_the_dataset_would_stop(tmp_path, capsys):
+    def slow_spin(block):
+        block["cameras"]["spin"]["fps"] = 500
+
+    rc, out, err = check(capsys, "--config", str(_tracked_config(tmp_path, slow_spin)))
+    assert rc == 1
+    assert "the workflow would stop at reduce" in err
+    assert "datasets.tracked.tracks: most likely cameras.spin.fps is 2x too low" in out
+
+
+def test_check_tracks_exits_1_with_fewer_than_3_usable_impacts_per_ball(tmp_path, capsys):
+    rc, out, err = check(capsys, "--config", str(_tracked_config(tmp_path, keep={"W01", "W02", "W04"})))
+    assert rc == 1
+    assert "2 of 3 impacts usable" in out + err and "with 3" in out + err, out + err
+    assert "Excluded: dot_not_rotating_about_centre: 1" in out
+
+
+def test_check_tracks_without_settings_does_not_call_files_usable(capsys):
+    rc, out, _ = check(capsys, "config/examples/tracked_tracks.csv", "--impacts", "config/examples/tracked_impacts.csv")
+    assert rc == 0 and "usable" not in out and "not reduced: give --config" in out
