@@ -78,9 +78,10 @@ def mistakes(tr, cameras, rig):
         cameras,
         Rig(rig.pivot_to_tip / 39.37, rig.pivot_to_impact / 39.37),
         tr,
-        "rig lengths are in metres",
+        "the rig lengths are in metres",
     )
-    out["rig in cm"] = (cameras, Rig(rig.pivot_to_tip * 2.54, rig.pivot_to_impact * 2.54), tr, "the rig lengths are in cm")
+    cm = Rig(rig.pivot_to_tip * 2.54, rig.pivot_to_impact * 2.54)
+    out["rig in cm"] = (cameras, cm, tr, "the rig lengths are in cm")
     out["y up, both cameras"] = (cameras, rig, _mapped(tr, lambda c, x, y: (x, 800.0 - y)), "y points up in both")
     out["y up, swing camera"] = (
         cameras,
