@@ -134,6 +134,24 @@ def test_ball_rows_filed_under_the_other_camera(rendered):
     assert np.all(red.flag[np.arange(tr.n) != i] == 0)
 
 
+def test_frame_number_typo_in_netcdf_names_the_row(tmp_path, rendered):
+    """The same in a NetCDF tracks file (the fast path of well-formed files)."""
+    from ballbat.pipeline.ncio import write_dataset
+    from ballbat.tracks.io import tracks_dataset
+
+    tr, _ = rendered
+    ds = tracks_dataset(tr)
+    frame = ds["frame"].values.copy()
+    frame[7] += 1_000_000_000
+    ds["frame"] = ("row", frame, ds["frame"].attrs)
+    path = tmp_path / "tracks.nc"
+    write_dataset(ds, path, title="t", rule="test", inputs={}, config={})
+    with pytest.raises(InputError) as exc:
+        load_tracks(path, balls=BALLS, bats=BATS)
+    (p,) = exc.value.problems
+    assert f"row 7, column frame: frame {frame[7]}" in p, p
+
+
 def test_frame_number_typo_names_the_row(tmp_path, rendered):
     """A frame number +1e9: the row is named and nothing is allocated for the gap."""
     tr, _ = rendered
@@ -161,8 +179,13 @@ def test_frame_number_typo_names_the_row(tmp_path, rendered):
     assert f"row {k + 2}, column frame: frame {rows['frame'][k]}" in p and "a typo?" in p, p
 
 
-def test_single_frame_glitches_are_removed_and_counted(rendered):
-    tr, s = rendered
+@pytest.mark.parametrize("noise_px", [0.5, 2.0])
+def test_single_frame_glitches_are_removed_and_counted(noise_px):
+    """40 px single-frame glitches in half the tracks: each removed and counted, none else."""
+    tr, s = render(
+        experiment(30, per_bat=8),
+        render_cfg(seed=31, swing={"pixel_noise_px": noise_px}, spin={"pixel_noise_px": noise_px}),
+    )
     clean, _ = run(tr, s)
     rng = np.random.default_rng(3)
     bad = mapped(tr, lambda c, x, y: (x, y))
