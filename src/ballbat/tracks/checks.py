@@ -25,6 +25,7 @@ setting that explains them best. A check that fails for single impacts excludes 
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
@@ -169,9 +170,10 @@ def glitch_mask(x: np.ndarray, y: np.ndarray, skip: np.ndarray | None = None) ->
     pooled = _mad_sd(comps.ravel())
     if not np.isfinite(pooled):
         return out
-    with np.errstate(invalid="ignore"):
-        fin = np.isfinite(comps)
-        med = np.array([np.median(np.abs(c[f])) if f.sum() >= 10 else 0.0 for c, f in zip(comps, fin, strict=True)])
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows
+        enough = np.isfinite(comps).sum(axis=1) >= 10
+        med = np.where(enough, np.nanmedian(np.abs(comps), axis=1), 0.0)
         sd = np.maximum(1.4826 * med, pooled)
         z = math.sqrt(2 * math.log(1 / GLITCH_FALSE_ALARM))
         rn = np.hypot(rx, ry)
