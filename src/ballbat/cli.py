@@ -1,13 +1,15 @@
 """The ``ballbat`` command: everyday questions without editing a config.
 
 ``ballbat check FILE`` validates a measured impacts file exactly as the workflow's ``ingest``
-rule does (the same function, :func:`ballbat.ingest.ingest`), and ``ballbat check --kind tracks
---config YAML`` raw tracks as the ``reduce`` rule does (:func:`ballbat.tracks.stage.reduce_checked`);
-``ballbat fly`` flies batted balls with Nathan's trajectory model (:func:`ballbat.flight.fly`), one from options or many
+rule does (the same function, :func:`ballbat.ingest.ingest`); ``ballbat fly`` flies batted
+balls with Nathan's trajectory model (:func:`ballbat.flight.fly`), one from options or many
 from a CSV file; ``ballbat summary results/{dataset}`` prints a dataset's headline numbers.
 Defaults (air, spin decay, integrator, property tables) are the config schema's, the one
 place the workflow's defaults live. Errors are one line naming the bad argument (exit 2);
 ``check`` exits 1 when the file is not usable.
+
+``ballbat check --kind tracks --config YAML`` checks raw camera tracks as the ``reduce`` rule
+does (the same function, :func:`ballbat.tracks.stage.reduce_checked`).
 """
 
 from __future__ import annotations
@@ -135,6 +137,11 @@ def _tracks_dataset(args: argparse.Namespace, defaults: dict) -> tuple[str, dict
     if args.dataset not in datasets:
         raise UsageError(f"argument --dataset: {cfg_path} has no dataset {args.dataset!r} with a tracks block")
     ds = datasets[args.dataset]
+    if "file" not in ds["tracks"]:
+        raise UsageError(
+            f"argument --config: datasets.{args.dataset}.tracks names no file (a folder of a tool's files: "
+            "convert it with ballbat import-tracks and give that CSV as the file)"
+        )
     tables = {**defaults, **(cfg.get("tables") or {})}
     return args.dataset, ds["tracks"], {k: ds.get(k, tables[k]) for k in ("balls", "bats")}
 
