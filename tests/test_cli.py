@@ -152,7 +152,7 @@ def test_check_raw_tracks():
     impacts = ROOT / "config" / "examples" / "tracked_impacts.csv"
     out = ballbat("check", str(tracks), "--kind", "tracks", "--impacts", str(impacts))
     assert out.returncode == 0, out.stdout + out.stderr
-    assert "usable: 12 impacts tracked by the cameras spin, swing" in out.stdout
+    assert "read and validated: 12 impacts tracked by the cameras spin, swing; not reduced" in out.stdout
 
 
 def test_check_raw_tracks_lists_every_problem(tmp_path):

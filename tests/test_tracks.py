@@ -305,8 +305,10 @@ def test_pixel_scale_systematic_reaches_e_x():
     def fit(rel, scale=1.0):
         truth = {k: ds[f"truth_{k}"].values for k in ("e_x", "e_y")}
         tr, s = render(ds, render_cfg(swing={"m_per_px_err": rel}), truth)
+        # both cameras' scales off alike (the spin camera cross-checks the swing camera's speed)
         cam = replace(s.swing.camera, m_per_px=s.swing.camera.m_per_px * scale)
-        red = reduction_dataset(reduce(tr, s, swing=cam))
+        spin = replace(s.spin.camera, m_per_px=s.spin.camera.m_per_px * scale)
+        red = reduction_dataset(reduce(tr, s, swing=cam, spin=spin))
         return fit_dataset(reconstruct(normalize(red, 77.0), BALLS, BATS), mu_k_example=0.5)
 
     base, sys1, sys2 = fit(0.0), fit(0.01), fit(0.02)

@@ -8,6 +8,9 @@ reads Tracker or Kinovea files into the long tracks CSV (:mod:`ballbat.tracks.fo
 Defaults (air, spin decay, integrator, property tables) are the config schema's, the one
 place the workflow's defaults live. Errors are one line naming the bad argument (exit 2);
 ``check`` exits 1 when the file is not usable.
+
+``ballbat check --kind tracks --config YAML`` checks raw camera tracks as the ``reduce`` rule
+does (the same function, :func:`ballbat.tracks.stage.reduce_checked`).
 """
 
 from __future__ import annotations
@@ -30,7 +33,8 @@ EXAMPLES = {
   ballbat check data/mylab/impacts.csv
   ballbat check data/mylab/impacts.csv --bats data/mylab/bats.csv
   ballbat check config/examples/maple_impacts.csv --bats config/examples/maple_bats.csv
-  ballbat check config/examples/tracked_tracks.csv --kind tracks --impacts config/examples/tracked_impacts.csv""",
+  ballbat check config/examples/tracked_tracks.csv --kind tracks --impacts config/examples/tracked_impacts.csv
+  ballbat check --kind tracks --config config/examples/tracked.yaml   (as the reduce rule: reduce, cross-check)""",
     "fly": """examples:
   ballbat fly --speed 103 --angle 27.5 --backspin 2500
   ballbat fly --speed 103 --angle 27.5 --backspin 2500 --method calculator --json
@@ -85,14 +89,20 @@ def cmd_check(args: argparse.Namespace) -> int:
     from .ingest import excluded_listing, ingest
     from .properties import InputError
 
+    defaults = _schema_defaults()["tables"]
+    if args.kind == "tracks" and args.file is None:
+        return _check_tracks(None, args, defaults)
+    if args.file is None:
+        raise UsageError("argument file: required")
     path = Path(args.file)
     if path.is_dir():
         raise UsageError(f"argument file: {path} is a directory, not an impacts file")
     if not path.exists():
         raise UsageError(f"argument file: {path}: no such file")
-    defaults = _schema_defaults()["tables"]
     if args.kind == "tracks":
         return _check_tracks(path, args, defaults)
+    if args.config or args.dataset:
+        raise UsageError("argument --config: only with --kind tracks (the dataset's camera settings and rig)")
     if args.impacts:
         raise UsageError("argument --impacts: only with --kind tracks (the impact table of a tracks file)")
     try:
@@ -113,11 +123,88 @@ def cmd_check(args: argparse.Namespace) -> int:
     return 0
 
 
-def _check_tracks(path: Path, args: argparse.Namespace, defaults: dict) -> int:
-    """Validate a raw-tracks file and its impact table as the workflow's reduce rule reads them."""
+def _tracks_dataset(args: argparse.Namespace, defaults: dict) -> tuple[str, dict, dict]:
+    """Return the dataset of ``--config`` that has a ``tracks`` block: (name, block, its balls/bats tables)."""
+    import yaml
+
+    cfg_path = Path(args.config)
+    if not cfg_path.is_file():
+        raise UsageError(f"argument --config: {cfg_path}: no such file")
+    try:
+        cfg = yaml.safe_load(cfg_path.read_text()) or {}
+    except yaml.YAMLError as exc:
+        raise UsageError(f"argument --config: {cfg_path}: not YAML ({exc})") from None
+    datasets = {k: v for k, v in (cfg.get("datasets") or {}).items() if isinstance(v, dict) and "tracks" in v}
+    if args.dataset is None:
+        if len(datasets) != 1:
+            names = ", ".join(sorted(datasets)) or "none"
+            raise UsageError(
+                f"argument --dataset: {cfg_path} has {len(datasets)} datasets with tracks ({names}): name one"
+            )
+        args.dataset = next(iter(datasets))
+    if args.dataset not in datasets:
+        raise UsageError(f"argument --dataset: {cfg_path} has no dataset {args.dataset!r} with a tracks block")
+    ds = datasets[args.dataset]
+    if "file" not in ds["tracks"]:
+        raise UsageError(
+            f"argument --config: datasets.{args.dataset}.tracks names no file (a folder of a tool's files: "
+            "convert it with ballbat import-tracks and give that CSV as the file)"
+        )
+    tables = {**defaults, **(cfg.get("tables") or {})}
+    return args.dataset, ds["tracks"], {k: ds.get(k, tables[k]) for k in ("balls", "bats")}
+
+
+def _check_tracks(path: Path | None, args: argparse.Namespace, defaults: dict) -> int:
+    """Check raw tracks as the workflow's reduce rule does: read, validate, reduce, cross-check.
+
+    With ``--config``: the same function as the reduce rule (:func:`ballbat.tracks.stage.reduce_checked`),
+    then what the workflow would do with every impact; exit 1 when the dataset would stop or
+    a ball would have fewer than three usable impacts. Without: the files are only read.
+    """
+    import numpy as np
+
+    from .linefit import MIN_FIT_IMPACTS
     from .properties import InputError, load_balls, load_bats
     from .tracks.io import load_tracks
+    from .tracks.stage import reduce_checked
 
+    if args.config:
+        name, block, tables = _tracks_dataset(args, defaults)
+        path = path or Path(block["file"])
+        impacts = args.impacts or block.get("impacts")
+        where = f"datasets.{name}.tracks"
+        try:
+            red, verdict = reduce_checked(
+                path, impacts, block, args.balls or tables["balls"], args.bats or tables["bats"], where
+            )
+        except InputError as exc:
+            for problem in exc.problems:
+                print(problem)
+            print(f"{path}: the workflow would stop at reduce: {len(exc.problems)} problem(s)", file=sys.stderr)
+            return 1
+        for line in verdict.lines:
+            print(f"cross-check: {line}")
+        for text in verdict.warnings:
+            print(f"warning: {text}")
+        for iid, flag, why in zip(red.tracks.impact_id, red.flag, red.reason, strict=True):
+            print(f"impact {iid}: " + ("used" if flag == 0 else f"excluded: {why}"))
+        usable = red.flag == 0
+        per_ball = {b: int((usable & (red.tracks.ball == b)).sum()) for b in sorted(set(red.tracks.ball))}
+        listing = ", ".join(f"{b} {k}" for b, k in per_ball.items())
+        short = [b for b, k in per_ball.items() if k < MIN_FIT_IMPACTS]
+        n_out = int(sum(np.sum(v) for v in red.n_outliers.values()))
+        summary = (
+            f"{path}: {int(usable.sum())} of {red.tracks.n} impacts usable (per ball: {listing}), "
+            f"{red.tracks.n - int(usable.sum())} excluded, {n_out} tracking glitch(es) removed, "
+            f"{len(verdict.warnings)} warning(s)"
+        )
+        if short:
+            print(f"{summary}; fewer than {MIN_FIT_IMPACTS} usable impacts of {', '.join(short)}", file=sys.stderr)
+            return 1
+        print(summary)
+        return 0
+    if path is None:
+        raise UsageError("argument file: required (or give --config with a dataset's tracks block)")
     if path.suffix.lower() != ".nc" and not args.impacts:
         raise UsageError("argument --impacts: required with --kind tracks for a CSV tracks file (impact_id,bat,ball)")
     try:
@@ -130,7 +217,10 @@ def _check_tracks(path: Path, args: argparse.Namespace, defaults: dict) -> int:
         print(f"{path}: not usable: {len(exc.problems)} problem(s)", file=sys.stderr)
         return 1
     cams = ", ".join(sorted(tracks.cameras))
-    print(f"{path}: usable: {tracks.n} impacts tracked by the cameras {cams}")
+    print(
+        f"{path}: read and validated: {tracks.n} impacts tracked by the cameras {cams}; not reduced: give --config "
+        "(the dataset's camera settings and rig) for the reduction and its cross-checks"
+    )
     return 0
 
 
@@ -385,11 +475,18 @@ def parser() -> argparse.ArgumentParser:
     fmt = argparse.RawDescriptionHelpFormatter
 
     p = sub.add_parser("check", help="validate a measured impacts file", epilog=EXAMPLES["check"], formatter_class=fmt)
-    p.add_argument("file", help="impacts file (CSV or NetCDF, the paper's units)")
+    p.add_argument("file", nargs="?", help="impacts file (CSV or NetCDF, the paper's units), or tracks file")
     p.add_argument("--bats", help="bat table (default: the workflow's config/bats.csv)")
     p.add_argument("--balls", help="ball table (default: the workflow's config/balls.csv)")
     p.add_argument("--kind", choices=("impacts", "tracks"), default="impacts", help="what the file holds")
     p.add_argument("--impacts", metavar="FILE", help="with --kind tracks: the impact table (impact_id,bat,ball)")
+    p.add_argument(
+        "--config",
+        metavar="YAML",
+        help="with --kind tracks: a workflow config whose dataset's tracks block gives the files, camera settings "
+        "and rig; runs the reduce rule's reduction and cross-checks",
+    )
+    p.add_argument("--dataset", help="with --config: the dataset (default: the one with a tracks block)")
     p.set_defaults(func=cmd_check)
 
     p = sub.add_parser(

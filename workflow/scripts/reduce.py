@@ -21,6 +21,10 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         inp.bats,
         where=snakemake.params.where,
     )
+    for line in ds.attrs["reduce_checks"].splitlines():
+        log.info("cross-check: %s", line)
+    for text in ds.attrs["reduce_warnings"].splitlines():
+        log.warning(text)
     excluded = excluded_listing(ds)
     log.info("%d of %d impacts excluded (kept in the file, flagged)", len(excluded), ds.sizes["impact"])
     for line in excluded:

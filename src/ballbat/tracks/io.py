@@ -19,6 +19,7 @@ import xarray as xr
 
 from ..pipeline.products import Var, build_dataset
 from ..properties import InputError, cell_text, read_csv_table
+from .checks import check_frame_runs
 from .data import POINTS, Camera, Rig, Tracks, to_dense, to_long
 from .validate import (
     IMPACT_COLUMNS,
@@ -148,6 +149,10 @@ def load_tracks(
     if not problems and impacts is not None and tracks_path.suffix.lower() in _NC:
         fast = _fast_nc(tracks_path, impacts)
         if fast is not None:  # well-formed: skip the row-by-row checks (they would find nothing)
+            labels = np.char.add("row ", np.arange(fast["frame"].size).astype(str))
+            runs = check_frame_runs(tracks_path, fast["impact_id"], fast["camera"], fast["frame"], labels)
+            if runs:
+                raise InputError(runs)
             return _assemble(fast, irows, ipath if impacts_path is None else None)
     try:
         header, rows = read_table(tracks_path, TRACK_COLUMNS, "row")
@@ -159,6 +164,8 @@ def load_tracks(
         raise InputError(problems)
     cols, rp = check_track_rows(tracks_path, rows, impacts, ipath)
     problems += rp
+    if not rp:  # a frame far outside its impact's run: named here, before any array is sized
+        problems += check_frame_runs(tracks_path, cols["impact_id"], cols["camera"], cols["frame"], cols["label"])
     if problems:
         raise InputError(problems)
     return _assemble({k: np.asarray(cols[k]) for k in TRACK_COLUMNS}, irows, ipath if impacts_path is None else None)

@@ -36,14 +36,15 @@ from __future__ import annotations
 
 import enum
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
 
 from ..pipeline.products import Var, build_dataset, flag_attrs
-from .data import Camera, CameraTracks, Rig, Tracks
+from .checks import IMPACT_Z, camera_agreement, glitch_mask
+from .data import POINTS, Camera, CameraTracks, Rig, Tracks
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -84,10 +85,14 @@ class ReduceFlag(enum.IntEnum):
     TOO_FEW_FRAMES = 2
     DOT_NOT_ROTATING_ABOUT_CENTRE = 3
     SPIN_TOO_FAST = 4
+    CAMERAS_DISAGREE = 5
+    IMPLAUSIBLE = 6
 
 
 #: Name of the flag the rest of the chain reads (the source stage's exclusions).
 FLAG_VAR = "ingest_flag"
+#: Stage named in every exclusion reason this module gives.
+STAGE = "reduce"
 
 
 @dataclass(frozen=True)
@@ -594,6 +599,32 @@ class Reduction:
     values: dict
     flag: np.ndarray
     reason: np.ndarray
+    n_outliers: dict
+    agreement: object = None
+
+
+def remove_glitches(tracks: Tracks, cameras: dict[str, Camera]) -> tuple[Tracks, dict[str, np.ndarray]]:
+    """Return the tracks without their single-frame glitches (:func:`.checks.glitch_mask`), and the count per impact.
+
+    The ball's and the dots' frames from the last at rest to the end of the longest contact
+    (:data:`CONTACT_MAX`) after the impact frame (:func:`find_onset` on the raw track) are
+    not tested. The input is not changed. Counts are per camera (all its points), shape (impact,).
+    """
+    cams, counts = {}, {}
+    for name, ct in tracks.cameras.items():
+        xs, ys = {}, {}
+        count = np.zeros(tracks.n, dtype=np.int64)
+        on = find_onset(ct.x["ball"], ct.y["ball"])
+        n_c = int(np.ceil(CONTACT_MAX * cameras[name].fps - 1e-9))
+        cols = np.arange(ct.n_columns)[None, :]
+        kink = on.found[:, None] & (cols >= on.rest[:, None] - 1) & (cols <= on.onset[:, None] + n_c + 1)
+        for p in POINTS[name]:
+            bad = glitch_mask(ct.x[p], ct.y[p], None if p == "bat_tip" else kink)
+            xs[p], ys[p] = np.where(bad, np.nan, ct.x[p]), np.where(bad, np.nan, ct.y[p])
+            count += bad.sum(axis=1)
+        cams[name] = CameraTracks(ct.frame0, xs, ys)
+        counts[name] = count
+    return replace(tracks, cameras=cams), counts
 
 
 def physical(ct: CameraTracks, cam: Camera, point: str) -> tuple[np.ndarray, np.ndarray]:
@@ -624,6 +655,7 @@ def reduce_tracks(
     """
     opt = options or ReduceOptions()
     n = tracks.n
+    tracks, n_outliers = remove_glitches(tracks, cameras)
     onset, flight, times, phys = {}, {}, {}, {}
     for name in ("swing", "spin"):
         ct, cam = tracks.cameras[name], cameras[name]
@@ -685,7 +717,7 @@ def reduce_tracks(
         new = cond & (flag == 0)
         flag[new] = code
         for i in np.flatnonzero(new):
-            reason[i] = texts(i)
+            reason[i] = f"{STAGE}: {texts(i)}"
 
     for name in ("swing", "spin"):
         mark(
@@ -696,11 +728,6 @@ def reduce_tracks(
                 "(needs >= 2 frames at rest, then motion to the end of the track)"
             ),
         )
-    mark(
-        swing.n < opt.min_tip_frames,
-        ReduceFlag.TOO_FEW_FRAMES,
-        lambda i: f"{swing.n[i]} pre-impact frame(s) of bat_tip in the swing camera, fewer than {opt.min_tip_frames}",
-    )
     for name in ("swing", "spin"):
         mark(
             flight[name].n < opt.min_flight_frames,
@@ -710,6 +737,32 @@ def reduce_tracks(
                 f"fewer than {opt.min_flight_frames}"
             ),
         )
+    agree = camera_agreement(flight, cameras)
+    mark(
+        np.abs(agree.z_speed) > IMPACT_Z,
+        ReduceFlag.CAMERAS_DISAGREE,
+        lambda i: (
+            f"the ball's speed differs between the cameras: {agree.v['swing'][i]:.2f} +- "
+            f"{agree.v_err['swing'][i]:.2f} m/s in swing, {agree.v['spin'][i]:.2f} +- {agree.v_err['spin'][i]:.2f} in "
+            f"spin (z = {agree.z_speed[i]:.1f}): rows filed under the wrong camera or impact?"
+        ),
+    )
+    mark(
+        np.abs(agree.z_angle) > IMPACT_Z,
+        ReduceFlag.CAMERAS_DISAGREE,
+        lambda i: (
+            f"the ball's launch angle differs between the cameras: {np.degrees(agree.launch['swing'][i]):.1f} "
+            f"+- {np.degrees(agree.launch_err['swing'][i]):.1f} deg in swing, "
+            f"{np.degrees(agree.launch['spin'][i]):.1f} +- {np.degrees(agree.launch_err['spin'][i]):.1f} in spin "
+            f"(z = {agree.z_angle[i]:.1f}): rows filed under the "
+            "wrong camera or impact, or a mirror or y setting?"
+        ),
+    )
+    mark(
+        swing.n < opt.min_tip_frames,
+        ReduceFlag.TOO_FEW_FRAMES,
+        lambda i: f"{swing.n[i]} pre-impact frame(s) of bat_tip in the swing camera, fewer than {opt.min_tip_frames}",
+    )
     for p in ("dot_a", "dot_b"):
         n_p = spin.mask[p].sum(axis=1)
         mark(
@@ -742,7 +795,22 @@ def reduce_tracks(
             f"spin too fast for {fps_spin:g} fps to unwrap"
         ),
     )
-    return Reduction(tracks, cameras, rig, onset, flight, swing, spin, times, phys, values, flag, reason.astype(str))
+    return Reduction(
+        tracks,
+        cameras,
+        rig,
+        onset,
+        flight,
+        swing,
+        spin,
+        times,
+        phys,
+        values,
+        flag,
+        reason.astype(str),
+        n_outliers,
+        agree,
+    )
 
 
 def _frame(ct: CameraTracks, col):
@@ -811,6 +879,10 @@ def reduction_table(truth_names: Sequence[str] = ()) -> dict[str, Var]:
     for p in ("dot_a", "dot_b"):
         table[f"{p}_radius"] = _v("m", f"mean distance of {p} from the ball's centre after separation")
         table[f"{p}_radius_sd"] = _v("m", f"standard deviation of the distance of {p} from the ball's centre")
+    for cam in ("swing", "spin"):
+        table[f"n_outliers_{cam}"] = _v(
+            "1", f"single-frame tracking glitches removed from the {cam} camera's tracks before the fits"
+        )
     table[FLAG_VAR] = Var(
         ("impact",), "1", "exclusion flag set when the camera tracks were reduced (0: usable)", flag_attrs(ReduceFlag)
     )
@@ -880,6 +952,8 @@ def reduction_dataset(red: Reduction) -> xr.Dataset:
         values[f"{p}_radius_sd"] = red.spin.radius_sd[p]
     values[FLAG_VAR] = red.flag
     values[f"{FLAG_VAR}_reason"] = red.reason
+    for cam in ("swing", "spin"):
+        values[f"n_outliers_{cam}"] = red.n_outliers[cam]
     truth = {k: v for k, v in tr.truth.items() if k.startswith("truth_")}
     values.update(truth)
     n = tr.n
@@ -890,6 +964,7 @@ def reduction_dataset(red: Reduction) -> xr.Dataset:
         "bat": (Var(("impact",), None, "bat (key of the bat table)"), tr.bat.astype(str)),
     }
     attrs = {"n_impacts": int(n), "n_excluded": int((red.flag != 0).sum())}
+    attrs["n_outliers"] = int(sum(int(v.sum()) for v in red.n_outliers.values()))
     for cam, c in red.cameras.items():
         attrs[f"{cam}_fps"] = float(c.fps)
         attrs[f"{cam}_m_per_px"] = float(c.m_per_px)

@@ -8,8 +8,9 @@ import numpy as np
 import xarray as xr
 
 from ..properties import load_balls, load_bats
+from .checks import Verdict, cross_check
 from .io import cameras_from_config, load_tracks, tracks_dataset
-from .reduce import FLAG_VAR, ReduceOptions, reduce_tracks, reduction_dataset
+from .reduce import FLAG_VAR, ReduceOptions, Reduction, reduce_tracks, reduction_dataset
 from .render import render_tracks, settings_from_config
 
 if TYPE_CHECKING:
@@ -50,15 +51,15 @@ def render_stage(simulated: xr.Dataset, balls_path: str | os.PathLike[str], rend
     return tracks_dataset(tracks)
 
 
-def reduce_stage(
+def reduce_checked(
     tracks_path: str | os.PathLike[str],
     impacts_path: str | os.PathLike[str] | None,
     cfg: dict,
     balls_path: str | os.PathLike[str],
     bats_path: str | os.PathLike[str],
     where: str,
-) -> xr.Dataset:
-    """Read, check and reduce a dataset's tracks; return ``reduce.nc``.
+) -> tuple[Reduction, Verdict]:
+    """Read, check, reduce and cross-check a dataset's tracks (the reduce rule and ``ballbat check --kind tracks``).
 
     Parameters
     ----------
@@ -73,18 +74,45 @@ def reduce_stage(
 
     Returns
     -------
-    xarray.Dataset
+    (Reduction, Verdict)
+
+    Raises
+    ------
+    ballbat.properties.InputError
+        Every problem of the files and settings, or a cross-check that stops the dataset
+        (:func:`.checks.cross_check`).
     """
     cameras, rig = cameras_from_config(cfg, where)
-    tracks = load_tracks(tracks_path, impacts_path, load_balls(balls_path), load_bats(bats_path))
+    balls, bats = load_balls(balls_path), load_bats(bats_path)
+    tracks = load_tracks(tracks_path, impacts_path, balls, bats)
     mf = cfg.get("min_frames", {})
     options = ReduceOptions(
         min_tip_frames=int(mf.get("tip", 5)),
         min_flight_frames=int(mf.get("flight", 5)),
         min_spin_frames=int(mf.get("spin", 4)),
     )
-    ds = reduction_dataset(reduce_tracks(tracks, cameras, rig, options))
+    red = reduce_tracks(tracks, cameras, rig, options)
+    return red, cross_check(red, balls, bats, where)
+
+
+def reduce_stage(
+    tracks_path: str | os.PathLike[str],
+    impacts_path: str | os.PathLike[str] | None,
+    cfg: dict,
+    balls_path: str | os.PathLike[str],
+    bats_path: str | os.PathLike[str],
+    where: str,
+) -> xr.Dataset:
+    """Read, check, reduce and cross-check a dataset's tracks; return ``reduce.nc`` (:func:`reduce_checked`).
+
+    The cross-checks' figures are the attribute ``reduce_checks`` (one per line), their
+    warnings ``reduce_warnings``.
+    """
+    red, verdict = reduce_checked(tracks_path, impacts_path, cfg, balls_path, bats_path, where)
+    ds = reduction_dataset(red)
     ds.attrs["source_file"] = str(tracks_path)
+    ds.attrs["reduce_checks"] = "\n".join(verdict.lines)
+    ds.attrs["reduce_warnings"] = "\n".join(verdict.warnings)
     return ds
 
 

@@ -12,6 +12,7 @@ import math
 from typing import TYPE_CHECKING
 
 from ..properties import EXTRA
+from .checks import SCALE_ERR_MAX
 from .data import CAMERAS, POINTS
 
 if TYPE_CHECKING:
@@ -227,6 +228,12 @@ def check_cameras(cfg: object, where: str) -> list[str]:
                 problems.append(f"{at}.{k}: {c[k]!r} must be a positive number")
         if "m_per_px_err" in c and not (_is_number(c["m_per_px_err"]) and c["m_per_px_err"] >= 0):
             problems.append(f"{at}.m_per_px_err: {c['m_per_px_err']!r} must be a number >= 0 (relative uncertainty)")
+        elif "m_per_px_err" in c and c["m_per_px_err"] >= SCALE_ERR_MAX:
+            problems.append(
+                f"{at}.m_per_px_err: {c['m_per_px_err']!r} is a relative uncertainty ({100 * c['m_per_px_err']:g} %): "
+                f"a pixel scale known no better than {100 * SCALE_ERR_MAX:g} % shifts e_x by about as much as e_x "
+                f"varies between bats. For {c['m_per_px_err']!r} % write {c['m_per_px_err'] / 100:g}"
+            )
         if "mirror" in c and not isinstance(c["mirror"], bool):
             problems.append(f"{at}.mirror: {c['mirror']!r} must be true or false")
     rig = cfg.get("rig")

@@ -1,0 +1,695 @@
+"""Physical cross-checks of raw camera tracks: the mistakes labs make with settings and files.
+
+The reduction (:mod:`.reduce`) trusts the camera settings and the rows it is given. What the
+tracks themselves can tell, checked here (docs/tracks.md, "Cross-checks"):
+
+* **Frame runs** (:func:`check_frame_runs`, when the file is read): a frame number far outside
+  its impact's run (a typo such as +1e9) is named by its row; nothing is allocated for the gap.
+* **Single-frame glitches** (:func:`glitch_mask`, before any fit): a point that sticks out of
+  its track on both sides is removed and counted (``n_outliers_*`` in reduce.nc).
+* **g with g free** (:func:`free_fall`): the ball's acceleration across its velocity is
+  gravity (drag acts along the velocity; Magnus lift, bounded by Nathan's lift coefficient,
+  is allowed for). It scales as m_per_px x fps^2 and changes sign when y points up.
+* **The two cameras** (:func:`camera_agreement`): they film the same ball, so its speed
+  (scaling as m_per_px x fps) and launch direction must agree within their errors.
+* **The tip's arc** (:func:`tip_arc`): the tip dot moves on a circle whose radius, seen in the
+  image, is pivot_to_tip; it scales with the swing camera's m_per_px only (not with fps).
+* **Spin dots** (dataset level): a dot on the ball is no further than the ball's radius
+  (Table I) from its centre; its distance scales with the spin camera's m_per_px.
+
+A check that fails for the dataset as a whole stops it (:class:`~ballbat.properties.InputError`,
+naming the setting); where several checks point to one mistake, :func:`diagnose` names the
+setting that explains them best. A check that fails for single impacts excludes them.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..units import INCH
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+G = 9.80665
+#: False-alarm probability of the glitch test per tracked point (2-D Gaussian noise:
+#: P(|r| > Z s) = exp(-Z^2 / 2)); 10^4 impacts of 200 points make 2e6 points.
+GLITCH_FALSE_ALARM = 1e-9
+#: z beyond which one impact's two cameras disagree (two-sided normal, 1e-6 per test).
+IMPACT_Z = 4.89
+#: z beyond which a dataset's pooled check fails (two-sided normal, 6e-7).
+DATASET_Z = 5.0
+#: A setting is wrong for the whole dataset when more than this fraction of impacts fails.
+DATASET_FRACTION = 0.5
+#: Air density (kg m-3) bounding the aerodynamic allowance (sea level, cold: 1.3).
+RHO_AIR_MAX = 1.3
+#: Allowance on Nathan's lift coefficient (its spread over measured baseballs is about +-30 %).
+LIFT_MARGIN = 1.5
+#: Relative tolerance of the tip's arc radius beyond its fitted error: the dot's offset from
+#: the bat's axis, a measured pivot distance and the machine's angular acceleration.
+ARC_TOLERANCE = 0.10
+#: A relative pixel-scale uncertainty at or above this is a percentage typed as a fraction.
+SCALE_ERR_MAX = 0.1
+
+
+# ---------------------------------------------------------------------------------------
+# frame runs
+
+
+def check_frame_runs(path, impact_id, camera, frame, labels) -> list[str]:
+    """Rows whose frame lies far outside the run of its impact and camera.
+
+    The frames of one impact in one camera are one clip. Sorted, they are split where a gap
+    holds more untracked frames than the impact has tracked frames in that camera (the dense
+    array would be mostly empty); the part with the most frames is the impact's run, and
+    every row of another part is a problem (a typo in the frame number, most likely).
+
+    Parameters
+    ----------
+    path : str
+        The tracks file, for messages.
+    impact_id, camera : array of str
+    frame : array of int
+    labels : array of str
+        Each row's label (``row 5``).
+
+    Returns
+    -------
+    list of str
+    """
+    impact_id = np.asarray(impact_id).astype(str)
+    camera = np.asarray(camera).astype(str)
+    frame = np.asarray(frame, dtype=np.int64)
+    labels = np.asarray(labels).astype(str)
+    problems: list[str] = []
+    if frame.size == 0:
+        return problems
+    key = np.char.add(np.char.add(impact_id, "\x00"), camera)
+    order = np.lexsort((frame, key))
+    k, f = key[order], frame[order]
+    starts = np.flatnonzero(np.r_[True, k[1:] != k[:-1]])
+    ends = np.r_[starts[1:], k.size]
+    for s, e in zip(starts, ends, strict=True):
+        ff = f[s:e]
+        uniq = np.unique(ff)
+        gaps = np.diff(uniq) - 1
+        cut = np.flatnonzero(gaps > uniq.size)
+        if cut.size == 0:
+            continue
+        bounds = np.r_[0, cut + 1, uniq.size]
+        sizes = np.diff(bounds)
+        main = int(np.argmax(sizes))
+        lo, hi = uniq[bounds[main]], uniq[bounds[main + 1] - 1]
+        out = (ff < lo) | (ff > hi)
+        rows = order[s:e][out]
+        iid, cam = impact_id[rows[0]], camera[rows[0]]
+        for r in rows[:5]:
+            d = frame[r] - hi if frame[r] > hi else lo - frame[r]
+            side = "after" if frame[r] > hi else "before"
+            problems.append(
+                f"{path}: {labels[r]}, column frame: frame {frame[r]} of impact {iid!r} in the {cam} camera is "
+                f"{d} frames {side} the rest of its run (frames {lo}-{hi}, {uniq.size} tracked): a typo?"
+            )
+        if rows.size > 5:
+            problems.append(f"{path}: and {rows.size - 5} more rows of impact {iid!r} in the {cam} camera far outside")
+    return problems
+
+
+# ---------------------------------------------------------------------------------------
+# glitches
+
+
+def _mad_sd(values: np.ndarray) -> float:
+    v = values[np.isfinite(values)]
+    return float(1.4826 * np.median(np.abs(v))) if v.size else math.nan
+
+
+def glitch_mask(x: np.ndarray, y: np.ndarray, skip: np.ndarray | None = None) -> np.ndarray:
+    """Single-frame glitches of one point's tracks, (impact, column) pixels, NaN untracked.
+
+    A point at frame k is a glitch when it lies far from the midpoint of its neighbours
+    (``r = p_k - (p_{k-1} + p_{k+1}) / 2`` beyond Z robust standard deviations, Z from
+    :data:`GLITCH_FALSE_ALARM`) and also from the straight-line extrapolation of the two
+    frames on each side, in the same direction (the projection of ``p_k - 2 p_{k-1} +
+    p_{k-2}`` and of its mirror on r above |r| / 2, where those frames are tracked). A
+    smooth track bent the other way (a kink at impact, a contact, a spinning dot) fails the
+    second test: there the extrapolations miss on the other side. The noise is the larger of
+    the track's own (1.4826 MAD of r's components) and the same point's over all impacts. Of
+    neighbouring candidates only the one furthest out counts (a glitch's neighbours are off
+    by half as much).
+    Only points with two tracked frames on each side are tested (not a track's first or last
+    two frames, nor those next to an untracked frame), and not the frames ``skip`` marks
+    (the ball's and its dots' around the impact, where the motion itself has a kink that a
+    noisy point can turn into a spike).
+    """
+    ok = np.isfinite(x) & np.isfinite(y)
+    n, m = x.shape
+    out = np.zeros((n, m), dtype=bool)
+    if m < 3:
+        return out
+
+    def sh(a, k):  # a shifted so that column j holds a[:, j + k] (NaN outside)
+        b = np.full_like(a, np.nan)
+        if k > 0:
+            b[:, :-k] = a[:, k:]
+        else:
+            b[:, -k:] = a[:, : m + k]
+        return b
+
+    with np.errstate(invalid="ignore"):
+        rx = x - 0.5 * (sh(x, -1) + sh(x, 1))
+        ry = y - 0.5 * (sh(y, -1) + sh(y, 1))
+        lx, ly = x - 2 * sh(x, -1) + sh(x, -2), y - 2 * sh(y, -1) + sh(y, -2)
+        qx, qy = x - 2 * sh(x, 1) + sh(x, 2), y - 2 * sh(y, 1) + sh(y, 2)
+    comps = np.concatenate([rx, ry], axis=1)
+    pooled = _mad_sd(comps.ravel())
+    if not np.isfinite(pooled):
+        return out
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows
+        enough = np.isfinite(comps).sum(axis=1) >= 10
+        med = np.where(enough, np.nanmedian(np.abs(comps), axis=1), 0.0)
+        sd = np.maximum(1.4826 * med, pooled)
+        z = math.sqrt(2 * math.log(1 / GLITCH_FALSE_ALARM))
+        rn = np.hypot(rx, ry)
+        big = rn > z * sd[:, None]
+        left = np.isfinite(lx) & np.isfinite(ly)
+        right = np.isfinite(qx) & np.isfinite(qy)
+        pl = (lx * rx + ly * ry) / rn
+        pr = (qx * rx + qy * ry) / rn
+        same = left & right & (pl > 0.5 * rn) & (pr > 0.5 * rn)
+        # a glitch's neighbours stick out by half as much: keep the local maximum only
+        peak = (rn >= np.nan_to_num(sh(rn, -1))) & (rn >= np.nan_to_num(sh(rn, 1)))
+    out = big & same & peak & ok
+    return out if skip is None else out & ~skip
+
+
+# ---------------------------------------------------------------------------------------
+# free fall with g free
+
+
+@dataclass
+class FreeFall:
+    """Per impact: gravity from the flight fitted with a free acceleration (m s-2), its error."""
+
+    g: np.ndarray
+    g_err: np.ndarray
+    lift_max: np.ndarray
+
+
+def lift_bound(v: ArrayLike, r: ArrayLike, m: ArrayLike, omega: ArrayLike) -> np.ndarray:
+    """Largest Magnus acceleration (m s-2) of a ball of radius r and mass m at speed v and spin omega.
+
+    ``RHO_AIR_MAX pi r^2 C_L v^2 / (2 m)`` with Nathan's lift coefficient ``C_L = 1.120 S /
+    (0.583 + 2.333 S)``, ``S = r |omega| / v``, times :data:`LIFT_MARGIN`, v at most the
+    fastest batted ball (:data:`ballbat.ingest.SPEED_MAX_MPH`), so that a wrong setting
+    does not widen the allowance without bound.
+    """
+    from ..ingest import SPEED_MAX_MPH
+    from ..units import MPH
+
+    v, r, m, omega = (np.asarray(a, dtype=float) for a in (v, r, m, omega))
+    with np.errstate(all="ignore"):
+        v = np.minimum(v, SPEED_MAX_MPH["v_ball"] * MPH)
+        S = r * np.abs(omega) / v
+        cl = 1.120 * S / (0.583 + 2.333 * S)
+        return LIFT_MARGIN * RHO_AIR_MAX * np.pi * r**2 * np.nan_to_num(cl) * v**2 / (2 * m)
+
+
+def free_fall(X, Y, t, flight, r, m, omega) -> FreeFall:
+    """Fit ``X = a + b u + c u^2`` and the same in Y over the flight frames; g across the velocity.
+
+    Drag acts along the velocity, so the acceleration's component across it, divided by
+    the cosine of the launch angle, is g (plus Magnus lift, bounded by :func:`lift_bound`).
+
+    Parameters
+    ----------
+    X, Y, t : ndarray
+        Ball centre (m, X along the swing, Y up) and time (s), (impact, column).
+    flight : reduce.Flight
+        The flight fit (its frames and reference time).
+    r, m, omega : ndarray
+        Ball radius and mass per impact (SI), and its measured spin (rad s-1).
+    """
+    w = flight.mask.astype(float)
+    u = np.where(flight.mask, t - flight.t_ref[:, None], 0.0)
+    n = w.sum(axis=1)
+    P = np.stack([np.ones_like(u), u, u**2], axis=-1) * w[..., None]
+    A = np.einsum("ikp,ikq->ipq", P, P)
+    bad = n < 4
+    A[bad] = np.eye(3)
+    Ainv = np.linalg.inv(A)
+    Xz, Yz = np.where(flight.mask, X, 0.0), np.where(flight.mask, Y, 0.0)
+    cx = np.einsum("ipq,iq->ip", Ainv, np.einsum("ikp,ik->ip", P, Xz))
+    cy = np.einsum("ipq,iq->ip", Ainv, np.einsum("ikp,ik->ip", P, Yz))
+    with np.errstate(all="ignore"):
+        rx = np.where(flight.mask, X - np.einsum("ikp,ip->ik", P, cx), 0.0)
+        ry = np.where(flight.mask, Y - np.einsum("ikp,ip->ik", P, cy), 0.0)
+        s2 = (np.sum(rx**2, axis=1) + np.sum(ry**2, axis=1)) / (2 * n - 6)
+        ax, ay = 2 * cx[:, 2], 2 * cy[:, 2]
+        var_a = 4 * s2 * Ainv[:, 2, 2]
+        tan = flight.vy / flight.vx
+        g = ax * tan - ay
+        g_err = np.sqrt(var_a * (1 + tan**2))
+        v = np.hypot(flight.vx, flight.vy)
+    ok = ~bad & np.isfinite(g_err) & (n >= 6)
+    return FreeFall(np.where(ok, g, np.nan), np.where(ok, g_err, np.nan), lift_bound(v, r, m, omega))
+
+
+# ---------------------------------------------------------------------------------------
+# the tip's arc radius
+
+
+def tip_arc(
+    swing, X, Y, t, t_contact, L_cfg: float, fps: float, tau_prior_frames: float
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per impact: ``kappa = (L_cfg / L_arc)^2`` and its error, from the tip's pre-impact frames.
+
+    Along the swing direction the tip moves as ``a + V s - V^3 w s^3 / 6 + ...`` (the series
+    of ``L sin(V s / L)``, s the time from alignment, w = 1 / L^2): a circle's radius L seen
+    from the curvature of the motion, in the swing camera's metres (independent of fps).
+    Fitted by Gauss-Newton from a straight line (w = 0), with the reduction's prior on the
+    alignment time (the contact's start ``t_contact``, +- ``tau_prior_frames``), so that
+    nothing of L_cfg enters the fit; kappa = w L_cfg^2 is 1 when the rig and pixel scale agree.
+    """
+    mask = swing.mask
+    along = np.where(mask, (X - swing.cx[:, None]) * swing.ux[:, None] + (Y - swing.cy[:, None]) * swing.uy[:, None], 0)
+    n = mask.sum(axis=1)
+    tau0 = np.asarray(t_contact, dtype=float).copy()
+    with np.errstate(all="ignore"):
+        s0 = np.where(mask, t - tau0[:, None], 0.0)
+        sm = s0.sum(axis=1) / n
+        um = along.sum(axis=1) / n
+        V = np.sum(np.where(mask, (s0 - sm[:, None]) * along, 0), axis=1) / np.sum(
+            np.where(mask, (s0 - sm[:, None]) ** 2, 0), axis=1
+        )
+        a = um - V * sm
+    tau = tau0.copy()
+    w = np.zeros(a.shape)
+    sigma_tau = tau_prior_frames / fps
+    fact = [math.factorial(2 * k + 1) for k in range(5)]
+
+    def model(a, V, tau, w):
+        s = np.where(mask, t - tau[:, None], 0.0)
+        f = np.zeros_like(s)
+        dV = np.zeros_like(s)
+        ds = np.zeros_like(s)
+        dw = np.zeros_like(s)
+        for k in range(5):
+            c = (-w[:, None]) ** k / fact[k]
+            f = f + c * V[:, None] ** (2 * k + 1) * s ** (2 * k + 1)
+            dV = dV + c * (2 * k + 1) * V[:, None] ** (2 * k) * s ** (2 * k + 1)
+            ds = ds + c * (2 * k + 1) * V[:, None] ** (2 * k + 1) * s ** (2 * k)
+            if k:
+                dw = dw + k * (-1) ** k * w[:, None] ** (k - 1) / fact[k] * V[:, None] ** (2 * k + 1) * s ** (2 * k + 1)
+        J = np.stack([np.ones_like(s), dV, -ds, dw], axis=-1)
+        return a[:, None] + f, np.where(mask[..., None], J, 0.0)
+
+    ok = (n >= 6) & np.isfinite(V) & np.isfinite(tau) & np.isfinite(a)
+    with np.errstate(all="ignore"):
+        a, V, tau = np.where(ok, a, 0.0), np.where(ok, V, 1.0), np.where(ok, tau, 0.0)
+        tau0 = np.where(ok, tau0, 0.0)
+        for _ in range(10):
+            f, J = model(a, V, tau, w)
+            r = np.where(mask, along - f, 0.0)
+            s2 = np.sum(r**2, axis=1) / np.maximum(n - 4, 1)
+            A = np.einsum("ikp,ikq->ipq", J, J)
+            b = np.einsum("ikp,ik->ip", J, r)
+            prior = s2 / sigma_tau**2
+            A[:, 2, 2] += prior
+            b[:, 2] += prior * (tau0 - tau)
+            A[~ok] = np.eye(4)
+            b[~ok] = 0.0
+            step = np.linalg.solve(A, b[..., None])[..., 0]
+            a, V, tau, w = a + step[:, 0], V + step[:, 1], tau + step[:, 2], w + step[:, 3]
+        f, J = model(a, V, tau, w)
+        r = np.where(mask, along - f, 0.0)
+        s2 = np.sum(r**2, axis=1) / np.maximum(n - 4, 1)
+        A = np.einsum("ikp,ikq->ipq", J, J)
+        A[:, 2, 2] += s2 / sigma_tau**2
+        A[~ok] = np.eye(4)
+        cov = np.linalg.inv(A) * s2[:, None, None]
+        kappa = w * L_cfg**2
+        kappa_err = np.sqrt(cov[:, 3, 3]) * L_cfg**2
+    good = ok & np.isfinite(kappa) & np.isfinite(kappa_err) & (kappa_err > 0)
+    return np.where(good, kappa, np.nan), np.where(good, kappa_err, np.nan)
+
+
+# ---------------------------------------------------------------------------------------
+# the two cameras
+
+
+@dataclass
+class Agreement:
+    """Per impact: the ball's speed and launch angle in each camera and the z of their difference."""
+
+    v: dict
+    v_err: dict
+    launch: dict
+    launch_err: dict
+    z_speed: np.ndarray
+    z_angle: np.ndarray
+    ratio: np.ndarray
+    ratio_err: np.ndarray
+
+
+def camera_agreement(flight: dict, cameras: dict) -> Agreement:
+    """Return the ball's speed and launch direction seen by the two cameras, and the z of their differences.
+
+    Each camera's speed carries its fit error and its pixel scale's stated relative error
+    (``m_per_px_err``); the launch angles their fit errors.
+    """
+    v, ve, la, le = {}, {}, {}, {}
+    with np.errstate(all="ignore"):
+        for c in ("swing", "spin"):
+            f = flight[c]
+            v[c] = np.hypot(f.vx, f.vy)
+            ve[c] = np.hypot(np.sqrt(f.vx_var), v[c] * cameras[c].m_per_px_err)
+            la[c] = np.arctan2(f.vy, f.vx)
+            le[c] = np.sqrt(f.vx_var) / v[c]
+        z_speed = (v["swing"] - v["spin"]) / np.hypot(ve["swing"], ve["spin"])
+        z_angle = np.angle(np.exp(1j * (la["swing"] - la["spin"]))) / np.hypot(le["swing"], le["spin"])
+        ratio = v["swing"] / v["spin"]
+        ratio_err = ratio * np.hypot(ve["swing"] / v["swing"], ve["spin"] / v["spin"])
+    return Agreement(v, ve, la, le, z_speed, z_angle, ratio, ratio_err)
+
+
+def weighted_mean(x: ArrayLike, err: ArrayLike) -> tuple[float, float, int]:
+    """Inverse-variance weighted mean of the finite values, its error (scaled up by the scatter if larger), count."""
+    x, err = np.asarray(x, dtype=float), np.asarray(err, dtype=float)
+    ok = np.isfinite(x) & np.isfinite(err) & (err > 0)
+    k = int(ok.sum())
+    if k == 0:
+        return math.nan, math.nan, 0
+    w = 1 / err[ok] ** 2
+    mean = float(np.sum(w * x[ok]) / np.sum(w))
+    se = float(1 / np.sqrt(np.sum(w)))
+    if k > 1:
+        chi2 = float(np.sum(w * (x[ok] - mean) ** 2) / (k - 1))
+        se *= math.sqrt(max(chi2, 1.0))
+    return mean, se, k
+
+
+# ---------------------------------------------------------------------------------------
+# diagnosis: which one setting explains what the checks see
+
+
+def hypotheses(cameras: dict) -> list[tuple[str, dict]]:
+    """Single mistakes and what they scale (config value over true value).
+
+    Keys: ``m_swing``, ``fps_swing``, ``m_spin``, ``fps_spin``, ``rig``, ``y_swing``, ``y_spin`` (signs).
+    """
+    out: list[tuple[str, dict]] = []
+    for c in ("swing", "spin"):
+        out += [
+            (f"cameras.{c}.fps is 2x too high", {f"fps_{c}": 2.0}),
+            (f"cameras.{c}.fps is 2x too low", {f"fps_{c}": 0.5}),
+            (f"cameras.{c}.m_per_px is in mm per pixel, not m", {f"m_{c}": 1000.0}),
+            (f"cameras.{c}.m_per_px is in cm per pixel, not m", {f"m_{c}": 100.0}),
+            (
+                f"y points up in the {c} camera's rows (Tracker and Kinovea export y up; ballbat's pixels have y down)",
+                {f"y_{c}": -1.0},
+            ),
+        ]
+    out += [
+        ("y points up in both cameras' rows (Tracker and Kinovea export y up)", {"y_swing": -1.0, "y_spin": -1.0}),
+        ("the rig lengths are in metres, not inches", {"rig": 1 / 39.37}),
+        ("the rig lengths are in cm, not inches", {"rig": 2.54}),
+    ]
+    mm = {f"m_{c}": cameras[c].m_per_px / 1e-3 for c in ("swing", "spin")}
+    out += [
+        ("x_px and y_px are millimetres, not pixels (a world-unit export)", mm),
+        (
+            "x_px and y_px are millimetres with y up, not pixels (a world-unit export)",
+            {**mm, "y_swing": -1, "y_spin": -1},
+        ),
+    ]
+    sw, sp = cameras["swing"], cameras["spin"]
+    out.append(
+        (
+            "the swing and spin camera settings are swapped",
+            {"m_swing": sw.m_per_px / sp.m_per_px, "fps_swing": sw.fps / sp.fps, "m_spin": sp.m_per_px / sw.m_per_px},
+        )
+    )
+    out[-1][1]["fps_spin"] = sp.fps / sw.fps
+    return out
+
+
+def predict(h: dict) -> dict:
+    """Observables a mistake predicts: g over its value per camera, L_arc / L_cfg, v_swing / v_spin."""
+    f = {k: h.get(k, 1.0) for k in ("m_swing", "fps_swing", "m_spin", "fps_spin", "rig", "y_swing", "y_spin")}
+    return {
+        "g_swing": f["y_swing"] * f["m_swing"] * f["fps_swing"] ** 2,
+        "g_spin": f["y_spin"] * f["m_spin"] * f["fps_spin"] ** 2,
+        "arc": f["m_swing"] / f["rig"],
+        "speed": f["m_swing"] * f["fps_swing"] / (f["m_spin"] * f["fps_spin"]),
+    }
+
+
+def diagnose(observed: dict, cameras: dict) -> tuple[str, float, float] | None:
+    """Return the single mistake that explains the observables best: (name, its chi^2, no mistake's chi^2).
+
+    ``observed`` maps ``g_swing``, ``g_spin``, ``arc``, ``speed`` to (ratio, relative error);
+    missing or non-finite ones are skipped. chi^2 compares log ratios (a wrong sign counts as 100).
+    """
+
+    def chi2(pred):
+        total = 0.0
+        for k, (val, rel) in observed.items():
+            if not (np.isfinite(val) and np.isfinite(rel)):
+                continue
+            p = pred[k]
+            if np.sign(val) != np.sign(p) or val == 0:
+                total += 100.0
+                continue
+            total += (math.log(abs(val) / abs(p)) / max(rel, 1e-3)) ** 2
+        return total
+
+    none = chi2(predict({}))
+    best = min(((chi2(predict(h)), name) for name, h in hypotheses(cameras)), default=None)
+    if best is None:
+        return None
+    return best[1], best[0], none
+
+
+# ---------------------------------------------------------------------------------------
+# the dataset's verdict
+
+
+@dataclass
+class Verdict:
+    """What the cross-checks found: pooled observables (for messages) and warnings."""
+
+    observed: dict
+    lines: list
+    warnings: list
+
+
+def _fmt_ratio(val: float, rel: float) -> str:
+    return f"{val:.3g} +- {abs(val) * rel:.2g}"
+
+
+def cross_check(red, balls: dict, bats: dict, where: str = "tracks") -> Verdict:
+    """Check a reduction against physics; exclude implausible impacts; stop a dataset a setting spoils.
+
+    Changes ``red.flag`` and ``red.reason`` in place: impacts whose reduced values no collision
+    gives (the ranges of a measured file, :func:`ballbat.ingest.implausible_rows`: speeds, the
+    exit-to-bat speed ratio, the e_x the spin implies).
+
+    Raises
+    ------
+    ballbat.properties.InputError
+        A setting wrong for the whole dataset (g, the two cameras, the tip's arc, the spin dots),
+        more than half the impacts implausible, every impact excluded, or no ball x bat pair
+        with enough usable impacts. The messages give the numbers, the setting most likely
+        wrong, and the count of every exclusion reason.
+    """
+    from ..ingest import implausible_rows
+    from ..linefit import MIN_FIT_IMPACTS
+    from ..properties import InputError, recoil_factors
+    from .reduce import STAGE, TAU_PRIOR_FRAMES, ReduceFlag, contact_start
+
+    tr, cams = red.tracks, red.cameras
+    ball_ids, bat_ids = tr.ball.astype(str), tr.bat.astype(str)
+    r = np.array([balls[b].r for b in ball_ids])
+    m = np.array([balls[b].m for b in ball_ids])
+    flag = red.flag
+    fitted = ~np.isin(flag, [ReduceFlag.NO_IMPACT, ReduceFlag.TOO_FEW_FRAMES])
+    disagree = flag == ReduceFlag.CAMERAS_DISAGREE
+    n_test = int(fitted.sum())
+    setting_wrong = n_test > 0 and disagree.sum() > DATASET_FRACTION * n_test
+    pool = fitted & (~disagree | setting_wrong)
+    observed: dict = {}
+    failed: list[str] = []
+    lines: list[str] = []
+
+    # g with g free, each camera
+    for c in ("swing", "spin"):
+        ff = free_fall(*red.phys[(c, "ball")], red.times[c], red.flight[c], r, m, red.values["omega"])
+        sel = pool & np.isfinite(ff.g)
+        g, se, k = weighted_mean(ff.g[sel], ff.g_err[sel])
+        if k == 0:
+            continue
+        w = 1 / ff.g_err[sel] ** 2
+        lift = float(np.sum(w * ff.lift_max[sel]) / np.sum(w))
+        allowed = lift + DATASET_Z * se
+        observed[f"g_{c}"] = (g / G, math.hypot(se, lift) / max(abs(g), 1e-9))
+        line = (
+            f"g in the {c} camera's ball flight, fitted free: {g:.2f} +- {se:.2f} m/s^2 over {k} impacts "
+            f"(expected {G:.2f}, allowing {lift:.1f} for Magnus lift)"
+        )
+        lines.append(line)
+        if abs(g - G) > allowed:
+            failed.append(
+                f"{where}.cameras.{c}: {line}: g scales as m_per_px x fps^2 and changes sign when y points up"
+            )
+
+    # the two cameras
+    ag = red.agreement
+    sel = pool & np.isfinite(ag.ratio)
+    ratio, se, k = weighted_mean(ag.ratio[sel], ag.ratio_err[sel])
+    if k:
+        observed["speed"] = (ratio, se / ratio)
+        n_bad = int((fitted & disagree).sum())
+        line = (
+            f"the ball's speed in swing / in spin: {ratio:.4f} +- {se:.4f} over {k} impacts (expected 1); "
+            f"{n_bad} of {n_test} impacts disagree beyond z = {IMPACT_Z}"
+        )
+        lines.append(line)
+        if setting_wrong:
+            failed.append(
+                f"{where}.cameras: {line}: the speed scales as m_per_px x fps in each camera, and the launch "
+                "direction with mirror and the direction of y"
+            )
+
+    # the tip's arc
+    t_contact = contact_start(*red.phys[("swing", "ball")], red.times["swing"], red.onset["swing"], red.flight["swing"])
+    kap, kap_err = tip_arc(
+        red.swing,
+        *red.phys[("swing", "bat_tip")],
+        red.times["swing"],
+        t_contact,
+        red.rig.pivot_to_tip,
+        cams["swing"].fps,
+        TAU_PRIOR_FRAMES,
+    )
+    sel = pool & np.isfinite(kap)
+    kh, se, k = weighted_mean(kap[sel], kap_err[sel])
+    if k:
+        L = red.rig.pivot_to_tip
+        if kh > 0:
+            arc = 1 / math.sqrt(kh)
+            observed["arc"] = (arc, 0.5 * se / kh + ARC_TOLERANCE)
+            arc_text = f"{arc * L / INCH:.1f} in ({arc:.3g} x pivot_to_tip; 1/kappa^0.5, kappa = {kh:.3f} +- {se:.3f})"
+        else:
+            observed["arc"] = (1 / math.sqrt(max(kh + se, 1e-12)), 0.5 + ARC_TOLERANCE)
+            arc_text = f"beyond {L / INCH / math.sqrt(max(kh + DATASET_Z * se, 1e-12)):.0f} in (straight)"
+        line = (
+            f"the bat tip's arc radius in the swing camera: {arc_text} over {k} impacts, against "
+            f"pivot_to_tip_in {L / INCH:g}"
+        )
+        lines.append(line)
+        lo, hi = (1 + ARC_TOLERANCE) ** -2 - DATASET_Z * se, (1 - ARC_TOLERANCE) ** -2 + DATASET_Z * se
+        if not lo <= kh <= hi:
+            failed.append(
+                f"{where}.rig / {where}.cameras.swing.m_per_px: {line}: the radius seen scales with m_per_px, "
+                "not with fps"
+            )
+
+    # spin dots against the ball's radius (Table I)
+    for b in sorted(set(ball_ids)):
+        sel = pool & (ball_ids == b)
+        rho = np.concatenate([red.spin.radius[p][sel] for p in ("dot_a", "dot_b")])
+        rho = rho[np.isfinite(rho)]
+        if rho.size < 2:
+            continue
+        mean, se = float(rho.mean()), float(rho.std(ddof=1) / math.sqrt(rho.size))
+        rb = balls[b].r
+        line = (
+            f"the spin dots' mean distance from the {b}'s centre: {1e3 * mean:.1f} +- {1e3 * se:.1f} mm over "
+            f"{rho.size // 2} impacts, against its radius {1e3 * rb:.1f} mm (Table I)"
+        )
+        lines.append(line)
+        if mean > rb + DATASET_Z * se:
+            failed.append(
+                f"{where}.cameras.spin.m_per_px: {line}: a dot on the ball cannot be further than its radius "
+                "(the distance scales with the spin camera's m_per_px)"
+            )
+
+    if failed:
+        found = diagnose(observed, cams)
+        tail = []
+        if found is not None:
+            name, chi2, none = found
+            ok = chi2 < DATASET_Z**2 * max(len(observed), 1) and chi2 < none
+            tail = [
+                f"{where}: most likely {name}"
+                if ok
+                else f"{where}: no single setting explains these; check fps, m_per_px, mirror and the direction of y "
+                "of both cameras, and the rig's units (inches)"
+            ]
+        raise InputError([*failed, *tail])
+
+    # ranges, as for a measured file
+    pairs = {(b, t): recoil_factors(balls[b], bats[t]) for b, t in set(zip(ball_ids, bat_ids, strict=True))}
+    r_x = np.array([pairs[(b, t)][0] for b, t in zip(ball_ids, bat_ids, strict=True)])
+    r_y = np.array([pairs[(b, t)][1] for b, t in zip(ball_ids, bat_ids, strict=True)])
+    alpha = np.array([balls[b].alpha for b in ball_ids])
+    v = red.values
+    live = (flag == 0) & np.all([np.isfinite(v[k]) for k in ("v_bat", "v_ball", "theta", "omega")], axis=0)
+    if live.any():
+        why = implausible_rows(
+            v["v_bat"][live],
+            v["v_ball"][live],
+            v["theta"][live],
+            v["omega"][live],
+            r[live],
+            alpha[live],
+            r_x[live],
+            r_y[live],
+            # one group per impact: the group-outlier test (a unit mistake in some rows of a file)
+            # does not apply to a reduction, whose rows share their settings; the ranges do
+            np.arange(int(live.sum())),
+        )
+        idx = np.flatnonzero(live)[why != ""]
+        for i, w in zip(idx, why[why != ""], strict=True):
+            flag[i] = ReduceFlag.IMPLAUSIBLE
+            red.reason[i] = f"{STAGE}: implausible: {w}"
+        if idx.size > DATASET_FRACTION * live.sum():
+            raise InputError(
+                [
+                    f"{where}: {idx.size} of {int(live.sum())} reduced impacts are measurements no ball-bat collision "
+                    "gives, more than half: check the camera settings (fps, m_per_px) and the rig",
+                    *[f"{where}: impact {tr.impact_id[i]}: {red.reason[i]}" for i in idx[:10]],
+                ]
+            )
+
+    usable = flag == 0
+    counts = {(b, t): int((usable & (ball_ids == b) & (bat_ids == t)).sum()) for b, t in sorted(pairs)}
+    if not usable.any() or not any(k >= MIN_FIT_IMPACTS for k in counts.values()):
+        reasons: dict[str, int] = {}
+        for i in np.flatnonzero(~usable):
+            key = ReduceFlag(int(flag[i])).name.lower()
+            reasons[key] = reasons.get(key, 0) + 1
+        listing = ", ".join(f"{k}: {n}" for k, n in sorted(reasons.items(), key=lambda kv: -kv[1]))
+        first = [f"{where}: impact {tr.impact_id[i]}: {red.reason[i]}" for i in np.flatnonzero(~usable)[:10]]
+        raise InputError(
+            [
+                f"{where}: {int(usable.sum())} of {tr.n} impacts usable, no ball x bat pair with {MIN_FIT_IMPACTS} "
+                f"({', '.join(f'{b} on {t}: {k}' for (b, t), k in counts.items())}): nothing to fit. "
+                f"Excluded: {listing or 'none'}",
+                *first,
+            ]
+        )
+    warnings = [
+        f"{where}: ball {b!r} on bat {t!r}: {k} usable impact(s), fewer than {MIN_FIT_IMPACTS}: e_x of this bat is "
+        "not fitted (reported as NaN)"
+        for (b, t), k in counts.items()
+        if k < MIN_FIT_IMPACTS
+    ]
+    return Verdict(observed, lines, warnings)
