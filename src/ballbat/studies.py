@@ -169,8 +169,14 @@ def replicate_seeds(seed: int, replicate: int) -> tuple[int, int]:
 # one replicate
 
 
-def _source(dataset: dict, seeds: tuple[int, int], balls: dict[str, Ball], bats: dict[str, Bat]) -> xr.Dataset:
-    """Simulate one experiment and, when the dataset renders tracks, render and reduce them."""
+def _source(
+    dataset: dict, seeds: tuple[int, int], balls: dict[str, Ball], bats: dict[str, Bat], where: str = "render"
+) -> xr.Dataset:
+    """Simulate one experiment and, when the dataset renders tracks, render, reduce and cross-check them.
+
+    The same stage functions as the workflow's render_tracks and reduce rules
+    (:mod:`ballbat.tracks.stage`), so every render and reduce setting is honoured alike.
+    """
     from .synthetic import SyntheticSettings, simulate_experiment
 
     sim = simulate_experiment(SyntheticSettings(**{**dataset["synthetic"], "seed": seeds[0]}), balls, bats)
@@ -178,19 +184,13 @@ def _source(dataset: dict, seeds: tuple[int, int], balls: dict[str, Ball], bats:
     if not render.get("enabled", False):
         return sim
     from .tracks.data import camera_block
-    from .tracks.io import cameras_from_config
-    from .tracks.reduce import reduce_tracks, reduction_dataset
-    from .tracks.render import render_tracks, settings_from_config
-    from .tracks.stage import SIMULATED_TRUTH
+    from .tracks.reduce import reduction_dataset
+    from .tracks.stage import reduce_in_memory, render_in_memory
 
     cfg = {**render, "seed": seeds[1]}
-    truth = {k: sim[f"truth_{k}"].values for k in SIMULATED_TRUTH if f"truth_{k}" in sim}
-    r = np.array([balls[b].r for b in sim["ball"].values.astype(str)])
-    tracks = render_tracks(
-        truth, r, settings_from_config(cfg), sim["impact"].values.astype(str), sim["ball"].values, sim["bat"].values
-    )
-    cameras, rig = cameras_from_config(camera_block(cfg))
-    return reduction_dataset(reduce_tracks(tracks, cameras, rig))
+    tracks = render_in_memory(sim, balls, cfg)
+    red, _ = reduce_in_memory(tracks, camera_block(cfg), balls, bats, where)
+    return reduction_dataset(red)
 
 
 def _truth_source(src: xr.Dataset) -> xr.Dataset:
@@ -245,7 +245,7 @@ def run_replicate(
     from .compare import fit_rows
     from .fitting import analyze_impacts, results_dataset
 
-    src = _source(dataset, replicate_seeds(settings.seed, replicate), balls, bats)
+    src = _source(dataset, replicate_seeds(settings.seed, replicate), balls, bats, f"render (replicate {replicate})")
     rec = reconstruct(normalize(src, v_ref_mph=settings.v_ref_mph), balls, bats)
     res = analyze_impacts(rec, settings.mu_k_example, systematic=False)  # no study quantity is a systematic
     fit = results_dataset(res)

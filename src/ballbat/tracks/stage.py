@@ -9,6 +9,7 @@ import xarray as xr
 
 from ..properties import load_balls, load_bats
 from .checks import Verdict, cross_check
+from .data import Tracks
 from .io import cameras_from_config, load_tracks, tracks_dataset
 from .reduce import FLAG_VAR, ReduceOptions, Reduction, reduce_tracks, reduction_dataset
 from .render import render_tracks, settings_from_config
@@ -20,8 +21,36 @@ if TYPE_CHECKING:
 SIMULATED_TRUTH = ("v_bat", "v_ball", "theta", "omega", "psi", "e_x", "e_y")
 
 
+def render_in_memory(simulated: xr.Dataset, balls: dict, render_cfg: dict) -> Tracks:
+    """Render both cameras' tracks of a synthetic experiment, in memory (the workflow and the studies).
+
+    Parameters
+    ----------
+    simulated : xarray.Dataset
+        The synthetic experiment, with its ``truth_*`` variables.
+    balls : dict
+        Ball table (radii).
+    render_cfg : dict
+        The dataset's ``render`` config block.
+
+    Returns
+    -------
+    Tracks
+    """
+    truth = {k: simulated[f"truth_{k}"].values for k in SIMULATED_TRUTH if f"truth_{k}" in simulated}
+    r = np.array([balls[b].r for b in simulated["ball"].values.astype(str)])
+    return render_tracks(
+        truth,
+        r,
+        settings_from_config(render_cfg),
+        simulated["impact"].values.astype(str),
+        simulated["ball"].values,
+        simulated["bat"].values,
+    )
+
+
 def render_stage(simulated: xr.Dataset, balls_path: str | os.PathLike[str], render_cfg: dict) -> xr.Dataset:
-    """Render both cameras' tracks of a synthetic experiment (``simulate.nc``).
+    """Render both cameras' tracks of a synthetic experiment (``simulate.nc``); return ``tracks.nc``.
 
     Parameters
     ----------
@@ -37,18 +66,45 @@ def render_stage(simulated: xr.Dataset, balls_path: str | os.PathLike[str], rend
     xarray.Dataset
         ``tracks.nc``: long rows and the impact table with the truth.
     """
-    balls = load_balls(balls_path)
-    truth = {k: simulated[f"truth_{k}"].values for k in SIMULATED_TRUTH if f"truth_{k}" in simulated}
-    r = np.array([balls[b].r for b in simulated["ball"].values.astype(str)])
-    tracks = render_tracks(
-        truth,
-        r,
-        settings_from_config(render_cfg),
-        simulated["impact"].values.astype(str),
-        simulated["ball"].values,
-        simulated["bat"].values,
+    return tracks_dataset(render_in_memory(simulated, load_balls(balls_path), render_cfg))
+
+
+def reduce_options(cfg: dict) -> ReduceOptions:
+    """Return the reduction's options of a ``tracks`` or ``render`` block (``min_frames``)."""
+    mf = cfg.get("min_frames", {})
+    return ReduceOptions(
+        min_tip_frames=int(mf.get("tip", 5)),
+        min_flight_frames=int(mf.get("flight", 5)),
+        min_spin_frames=int(mf.get("spin", 4)),
     )
-    return tracks_dataset(tracks)
+
+
+def reduce_in_memory(tracks: Tracks, cfg: dict, balls: dict, bats: dict, where: str) -> tuple[Reduction, Verdict]:
+    """Reduce and cross-check tracks already read (the reduce rule, the checker and the studies).
+
+    Parameters
+    ----------
+    tracks : Tracks
+        Both cameras' tracks and the impact table.
+    cfg : dict
+        ``cameras`` and ``rig`` (and optional ``min_frames``) as in the config.
+    balls, bats : dict
+        Property tables.
+    where : str
+        Config key of ``cfg``, for messages.
+
+    Returns
+    -------
+    (Reduction, Verdict)
+
+    Raises
+    ------
+    ballbat.properties.InputError
+        A setting wrong or a cross-check that stops the dataset (:func:`.checks.cross_check`).
+    """
+    cameras, rig = cameras_from_config(cfg, where)
+    red = reduce_tracks(tracks, cameras, rig, reduce_options(cfg))
+    return red, cross_check(red, balls, bats, where)
 
 
 def reduce_checked(
@@ -82,17 +138,10 @@ def reduce_checked(
         Every problem of the files and settings, or a cross-check that stops the dataset
         (:func:`.checks.cross_check`).
     """
-    cameras, rig = cameras_from_config(cfg, where)
     balls, bats = load_balls(balls_path), load_bats(bats_path)
+    cameras_from_config(cfg, where)  # the settings are checked before the files are read
     tracks = load_tracks(tracks_path, impacts_path, balls, bats)
-    mf = cfg.get("min_frames", {})
-    options = ReduceOptions(
-        min_tip_frames=int(mf.get("tip", 5)),
-        min_flight_frames=int(mf.get("flight", 5)),
-        min_spin_frames=int(mf.get("spin", 4)),
-    )
-    red = reduce_tracks(tracks, cameras, rig, options)
-    return red, cross_check(red, balls, bats, where)
+    return reduce_in_memory(tracks, cfg, balls, bats, where)
 
 
 def reduce_stage(
