@@ -1,0 +1,155 @@
+"""Per-impact analysis stages: normalisation to the reference bat speed and psi reconstruction (Secs. II-III).
+
+Each function takes the impacts as an :class:`xarray.Dataset` (dimension ``impact``, SI
+units) and returns a copy with new variables, every one with units and a long name.
+Nothing is dropped: impacts that cannot be reconstructed keep their row, with ``flag`` > 0
+and the reason in ``flag_reason``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+
+from .kinematics import (
+    FLAG_TEXT,
+    ImpactFlag,
+    normalize_to_bat_speed,
+    offset_from_psi,
+    reconstruct_psi,
+    spin_bracket,
+    tan_psi_minus_theta,
+    vtf_bracket,
+    vtf_ordinate,
+)
+from .pipeline.products import Var, add_variables, flag_attrs
+from .properties import Ball, Bat, recoil_factors
+from .units import MPH
+
+#: Variables that ``normalize`` adds.
+NORMALIZE_TABLE = {
+    "omega_norm": Var(("impact",), "rad s-1", "spin normalised to the reference bat speed"),
+    "omega_norm_err": Var(("impact",), "rad s-1", "standard uncertainty of normalised spin"),
+    "v_ball_norm": Var(("impact",), "m s-1", "exit speed normalised to the reference bat speed"),
+    "v_ball_norm_err": Var(("impact",), "m s-1", "standard uncertainty of normalised exit speed"),
+}
+
+
+def impact_labels(ds: xr.Dataset) -> np.ndarray:
+    """Return each impact's label for messages: ``impact <id> (<where in the source file>)``.
+
+    The id is ``impact_id`` (a measured file's own, or a tracked impact's); an impact without
+    one (a synthetic experiment in the direct-noise mode) is numbered from 1 (``impact #31``),
+    never by its 0-based index. The place in the file (``row 32``: its CSV line, the header
+    being line 1) is added where the impacts came from a file (``source_row``).
+    """
+    n = ds.sizes["impact"]
+    ids = ds["impact_id"].values.astype(str) if "impact_id" in ds else np.array([f"#{i + 1}" for i in range(n)])
+    rows = ds["source_row"].values.astype(str) if "source_row" in ds else np.full(n, "")
+    out = [
+        f"impact at {r}" if i == r else f"impact {i}" + (f" ({r})" if r else "") for i, r in zip(ids, rows, strict=True)
+    ]
+    return np.array(out, dtype=str)
+
+
+def normalize(ds: xr.Dataset, v_ref_mph: float) -> xr.Dataset:
+    """Add spin and exit speed normalised to the reference bat speed (Sec. II, Figs. 3-4).
+
+    Adds ``omega_norm`` and ``v_ball_norm`` (and their propagated standard uncertainties
+    when the measurements carry ``*_err``): value * v_ref / v_bat, with v_ref =
+    ``v_ref_mph`` (the config's value, in mph) recorded in SI as the attribute ``v_ref``.
+    """
+    v_ref = v_ref_mph * MPH
+    values = {}
+    for k in ("omega", "v_ball"):
+        val = normalize_to_bat_speed(ds[k].values, ds["v_bat"].values, v_ref)
+        values[f"{k}_norm"] = val
+        if f"{k}_err" in ds and "v_bat_err" in ds:
+            values[f"{k}_norm_err"] = np.hypot(
+                ds[f"{k}_err"].values * v_ref / ds["v_bat"].values,
+                np.abs(val) * ds["v_bat_err"].values / ds["v_bat"].values,
+            )
+    out = add_variables(ds, NORMALIZE_TABLE, values)
+    out.attrs["v_ref"] = float(v_ref)
+    out.attrs["v_ref_units"] = "m s-1"
+    return out
+
+
+#: Variables that ``reconstruct`` adds.
+RECONSTRUCT_TABLE = {
+    "r": Var(("impact",), "m", "ball radius"),
+    "m": Var(("impact",), "kg", "ball mass"),
+    "alpha": Var(("impact",), "1", "ball moment of inertia over m r^2 (Eq. iball)"),
+    "R_bat": Var(("impact",), "m", "bat radius R at the impact location (Table II)"),
+    "r_x": Var(("impact",), "1", "tangential recoil factor r_x (Eq. rx)"),
+    "r_y": Var(("impact",), "1", "normal recoil factor r_y (Eq. ry)"),
+    "psi": Var(("impact",), "rad", "impact angle psi reconstructed from Eq. angmom"),
+    "flag": Var(("impact",), "1", "reconstruction flag (0: usable)", flag_attrs(ImpactFlag)),
+    "flag_reason": Var(("impact",), None, "why the impact is not used (ok if it is)"),
+    "D": Var(("impact",), "m", "ball-bat offset D (Eq. D)"),
+    "v_n": Var(("impact",), "m s-1", "normal component of the exit velocity"),
+    "v_t": Var(("impact",), "m s-1", "tangential component of the exit velocity"),
+    "v_bat_n": Var(("impact",), "m s-1", "normal component of the bat velocity"),
+    "spin_bracket": Var(("impact",), "rad s-1", "bracket of Eq. omega: v_bat sin psi / (r (1 + r_x)(1 + alpha))"),
+    "vtf_x": Var(("impact",), "1", "bracket of Eq. vtf: tan psi / (1 + r_x)"),
+    "vtf_y": Var(("impact",), "1", "left side of Eq. vtf: (v_ball,t + r omega) / v_bat,n"),
+    "tan_psi": Var(("impact",), "1", "tan psi (Fig. 6 abscissa)"),
+    "tan_psi_minus_theta": Var(
+        ("impact",), "1", "tan(psi - theta) = v_ball,t / v_ball,n (Eqs. muk, ratio; Fig. 6 ordinate)"
+    ),
+}
+
+
+def reconstruct(ds: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]) -> xr.Dataset:
+    """Reconstruct psi and the Sec. III quantities of every impact.
+
+    Adds the ball and bat properties used (r, alpha, R, r_x, r_y), psi (Eq. angmom), the
+    flag and its reason, D (Eq. D), v_n and v_t, and the bracket terms of Eq. omega
+    (``spin_bracket``) and Eq. vtf (``vtf_x``, with the left side ``vtf_y``), plus
+    tan(psi - theta) of Eq. ratio.
+    """
+    ball_ids = ds["ball"].values.astype(str)
+    bat_ids = ds["bat"].values.astype(str)
+    missing = sorted(
+        {f"ball {b!r}" for b in ball_ids if b not in balls} | {f"bat {t!r}" for t in bat_ids if t not in bats}
+    )
+    if missing:
+        raise ValueError("reconstruct: not in the property tables: " + ", ".join(missing))
+    pairs = {(b, t): recoil_factors(balls[b], bats[t]) for b, t in set(zip(ball_ids, bat_ids, strict=True))}
+    r = np.array([balls[b].r for b in ball_ids])
+    alpha = np.array([balls[b].alpha for b in ball_ids])
+    r_x = np.array([pairs[(b, t)][0] for b, t in zip(ball_ids, bat_ids, strict=True)])
+    R = np.array([bats[t].R for t in bat_ids])
+
+    v_bat, v_ball, theta, omega = (ds[k].values for k in ("v_bat", "v_ball", "theta", "omega"))
+    psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
+    reasons = np.array([FLAG_TEXT[ImpactFlag(int(f))] for f in flag], dtype=object).astype(str)
+    if "ingest_flag" in ds:  # measured data: keep the ingest's exclusions out of every fit
+        excluded = ds["ingest_flag"].values != 0
+        flag = np.where(excluded, ImpactFlag.EXCLUDED_AT_INGEST, flag).astype(np.int8)
+        ingest_reasons = ds["ingest_flag_reason"].values.astype(str)
+        reasons = np.where(excluded, np.char.add("excluded at ingest: ", ingest_reasons), reasons)
+    values = {
+        "r": r,
+        "m": np.array([balls[b].m for b in ball_ids]),
+        "alpha": alpha,
+        "R_bat": R,
+        "r_x": r_x,
+        "r_y": np.array([pairs[(b, t)][1] for b, t in zip(ball_ids, bat_ids, strict=True)]),
+        "psi": psi,
+        "flag": flag,
+        "flag_reason": reasons,
+    }
+    with np.errstate(invalid="ignore"):
+        values.update(
+            D=offset_from_psi(psi, r, R),
+            v_n=v_ball * np.cos(psi - theta),
+            v_t=v_ball * np.sin(psi - theta),
+            v_bat_n=v_bat * np.cos(psi),
+            spin_bracket=spin_bracket(v_bat, psi, r, r_x, alpha),
+            vtf_x=vtf_bracket(psi, r_x),
+            vtf_y=vtf_ordinate(v_ball, theta, omega, v_bat, psi, r),
+            tan_psi=np.tan(psi),
+            tan_psi_minus_theta=tan_psi_minus_theta(v_ball, omega, r, alpha),
+        )
+    return add_variables(ds, RECONSTRUCT_TABLE, values)

@@ -1,0 +1,483 @@
+"""The ``ballbat`` command: everyday questions without editing a config.
+
+``ballbat check FILE`` validates a measured impacts file exactly as the workflow's ``ingest``
+rule does (the same function, :func:`ballbat.ingest.ingest`); ``ballbat fly`` flies batted
+balls with Nathan's trajectory model (:func:`ballbat.flight.fly`), one from options or many
+from a CSV file; ``ballbat summary results/{dataset}`` prints a dataset's headline numbers.
+Defaults (air, spin decay, integrator, property tables) are the config schema's, the one
+place the workflow's defaults live. Errors are one line naming the bad argument (exit 2);
+``check`` exits 1 when the file is not usable.
+"""
+
+from __future__ import annotations
+
+import argparse
+import csv
+import json
+import math
+import os
+import re
+import sys
+from pathlib import Path
+from typing import TYPE_CHECKING, NoReturn
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+#: The config schema and the default property tables, shipped with the package (``data/`` links
+#: to ``workflow/schemas/`` and ``config/`` of the checkout, so there is one copy of each).
+DATA = Path(__file__).resolve().parent / "data"
+
+EXAMPLES = {
+    "check": """examples:
+  ballbat check data/mylab/impacts.csv
+  ballbat check data/mylab/impacts.csv --bats data/mylab/bats.csv
+  ballbat check config/examples/maple_impacts.csv --bats config/examples/maple_bats.csv
+  ballbat check config/examples/tracked_tracks.csv --kind tracks --impacts config/examples/tracked_impacts.csv""",
+    "fly": """examples:
+  ballbat fly --speed 103 --angle 27.5 --backspin 2500
+  ballbat fly --speed 103 --angle 27.5 --backspin 2500 --method calculator --json
+  ballbat fly --speed 95 --angle 30 --backspin 2200 --sidespin -500 --spray 15 --wind 0,10
+  ballbat fly --csv balls.csv        (columns named like the options: speed, angle, backspin, ...)""",
+    "summary": """examples:
+  ballbat summary results/synthetic
+  ballbat summary results/maple""",
+}
+
+
+class UsageError(Exception):
+    """A bad argument: reported as one line, exit status 2."""
+
+
+class _Parser(argparse.ArgumentParser):
+    """An argument parser whose errors are one line (no usage block) and exit with status 2.
+
+    A value that starts with ``-`` and a digit (``--elevation -1e6``, ``--wind -5,3``) or reads
+    ``-inf``/``-nan`` is a value, not an option (argparse's own test misses exponents).
+    """
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
+
+    def error(self, message: str) -> NoReturn:
+        """Report ``message`` as one line on stderr and exit 2."""
+        self.exit(2, f"{self.prog}: error: {message}\n")
+
+
+def _schema_defaults() -> dict:
+    """Return the defaults the config schema gives the air and the flight (the workflow's own)."""
+    import yaml
+
+    schema = yaml.safe_load((DATA / "config.schema.yaml").read_text())
+    air = schema["properties"]["implications"]["properties"]["air"]["properties"]
+    flight = schema["$defs"]["flight"]["properties"]
+    tables = schema["properties"]["tables"]["properties"]
+    return {
+        "air": {k: v["default"] for k, v in air.items()},
+        "flight": {k: v["default"] for k, v in flight.items()},
+        "tables": {k: str(DATA / Path(v["default"]).name) for k, v in tables.items()},
+        "limits": schema["$defs"],
+    }
+
+
+def _finite(text: str) -> float:
+    """Parse a number that must be finite (``nan``, ``inf`` and ``1e400`` are not)."""
+    try:
+        val = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(val):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return val
+
+
+def _range_problem(val: float, limits: dict, unit: str) -> str | None:
+    """Return why ``val`` lies outside the schema's range ``limits`` (None when inside)."""
+    if not math.isfinite(val):
+        return f"{val!r} is not a finite number"
+    lo, hi = limits.get("minimum"), limits.get("maximum")
+    xlo, xhi = limits.get("exclusiveMinimum"), limits.get("exclusiveMaximum")
+    if (lo is not None and val < lo) or (hi is not None and val > hi) or (xlo is not None and val <= xlo):
+        left = f"[{lo:g}" if lo is not None else f"({xlo:g}"
+        right = f"{hi:g}]" if hi is not None else f"{xhi:g})"
+        about = limits.get("description", "")
+        return f"{val:g} {unit} is outside {left}, {right} {unit}" + (f" ({about})" if about else "")
+    if xhi is not None and val >= xhi:
+        return f"{val:g} {unit} is outside the range, below {xhi:g} {unit}"
+    return None
+
+
+# --------------------------------------------------------------------------------------
+# check
+
+
+def cmd_check(args: argparse.Namespace) -> int:
+    """Validate a measured impacts file as the ingest rule does; print every problem and warning."""
+    from .fitting import fit_problems
+    from .ingest import excluded_listing, ingest
+    from .properties import InputError, load_balls, load_bats
+
+    path = Path(args.file)
+    if path.is_dir():
+        raise UsageError(f"argument file: {path} is a directory, not an impacts file")
+    if not path.exists():
+        raise UsageError(f"argument file: {path}: no such file")
+    defaults = _schema_defaults()["tables"]
+    if args.kind == "tracks":
+        return _check_tracks(path, args, defaults)
+    if args.impacts:
+        raise UsageError("argument --impacts: only with --kind tracks (the impact table of a tracks file)")
+    try:
+        ds, warnings = ingest(path, balls_path=args.balls or defaults["balls"], bats_path=args.bats or defaults["bats"])
+    except InputError as exc:
+        for problem in exc.problems:
+            print(problem)
+        print(f"{path}: not usable: {len(exc.problems)} problem(s)", file=sys.stderr)
+        return 1
+    problems = fit_problems(ds, load_balls(args.balls or defaults["balls"]), load_bats(args.bats or defaults["bats"]))
+    if problems:  # what the workflow's fit_ex would stop on: the same chain and test (issue 19)
+        for text in [*problems, *warnings]:
+            print(f"{path}: {text}" if text.startswith("the fit") else f"warning: {text}")
+        print(f"{path}: not usable: {len(problems)} problem(s)", file=sys.stderr)
+        return 1
+    for text in warnings:
+        print(f"warning: {text}")
+    for line in excluded_listing(ds):
+        print(f"excluded: {line}")
+    print(
+        f"{path}: usable: {ds.sizes['impact']} impacts, {int(ds.attrs['n_excluded'])} excluded, "
+        f"{len(warnings)} warning(s)"
+    )
+    return 0
+
+
+def _check_tracks(path: Path, args: argparse.Namespace, defaults: dict) -> int:
+    """Validate a raw-tracks file and its impact table as the workflow's reduce rule reads them."""
+    from .properties import InputError, load_balls, load_bats
+    from .tracks.io import load_tracks
+
+    if path.suffix.lower() != ".nc" and not args.impacts:
+        raise UsageError("argument --impacts: required with --kind tracks for a CSV tracks file (impact_id,bat,ball)")
+    try:
+        balls = load_balls(args.balls or defaults["balls"])
+        bats = load_bats(args.bats or defaults["bats"])
+        tracks = load_tracks(path, args.impacts, balls, bats)
+    except InputError as exc:
+        for problem in exc.problems:
+            print(problem)
+        print(f"{path}: not usable: {len(exc.problems)} problem(s)", file=sys.stderr)
+        return 1
+    cams = ", ".join(sorted(tracks.cameras))
+    print(f"{path}: usable: {tracks.n} impacts tracked by the cameras {cams}")
+    return 0
+
+
+# --------------------------------------------------------------------------------------
+# fly
+
+#: ``fly`` options that take one number per ball: name -> (unit, help, the schema's range of it).
+FLY_NUMBERS = {
+    "speed": ("mph", "exit speed (required)", "exit_speed_mph"),
+    "angle": ("deg", "launch angle above the horizontal (required)", "launch_deg"),
+    "backspin": ("rpm", "backspin; negative is topspin (default 0)", "spin_rpm"),
+    "sidespin": ("rpm", "sidespin; positive curves towards third base (default 0)", "spin_rpm"),
+    "spray": ("deg", "spray angle from centre field towards first base (default 0)", "spray_deg"),
+}
+#: ``fly`` options of the conditions: option -> (attribute, unit, the schema's range of it).
+FLY_CONDITIONS = {
+    "--temperature": ("temperature", "deg F", "temperature_F"),
+    "--elevation": ("elevation", "ft", "elevation_ft"),
+    "--humidity": ("humidity", "%", "humidity_pct"),
+    "--pressure": ("pressure", "inHg", "pressure_inHg"),
+    "--spin-decay": ("spin_decay", "s", "tau_s"),
+}
+
+
+def _wind(text: str) -> tuple[float, float]:
+    try:
+        wx, wy = (float(v) for v in text.split(","))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"invalid wind {text!r}: give 'x,y' in mph") from None
+    if not (math.isfinite(wx) and math.isfinite(wy)):
+        raise argparse.ArgumentTypeError(f"invalid wind {text!r}: both components must be finite numbers of mph")
+    return wx, wy
+
+
+def _read_balls_csv(path: Path, limits: dict) -> dict[str, list[float]]:
+    """Return the columns of a ``fly --csv`` file (names as the options), one value per ball.
+
+    Read as the workflow reads a lab's CSV (:func:`ballbat.properties.read_csv_rows`: comma or
+    semicolon, a byte-order mark, UTF-8 only). Every cell of a column the header names must hold
+    a finite number: a blank cell is an error naming its row and column, never 0.
+    """
+    from .properties import InputError, read_csv_rows
+
+    if path.is_dir():
+        raise UsageError(f"argument --csv: {path}: is a directory, not a CSV file")
+    if not path.exists():
+        raise UsageError(f"argument --csv: {path}: no such file")
+    try:
+        header, lines = read_csv_rows(path)
+    except InputError as exc:
+        raise UsageError(f"argument --csv: {exc.problems[0]}") from None
+    if not header:
+        raise UsageError(f"argument --csv: {path}: empty file (expected a header line speed,angle,...)")
+    if not lines:
+        raise UsageError(f"argument --csv: {path}: no rows")
+    unknown = sorted(set(header) - set(FLY_NUMBERS))
+    if unknown:
+        raise UsageError(
+            f"argument --csv: {path}: unknown column(s) {', '.join(unknown)} (allowed: {', '.join(FLY_NUMBERS)})"
+        )
+    missing = [c for c in ("speed", "angle") if c not in header]
+    if missing:
+        raise UsageError(f"argument --csv: {path}: missing column(s) {', '.join(missing)}")
+    repeated = sorted({c for c in header if header.count(c) > 1})
+    if repeated:
+        raise UsageError(f"argument --csv: {path}: column(s) {', '.join(repeated)} appear more than once")
+    cols: dict[str, list[float]] = {k: [] for k in FLY_NUMBERS}
+    for line, cells in lines:
+        at = f"argument --csv: {path}, row {line}"
+        if len(cells) > len(header):
+            raise UsageError(f"{at}: {len(cells) - len(header)} more cell(s) than the header has columns")
+        row = dict(zip(header, cells, strict=False))
+        for k in FLY_NUMBERS:
+            if k not in header:  # a column the file does not have: the option's default
+                cols[k].append(0.0)
+                continue
+            raw = row.get(k, "")
+            if not raw:
+                raise UsageError(f"{at}, column {k}: empty (give a value; 0 {FLY_NUMBERS[k][0]} is a value too)")
+            try:
+                val = float(raw)
+            except ValueError:
+                raise UsageError(f"{at}, column {k}: {raw!r} is not a number") from None
+            if not math.isfinite(val):
+                raise UsageError(f"{at}, column {k}: {raw!r} is not a finite number")
+            why = _range_problem(val, limits[FLY_NUMBERS[k][2]], FLY_NUMBERS[k][0])
+            if why:
+                raise UsageError(f"{at}, column {k}: {why}")
+            cols[k].append(val)
+    return cols
+
+
+def _check_ranges(args: argparse.Namespace, cols: dict[str, list[float]], limits: dict) -> None:
+    """Refuse any ball or condition outside the config schema's physical ranges, naming the argument."""
+    if not args.csv:  # a CSV file's cells are checked as they are read, naming row and column
+        for k, (unit, _, ref) in FLY_NUMBERS.items():
+            why = _range_problem(cols[k][0], limits[ref], unit)
+            if why:
+                raise UsageError(f"argument --{k}: {why}")
+    for opt, (attr, unit, ref) in FLY_CONDITIONS.items():
+        why = _range_problem(getattr(args, attr), limits[ref], unit)
+        if why:
+            raise UsageError(f"argument {opt}: {why}")
+    for val in args.wind:
+        why = _range_problem(val, limits["wind_component_mph"], "mph")
+        if why:
+            raise UsageError(f"argument --wind: {why}")
+
+
+def fly_table(args: argparse.Namespace) -> list[dict]:
+    """Fly the balls the arguments describe; return one result row per ball (calculator units)."""
+    import numpy as np
+
+    from .flight import air_density, fly
+    from .units import DEGREE, FOOT, INHG_IN_MMHG, MPH, RPM, fahrenheit_to_celsius
+
+    limits = _schema_defaults()["limits"]
+    if args.csv:
+        cols = _read_balls_csv(Path(args.csv), limits)
+    else:
+        missing = [f"--{k}" for k in ("speed", "angle") if getattr(args, k) is None]
+        if missing:
+            raise UsageError(f"argument {missing[0]}: required (or give --csv FILE)")
+        cols = {k: [getattr(args, k) or 0.0] for k in FLY_NUMBERS}
+    _check_ranges(args, cols, limits)
+    speed = np.asarray(cols["speed"], dtype=float)
+    rho = air_density(
+        fahrenheit_to_celsius(args.temperature),
+        args.pressure * INHG_IN_MMHG,
+        args.elevation * FOOT,
+        args.humidity,
+    )
+    res = fly(
+        speed * MPH,
+        np.asarray(cols["angle"]) * DEGREE,
+        np.asarray(cols["spray"]) * DEGREE,
+        np.asarray(cols["backspin"]) * RPM,
+        np.asarray(cols["sidespin"]) * RPM,
+        rho=rho,
+        wind=np.asarray(args.wind, dtype=float) * MPH,
+        tau=args.spin_decay,
+        method=args.method,
+    )
+    x, y = res.landing[..., 0], res.landing[..., 1]
+    rows = []
+    for i in range(speed.size):
+        rows.append(
+            {
+                **{k: cols[k][i] for k in FLY_NUMBERS},
+                "carry_ft": float(np.atleast_1d(res.carry)[i] / FOOT),
+                "hang_time_s": float(np.atleast_1d(res.hang_time)[i]),
+                "apex_ft": float(np.atleast_1d(res.apex)[i] / FOOT),
+                "bearing_deg": float(np.degrees(np.arctan2(np.atleast_1d(x)[i], np.atleast_1d(y)[i]))),
+            }
+        )
+    return rows
+
+
+def cmd_fly(args: argparse.Namespace) -> int:
+    """Print carry, hang time, apex and landing bearing of each ball (text, CSV or JSON)."""
+    rows = fly_table(args)
+    if args.json:
+        print(json.dumps(rows if args.csv else rows[0], indent=2))
+    elif args.csv:
+        w = csv.DictWriter(sys.stdout, fieldnames=list(rows[0]), lineterminator="\n")
+        w.writeheader()
+        w.writerows({k: f"{v:.6g}" for k, v in r.items()} for r in rows)
+    else:
+        r = rows[0]
+        print(f"carry {r['carry_ft']:.1f} ft, hang time {r['hang_time_s']:.2f} s, apex {r['apex_ft']:.1f} ft, ", end="")
+        print(f"landing bearing {r['bearing_deg']:+.1f} deg (+: towards first base)")
+    return 0
+
+
+# --------------------------------------------------------------------------------------
+# summary
+
+
+def summary_lines(folder: Path) -> list[str]:
+    """Return the headline numbers of a dataset's results folder as lines of a terminal table."""
+    from .analysis import impact_labels
+    from .pipeline.ncio import read_dataset
+
+    need = {name: folder / f"{name}.nc" for name in ("reconstruct", "fit_ex", "stronge")}
+    missing = [str(p) for p in need.values() if not p.is_file()]
+    if missing:
+        raise UsageError(f"argument folder: {folder} lacks {', '.join(missing)} (run the workflow first)")
+    read = []
+    for path in need.values():
+        try:
+            read.append(read_dataset(path))
+        except Exception as exc:  # any damage (truncated, not NetCDF) gets the same answer
+            why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise UsageError(
+                f"argument folder: {path} cannot be read ({why}): damaged or cut short; "
+                "rerun the workflow to rebuild it"
+            ) from None
+    rec, fit, st = read
+    lines = [f"{folder.name}: {rec.sizes['impact']} impacts, {int((rec['flag'].values != 0).sum())} not used (flagged)"]
+    lines += ["", f"{'ball':<10} {'bat':<20} {'e_x':>7} {'± se':>7} {'95 % interval':>17} {'n':>4}"]
+    for ball in fit["ball"].values.astype(str):
+        for bat in [*fit["bat"].values.astype(str), "pooled"]:
+            f = fit.sel(ball=ball) if bat == "pooled" else fit.sel(ball=ball, bat=bat)
+            pre = "e_x_pooled" if bat == "pooled" else "e_x"
+            n = int(f[f"{pre}_n"])
+            if n == 0:
+                continue
+            v, e = float(f[pre]), float(f[f"{pre}_err"])
+            lo, hi = float(f[f"{pre}_ci_low"]), float(f[f"{pre}_ci_high"])
+            lines.append(f"{ball:<10} {bat:<20} {v:7.3f} {e:7.3f} {f'[{lo:.3f}, {hi:.3f}]':>17} {n:4d}")
+    lines += ["", f"{'ball':<10} {'eta^2':>7} {'± se':>7} {'95 % interval':>17} {'n':>4}"]
+    for ball in st["ball"].values.astype(str):
+        s = st.sel(ball=ball)
+        lo, hi = float(s["eta2_ci_low"]), float(s["eta2_ci_high"])
+        lines.append(
+            f"{ball:<10} {float(s['eta2']):7.3f} {float(s['eta2_err']):7.3f} {f'[{lo:.3f}, {hi:.3f}]':>17} "
+            f"{int(s['eta2_n']):4d}"
+        )
+    bad = rec["flag"].values != 0
+    reasons = rec["flag_reason"].values[bad].astype(str)
+    if reasons.size:
+        labels = impact_labels(rec)[bad]
+        lines += ["", "not used:"] + [f"  {lab}: {r}" for lab, r in zip(labels, reasons, strict=True)]
+    return lines
+
+
+def cmd_summary(args: argparse.Namespace) -> int:
+    """Print the headline numbers of a dataset's results."""
+    folder = Path(args.folder)
+    if not folder.is_dir():
+        raise UsageError(f"argument folder: {folder}: not a directory")
+    print("\n".join(summary_lines(folder)))
+    return 0
+
+
+# --------------------------------------------------------------------------------------
+
+
+def parser() -> argparse.ArgumentParser:
+    """Return the ``ballbat`` argument parser (defaults from the config schema)."""
+    d = _schema_defaults()
+    air, flight = d["air"], d["flight"]
+    top = _Parser(prog="ballbat", description=__doc__.split("\n\n")[0])
+    sub = top.add_subparsers(dest="command", required=True, parser_class=_Parser)
+    fmt = argparse.RawDescriptionHelpFormatter
+
+    p = sub.add_parser("check", help="validate a measured impacts file", epilog=EXAMPLES["check"], formatter_class=fmt)
+    p.add_argument("file", help="impacts file (CSV or NetCDF, the paper's units)")
+    p.add_argument("--bats", help="bat table (default: the workflow's config/bats.csv)")
+    p.add_argument("--balls", help="ball table (default: the workflow's config/balls.csv)")
+    p.add_argument("--kind", choices=("impacts", "tracks"), default="impacts", help="what the file holds")
+    p.add_argument("--impacts", metavar="FILE", help="with --kind tracks: the impact table (impact_id,bat,ball)")
+    p.set_defaults(func=cmd_check)
+
+    p = sub.add_parser(
+        "fly", help="carry, hang time and apex of batted balls", epilog=EXAMPLES["fly"], formatter_class=fmt
+    )
+    for name, (unit, text, _) in FLY_NUMBERS.items():
+        p.add_argument(f"--{name}", type=_finite, metavar=unit.upper(), help=f"{text}, {unit}")
+    p.add_argument("--csv", metavar="FILE", help="many balls: a CSV with columns named like the options above")
+    p.add_argument(
+        "--temperature", type=_finite, default=air["temperature_F"], help="air temperature, deg F (default %(default)s)"
+    )
+    p.add_argument("--elevation", type=_finite, default=air["elevation_ft"], help="elevation, ft (default %(default)s)")
+    p.add_argument(
+        "--humidity", type=_finite, default=air["humidity_pct"], help="relative humidity, %% (default %(default)s)"
+    )
+    p.add_argument(
+        "--pressure", type=_finite, default=air["pressure_inHg"], help="pressure, inHg (default %(default)s)"
+    )
+    p.add_argument("--wind", type=_wind, default=tuple(flight["wind_mph"]), help="wind 'x,y', mph (default 0,0)")
+    p.add_argument(
+        "--spin-decay",
+        type=_finite,
+        default=flight["tau_s"],
+        metavar="SECONDS",
+        help="spin-decay time (default %(default)s s)",
+    )
+    p.add_argument(
+        "--method",
+        choices=("accurate", "calculator"),
+        default=flight["method"],
+        help="integrator (default %(default)s)",
+    )
+    p.add_argument("--json", action="store_true", help="print JSON")
+    p.set_defaults(func=cmd_fly)
+
+    p = sub.add_parser("summary", help="a dataset's headline numbers", epilog=EXAMPLES["summary"], formatter_class=fmt)
+    p.add_argument("folder", help="a results folder, e.g. results/synthetic")
+    p.set_defaults(func=cmd_summary)
+    return top
+
+
+def main(argv: Sequence[str] | None = None) -> int:
+    """Run the ``ballbat`` command; return its exit status."""
+    args = parser().parse_args(argv)
+    try:
+        status = args.func(args)
+        sys.stdout.flush()
+    except UsageError as exc:
+        print(f"ballbat {args.command}: error: {exc}", file=sys.stderr)
+        return 2
+    except BrokenPipeError:  # the reader left (`ballbat summary ... | head`): stop quietly, as cat does
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # nothing left to flush at exit
+        return 141  # 128 + SIGPIPE, the status of a Unix tool the pipe ended
+    return status
+
+
+if __name__ == "__main__":
+    sys.exit(main())

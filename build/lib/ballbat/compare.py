@@ -1,0 +1,317 @@
+"""The paper-comparison table: every published number beside ours (and the truth).
+
+Columns: ``quantity, ball, bat, paper, paper_uncertainty, value, uncertainty, systematic,
+truth, unit``, in the paper's units. ``uncertainty`` is the statistical standard error;
+``systematic`` a systematic error reported apart from it (e_x of a dataset reduced from
+camera tracks with a pixel-scale uncertainty). One row per published number (``ballbat.published``) and one per
+result of ours that the paper does not publish (e.g. e_x of a bat not in the paper, or
+e_y implied by Eq. ratio). Cells that do not apply are empty.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .kinematics import offset_from_psi
+from .published import PUBLISHED, UNPUBLISHED
+from .units import from_si
+
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Iterable, Sequence
+
+    import xarray as xr
+
+    from .published import Published
+
+COLUMNS = (
+    "quantity",
+    "ball",
+    "bat",
+    "paper",
+    "paper_uncertainty",
+    "value",
+    "uncertainty",
+    "systematic",
+    "truth",
+    "unit",
+)
+
+#: quantity -> (variable in fit_ex.nc, unit of the table); value's error is ``<var>_err``.
+FIT_QUANTITIES = {
+    "e_x": ("e_x", "1"),
+    "e_x_pooled": ("e_x_pooled", "1"),
+    "spin_theta_slope": ("spin_theta_slope", "rpm/deg"),
+    "speed_theta_slope": ("speed_theta_slope", "mph/deg"),
+    "tan_ratio_slope": ("tan_ratio_slope", "1"),
+    "e_y_implied": ("e_y_implied", "1"),
+    "mu_k_lower_bound": ("mu_k_lower_bound", "1"),
+    "gross_slip_psi": ("gross_slip_psi", "deg"),
+    "gross_slip_theta": ("gross_slip_theta", "deg"),
+    "gross_slip_omega": ("gross_slip_omega", "rpm"),
+}
+
+
+def format_number(x: float | None) -> str:
+    """Return a number as the tables print it (6 significant digits; empty for None, NaN or inf)."""
+    if x is None:
+        return ""
+    x = float(x)
+    return "" if not math.isfinite(x) else f"{x:.6g}"
+
+
+def _pick(ds, var, ball, bat):
+    if var not in ds:
+        return None
+    v = ds[var]
+    if "ball" in v.dims:
+        if ball not in ds["ball"].values:
+            return None
+        v = v.sel(ball=ball)
+    if "bat" in v.dims:
+        if bat not in ds["bat"].values:
+            return None
+        v = v.sel(bat=bat)
+    return float(v.values)
+
+
+def fit_rows(fit: xr.Dataset) -> list[dict]:
+    """Rows for the quantities of ``fit_ex.nc`` (values in SI converted to the table's units)."""
+    rows = []
+    balls = [str(b) for b in fit["ball"].values]
+    bats = [str(b) for b in fit["bat"].values]
+    for q, (var, unit) in FIT_QUANTITIES.items():
+        per_bat = "bat" in fit[var].dims
+        for ball in balls:
+            for bat in bats if per_bat else [""]:
+                val = _pick(fit, var, ball, bat or None)
+                if val is None or (per_bat and not np.isfinite(val) and _pick(fit, f"{var}_n", ball, bat) == 0):
+                    continue
+                err = _pick(fit, f"{var}_err", ball, bat or None)
+                tru = _pick(fit, f"truth_{var}", ball, bat or None)
+                sys_ = _pick(fit, f"{var}_err_scale", ball, bat or None)
+                conv = (lambda x, unit=unit: None if x is None else from_si(x, unit)) if unit != "1" else (lambda x: x)
+                rows.append(
+                    {
+                        "quantity": q,
+                        "ball": ball,
+                        "bat": bat,
+                        "value": conv(val),
+                        "uncertainty": conv(err),
+                        "systematic": conv(sys_),
+                        "truth": conv(tru),
+                        "unit": unit,
+                    }
+                )
+    return rows
+
+
+def impact_rows(rec: xr.Dataset) -> list[dict]:
+    """Rows from the reconstructed impacts: psi_max, D_max, n_impacts (usable) and n_excluded per ball."""
+    rows = []
+    ok = rec["flag"].values == 0
+    ball = rec["ball"].values.astype(str)
+    has_truth = "truth_psi" in rec
+    for b in sorted(set(ball)):
+        sel = ok & (ball == b)
+        psi = rec["psi"].values[sel]
+        D = rec["D"].values[sel]
+        tpsi = rec["truth_psi"].values[ball == b] if has_truth else None
+        tD = offset_from_psi(tpsi, rec["r"].values[ball == b], rec["R_bat"].values[ball == b]) if has_truth else None
+        rows += [
+            {
+                "quantity": "psi_max",
+                "ball": b,
+                "bat": "",
+                "value": from_si(psi.max(), "deg") if psi.size else None,
+                "truth": from_si(tpsi.max(), "deg") if has_truth else None,
+                "unit": "deg",
+            },
+            {
+                "quantity": "D_max",
+                "ball": b,
+                "bat": "",
+                "value": from_si(D.max(), "in") if D.size else None,
+                "truth": from_si(tD.max(), "in") if has_truth else None,
+                "unit": "in",
+            },
+            {
+                "quantity": "n_impacts",
+                "ball": b,
+                "bat": "",
+                "value": int(sel.sum()),
+                "truth": int((ball == b).sum()) if has_truth else None,
+                "unit": "1",
+            },
+            {  # impacts kept in reconstruct.nc with flag > 0 (the reasons are there)
+                "quantity": "n_excluded",
+                "ball": b,
+                "bat": "",
+                "value": int((~ok & (ball == b)).sum()),
+                "unit": "1",
+            },
+        ]
+    return rows
+
+
+def comparison_table(rows: list[dict], published: Sequence[Published] = PUBLISHED) -> list[dict]:
+    """Merge our rows with the published values: one row per published number, plus ours."""
+    ours = {(r["quantity"], r["ball"], r["bat"]): r for r in rows}
+    table = []
+    for p in published:
+        key = (p.quantity, p.ball, p.bat)
+        r = ours.pop(key, {})
+        table.append(
+            {
+                **{c: None for c in COLUMNS},
+                **r,
+                "quantity": p.quantity,
+                "ball": p.ball,
+                "bat": p.bat,
+                "paper": p.value,
+                "paper_uncertainty": p.uncertainty,
+                "unit": p.unit,
+            }
+        )
+    for key, r in ours.items():  # results with no published counterpart
+        unit = r.get("unit") or UNPUBLISHED.get(key[0], "")
+        table.append({**{c: None for c in COLUMNS}, **r, "unit": unit})
+    return table
+
+
+def to_csv(table: list[dict]) -> str:
+    """Return the comparison table as CSV text (columns :data:`COLUMNS`)."""
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(COLUMNS)
+    for r in table:
+        w.writerow([r[c] if c in ("quantity", "ball", "bat", "unit") else format_number(r[c]) for c in COLUMNS])
+    return buf.getvalue()
+
+
+#: What an ``uncertainty`` is where it is not the standard error of a fit (notes under the Markdown
+#: table; the replicate studies' ``error_kind``). Every other uncertainty is :data:`STANDARD_ERROR`.
+STANDARD_ERROR = "a standard error of the fit (covariance scaled by the reduced chi-square)"
+UNCERTAINTY_NOTES = {
+    "mu_k_lower_bound": (
+        "the measurement uncertainty of the largest tan(psi - theta), not a standard error of a sample "
+        "maximum: it says how well the largest value of these impacts is measured (docs/studies.md)"
+    ),
+    "e_y_implied": "a sandwich standard error (the impacts' influences through the Eq. ratio slope and e_x per bat)",
+    "spin_theta_slope": "a sandwich (HC3) standard error",
+    "speed_theta_slope": "a sandwich (HC3) standard error",
+    "eta2": (
+        "a sandwich (HC3) standard error centred within bats, with Bell-McCaffrey degrees of freedom "
+        "(eta2_dof in stronge.nc) for its Student's t interval"
+    ),
+}
+
+
+def to_markdown(table: list[dict], title: str) -> str:
+    """Return the comparison table as a Markdown table under the heading ``title``, with notes on the uncertainties."""
+    lines = [f"# {title}", "", "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
+    for r in table:
+        cells = [r[c] or "" if c in ("quantity", "ball", "bat", "unit") else format_number(r[c]) for c in COLUMNS]
+        lines.append("| " + " | ".join(cells) + " |")
+    present = {r["quantity"] for r in table if r.get("uncertainty") is not None}
+    notes = [f"- `{q}`: uncertainty is {UNCERTAINTY_NOTES[q]}" for q in UNCERTAINTY_NOTES if q in present]
+    if any(r.get("systematic") is not None for r in table):
+        notes.append("- `systematic`: from the swing camera's pixel-scale uncertainty, apart from the standard error")
+    if notes:
+        lines += [
+            "",
+            f"Every uncertainty is {STANDARD_ERROR} (95 % intervals with Student's t), except:",
+            "",
+            *notes,
+        ]
+    return "\n".join(lines) + "\n"
+
+
+def read_csv(path: str | os.PathLike[str]) -> list[dict]:
+    """Read a comparison CSV back (strings)."""
+    with open(path, newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def write_comparison(
+    fit: xr.Dataset,
+    impacts: xr.Dataset,
+    csv_path: str | os.PathLike[str],
+    md_path: str | os.PathLike[str],
+    title: str,
+    extra_rows: Iterable[dict] = (),
+) -> list[dict]:
+    """Build the comparison from ``fit_ex.nc`` and ``reconstruct.nc``; write CSV and Markdown."""
+    from .pipeline.ncio import read_dataset
+
+    rec = read_dataset(impacts)
+    warnings = [w for w in rec.attrs.get("ingest_warnings", "").split("\n") if w]
+    rows = [
+        *fit_rows(read_dataset(fit)),
+        *impact_rows(rec),
+        *extra_rows,
+        {"quantity": "n_warnings", "ball": "", "bat": "", "value": len(warnings), "unit": "1"},
+    ]
+    return write_table(rows, csv_path, md_path, title, warnings=warnings)
+
+
+def write_table(
+    rows: list[dict],
+    csv_path: str | os.PathLike[str],
+    md_path: str | os.PathLike[str],
+    title: str,
+    published: Sequence[Published] = PUBLISHED,
+    warnings: Sequence[str] = (),
+) -> list[dict]:
+    """Merge ``rows`` with the published values; write the CSV and its Markdown rendering.
+
+    ``warnings`` (those of the measured file, carried from ingest.nc) are listed under the
+    Markdown table; the CSV has their count as the row ``n_warnings``.
+    """
+    from .pipeline.ncio import atomic_write_text
+
+    table = comparison_table(rows, published)
+    atomic_write_text(csv_path, to_csv(table))
+    md = to_markdown(table, title)
+    if warnings:
+        md += "\n## Warnings\n\n" + "".join(f"- {w}\n" for w in warnings)
+    atomic_write_text(md_path, md)
+    return table
+
+
+def stronge_rows(stronge: xr.Dataset) -> list[dict]:
+    """Rows from ``stronge.nc``: eta2 (with its standard error), Omega_t/Omega_n and the Fig. 10 times per ball.
+
+    The event times are named by the file's ``psi_history_deg`` (e.g. ``stick_end_time_psi30``),
+    so they meet the paper's values (Sec. V.A, psi = 30 deg) only when the histories are at that psi.
+    """
+    rows = []
+    at = f"_psi{stronge.attrs['psi_history_deg']:g}"  # the paper's timeline is at psi = 30 deg
+    for b in map(str, stronge["ball"].values):
+        s = stronge.sel(ball=b)
+        rows += [
+            {
+                "quantity": "eta2",
+                "ball": b,
+                "bat": "",
+                "value": float(s.eta2),
+                "uncertainty": float(s.eta2_err),
+                "unit": "1",
+            },
+            {"quantity": "omega_t_over_omega_n", "ball": b, "bat": "", "value": float(s.omega_ratio), "unit": "1"},
+            {
+                "quantity": "stretch_max_time" + at,
+                "ball": b,
+                "bat": "",
+                "value": float(s.t_stretch_max),
+                "unit": "t_c",
+            },
+            {"quantity": "stick_end_time" + at, "ball": b, "bat": "", "value": float(s.t_stick_end), "unit": "t_c"},
+            {"quantity": "separation_time" + at, "ball": b, "bat": "", "value": float(s.t_separation), "unit": "t_c"},
+        ]
+    return rows

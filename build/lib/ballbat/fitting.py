@@ -1,0 +1,563 @@
+"""Sec. IV of one dataset: e_x per bat and ball (Eq. omega), Eq. ratio, Eq. muk and Figs. 3-4 slopes.
+
+:func:`analyze_impacts` computes (a :class:`Sec4` of arrays and line fits);
+:func:`results_dataset` assembles the fit_ex.nc file from the declared table
+:func:`fit_ex_table`. Every fit is a straight line fitted with lmfit (:mod:`ballbat.linefit`)
+on a design of :mod:`ballbat.designs`. Measurement uncertainties enter through
+the *effective variance* of each impact's residual: the abscissa and the ordinate are
+both functions of the measured (v_bat, v_ball, theta, omega), so the residual
+y - (a + s x) has variance sum_k (dy/dm_k - s dx/dm_k)^2 sigma_k^2 over the measured
+quantities m_k (correlations between x and y through psi included). The weights depend
+on the slope, so the fit is iterated (three passes converge to far below the standard
+error). Standard errors of the model's own equations (Eq. omega per bat and pooled, Eq.
+ratio) are lmfit's, scaled by the reduced chi-square (as the paper's standard errors come
+from the scatter of the data); the reduced chi-square itself tells whether the stated
+measurement uncertainties explain that scatter. The Figs. 3-4 lines summarise data the
+model does not describe impact by impact (bats of different e_x, spin and speed not exactly
+linear in theta): their scatter is not the same everywhere, and their standard errors are
+the sandwich (HC3) ones, which the replicate studies (:mod:`ballbat.studies`) find
+calibrated where the scaled covariance was 10-20 % small. e_y implied by Eq. ratio inverts
+the slope with each impact's recoil factors and its bat's e_x, weighted as the fit weighs the
+impacts (:func:`implied_e_y`), with a sandwich standard error. 95 % intervals use Student's
+t with n - p degrees of freedom. Without uncertainties the fit is unweighted and the
+reduced chi-square is undefined (NaN).
+
+References
+----------
+.. [1] J. R. Kensrud, A. M. Nathan and L. V. Smith, Am. J. Phys. 85, 503 (2017), Sec. IV.
+.. [2] J. Orear, "Least squares when both variables have uncertainties",
+   Am. J. Phys. 50, 912 (1982) (effective variance).
+"""
+
+from __future__ import annotations
+
+import enum
+from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .designs import MEASURED, normalized_theta_design, spin_design, tan_ratio_design
+from .kinematics import gross_slip_onset, normalize_to_bat_speed, tan_ratio_slope_model
+from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, wls_slope
+from .pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+
+class FitStatus(enum.IntEnum):
+    """Why a fit of e_x has no value (``e_x_status``, ``e_x_pooled_status``)."""
+
+    OK = 0
+    NO_IMPACTS = 1
+    TOO_FEW_IMPACTS = 2
+    FIT_FAILED = 3
+
+
+def fit_status(fit: LineFit) -> FitStatus:
+    """Return the :class:`FitStatus` of a fit of e_x."""
+    if fit.n == 0:
+        return FitStatus.NO_IMPACTS
+    if fit.n < MIN_FIT_IMPACTS:
+        return FitStatus.TOO_FEW_IMPACTS
+    return FitStatus.OK if fit.success else FitStatus.FIT_FAILED
+
+
+@dataclass
+class FitGrid:
+    """Line fits on a grid of labels (ball, or ball x bat), with the truth of each (NaN if none)."""
+
+    fits: np.ndarray  # object array of LineFit
+    truth: np.ndarray  # float
+
+    @classmethod
+    def empty(cls, shape: tuple[int, ...]) -> FitGrid:
+        """Return a grid of fits not made (no impacts)."""
+        fits = np.empty(shape, dtype=object)
+        for idx in np.ndindex(shape):
+            fits[idx] = LineFit.not_fitted(0)
+        return cls(fits, np.full(shape, np.nan))
+
+    def field(self, name: str, offset: float = 0.0) -> np.ndarray:
+        """One field of every fit (``slope``, ``slope_err``...), plus ``offset``."""
+        return np.vectorize(lambda f: getattr(f, name), otypes=[float])(self.fits) + offset
+
+
+@dataclass
+class Sec4:
+    """The Sec. IV results of one dataset (dims: ball, or ball x bat)."""
+
+    balls: list[str]
+    bats: list[str]
+    has_truth: bool
+    mu_k_example: float
+    e_x: FitGrid  # Eq. omega per bat: the slope is 1 + e_x
+    e_x_pooled: FitGrid
+    tan_ratio_slope: FitGrid
+    spin_theta_slope: FitGrid
+    speed_theta_slope: FitGrid
+    per_ball: dict[str, np.ndarray] = field(default_factory=dict)
+    systematic: dict[str, np.ndarray] | None = None  # pixel-scale systematic of e_x (scale_systematic)
+
+
+#: Per-ball quantities that are not line fits (values of :attr:`Sec4.per_ball`).
+PER_BALL = (
+    "e_y_implied",
+    "e_y_implied_err",
+    "truth_e_y_implied",
+    "mu_k_lower_bound",
+    "mu_k_lower_bound_err",
+    "mu_k_lower_bound_impact",
+    "truth_mu_k_lower_bound",
+    "gross_slip_psi",
+    "gross_slip_theta",
+    "gross_slip_omega",
+)
+
+
+def _measured(ds, sel, prefix=""):
+    return [np.asarray(ds[prefix + k].values[sel], dtype=float) for k in MEASURED]
+
+
+def _sigma(ds, sel):
+    if all(f"{k}_err" in ds for k in MEASURED):
+        return np.stack([ds[f"{k}_err"].values[sel] for k in MEASURED], axis=1).astype(float)
+    return None
+
+
+def _weights(jx, jy, sigma, slope):
+    if sigma is None or not np.isfinite(slope):
+        return None
+    var = np.sum((jy - slope * jx) ** 2 * sigma**2, axis=1)
+    return 1.0 / np.sqrt(var) if np.all(var > 0) else None
+
+
+def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool) -> tuple[FitGrid, FitGrid]:
+    """Fit Eq. omega per bat and ball and pooled per ball (usable impacts, ``flag == 0``).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Reconstructed impacts.
+    balls, bats : list of str
+        The grid's labels.
+    with_truth : bool
+        Also apply the estimator to the noise-free ``truth_*`` (same weights).
+
+    Returns
+    -------
+    (FitGrid, FitGrid)
+        Per bat and ball (ball x bat; the slope is 1 + e_x), pooled per ball.
+    """
+    usable = ds["flag"].values == 0
+    ball_of = ds["ball"].values.astype(str)
+    bat_of = ds["bat"].values.astype(str)
+    per_bat, pooled = FitGrid.empty((len(balls), len(bats))), FitGrid.empty((len(balls),))
+
+    def spin_fit(sel):
+        n = int(np.sum(sel))
+        if n < MIN_FIT_IMPACTS:  # too few for a slope and its error: report, do not fit
+            return LineFit.not_fitted(n), np.nan
+        r, r_x, alpha = (ds[k].values[sel] for k in ("r", "r_x", "alpha"))
+        x, y, jx, jy = spin_design(*_measured(ds, sel), r, r_x, alpha)
+        sig = _sigma(ds, sel)
+        fit = fit_line(x, y, jx, jy, sig)
+        t = np.nan
+        if with_truth and fit.success:
+            xt, yt, _, _ = spin_design(*_measured(ds, sel, "truth_"), r, r_x, alpha)
+            t = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope))[0] - 1.0
+        return fit, t
+
+    for i, ball in enumerate(balls):
+        in_ball = usable & (ball_of == ball)
+        for bat in sorted(set(bat_of[ball_of == ball])):
+            j = bats.index(bat)
+            per_bat.fits[i, j], per_bat.truth[i, j] = spin_fit(in_ball & (bat_of == bat))
+        pooled.fits[i], pooled.truth[i] = spin_fit(in_ball)
+    return per_bat, pooled
+
+
+#: Per-impact systematic uncertainties of the speeds from a camera's pixel scale (reduce.nc).
+SCALE_VARS = ("v_bat_err_scale", "v_ball_err_scale")
+
+
+def scale_systematic(ds: xr.Dataset, res: Sec4) -> dict[str, np.ndarray] | None:
+    """Systematic error of e_x from the swing camera's pixel-scale uncertainty.
+
+    The pixel scale is shared by every impact of a camera, so its uncertainty does not
+    average out: every v_bat and v_ball is scaled by (1 +- its relative uncertainty) at once
+    and e_x refitted; half the difference of the two fits is the systematic error. It is
+    reported beside the statistical error, never added into it.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Reconstructed impacts with ``v_bat_err_scale`` and ``v_ball_err_scale`` (datasets
+        reduced from camera tracks).
+    res : Sec4
+        The fits of ``ds`` (for its labels).
+
+    Returns
+    -------
+    dict or None
+        ``e_x_err_scale`` (ball x bat) and ``e_x_pooled_err_scale`` (ball); None when the
+        dataset has no pixel-scale uncertainty.
+    """
+    if not all(k in ds for k in SCALE_VARS):
+        return None
+    fits = []
+    for sign in (1.0, -1.0):
+        scaled = ds.copy()
+        for k in ("v_bat", "v_ball"):
+            rel = np.divide(ds[f"{k}_err_scale"].values, np.abs(ds[k].values))
+            scaled[k] = ds[k] * (1.0 + sign * np.nan_to_num(rel))
+        fits.append(fit_e_x(scaled, res.balls, res.bats, with_truth=False))
+    return {
+        "e_x_err_scale": 0.5 * np.abs(fits[0][0].field("slope") - fits[1][0].field("slope")),
+        "e_x_pooled_err_scale": 0.5 * np.abs(fits[0][1].field("slope") - fits[1][1].field("slope")),
+    }
+
+
+def implied_e_y(
+    ds: xr.Dataset, sel: np.ndarray, res: Sec4, i: int, ratio_design: tuple, rfit: LineFit
+) -> tuple[float, float]:
+    """Return e_y implied by the Eq. ratio slope of one ball, and its standard error.
+
+    Eq. ratio holds impact by impact: tan(psi - theta) = c_i (1 + e_x) / (1 + e_y) tan psi,
+    with c_i = alpha/(1 + alpha) (1 + r_y)/(1 + r_x) of the impact's bat and ball and e_x of
+    its bat. The fitted slope is the weighted mean of the impacts' slopes, so it is inverted
+    with the same weighted mean of c_i (1 + e_x): 1 + e_y = sum(W x^2 c_i (1 + e_x,bat(i)))
+    / sum(W x y), with the fit's weights W. (Inverting with the mean recoil factors
+    and the pooled e_x instead, as a first version did, is biased by 0.3-0.6 of its error once
+    the weights differ between bats: found by the replicate studies, docs/studies.md.)
+
+    The standard error comes from the impacts' influences on ln(1 + e_y): through the e_x fit
+    of the impact's bat and through sum(W x y), each impact about its own slope (the bats'
+    differences are structure, not scatter; the same spin measurement enters both), a
+    sandwich estimate with n / (n - k) for the k fitted slopes.
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Reconstructed impacts.
+    sel : ndarray of bool
+        The ball's usable impacts.
+    res : Sec4
+        The fits so far (e_x per bat and pooled).
+    i : int
+        The ball's index in ``res.balls``.
+    ratio_design : tuple
+        ``(x, y, jx, jy, sigma)`` of the Eq. ratio fit.
+    rfit : LineFit
+        The Eq. ratio fit.
+
+    Returns
+    -------
+    (float, float)
+    """
+    x, y, jx, jy, sig = ratio_design
+    r, r_x, r_y, alpha = (ds[k].values[sel] for k in ("r", "r_x", "r_y", "alpha"))
+    bat_of = ds["bat"].values.astype(str)[sel]
+    n = x.size
+    w_r = _weights(jx, jy, sig, rfit.slope)
+    W = np.ones(n) if w_r is None else w_r**2
+    # each impact's e_x (its bat's; the pooled one where the bat has no fit) and its influence
+    xs, ys, jxs, jys = spin_design(*_measured(ds, sel), r, r_x, alpha)
+    one_plus = np.empty(n)
+    influence_ex = np.empty(n)
+    groups = []
+    for bat in sorted(set(bat_of)):
+        m = bat_of == bat
+        fit, m_fit = res.e_x.fits[i, res.bats.index(bat)], m
+        if not (fit.success and np.isfinite(fit.slope)):  # no fit of its own: the pooled one
+            fit, m_fit = res.e_x_pooled.fits[i], np.ones(n, dtype=bool)
+        w = _weights(jxs[m_fit], jys[m_fit], None if sig is None else sig[m_fit], fit.slope)
+        ws = np.ones(int(m_fit.sum())) if w is None else w**2
+        infl = np.zeros(n)
+        infl[m_fit] = ws * xs[m_fit] * (ys[m_fit] - fit.slope * xs[m_fit]) / np.sum(ws * xs[m_fit] ** 2)
+        one_plus[m], influence_ex[m] = fit.slope, infl[m]
+        groups.append(m)
+    # each impact's Eq. ratio slope times (1 + e_y): its recoil factors and its bat's e_x
+    k_i = tan_ratio_slope_model(one_plus - 1.0, 0.0, r_x, r_y, alpha)
+    # 1 + e_y = D / T with D = sum(W x^2 k_i) and T = sum(W x y) (= slope sum(W x^2))
+    d = float(np.sum(W * x * x * k_i))
+    t = float(np.sum(W * x * y))
+    e_y = d / t - 1.0
+    # influences on ln D (through each bat's e_x) and on ln T (each impact about its own
+    # slope k_i / (1 + e_y): the bats' differences are structure, not scatter)
+    share = np.zeros(n)
+    for m in groups:
+        share[m] = np.sum((W * x * x * k_i / one_plus)[m])
+    infl_t = W * x * (y - k_i / (1.0 + e_y) * x)
+    infl = share * influence_ex / d - infl_t / t
+    k = len(groups) + 1
+    var = np.sum(infl**2) * n / max(n - k, 1)
+    return float(e_y), float((1.0 + e_y) * np.sqrt(var))
+
+
+def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True) -> Sec4:
+    """Sec. IV analysis of a normalised and reconstructed dataset (output of ``reconstruct``).
+
+    Uses only impacts with ``flag == 0``. The Figs. 3-4 fits read the normalised spin and
+    exit speed that ``normalize`` wrote (``omega_norm``, ``v_ball_norm``) and its reference
+    bat speed (attribute ``v_ref``). When the dataset holds ``truth_*`` variables
+    (synthetic), each quantity also gets a truth value: the same estimator applied to the
+    noise-free truth with the same weights. ``systematic=False`` skips the pixel-scale
+    systematic (:func:`scale_systematic`, two more e_x fits), which the replicate studies do
+    not judge.
+    """
+    usable = ds["flag"].values == 0
+    balls = ds["ball"].values.astype(str)
+    bats = ds["bat"].values.astype(str)
+    v_ref = float(ds.attrs["v_ref"])
+    has_truth = all(f"truth_{k}" in ds for k in MEASURED)
+    ball_list = sorted(set(balls))
+    bat_list = sorted(set(bats))
+    nb, nt = len(ball_list), len(bat_list)
+    res = Sec4(
+        ball_list,
+        bat_list,
+        has_truth,
+        float(mu_k_example),
+        e_x=FitGrid.empty((nb, nt)),
+        e_x_pooled=FitGrid.empty((nb,)),
+        tan_ratio_slope=FitGrid.empty((nb,)),
+        spin_theta_slope=FitGrid.empty((nb,)),
+        speed_theta_slope=FitGrid.empty((nb,)),
+        per_ball={k: np.full(nb, np.nan) for k in PER_BALL},
+    )
+    res.per_ball["mu_k_lower_bound_impact"] = np.full(nb, -1, dtype=np.int64)
+
+    res.e_x, res.e_x_pooled = fit_e_x(ds, ball_list, bat_list, with_truth=has_truth)
+    pb = res.per_ball
+    for i, ball in enumerate(ball_list):
+        in_ball = usable & (balls == ball)
+        n_ball = int(in_ball.sum())
+        if n_ball < MIN_FIT_IMPACTS:  # per-ball fits need the same minimum: report NaN
+            for grid in (res.tan_ratio_slope, res.spin_theta_slope, res.speed_theta_slope):
+                grid.fits[i] = LineFit.not_fitted(n_ball)
+            continue
+
+        r, r_x, alpha = (ds[k].values[in_ball] for k in ("r", "r_x", "alpha"))
+        x, y, jx, jy = tan_ratio_design(*_measured(ds, in_ball), r, alpha)
+        sig = _sigma(ds, in_ball)
+        rfit = fit_line(x, y, jx, jy, sig)
+        res.tan_ratio_slope.fits[i] = rfit
+        exf = res.e_x_pooled.fits[i]
+        a = float(np.mean(alpha))
+        e_y, e_y_err = implied_e_y(ds, in_ball, res, i, (x, y, jx, jy, sig), rfit)
+        pb["e_y_implied"][i], pb["e_y_implied_err"][i] = e_y, e_y_err
+        # Eq. muk: the largest measured tan(psi - theta) bounds mu_k from below.
+        k = int(np.nanargmax(y))
+        pb["mu_k_lower_bound"][i] = float(y[k])
+        pb["mu_k_lower_bound_err"][i] = float(np.sqrt(np.sum(jy[k] ** 2 * sig[k] ** 2))) if sig is not None else np.nan
+        pb["mu_k_lower_bound_impact"][i] = int(ds["impact"].values[in_ball][k])
+        psi_g, theta_g, omega_g = gross_slip_onset(
+            mu_k_example, rfit.slope, v_ref, exf.slope - 1.0, float(np.mean(r)), float(np.mean(r_x)), a
+        )
+        pb["gross_slip_psi"][i], pb["gross_slip_theta"][i], pb["gross_slip_omega"][i] = psi_g, theta_g, omega_g
+        if has_truth:
+            xt, yt, _, _ = tan_ratio_design(*_measured(ds, in_ball, "truth_"), r, alpha)
+            res.tan_ratio_slope.truth[i] = wls_slope(xt, yt, _weights(jx, jy, sig, rfit.slope))[0]
+            pb["truth_e_y_implied"][i] = float(np.mean(ds["truth_e_y"].values[in_ball]))
+            pb["truth_mu_k_lower_bound"][i] = float(np.max(yt))
+
+        v_bat, _, theta, _ = _measured(ds, in_ball)
+        tv = _measured(ds, in_ball, "truth_") if has_truth else None
+        for grid, which in ((res.spin_theta_slope, "omega"), (res.speed_theta_slope, "v_ball")):
+            y_norm = ds[f"{which}_norm"].values[in_ball].astype(float)
+            x, y, jx, jy = normalized_theta_design(v_bat, y_norm, theta, which, v_ref)
+            fit = fit_line(x, y, jx, jy, sig, through_origin=False, robust=True)
+            grid.fits[i] = fit
+            if has_truth:
+                yt_norm = normalize_to_bat_speed(tv[MEASURED.index(which)], tv[0], v_ref)
+                xt, yt, _, _ = normalized_theta_design(tv[0], yt_norm, tv[2], which, v_ref)
+                grid.truth[i] = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope), through_origin=False)[0]
+    res.systematic = scale_systematic(ds, res) if systematic else None
+    return res
+
+
+# ---------------------------------------------------------------------------------------
+# fit_ex.nc: the declared table and its assembly
+
+#: The line-fit families of fit_ex.nc: name -> (dims, units, what).
+FIT_FAMILIES = {
+    "e_x": (("ball", "bat"), "1", "tangential coefficient of restitution e_x per bat and ball (Eq. omega)"),
+    "e_x_pooled": (("ball",), "1", "tangential coefficient of restitution e_x pooled over bats (Eq. ex, Fig. 5)"),
+    "tan_ratio_slope": (("ball",), "1", "slope of tan(psi - theta) against tan psi (Eq. ratio, Fig. 6)"),
+    "spin_theta_slope": (("ball",), "rad s-1 rad-1", "slope of normalised spin against theta (Fig. 3)"),
+    "speed_theta_slope": (("ball",), "m s-1 rad-1", "slope of normalised exit speed against theta (Fig. 4)"),
+}
+
+#: Families whose fitted slope is 1 + e_x (Eq. omega): the file holds e_x = slope - 1.
+_SLOPE_IS_ONE_PLUS = ("e_x", "e_x_pooled")
+
+
+def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) -> dict[str, Var]:
+    """Return the variables of fit_ex.nc, declared once (name -> :class:`Var`).
+
+    ``has_scale``: the dataset carries a pixel-scale uncertainty (reduced from camera
+    tracks), so e_x gets a systematic error (``*_err_scale``).
+    """
+    table: dict[str, Var] = {}
+    for name, (dims, units, what) in FIT_FAMILIES.items():
+        table.update(estimate_vars(name, dims, units, what))
+        if has_scale and name in _SLOPE_IS_ONE_PLUS:
+            table[f"{name}_err_scale"] = Var(
+                dims,
+                units,
+                f"systematic error of {name} from the pixel-scale uncertainty of the swing camera "
+                "(shared by every impact; not included in the standard error)",
+            )
+        if has_truth:
+            table[f"truth_{name}"] = Var(
+                dims, units, f"true {what} (same estimator on the noise-free truth)", {"ballbat_role": "truth"}
+            )
+    for name in ("spin_theta_slope", "speed_theta_slope"):
+        units = FIT_FAMILIES[name][1].replace(" rad-1", "")
+        table[f"{name}_intercept"] = Var(("ball",), units, f"intercept at theta = 0 of the fit of {name}")
+    for name in _SLOPE_IS_ONE_PLUS:
+        dims = FIT_FAMILIES[name][0]
+        table[f"{name}_status"] = Var(
+            dims, "1", f"why {name} has no value (0: it has one; the count is {name}_n)", flag_attrs(FitStatus)
+        )
+    table["e_y_implied"] = Var(
+        ("ball",),
+        "1",
+        "normal COR e_y implied by the Eq. ratio slope (each impact's r_x, r_y and its bat's e_x)",
+        {"ancillary_variables": "e_y_implied_err"},
+    )
+    table["e_y_implied_err"] = Var(
+        ("ball",), "1", "standard error of e_y implied (sandwich: the impacts' influences via the slope and e_x)"
+    )
+    table["mu_k_lower_bound"] = Var(
+        ("ball",),
+        "1",
+        "lower bound on mu_k: largest tan(psi - theta) (Eq. muk)",
+        {"ancillary_variables": "mu_k_lower_bound_err mu_k_lower_bound_impact"},
+    )
+    table["mu_k_lower_bound_err"] = Var(
+        ("ball",),
+        "1",
+        "measurement uncertainty of that largest tan(psi - theta) (not the spread of a sample maximum: "
+        "it says how well the largest value of these impacts is measured)",
+    )
+    table["mu_k_lower_bound_impact"] = Var(("ball",), "1", "impact number of the largest tan(psi - theta)")
+    for nm, units, what in (
+        ("psi", "rad", "impact angle psi"),
+        ("theta", "rad", "angle theta"),
+        ("omega", "rad s-1", "spin at the reference bat speed"),
+    ):
+        table[f"gross_slip_{nm}"] = Var(
+            ("ball",), units, f"{what} where gross slip sets in for mu_k = {mu_k_example} (Sec. IV)"
+        )
+    if has_truth:
+        for q in ("e_y_implied", "mu_k_lower_bound"):
+            table[f"truth_{q}"] = Var(("ball",), "1", f"true {q.replace('_', ' ')}", {"ballbat_role": "truth"})
+    return table
+
+
+def results_dataset(res: Sec4) -> xr.Dataset:
+    """fit_ex.nc's contents: the :class:`Sec4` results on the declared table (dims ball, bat)."""
+    values: dict[str, np.ndarray] = {}
+    for name in FIT_FAMILIES:
+        grid: FitGrid = getattr(res, name)
+        shift = -1.0 if name in _SLOPE_IS_ONE_PLUS else 0.0
+        values[name] = grid.field("slope", shift)
+        values[f"{name}_err"] = grid.field("slope_err")
+        values[f"{name}_ci_low"] = grid.field("slope_ci_low", shift)
+        values[f"{name}_ci_high"] = grid.field("slope_ci_high", shift)
+        values[f"{name}_n"] = grid.field("n").astype(np.int64)
+        values[f"{name}_redchi"] = grid.field("redchi")
+        if res.has_truth:
+            values[f"truth_{name}"] = grid.truth
+    for name in ("spin_theta_slope", "speed_theta_slope"):
+        values[f"{name}_intercept"] = getattr(res, name).field("intercept")
+    for name in _SLOPE_IS_ONE_PLUS:
+        values[f"{name}_status"] = np.vectorize(lambda f: int(fit_status(f)), otypes=[np.int8])(getattr(res, name).fits)
+    values.update({k: v for k, v in res.per_ball.items() if res.has_truth or not k.startswith("truth_")})
+    if res.systematic is not None:
+        values.update(res.systematic)
+    coords = {
+        "ball": (Var(("ball",), None, "ball type"), np.array(res.balls, dtype=str)),
+        "bat": (Var(("bat",), None, "bat"), np.array(res.bats, dtype=str)),
+    }
+    return build_dataset(
+        fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None),
+        values,
+        coords,
+        {"mu_k_example": res.mu_k_example},
+    )
+
+
+#: Physical bounds of a tangential COR: |u_final| <= |u_initial| (no tangential energy gain).
+E_X_BOUNDS = (-1.0, 1.0)
+
+
+class ImplausibleFit(ValueError):
+    """A fitted e_x no ball-bat collision can have: the dataset's numbers are not to be used."""
+
+
+def check_physical(res: Sec4, source: str = "fit_ex") -> None:
+    """Raise :class:`ImplausibleFit` naming every fitted e_x outside :data:`E_X_BOUNDS`."""
+    lo, hi = E_X_BOUNDS
+    bad = []
+    for name, grid in (("e_x", res.e_x), ("e_x_pooled", res.e_x_pooled)):
+        e_x = grid.field("slope", -1.0)
+        for idx in zip(*np.nonzero(np.isfinite(e_x) & ((e_x < lo) | (e_x > hi))), strict=True):
+            where = f"ball {res.balls[idx[0]]}" + (f", bat {res.bats[idx[1]]}" if len(idx) > 1 else "")
+            bad.append(f"{name} ({where}) = {e_x[idx]:.3f}")
+    if bad:
+        raise ImplausibleFit(
+            f"{source}: fitted e_x outside the physical range [{lo:g}, {hi:g}]: {'; '.join(bad)}. No ball-bat "
+            "collision gives such a value: check the units and the spin sign of the measurements (mph, deg, "
+            "rpm; omega > 0 is backspin)."
+        )
+
+
+def fit_dataset(impacts: xr.Dataset, mu_k_example: float) -> xr.Dataset:
+    """Return the Sec. IV fits of a reconstructed dataset, as a Dataset ready to write.
+
+    Raises :class:`ImplausibleFit` when a fitted e_x lies outside [-1, 1] (an error for the
+    dataset, not a note: such a number is always a mistake in the data).
+    """
+    res = analyze_impacts(impacts, mu_k_example)
+    check_physical(res)
+    ds = results_dataset(res)
+    ds.attrs["n_impacts"] = int(impacts.sizes["impact"])
+    ds.attrs["n_excluded"] = int((impacts["flag"].values != 0).sum())
+    ds.attrs["v_ref"] = float(impacts.attrs["v_ref"])
+    ds.attrs.update(carried_warnings(impacts))
+    return ds
+
+
+def not_fitted(ds: xr.Dataset) -> list[str]:
+    """List the fits of e_x in fit_ex.nc that have impacts but no value, one line each (for the log)."""
+    lines = []
+    for name in _SLOPE_IS_ONE_PLUS:
+        status, n = ds[f"{name}_status"], ds[f"{name}_n"]
+        for idx in zip(*np.nonzero(status.values > FitStatus.NO_IMPACTS), strict=True):
+            where = ", ".join(f"{d} {ds[d].values[i]}" for d, i in zip(status.dims, idx, strict=True))
+            reason = FitStatus(int(status.values[idx])).name.lower().replace("_", " ")
+            lines.append(f"{name} ({where}): not fitted: {reason} ({int(n.values[idx])} usable impacts)")
+    return lines
+
+
+def fit_problems(ds: xr.Dataset, balls: dict, bats: dict) -> list[str]:
+    """Return why the workflow's fit_ex would stop on these impacts (empty when it would not).
+
+    The same chain as the workflow's (normalize, reconstruct, the Sec. IV fits) and the same
+    test (:func:`ballbat.fitting.check_physical`: every fitted e_x in [-1, 1]), so that
+    ``ballbat check`` never calls usable a file that fit_ex refuses (the ingest job itself
+    stays light: it imports no fitting). The
+    reference bat speed and the friction of the Sec. IV example do not enter e_x.
+    """
+    from .analysis import normalize, reconstruct
+
+    rec = reconstruct(normalize(ds, v_ref_mph=77.0), balls, bats)
+    try:
+        check_physical(analyze_impacts(rec, mu_k_example=0.5, systematic=False), source="the fit of e_x (fit_ex)")
+    except ImplausibleFit as exc:
+        return [str(exc)]
+    return []

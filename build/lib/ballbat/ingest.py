@@ -1,0 +1,727 @@
+"""Measured impacts from a user's file: read, check every row, convert to SI.
+
+A measured dataset is a CSV file (or a NetCDF file with the same content) with one row per
+impact and the columns of :data:`REQUIRED` in the paper's units (mph, deg, rpm), optional
+``impact_id`` and optional per-row standard uncertainties ``<column>_err``. :func:`ingest`
+checks the file whole against the ball and bat tables and returns the impacts in SI with
+the variable names of a synthetic experiment (``v_bat``, ``v_ball``, ``theta``, ``omega``
+and ``*_err``), so every later stage treats both alike.
+
+Two kinds of problems (docs/ingest.md):
+
+* **Stop** (:class:`~ballbat.properties.InputError` listing every problem, each naming the
+  file, the row (CSV line number; the header is line 1) and the column): an unreadable
+  file, missing, unknown or repeated columns, empty or non-numeric cells, non-finite
+  values, non-positive speeds, angles outside (-90, 90) deg, negative uncertainties, a
+  ball or bat not in the property tables, duplicate impact ids, a bad property table, and
+  a file in which no bat x ball pair has :data:`MIN_FIT_IMPACTS` usable impacts. These
+  are mistakes a person must fix; guessing would hide them.
+* **Exclude** (the row is kept with ``ingest_flag`` > 0 and ``ingest_flag_reason``):
+  well-formed measurements the physics cannot use, i.e. impacts whose psi cannot be
+  reconstructed (|alpha r omega / v_ball| > 1, Eq. angmom) or lands at |psi| >= 90 deg.
+
+Warnings (log and the ``ingest_warnings`` attribute) flag what is possible but suspicious:
+a bat x ball pair with fewer than :data:`MIN_FIT_IMPACTS` usable impacts (not fitted per
+bat), only some of the four uncertainty columns (the fits are then unweighted), and values
+that betray a unit mistake (:func:`unit_warnings`).
+
+References
+----------
+.. [1] J. R. Kensrud, A. M. Nathan and L. V. Smith, "Oblique collisions of baseballs and
+   softballs with a bat", Am. J. Phys. 85, 503 (2017), Secs. II-III.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import xarray as xr
+
+from .kinematics import (
+    FLAG_TEXT,
+    ImpactFlag,
+    angmom_argument,
+    reconstruct_psi,
+    spin_bracket,
+)
+from .linefit import MIN_FIT_IMPACTS
+from .pipeline.products import flag_attrs, variable
+from .properties import (
+    EXTRA,
+    Ball,
+    Bat,
+    InputError,
+    cell_text,
+    load_balls,
+    load_bats,
+    read_csv_table,
+    recoil_factors,
+)
+from .units import DEGREE, MPH, RPM
+
+if TYPE_CHECKING:
+    import os
+
+    from numpy.typing import ArrayLike
+
+#: Required columns of an impacts file.
+REQUIRED = ("bat", "ball", "v_bat_mph", "v_ball_mph", "theta_deg", "omega_rpm")
+
+#: Measured columns: file column -> (variable in SI, factor to SI, long name).
+MEASURED_COLUMNS = {
+    "v_bat_mph": ("v_bat", MPH, "bat speed at the impact point"),
+    "v_ball_mph": ("v_ball", MPH, "exit speed of the ball"),
+    "theta_deg": ("theta", DEGREE, "angle of the batted ball from the bat's direction of travel"),
+    "omega_rpm": ("omega", RPM, "spin of the batted ball (positive: backspin, Fig. 2)"),
+}
+SI_UNITS = {"v_bat": "m s-1", "v_ball": "m s-1", "theta": "rad", "omega": "rad s-1"}
+
+#: Optional columns: an impact's own id and the standard uncertainty of each measurement.
+OPTIONAL = ("impact_id", *(f"{c}_err" for c in MEASURED_COLUMNS))
+
+
+#: Range of e_x (Eq. omega) that real ball-bat impacts can show; used only to spot unit mistakes.
+E_X_PLAUSIBLE = (-0.5, 1.0)
+#: Least median normal COR e_y the impacts of a bat x ball pair may imply (Eq. vballn: the
+#: ball's normal exit speed v_ball cos(psi - theta) = (1 + e_y) / (1 + r_y) v_bat cos psi).
+#: Balls on bats have e_y of 0.3-0.6 (the paper: 0.32 and 0.45 for its balls; the maple
+#: example's impacts imply 0.42-0.47); with v_bat and v_ball swapped they imply 0.07-0.41,
+#: median 0.15, so a median below 0.2 betrays that mistake.
+E_Y_MIN = 0.2
+#: Fastest bat (at the impact point) and batted ball, mph, that count as measured: swing
+#: machines and the fastest swings stay below 100 mph at the impact point and the hardest-hit
+#: balls below 125 mph, so faster values point to a unit mistake (km/h read as mph).
+SPEED_MAX_MPH = {"v_bat": 110.0, "v_ball": 140.0}
+#: Robust outliers: a spin residual (about its group's median) above this many 1.4826 MAD (a
+#: normal sigma) of the whole file's residuals. Spin in rad/s (z ~ 12) or of the wrong sign
+#: (z ~ 25) in some rows stands far above it.
+OUTLIER_Z = 6.0
+#: Fewest impacts of a bat x ball group for the robust comparison.
+OUTLIER_MIN_GROUP = 6
+#: A file with more implausible rows than this fraction is an error: a fit would rest on them.
+IMPLAUSIBLE_MAX_FRACTION = 0.5
+#: Impacts with |psi| below this are too head-on for an implied e_x (sin psi ~ 0).
+PSI_MIN_FOR_E_X = 10.0 * DEGREE
+#: A check that fails for more than this fraction of impacts triggers a unit warning ...
+UNIT_WARN_FRACTION = 0.5
+#: ... and a suspected mistake is named when correcting it leaves at most this fraction.
+UNIT_FIX_FRACTION = 0.2
+
+
+# ---------------------------------------------------------------------------------------
+# Reading: every cell as text, with the label of its row
+
+
+def _read_netcdf(path: Path) -> tuple[list[str], list[tuple[str, dict]]]:
+    try:
+        with xr.open_dataset(path) as ds:
+            ds = ds.load()
+    except (OSError, ValueError) as exc:
+        raise InputError([f"{path}: cannot be read as NetCDF ({exc})"]) from None
+    dims = sorted({d for v in ds.variables.values() for d in v.dims})
+    if len(dims) != 1:
+        raise InputError([f"{path}: expected one dimension (impact), found {', '.join(dims) or 'none'}"])
+    dim = dims[0]
+    header = [str(k) for k, v in ds.variables.items() if v.dims == (dim,) and k != dim]
+    problems = []
+    for col in MEASURED_COLUMNS:
+        expected = col.rsplit("_", 1)[1]
+        for name in (col, f"{col}_err"):  # an uncertainty has the unit of its value
+            units = ds[name].attrs.get("units") if name in ds else None
+            if units is not None and units != expected:
+                problems.append(f"{path}: variable {name}: units {units!r}, expected {expected!r}")
+    if problems:
+        raise InputError(problems)
+    cols = {k: ds[k].values for k in header}
+    rows = [(f"entry {i + 1}", {k: cell_text(cols[k][i]) for k in header}) for i in range(ds.sizes[dim])]
+    return header, rows
+
+
+def read_impacts_table(path: str | os.PathLike[str]) -> tuple[list[str], list[tuple[str, dict]]]:
+    """Header and rows (label, {column: text}) of a CSV or NetCDF impacts file.
+
+    A CSV row's label is its line number (``row 5``; the header is line 1); a NetCDF row's
+    is its place along the impact dimension, counted from 1 (``entry 4``).
+    """
+    path = Path(path)
+    if path.suffix.lower() in (".nc", ".nc4", ".netcdf") and path.is_file():
+        return _read_netcdf(path)
+    return read_csv_table(path, REQUIRED)
+
+
+# ---------------------------------------------------------------------------------------
+# Checks
+
+
+def _number(raw: str, where: str, problems: list[str]) -> float:
+    if raw == "":
+        problems.append(f"{where}: empty (every impact needs a value; delete the row or fill it in)")
+        return math.nan
+    try:
+        val = float(raw)
+    except ValueError:
+        problems.append(f"{where}: {raw!r} is not a number")
+        return math.nan
+    if not math.isfinite(val):
+        problems.append(f"{where}: {raw!r} is not finite")
+        return math.nan
+    return val
+
+
+def check_rows(
+    path: str | os.PathLike[str], header: list[str], rows: list[dict], balls: dict | None, bats: dict | None
+) -> tuple[dict, list[str]]:
+    """Check header and cells; return (columns as arrays in the file's units, problems).
+
+    ``balls`` / ``bats`` None (their table was bad) skip the membership checks.
+    """
+    problems: list[str] = []
+    allowed = (*REQUIRED, *OPTIONAL)
+    missing = [c for c in REQUIRED if c not in header]
+    if missing:
+        problems.append(
+            f"{path}: missing column(s) {', '.join(missing)} (required: {', '.join(REQUIRED)}; "
+            f"optional: {', '.join(OPTIONAL)})"
+        )
+    unknown = [c for c in header if c not in allowed]
+    if unknown:
+        problems.append(f"{path}: unknown column(s) {', '.join(map(repr, unknown))} (allowed: {', '.join(allowed)})")
+    repeated = sorted({c for c in header if header.count(c) > 1})
+    if repeated:
+        problems.append(f"{path}: column(s) {', '.join(repeated)} appear more than once")
+    if missing:
+        return {}, problems
+    if not rows:
+        problems.append(f"{path}: no impacts (only a header)")
+        return {}, problems
+    errs = [c for c in OPTIONAL if c.endswith("_err") and c in header]
+    out: dict = {c: [] for c in ("label", "bat", "ball", "impact_id", *MEASURED_COLUMNS, *errs)}
+    seen_ids: dict[str, str] = {}
+    seen_rows: dict[tuple, str] = {}
+    zeros: dict[str, list[str]] = {c: [] for c in errs}
+    for label, row in rows:
+        at = f"{path}: {label}"
+        if EXTRA in row:
+            problems.append(f"{at}: {row[EXTRA]} more cell(s) than the header has columns")
+        for key, table, what in (("bat", bats, "bat"), ("ball", balls, "ball")):
+            name = row.get(key, "")
+            if not name:
+                problems.append(f"{at}, column {key}: empty")
+            elif table is not None and name not in table:
+                problems.append(
+                    f"{at}, column {key}: {what} {name!r} is not in the {what} table "
+                    f"(known: {', '.join(sorted(table))})"
+                )
+            out[key].append(name)
+        vals = {c: _number(row.get(c, ""), f"{at}, column {c}", problems) for c in MEASURED_COLUMNS}
+        for c in ("v_bat_mph", "v_ball_mph"):
+            if vals[c] <= 0:
+                problems.append(f"{at}, column {c}: {row[c]} mph; a speed must be positive")
+        if abs(vals["theta_deg"]) >= 90:
+            problems.append(
+                f"{at}, column theta_deg: {row['theta_deg']} deg is outside the physical range (-90, 90) "
+                "(the ball leaves the bat forwards)"
+            )
+        for c in MEASURED_COLUMNS:
+            out[c].append(vals[c])
+        for c in errs:
+            e = _number(row.get(c, ""), f"{at}, column {c}", problems)
+            if e < 0:
+                problems.append(f"{at}, column {c}: {row[c]} is negative; an uncertainty must be >= 0")
+            elif e == 0:
+                zeros[c].append(label)
+            out[c].append(e)
+        iid = row.get("impact_id", "") if "impact_id" in header else label
+        if "impact_id" in header:
+            if not iid:
+                problems.append(f"{at}, column impact_id: empty")
+            elif iid in seen_ids:
+                problems.append(f"{at}, column impact_id: {iid!r} duplicates {seen_ids[iid]}")
+            else:
+                seen_ids[iid] = label
+        out["impact_id"].append(iid)
+        out["label"].append(label)
+        # The same measurement twice (rows pasted twice) would shrink every standard error by
+        # sqrt(2): the bat, ball and every measured value and uncertainty, to the digit.
+        # (With an impact_id column, a pasted row repeats its id, which is reported above.)
+        key = tuple(row.get(c, "").strip() for c in ("bat", "ball", *MEASURED_COLUMNS, *errs))
+        if "impact_id" not in header and key in seen_rows:
+            problems.append(
+                f"{at}: the same measurement as {seen_rows[key]} (bat, ball and every value): "
+                "a row pasted twice? Remove one, or give the impacts an impact_id column if these really are "
+                "two impacts that measured alike"
+            )
+        else:
+            seen_rows[key] = label
+    for c, labels in zeros.items():
+        if not labels:
+            continue
+        where = "every row" if len(labels) == len(rows) else ", ".join(labels[:5]) + (" ..." if len(labels) > 5 else "")
+        problems.append(
+            f"{path}: column {c}: zero uncertainty in {where}: a zero standard uncertainty says the measurement is "
+            "exact, which none is (the weighted fits would divide by it); give the real uncertainties, or leave "
+            "the column out (the fits are then unweighted)"
+        )
+    return {k: np.asarray(v) for k, v in out.items()}, problems
+
+
+def exclusions(
+    v_ball: ArrayLike, theta: ArrayLike, omega: ArrayLike, r: ArrayLike, alpha: ArrayLike
+) -> tuple[np.ndarray, np.ndarray]:
+    """Per impact: ``(ingest_flag, ingest_flag_reason)`` for impacts psi cannot use (SI inputs).
+
+    The flag is that of :func:`ballbat.kinematics.reconstruct_psi` (an
+    :class:`~ballbat.kinematics.ImpactFlag`); the reason quotes the offending number.
+    """
+    _psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
+    q = angmom_argument(v_ball, omega, r, alpha)
+    with np.errstate(invalid="ignore"):
+        psi_clipped = theta + np.arcsin(np.clip(q, -1, 1))
+    words = {
+        ImpactFlag.PSI_UNDEFINED: lambda qq, p: (
+            f"alpha r omega / v_ball = {qq:.3g}: psi cannot be reconstructed (Eq. angmom)"
+        ),
+        ImpactFlag.BAD_SPEED: lambda qq, p: FLAG_TEXT[ImpactFlag.BAD_SPEED],
+        ImpactFlag.BAT_BEHIND_BALL: lambda qq, p: (
+            f"reconstructed psi = {np.degrees(p):.1f} deg: the bat cannot reach the ball there"
+        ),
+    }
+    reason = np.array(
+        ["ok" if f == 0 else words[ImpactFlag(f)](qq, p) for f, qq, p in zip(flag, q, psi_clipped, strict=True)],
+        dtype=object,
+    ).astype(str)
+    return flag, reason
+
+
+def implausible(
+    v_bat: ArrayLike,
+    v_ball: ArrayLike,
+    theta: ArrayLike,
+    omega: ArrayLike,
+    r: ArrayLike,
+    alpha: ArrayLike,
+    r_x: ArrayLike,
+    r_y: ArrayLike,
+) -> dict[str, tuple[int, int]]:
+    """Physics checks that betray unit mistakes: name -> (failing, checked) impact counts (SI).
+
+    Notes
+    -----
+    * ``psi``: Eq. angmom has a solution with |psi| < 90 deg.
+    * ``ratio_high``: v_ball / v_bat <= 2 / (1 + r_y): with e_y, e_x <= 1, Eqs. vballn and vxf
+      bound the exit speed of a ball at rest.
+    * ``ratio_low``: v_ball / v_bat >= cos psi / (1 + r_y): the normal component alone
+      (Eq. vballn, e_y >= 0).
+    * ``e_x``: the e_x each impact implies through Eq. omega lies in :data:`E_X_PLAUSIBLE`
+      (impacts with |psi| >= :data:`PSI_MIN_FOR_E_X` only).
+    """
+    c = _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y)
+    n = c.psi.size
+    return {
+        "psi": (int((~c.ok).sum()), n),
+        "ratio_high": (int(c.ratio_high.sum()), n),
+        "ratio_low": (int(c.ratio_low.sum()), int(c.ok.sum())),
+        "e_x": (int(c.e_x_out.sum()), int(c.use_ex.sum())),
+    }
+
+
+@dataclass(frozen=True)
+class _Checks:
+    """Per impact: reconstructed psi, implied e_x and the collision's bounds (SI)."""
+
+    psi: np.ndarray
+    ok: np.ndarray  # psi reconstructed (Eq. angmom)
+    ratio: np.ndarray  # v_ball / v_bat
+    e_x: np.ndarray  # implied through Eq. omega
+    use_ex: np.ndarray  # ok and |psi| >= PSI_MIN_FOR_E_X
+    ratio_high: np.ndarray  # v_ball / v_bat > 2 / (1 + r_y)
+    ratio_low: np.ndarray  # ok and v_ball / v_bat < cos psi / (1 + r_y)
+    e_x_out: np.ndarray  # use_ex and implied e_x outside E_X_PLAUSIBLE
+    e_y: np.ndarray  # implied through Eq. vballn
+
+
+def _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y) -> _Checks:
+    """Return the bounds a collision of a ball at rest sets (:func:`implausible`), impact by impact."""
+    v_bat, v_ball, theta, omega = (np.asarray(a, dtype=float) for a in (v_bat, v_ball, theta, omega))
+    psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
+    ok = flag == ImpactFlag.OK
+    with np.errstate(invalid="ignore", divide="ignore"):
+        ratio = v_ball / v_bat
+        e_x = omega / spin_bracket(v_bat, psi, r, r_x, alpha) - 1.0
+        use_ex = ok & (np.abs(psi) >= PSI_MIN_FOR_E_X)
+        e_y = (1.0 + r_y) * ratio * np.cos(psi - theta) / np.cos(psi) - 1.0
+        return _Checks(
+            e_y=np.broadcast_to(e_y, psi.shape),
+            psi=psi,
+            ok=ok,
+            ratio=ratio,
+            e_x=e_x,
+            use_ex=use_ex,
+            ratio_high=np.broadcast_to(ratio > 2.0 / (1.0 + r_y), psi.shape),
+            ratio_low=np.broadcast_to(ok & (ratio < np.cos(psi) / (1.0 + r_y)), psi.shape),
+            e_x_out=use_ex & ~((e_x >= E_X_PLAUSIBLE[0]) & (e_x <= E_X_PLAUSIBLE[1])),
+        )
+
+
+def implausible_rows(
+    v_bat: ArrayLike,
+    v_ball: ArrayLike,
+    theta: ArrayLike,
+    omega: ArrayLike,
+    r: ArrayLike,
+    alpha: ArrayLike,
+    r_x: ArrayLike,
+    r_y: ArrayLike,
+    groups: ArrayLike,
+    sigma: dict | None = None,
+    coarse: ArrayLike | None = None,
+) -> np.ndarray:
+    """Return, per impact, why its measurement is implausible ("" when it is not); SI inputs.
+
+    ``sigma`` maps ``v_bat``, ``theta`` and ``omega`` to their stated standard uncertainties
+    (SI, per impact) when the file gives them: the group outliers below are then judged
+    against each impact's own uncertainty, else against the file's robust spread.
+
+    Row by row, so that a file with a unit mistake in some rows is caught where it is:
+
+    * a speed above :data:`SPEED_MAX_MPH` (km/h read as mph?);
+    * v_ball / v_bat above 2 / (1 + r_y) or below cos psi / (1 + r_y): beyond what any collision
+      of a ball at rest gives (Eqs. vballn, vxf with 0 <= e_y <= 1, e_x <= 1);
+    * the e_x the impact implies through Eq. omega outside :data:`E_X_PLAUSIBLE` (for |psi| >=
+      10 deg, where sin psi is not ~ 0): no tangential COR exceeds 1, and ball-bat impacts do
+      not reverse the contact point's slip by more than half;
+    * its spin an outlier of its bat x ball group (``groups``): the residual of Eq. omega,
+      omega - (1 + e_x) x with the group's median (1 + e_x), more than :data:`OUTLIER_Z` robust
+      standard deviations from the group's median residual, the spread (1.4826 MAD) taken over
+      the file's groups of at least :data:`OUTLIER_MIN_GROUP` impacts (spin in rad/s or of the
+      wrong sign in some rows). A group of fewer than :data:`OUTLIER_MIN_GROUP` impacts is
+      judged against its ``coarse`` group (the ball's impacts on every bat) when that has enough:
+      bats differ in e_x by a tenth, a row in km/h or rad/s by a factor of 1.6 or 10.
+
+    Impacts psi cannot reconstruct are left to :func:`exclusions` ("" here).
+    """
+    v_bat, v_ball, theta, omega = (np.asarray(a, dtype=float) for a in (v_bat, v_ball, theta, omega))
+    groups = np.asarray(groups)
+    coarse = None if coarse is None else np.asarray(coarse)
+    c = _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y)
+    psi, ok, ratio, e_x, use_ex = c.psi, c.ok, c.ratio, c.e_x, c.use_ex
+    out = np.full(v_bat.shape, "", dtype=object)
+    # Group outliers on the spin residual of Eq. omega, omega - (1 + e_x) x with x its bracket:
+    # spin noise is the same for every impact, so the residuals share one spread (the implied
+    # e_x does not: its noise grows as sin psi -> 0), and a robust spread (MAD) of the group
+    # is not pulled by the outliers themselves.
+    with np.errstate(invalid="ignore", divide="ignore"):
+        x = spin_bracket(v_bat, psi, r, r_x, alpha)
+    # Two planes where a group's impacts lie close to a line through the origin: Eq. omega
+    # (spin against its bracket) and Fig. 3 (spin per bat speed against theta, the paper's
+    # "remarkably linear" relation). Rows in the wrong unit fall off at least one of them; the
+    # second also catches them at small psi, where the bracket itself follows the bad spin.
+    with np.errstate(invalid="ignore", divide="ignore"):
+        planes = {"spin vs its Eq. omega bracket": (omega, x), "spin vs theta (Fig. 3)": (omega / v_bat, theta)}
+    if sigma is not None and all(k in sigma for k in ("v_bat", "theta", "omega")):
+        s_om, s_th, s_vb = (np.asarray(sigma[k], dtype=float) for k in ("omega", "theta", "v_bat"))
+        own = {"spin vs its Eq. omega bracket": s_om, "spin vs theta (Fig. 3)": None}
+    else:
+        own = {}
+    off = {}
+    for name, (y, xx) in planes.items():
+        dev = np.full(v_bat.shape, np.nan)
+        for g in np.unique(groups):
+            sel = ok & (groups == g)
+            ref = sel
+            if sel.sum() < OUTLIER_MIN_GROUP and coarse is not None and sel.any():
+                ref = ok & (coarse == coarse[np.flatnonzero(sel)[0]])
+            fit = use_ex & ref
+            if ref.sum() < OUTLIER_MIN_GROUP or not fit.any():
+                continue
+            slope = np.median(y[fit] / xx[fit])
+            res = y[sel] - slope * xx[sel]
+            dev[sel] = np.abs(res - np.median(y[ref] - slope * xx[ref]))
+            if name in own:  # the residual's own standard uncertainty from the stated ones
+                sd = own[name]
+                if sd is None:
+                    sd = np.hypot(np.hypot(s_om / v_bat, omega * s_vb / v_bat**2), slope * s_th)
+                dev[sel] = dev[sel] / np.maximum(sd[sel], 1e-12)
+        if not np.isfinite(dev).any():
+            continue
+        if name in own:
+            off[name] = np.isfinite(dev) & (dev > OUTLIER_Z)
+        else:  # one spread for the file: a MAD of a dozen impacts is too uncertain
+            spread = 1.4826 * np.median(dev[np.isfinite(dev)])
+            off[name] = np.isfinite(dev) & (dev > OUTLIER_Z * max(spread, 1e-12))
+    robust = np.any(list(off.values()), axis=0) if off else np.zeros(v_bat.shape, dtype=bool)
+    for i in np.flatnonzero(ok):
+        words = []
+        for k, top in SPEED_MAX_MPH.items():
+            speed = (v_bat if k == "v_bat" else v_ball)[i] / MPH
+            if speed > top:
+                words.append(f"{k} = {speed:.1f} mph is faster than any {k[2:]} reaches (above {top:g}; km/h?)")
+        if c.ratio_high[i]:
+            words.append(f"v_ball/v_bat = {ratio[i]:.2f} exceeds 2/(1 + r_y), the most any collision gives")
+        elif c.ratio_low[i]:
+            words.append(f"v_ball/v_bat = {ratio[i]:.2f} is below cos(psi)/(1 + r_y), the least any collision gives")
+
+        if c.e_x_out[i]:
+            lo, hi = E_X_PLAUSIBLE
+            words.append(f"implied e_x = {e_x[i]:.2f} (Eq. omega) is outside [{lo:g}, {hi:g}], where impacts lie")
+        elif robust[i]:
+            planes_off = " and ".join(k for k, v in off.items() if v[i])
+            words.append(
+                f"{planes_off} far from its bat x ball group's line (spin {omega[i] / RPM:.0f} rpm, implied"
+                f" e_x = {e_x[i]:.2f}; robust z > {OUTLIER_Z:g})"
+            )
+        out[i] = "; ".join(words)
+    return out.astype(str)
+
+
+_CHECK_WORDS = {
+    "psi": "psi cannot be reconstructed (Eq. angmom)",
+    "ratio_high": "exit speed above 2/(1 + r_y) times the bat speed, more than any collision allows",
+    "ratio_low": "exit speed below cos(psi)/(1 + r_y) times the bat speed, less than any collision allows",
+    "e_x": f"implied e_x (Eq. omega) outside [{E_X_PLAUSIBLE[0]:g}, {E_X_PLAUSIBLE[1]:g}]",
+}
+
+#: Suspected unit mistakes: (columns, what went wrong, correction of the SI arrays).
+_MISTAKES = (
+    ("omega_rpm", "spin in rad/s, not rpm", lambda d: {**d, "omega": d["omega"] / RPM}),
+    ("v_bat_mph", "bat speed in m/s, not mph", lambda d: {**d, "v_bat": d["v_bat"] / MPH}),
+    ("v_ball_mph", "exit speed in m/s, not mph", lambda d: {**d, "v_ball": d["v_ball"] / MPH}),
+    (
+        "v_bat_mph, v_ball_mph",
+        "speeds in m/s, not mph",
+        lambda d: {**d, "v_bat": d["v_bat"] / MPH, "v_ball": d["v_ball"] / MPH},
+    ),
+    ("theta_deg", "angle in radians, not degrees", lambda d: {**d, "theta": d["theta"] / DEGREE}),
+    (
+        "v_bat_mph, v_ball_mph",
+        "the two speed columns swapped (v_bat_mph holds the exit speeds)",
+        lambda d: {**d, "v_bat": d["v_ball"], "v_ball": d["v_bat"]},
+    ),
+    # last: on a tie the mistakes above are the likelier
+    ("omega_rpm", "spin with the opposite sign (omega > 0 is backspin, Fig. 2)", lambda d: {**d, "omega": -d["omega"]}),
+)
+
+
+def swapped_speeds(
+    path: str | os.PathLike[str], data: dict, usable: np.ndarray, groups: np.ndarray, r, alpha, r_x, r_y
+) -> list[str]:
+    """Problems naming bat x ball pairs whose impacts imply a median e_y below :data:`E_Y_MIN` (SI ``data``).
+
+    Such impacts came out slower, against the bat's speed, than any ball-bat collision sends
+    a ball: most often the columns v_bat_mph and v_ball_mph are swapped; the message says
+    what the median would be with them swapped back.
+    """
+    c = _collision_checks(data["v_bat"], data["v_ball"], data["theta"], data["omega"], r, alpha, r_x, r_y)
+    back = _collision_checks(data["v_ball"], data["v_bat"], data["theta"], data["omega"], r, alpha, r_x, r_y)
+    problems = []
+    for g in np.unique(groups):
+        sel = usable & (groups == g) & c.ok & np.isfinite(c.e_y)
+        if sel.sum() < 3:
+            continue
+        med = float(np.median(c.e_y[sel]))
+        if med < E_Y_MIN:
+            other = back.e_y[sel & back.ok]
+            then = f"; swapped back it would be {np.median(other):.2f}" if other.size else ""
+            problems.append(
+                f"{path}: {g}: the {int(sel.sum())} usable impacts imply a median e_y of {med:.2f} (Eq. vballn), "
+                f"below the {E_Y_MIN:g} no ball-bat collision goes under: the exit speeds are too slow for the bat "
+                f"speeds. Are the columns v_bat_mph and v_ball_mph swapped{then}?"
+            )
+    return problems
+
+
+def _score(checks: dict) -> float:
+    """Largest fraction of impacts failing one check (checks with fewer than 3 impacts skipped)."""
+    return max((bad / n for bad, n in checks.values() if n >= 3), default=0.0)
+
+
+def unit_warnings(
+    path: str | os.PathLike[str], data: dict, r: ArrayLike, alpha: ArrayLike, r_x: ArrayLike, r_y: ArrayLike
+) -> list[str]:
+    """Warnings naming a column whose values look like a unit mistake (SI ``data``).
+
+    When a physics check of :func:`implausible` fails for most impacts, each suspected
+    mistake of :data:`_MISTAKES` is undone in turn; one that makes the data plausible is
+    named with its column. Only warnings: such values are possible, just unlikely.
+    """
+    args = (r, alpha, r_x, r_y)
+    theta_deg = np.abs(data["theta"]) / DEGREE
+    if theta_deg.size >= 5 and np.all(theta_deg < 90 * DEGREE) and np.ptp(theta_deg) > 0:
+        return [
+            f"{path}: column theta_deg: every |theta| is below {90 * DEGREE:.2f} deg, a range no oblique "
+            "impacts span: the values look like radians, not degrees"
+        ]
+    raw = implausible(data["v_bat"], data["v_ball"], data["theta"], data["omega"], *args)
+    if _score(raw) <= UNIT_WARN_FRACTION:
+        return []
+    failing = "; ".join(f"{_CHECK_WORDS[k]} for {bad} of {n}" for k, (bad, n) in raw.items() if bad)
+    best = None
+    for cols, what, fix in _MISTAKES:
+        d = fix(data)
+        s = _score(implausible(d["v_bat"], d["v_ball"], d["theta"], d["omega"], *args))
+        if s <= UNIT_FIX_FRACTION and (best is None or s < best[0]):
+            best = (s, cols, what)
+    if best is None:
+        return [
+            f"{path}: most impacts are physically implausible ({failing}); check the units of "
+            "v_bat_mph and v_ball_mph (mph), theta_deg (deg) and omega_rpm (rpm, positive for backspin)"
+        ]
+    s, cols, what = best
+    return [
+        f"{path}: column {cols}: most impacts are physically implausible ({failing}); the values look like "
+        f"{what} (corrected for that, every check passes for at least {100 * (1 - s):.0f} % of impacts)"
+    ]
+
+
+# ---------------------------------------------------------------------------------------
+# The whole file
+
+
+def ingest(
+    impacts_path: str | os.PathLike[str], balls_path: str | os.PathLike[str], bats_path: str | os.PathLike[str]
+) -> tuple[xr.Dataset, list[str]]:
+    """Read and check a measured dataset; return ``(impacts in SI, warnings)``.
+
+    Raises :class:`~ballbat.properties.InputError` listing every problem that stops the
+    dataset (bad property tables included). Impacts psi cannot use stay in the output with
+    ``ingest_flag`` > 0 and the reason in ``ingest_flag_reason``.
+    """
+    problems: list[str] = []
+    balls: dict[str, Ball] | None = None
+    bats: dict[str, Bat] | None = None
+    try:
+        balls = load_balls(balls_path)
+    except InputError as exc:
+        problems += exc.problems
+    try:
+        bats = load_bats(bats_path)
+    except InputError as exc:
+        problems += exc.problems
+    try:
+        header, rows = read_impacts_table(impacts_path)
+    except InputError as exc:
+        raise InputError(problems + exc.problems) from None
+    cols, row_problems = check_rows(impacts_path, header, rows, balls, bats)
+    problems += row_problems
+    if problems:
+        raise InputError(problems)
+
+    data = {si: cols[c] * factor for c, (si, factor, _) in MEASURED_COLUMNS.items()}
+    ball_ids, bat_ids = cols["ball"].astype(str), cols["bat"].astype(str)
+    r = np.array([balls[b].r for b in ball_ids])
+    alpha = np.array([balls[b].alpha for b in ball_ids])
+    rxy = {(b, t): recoil_factors(balls[b], bats[t]) for b, t in set(zip(ball_ids, bat_ids, strict=True))}
+    r_x = np.array([rxy[(b, t)][0] for b, t in zip(ball_ids, bat_ids, strict=True)])
+    r_y = np.array([rxy[(b, t)][1] for b, t in zip(ball_ids, bat_ids, strict=True)])
+    flag, reason = exclusions(data["v_ball"], data["theta"], data["omega"], r, alpha)
+    sigma = {si: cols[f"{c}_err"] * factor for c, (si, factor, _) in MEASURED_COLUMNS.items() if f"{c}_err" in cols}
+    why = implausible_rows(
+        data["v_bat"],
+        data["v_ball"],
+        data["theta"],
+        data["omega"],
+        r,
+        alpha,
+        r_x,
+        r_y,
+        np.char.add(ball_ids, bat_ids),
+        sigma=sigma,
+        coarse=ball_ids,
+    )
+    bad = why != ""
+    flag = np.where(bad, ImpactFlag.IMPLAUSIBLE, flag).astype(np.int8)
+    reason = np.where(bad, np.char.add("implausible: ", why.astype(str)), reason)
+    if bad.sum() > IMPLAUSIBLE_MAX_FRACTION * bad.size:
+        listing = [f"{impacts_path}: {lab}: {w}" for lab, w in zip(cols["label"][bad], why[bad], strict=True)][:10]
+        raise InputError(
+            [
+                f"{impacts_path}: {int(bad.sum())} of {bad.size} impacts are measurements no ball-bat collision "
+                "can produce, more than half: the file's units are likely wrong (mph, deg, rpm expected)",
+                *unit_warnings(impacts_path, data, r, alpha, r_x, r_y),
+                *listing,
+            ]
+        )
+
+    warnings: list[str] = []
+    usable = flag == 0
+    pairs = np.array([f"ball {str(b)!r} on bat {str(t)!r}" for b, t in zip(ball_ids, bat_ids, strict=True)], dtype=str)
+    swapped = swapped_speeds(impacts_path, data, usable, pairs, r, alpha, r_x, r_y)
+    if swapped:
+        raise InputError(swapped)
+    groups = sorted({(str(b), str(t)) for b, t in zip(ball_ids, bat_ids, strict=True)})
+    counts = {g: int((usable & (ball_ids == g[0]) & (bat_ids == g[1])).sum()) for g in groups}
+    for (b, t), k in counts.items():
+        if k < MIN_FIT_IMPACTS:
+            warnings.append(
+                f"{impacts_path}: ball {b!r} on bat {t!r}: {k} usable impact(s), fewer than {MIN_FIT_IMPACTS}: "
+                "e_x of this bat is not fitted (reported as NaN); its impacts still enter the pooled fit"
+            )
+    if not any(k >= MIN_FIT_IMPACTS for k in counts.values()):
+        raise InputError(
+            [
+                f"{impacts_path}: no ball x bat pair has {MIN_FIT_IMPACTS} usable impacts "
+                f"({', '.join(f'{b} on {t}: {k}' for (b, t), k in counts.items())}): nothing to fit"
+            ]
+        )
+    errs = [c for c in MEASURED_COLUMNS if f"{c}_err" in cols]
+    if errs and len(errs) < len(MEASURED_COLUMNS):
+        given = ", ".join(f"{c}_err" for c in errs)
+        warnings.append(
+            f"{impacts_path}: only {given} of the four uncertainty columns given: the fits are unweighted "
+            "and their reduced chi-square undefined"
+        )
+    warnings += unit_warnings(impacts_path, data, r, alpha, r_x, r_y)
+
+    n = len(ball_ids)
+    out = {}
+    for c, (si, factor, long_name) in MEASURED_COLUMNS.items():
+        out[si] = variable("impact", data[si], SI_UNITS[si], f"measured {long_name}", ballbat_role="measurement")
+        if f"{c}_err" in cols:
+            out[f"{si}_err"] = variable(
+                "impact",
+                cols[f"{c}_err"] * factor,
+                SI_UNITS[si],
+                f"standard uncertainty of measured {long_name}",
+                ballbat_role="uncertainty",
+            )
+    out["impact_id"] = ("impact", cols["impact_id"].astype(str), {"long_name": "impact id given in the source file"})
+    out["source_row"] = (
+        "impact",
+        cols["label"].astype(str),
+        {"long_name": "where the impact is in the source file (CSV line number, header = 1; NetCDF index)"},
+    )
+    out["ingest_flag"] = variable(
+        "impact",
+        flag,
+        "1",
+        "exclusion flag set when the file was read (0: usable)",
+        **flag_attrs(ImpactFlag),
+    )
+    out["ingest_flag_reason"] = ("impact", reason, {"long_name": "why the impact is excluded (ok if it is not)"})
+    ds = xr.Dataset(
+        out,
+        coords={
+            "impact": ("impact", np.arange(n, dtype=np.int64), {"long_name": "impact number", "units": "1"}),
+            "ball": ("impact", ball_ids, {"long_name": "ball type (key of the ball table)"}),
+            "bat": ("impact", bat_ids, {"long_name": "bat (key of the bat table)"}),
+        },
+    )
+    ds.attrs["source_file"] = str(impacts_path)
+    ds.attrs["n_impacts"] = int(n)
+    ds.attrs["n_excluded"] = int((flag != 0).sum())
+    ds.attrs["n_warnings"] = len(warnings)
+    ds.attrs["ingest_warnings"] = "\n".join(warnings)
+    return ds, warnings
+
+
+def excluded_listing(ds: xr.Dataset) -> list[str]:
+    """One line per excluded impact: id, where it is in the file, and why."""
+    from .analysis import impact_labels
+
+    bad = np.flatnonzero(ds["ingest_flag"].values != 0)
+    labels = impact_labels(ds)
+    return [f"{labels[i]}: {ds['ingest_flag_reason'].values[i]}" for i in bad]

@@ -1,0 +1,274 @@
+"""Straight-line fits with the effective variance of each residual (lmfit).
+
+Measurement uncertainties enter through the *effective variance* of each impact's residual:
+the abscissa and the ordinate are both functions of the measured (v_bat, v_ball, theta,
+omega), so the residual y - (a + s x) has variance sum_k (dy/dm_k - s dx/dm_k)^2 sigma_k^2
+over the measured quantities m_k (correlations between x and y through psi included). The
+weights depend on the slope, so the fit is iterated (three passes converge to far below the
+standard error). Standard errors are lmfit's, scaled by the reduced chi-square (as the
+paper's standard errors come from the scatter of the data); the reduced chi-square itself
+tells whether the stated measurement uncertainties explain that scatter. 95 % intervals use
+Student's t with n - p degrees of freedom. Without uncertainties the fit is unweighted and
+the reduced chi-square is undefined (NaN). lmfit and scipy are imported inside
+:func:`fit_line` only, so that modules which merely read these names start fast.
+
+References
+----------
+.. [1] J. Orear, "Least squares when both variables have uncertainties",
+   Am. J. Phys. 50, 912 (1982) (effective variance).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+if TYPE_CHECKING:
+    from numpy.typing import ArrayLike
+
+#: Fewest usable impacts for a fit of e_x per bat or pooled; fewer give NaN with n and a note.
+MIN_FIT_IMPACTS = 3
+
+
+@dataclass(frozen=True)
+class LineFit:
+    """Result of a straight-line fit."""
+
+    slope: float
+    slope_err: float
+    slope_ci_low: float
+    slope_ci_high: float
+    intercept: float  # 0 for fits through the origin
+    intercept_err: float
+    n: int
+    redchi: float
+    success: bool
+
+    @classmethod
+    def not_fitted(cls, n: int) -> LineFit:
+        """Return the result of a fit that was not made (too few impacts) or failed: NaN with ``n``."""
+        return cls(np.nan, np.nan, np.nan, np.nan, np.nan, np.nan, n, np.nan, False)
+
+
+def _line(x, slope, intercept=0.0):
+    return intercept + slope * x
+
+
+def fit_line(
+    x: ArrayLike,
+    y: ArrayLike,
+    jx: ArrayLike = None,
+    jy: ArrayLike = None,
+    sigma: ArrayLike = None,
+    through_origin: bool = True,
+    iterations: int = 3,
+    robust: bool = False,
+) -> LineFit:
+    """Fit y = slope x (+ intercept) with lmfit, weighting by the effective variance.
+
+    Parameters
+    ----------
+    x, y : (n,) arrays.
+    jx, jy : (n, k) partial derivatives of x and y with respect to the k measured
+        quantities; ``sigma`` (n, k) their standard uncertainties. All three or none.
+    through_origin : fit y = slope x (Eq. omega, Eq. ratio) or a line with intercept.
+    robust : standard errors from the sandwich (HC3, :func:`sandwich_cov`) instead of the
+        covariance scaled by the reduced chi-square: for lines that summarise data the
+        model does not describe impact by impact (Figs. 3-4: bats of different e_x, spin
+        and speed not exactly linear in theta), whose scatter about the line is not the
+        same everywhere.
+    """
+    import lmfit
+    from scipy import stats
+
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    n = x.size
+    p = 1 if through_origin else 2
+    if n <= p:
+        return LineFit.not_fitted(n)
+    model = lmfit.Model(_line, independent_vars=["x"])
+    params = model.make_params(slope=1.0, intercept=0.0)
+    if through_origin:
+        params["intercept"].set(value=0.0, vary=False)
+    weighted = sigma is not None and np.all(np.isfinite(sigma)) and np.any(np.asarray(sigma) > 0)
+    # Closed-form start (ordinary least squares) keeps lmfit's iterations few.
+    if through_origin:
+        params["slope"].set(value=float(np.dot(x, y) / np.dot(x, x)))
+    else:
+        s0, c0 = np.polyfit(x, y, 1)
+        params["slope"].set(value=float(s0))
+        params["intercept"].set(value=float(c0))
+    weights = None
+    result = None
+    for _ in range(iterations if weighted else 1):
+        if weighted:
+            s = params["slope"].value
+            var = np.sum((np.asarray(jy) - s * np.asarray(jx)) ** 2 * np.asarray(sigma) ** 2, axis=1)
+            if np.any(var <= 0):
+                weights = None
+                weighted = False
+            else:
+                weights = 1.0 / np.sqrt(var)
+        result = model.fit(y, params, x=x, weights=weights, scale_covar=True)
+        params = result.params
+    if not result.success or result.params["slope"].stderr is None:
+        return LineFit.not_fitted(n)
+    slope = float(result.params["slope"].value)
+    err = float(result.params["slope"].stderr)
+    tq = float(stats.t.ppf(0.975, n - p))
+    icpt = 0.0 if through_origin else float(result.params["intercept"].value)
+    icpt_err = 0.0 if through_origin else float(result.params["intercept"].stderr)
+    if robust:
+        X = x[:, None] if through_origin else np.stack([x, np.ones_like(x)], axis=1)
+        w = np.ones(n) if weights is None else np.asarray(weights, dtype=float)
+        cov = sandwich_cov(X * w[:, None], (y - slope * x - icpt) * w)
+        err = float(np.sqrt(cov[0, 0]))
+        icpt_err = 0.0 if through_origin else float(np.sqrt(cov[1, 1]))
+    return LineFit(
+        slope=slope,
+        slope_err=err,
+        slope_ci_low=slope - tq * err,
+        slope_ci_high=slope + tq * err,
+        intercept=icpt,
+        intercept_err=icpt_err,
+        n=n,
+        redchi=float(result.redchi) if weighted else np.nan,
+        success=True,
+    )
+
+
+def _strata_blocks(n: int, strata: ArrayLike | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Stratum index of each row, and per stratum its size n_b, the factor f_b and the centering switch c_b.
+
+    Without strata every row is one uncentred block (f = 1, c = 0): the plain sandwich. With
+    strata, each stratum's scores are centred on their mean (c = 1) and scaled by
+    f_b = n_b/(n_b - 1). Strata of one row cannot be centred; they are pooled into one
+    stratum, which stays uncentred (f = 1, c = 0) if it holds a single row.
+    """
+    if strata is None:
+        return np.zeros(n, dtype=np.int64), np.array([float(n)]), np.ones(1), np.zeros(1)
+    labels = np.asarray(strata)
+    if labels.shape != (n,):
+        raise ValueError(f"sandwich: strata must have one label per row ({n}); got shape {labels.shape}")
+    _, idx, counts = np.unique(labels, return_inverse=True, return_counts=True)
+    single = counts[idx] == 1
+    idx = np.where(single, counts.size, idx)  # pool the single-row strata
+    _, idx = np.unique(idx, return_inverse=True)
+    nb = np.bincount(idx).astype(float)
+    centred = nb > 1
+    f = np.where(centred, nb / np.maximum(nb - 1.0, 1.0), 1.0)
+    return idx, nb, f, centred.astype(float)
+
+
+def _hc3_parts(J: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(J'J)^-1 and the leverages h_i = J_i (J'J)^-1 J_i'."""
+    A = np.linalg.inv(J.T @ J)
+    h = np.einsum("ij,jk,ik->i", J, A, J)
+    return A, np.minimum(h, 1.0 - 1e-12)
+
+
+def sandwich_cov(J: ArrayLike, r: ArrayLike, strata: ArrayLike | None = None) -> np.ndarray:
+    """Heteroscedasticity-consistent (HC3) covariance of least-squares parameters.
+
+    ``J`` (n, p) is the Jacobian of the weighted model (for a line, the weighted design
+    matrix) and ``r`` (n,) the weighted residuals at the fit. The covariance is
+    (J'J)^-1 M (J'J)^-1 with the scores u_i = J_i r_i / (1 - h_i) and the leverages h_i
+    (MacKinnon and White 1985): it holds whether or not the scatter about the model is the
+    same for every point, and whether or not the stated uncertainties explain it.
+
+    Without ``strata``, M = sum_i u_i u_i'. With ``strata`` (one label per row: the fixed
+    groups of a stratified design, such as the bats of an experiment whose number of impacts
+    per bat is chosen), M = sum_b n_b/(n_b - 1) sum_{i in b} (u_i - u_b)(u_i - u_b)' with u_b
+    the stratum's mean score: a misfit common to a stratum is the same in every repetition
+    of the design and is not counted as scatter (the stratified variance of survey sampling,
+    e.g. Cochran, *Sampling Techniques*, 3rd ed., Sec. 5.3). Strata of one row are pooled.
+
+    Returns
+    -------
+    ndarray
+        (p, p).
+    """
+    J = np.asarray(J, dtype=float)
+    r = np.asarray(r, dtype=float)
+    A, h = _hc3_parts(J)
+    if strata is None:
+        u = r / (1.0 - h)
+        return A @ (J.T @ (u[:, None] ** 2 * J)) @ A
+    u = J * (r / (1.0 - h))[:, None]
+    idx, nb, f, c = _strata_blocks(J.shape[0], strata)
+    mean = np.zeros((f.size, u.shape[1]))
+    np.add.at(mean, idx, u)
+    u = u - (c / nb)[idx, None] * mean[idx]
+    B = (u * f[idx, None]).T @ u
+    return A @ B @ A
+
+
+def sandwich_dof(J: ArrayLike, strata: ArrayLike | None = None, column: int = 0) -> float:
+    """Bell-McCaffrey degrees of freedom of one parameter's :func:`sandwich_cov` variance.
+
+    The sandwich variance of parameter ``column`` is a quadratic form r'Wr in the residuals.
+    If the errors were independent with equal variance, it would be distributed as a
+    multiple of chi^2 with nu = (tr W)^2 / tr(W^2) degrees of freedom (Satterthwaite); the
+    interval uses Student's t with nu (Bell and McCaffrey, Survey Methodology 28, 169 (2002);
+    Imbens and Kolesar, Rev. Econ. Stat. 98, 701 (2016)). nu depends on the design only, not
+    on the residuals, and is smaller than n - p when a few points carry the fit: the variance
+    estimate then rests on few of them. Computed in O(n p^2) from the low-rank structure of W.
+
+    Parameters
+    ----------
+    J : (n, p) Jacobian of the weighted model at the fit.
+    strata : labels as for :func:`sandwich_cov`, or None.
+    column : the parameter.
+
+    Returns
+    -------
+    float
+    """
+    J = np.asarray(J, dtype=float)
+    n = J.shape[0]
+    A, h = _hc3_parts(J)
+    a = (J @ A[:, column]) / (1.0 - h)  # the diagonal of D: the parameter's score weights
+    idx, nb, f, c = _strata_blocks(n, strata)
+    K = J @ A  # the projection onto the model is P = K J'
+
+    def apply_b(X: np.ndarray) -> np.ndarray:
+        """B X with B = D C D: per stratum f_b (diag(a^2) - c_b a a'/n_b)."""
+        s = np.zeros((f.size, X.shape[1]))
+        np.add.at(s, idx, a[:, None] * X)
+        return f[idx, None] * (a[:, None] ** 2 * X - (c / nb)[idx, None] * a[:, None] * s[idx])
+
+    a2 = np.bincount(idx, weights=a**2, minlength=f.size)
+    a4 = np.bincount(idx, weights=a**4, minlength=f.size)
+    tr_b = float(np.sum(f * (1.0 - c / nb) * a2))
+    tr_bb = float(np.sum(f**2 * (a4 - 2.0 * c * a4 / nb + c * a2**2 / nb**2)))
+    BK = apply_b(K)
+    Q = J.T @ BK  # tr(B P) = tr(Q)
+    tr_bbp = float(np.trace(J.T @ apply_b(BK)))
+    tr_w = tr_b - float(np.trace(Q))
+    tr_ww = tr_bb - 2.0 * tr_bbp + float(np.trace(Q @ Q))
+    return tr_w**2 / tr_ww
+
+
+def wls_slope(
+    x: ArrayLike, y: ArrayLike, weights: ArrayLike = None, through_origin: bool = True
+) -> tuple[float, float]:
+    """Weighted least-squares (slope, intercept) in closed form (used for truth values)."""
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    w = np.ones_like(x) if weights is None else np.asarray(weights, dtype=float) ** 2
+    if through_origin:
+        return float(np.sum(w * x * y) / np.sum(w * x * x)), 0.0
+    xm = np.sum(w * x) / np.sum(w)
+    ym = np.sum(w * y) / np.sum(w)
+    s = np.sum(w * (x - xm) * (y - ym)) / np.sum(w * (x - xm) ** 2)
+    return float(s), float(ym - s * xm)
+
+
+def effective_sigma(jx: ArrayLike, jy: ArrayLike, sigma: ArrayLike, slope: ArrayLike) -> np.ndarray | None:
+    """Return the standard deviation of y - slope x from the measurement uncertainties (effective variance)."""
+    if sigma is None:
+        return None
+    return np.sqrt(np.sum((jy - slope * jx) ** 2 * sigma**2, axis=1))

@@ -1,0 +1,99 @@
+"""Which package modules a workflow script depends on (so results never outlive code).
+
+Snakemake reruns a job when its script changes, but not when a module the script imports
+changes. The workflow therefore lists, as inputs of every rule, the source files of the
+ballbat modules its script imports, directly or through other ballbat modules. Editing
+one of them makes exactly the dependent outputs out of date; an unrelated edit (README,
+another module) does not. Standard library only: this runs when the Snakefile is parsed.
+"""
+
+from __future__ import annotations
+
+import re
+from functools import cache
+from pathlib import Path
+
+PACKAGE = "ballbat"
+PACKAGE_DIR = Path(__file__).resolve().parent.parent  # src/ballbat
+
+
+_IMPORT = re.compile(
+    r"^[ \t]*(?:from[ \t]+(?P<from>\.+[\w.]*|[\w.]+)[ \t]+import[ \t]+(?P<names>\([^)]*\)|[^\n#]+)"
+    r"|import[ \t]+(?P<mods>[^\n#]+))",
+    re.MULTILINE,
+)
+
+
+@cache
+def _imports_cached(path: str, mtime_ns: int, module: str | None) -> frozenset[str]:
+    found: set[str] = set()
+    for m in _IMPORT.finditer(Path(path).read_text()):
+        if m.group("mods"):
+            for part in m.group("mods").split(","):
+                name = part.split(" as ")[0].strip()
+                if name == PACKAGE or name.startswith(PACKAGE + "."):
+                    found.add(name)
+            continue
+        target = m.group("from")
+        if target.startswith("."):  # relative import inside the package
+            level = len(target) - len(target.lstrip("."))
+            base = PACKAGE if module is None else module.rsplit(".", level)[0]
+            rest = target[level:]
+            target = f"{base}.{rest}" if rest else base
+        if target == PACKAGE or target.startswith(PACKAGE + "."):
+            found.add(target)
+            for part in m.group("names").strip("()").split(","):
+                name = part.split(" as ")[0].strip()
+                cand = f"{target}.{name}"
+                if name and _module_file(cand) is not None:  # from ballbat import kinematics
+                    found.add(cand)
+    return frozenset(found)
+
+
+def _imports(path: Path, module: str | None) -> set[str]:
+    """Ballbat submodule names imported anywhere in ``path`` (``module`` is its own name).
+
+    Reads import statements with a regular expression (this runs every time Snakemake parses
+    the workflow, where a full parse of every module would cost a noticeable fraction of a
+    no-op run); results are cached per file and modification time.
+    """
+    return set(_imports_cached(str(path), path.stat().st_mtime_ns, module))
+
+
+def _module_file(name: str) -> Path | None:
+    parts = name.split(".")[1:]
+    if not parts:
+        return PACKAGE_DIR / "__init__.py"
+    p = PACKAGE_DIR.joinpath(*parts)
+    if p.with_suffix(".py").is_file():
+        return p.with_suffix(".py")
+    if (p / "__init__.py").is_file():
+        return p / "__init__.py"
+    return None
+
+
+@cache
+def _modules(script: str) -> dict[str, Path]:
+    """Every ballbat module ``script`` imports, transitively: name -> source file."""
+    todo = sorted(_imports(Path(script), None))
+    seen: dict[str, Path] = {PACKAGE: PACKAGE_DIR / "__init__.py"}
+    while todo:
+        name = todo.pop()
+        if name in seen:
+            continue
+        f = _module_file(name)
+        if f is None:
+            continue
+        seen[name] = f
+        todo += sorted(_imports(f, name if f.name != "__init__.py" else name + "._"))
+    return seen
+
+
+def module_files(script: str) -> tuple[str, ...]:
+    """Source files of every ballbat module ``script`` imports, transitively (sorted)."""
+    return tuple(sorted(str(p) for p in _modules(script).values()))
+
+
+def module_names(script: str) -> tuple[str, ...]:
+    """Dotted names of every ballbat module ``script`` imports, transitively (sorted)."""
+    return tuple(sorted(_modules(script)))

@@ -1,0 +1,396 @@
+"""Validation of the workflow config against its JSON schema, with messages that name keys.
+
+Used by ``workflow/rules/common.smk`` when the workflow starts. Every problem is reported
+at once, each with the dotted path of the offending key (``datasets.synthetic.seed: 'x'
+is not of type 'integer'``). Missing keys that the schema gives a ``default`` are filled in.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+import re
+from typing import TYPE_CHECKING
+
+if TYPE_CHECKING:
+    import os
+
+
+class ConfigError(ValueError):
+    """The config does not match the schema."""
+
+
+#: Names the workflow uses for folders and files of its own under ``results/`` (and ``all``,
+#: the default rule): a dataset may not take them, nor, in ``results/implications/``, a scenario.
+RESERVED_DATASET_NAMES = ("all", "benchmarks", "figures", "implications", "logs", "report", "studies", "tracks")
+RESERVED_SCENARIO_NAMES = ("benchmarks", "figures", "logs", "paper_comparison", "results")
+
+#: What a dataset or scenario may be called: letters, digits, _ and - (a folder and file name).
+NAME = re.compile(r"[A-Za-z0-9_-]+")
+
+#: Bytes of memory one impact and one batted-ball case need. Measured peaks (ru_maxrss, default
+#: stack, 2026-11): simulate + normalize + reconstruct + fit_ex + fit_stronge of 10^5 impacts
+#: ~1.0 kB per impact (4 kB here leaves room for the NetCDF copies); a D sweep of 10^4 and
+#: 4 x 10^4 cases with 101 trajectory samples 59 and 52 kB per case.
+BYTES_PER_IMPACT = 4_000
+BYTES_PER_CASE = 60_000
+#: An impact rendered as camera tracks and reduced (dense tracks of both cameras, the fits'
+#: arrays): 34-35 kB measured (2026-11, 7000 and 28000 impacts through render, reduce and the
+#: Sec. IV fits); 50 kB leaves room.
+BYTES_PER_TRACKED_IMPACT = 50_000
+
+
+def impact_bytes(dataset: dict) -> int:
+    """Return the memory one impact of a dataset's chain may need (bytes): more when it renders tracks."""
+    renders = bool((dataset.get("render") or {}).get("enabled", False)) or "tracks" in dataset
+    return BYTES_PER_TRACKED_IMPACT if renders else BYTES_PER_IMPACT
+
+
+#: Share of the machine's available memory one job may plan to use.
+MEMORY_SHARE = 0.5
+
+#: A study's aggregate memory per replicate: 4 numbers of 8 bytes per quantity (21 quantities in
+#: the paper's design: 0.7 kB), copied about 3 times while the batches are combined; 4 kB leaves
+#: room for more bats. Measured: 190 MB in all for the calibration study's 1000 replicates.
+STUDY_BYTES_PER_REPLICATE = 4_000
+#: Most batch jobs one study may have: Snakemake builds its job graph before running anything,
+#: and at 10^5 jobs that takes minutes and gigabytes (10^7 replicates had not finished after 300 s
+#: at 4.2 GB); a larger study needs a larger ``batch_size``.
+MAX_STUDY_BATCHES = 10_000
+
+
+def study_impacts(dataset: dict, parameter: str | None, values: list, truth_impacts: int) -> tuple[int, int]:
+    """Impacts of a study's largest replicate, and of its noise-free design (the truth job), per sweep point."""
+    impacts = dataset["synthetic"]["impacts"]
+    pairs = sum(len(v or {}) for v in impacts.values())
+    most = max((int(n) for v in impacts.values() for n in (v or {}).values()), default=0)
+    counts = [int(v) for v in values] if parameter == "impacts_per_bat" else [most]
+    return pairs * max(counts), pairs * max(int(truth_impacts), max(counts))
+
+
+def drop_nulls(config: dict) -> dict:
+    """Drop datasets, scenarios and studies set to null (``datasets: {synthetic: null}`` in an override).
+
+    A study of a dataset dropped this way is dropped with it (it has nothing to replicate).
+    """
+    dropped = set()
+    if isinstance(config.get("datasets"), dict):
+        dropped = {k for k, v in config["datasets"].items() if v is None}
+        config["datasets"] = {k: v for k, v in config["datasets"].items() if v is not None}
+    if isinstance(config.get("studies"), dict):
+        config["studies"] = {
+            k: v
+            for k, v in config["studies"].items()
+            if v is not None and not (isinstance(v, dict) and v.get("dataset") in dropped)
+        }
+    imp = config.get("implications")
+    if isinstance(imp, dict) and isinstance(imp.get("scenarios"), dict):
+        imp["scenarios"] = {k: v for k, v in imp["scenarios"].items() if v is not None}
+    return config
+
+
+def _names(config: dict) -> list[str]:
+    problems = []
+    groups = (
+        ("datasets", config.get("datasets") or {}, RESERVED_DATASET_NAMES, "results/{name}/"),
+        (
+            "implications.scenarios",
+            (config.get("implications") or {}).get("scenarios") or {},
+            RESERVED_SCENARIO_NAMES,
+            "results/implications/{name}.*",
+        ),
+    )
+    groups += (("studies", config.get("studies") or {}, (), "results/studies/{name}/"),)
+    for where, table, reserved, folder in groups:
+        if not isinstance(table, dict):
+            continue
+        for name in table:
+            if not isinstance(name, str):
+                kind = "a boolean (as yes, no, on, off)" if isinstance(name, bool) else "a number"
+                problems.append(
+                    f"{where}.{name}: YAML reads this name as {kind}, not text; a name must be text: "
+                    "quote it in the YAML file (e.g. '123') or choose a name that starts with a letter"
+                )
+            elif not NAME.fullmatch(str(name)):
+                problems.append(f"{where}.{name!r}: a name may hold only letters, digits, _ and - (it names {folder})")
+            elif name in reserved:
+                problems.append(
+                    f"{where}.{name}: {name!r} is reserved for the workflow's own results "
+                    f"(reserved: {', '.join(reserved)}); choose another name"
+                )
+    return problems
+
+
+def _studies(config: dict) -> list[str]:
+    """Check that each study names a synthetic dataset and that its sweep suits that dataset."""
+    from ..sweeps import check_sweep
+
+    problems = []
+    datasets = config.get("datasets") or {}
+    for name, study in (config.get("studies") or {}).items():
+        where = f"studies.{name}"
+        ds = datasets.get(study["dataset"])
+        if ds is None:
+            problems.append(
+                f"{where}.dataset: no dataset {study['dataset']!r} (datasets: {', '.join(datasets)}); "
+                f"name one, or drop the study with {where}: null"
+            )
+        elif "synthetic" not in ds:
+            problems.append(
+                f"{where}.dataset: {study['dataset']!r} is not synthetic (a study replicates a synthetic experiment)"
+            )
+        else:
+            sweep = study.get("sweep") or {}
+            problems += check_sweep(ds, sweep.get("parameter"), sweep.get("values", ()), where)
+    return problems
+
+
+def _synthetic_keys(config: dict) -> list[str]:
+    """Check that the per-ball and per-bat mappings of each synthetic dataset name the balls and bats it draws.
+
+    ``impacts`` names the balls and, under each, the bats; ``e_x`` must give every one of these
+    pairs and no other, ``e_y`` every ball, and ``psi_deg`` only these balls: a misspelt name
+    (``psi_deg: {basebal: ...}``) would otherwise be ignored and the default used silently.
+    """
+    problems = []
+    for name, ds in (config.get("datasets") or {}).items():
+        syn = ds.get("synthetic") if isinstance(ds, dict) else None
+        if not isinstance(syn, dict):
+            continue
+        where = f"datasets.{name}.synthetic"
+        impacts = {b: set(v or {}) for b, v in (syn.get("impacts") or {}).items()}
+        balls = ", ".join(map(str, impacts)) or "none"
+        for key in ("e_x", "e_y", "psi_deg"):
+            for ball in syn.get(key) or {}:
+                if ball not in impacts:
+                    problems.append(
+                        f"{where}.{key}.{ball}: unknown ball (the balls of {where}.impacts: {balls}); a misspelt name?"
+                    )
+        for ball, bats in impacts.items():
+            e_x = (syn.get("e_x") or {}).get(ball)
+            if e_x is None:
+                problems.append(f"{where}.e_x: no entry for ball {ball} (it has impacts); give its true e_x per bat")
+            else:
+                for bat in sorted(set(e_x) - bats, key=str):
+                    problems.append(
+                        f"{where}.e_x.{ball}.{bat}: unknown bat (the bats of {where}.impacts.{ball}: "
+                        f"{', '.join(map(str, bats))}); a misspelt name?"
+                    )
+                for bat in sorted(bats - set(e_x), key=str):
+                    problems.append(f"{where}.e_x.{ball}: no entry for bat {bat} (it has impacts); give its true e_x")
+            if ball not in (syn.get("e_y") or {}):
+                problems.append(f"{where}.e_y: no entry for ball {ball} (it has impacts); give its true e_y")
+    return problems
+
+
+def _finite(node: object, where: str = "") -> list[str]:
+    """Name every number that is not finite (``.nan``, ``.inf``): no range check can hold it."""
+    if isinstance(node, dict):
+        return [p for k, v in node.items() for p in _finite(v, f"{where}.{k}" if where else str(k))]
+    if isinstance(node, list):
+        return [p for i, v in enumerate(node) for p in _finite(v, f"{where}[{i}]")]
+    if isinstance(node, float) and not math.isfinite(node):
+        return [f"{where}: {node} is not a finite number"]
+    return []
+
+
+def _offsets(config: dict) -> list[str]:
+    """Refuse a D sweep of one offset that names a stop it would drop."""
+    problems = []
+    for name, sc in ((config.get("implications") or {}).get("scenarios") or {}).items():
+        d = (sc.get("sweep") or {}).get("D_in") if isinstance(sc, dict) else None
+        if isinstance(d, dict) and d.get("num") == 1 and d.get("start") != d.get("stop"):
+            problems.append(
+                f"implications.scenarios.{name}.sweep.D_in: num 1 gives the one offset start = {d['start']} in, "
+                f"so stop = {d['stop']} would be dropped; give num >= 2, or stop equal to start"
+            )
+    return problems
+
+
+def _available_memory() -> int:
+    """Return the memory available to a job, bytes (psutil; /proc/meminfo as a fallback)."""
+    try:
+        import psutil
+
+        return int(psutil.virtual_memory().available)
+    except ImportError:  # pragma: no cover - psutil ships with snakemake
+        with open("/proc/meminfo") as fh:
+            info = dict(line.split(":", 1) for line in fh)
+        return int(info["MemAvailable"].split()[0]) * 1024
+
+
+def _sizes(config: dict, available: int) -> list[str]:
+    """Refuse counts the machine cannot hold, with the estimate; refuse empty datasets."""
+    problems = []
+    budget = MEMORY_SHARE * available
+
+    def check(where: str, count: int, per: int, what: str) -> None:
+        need = count * per
+        if need > budget:
+            problems.append(
+                f"{where}: {count:,} {what} need about {need / 2**30:.1f} GiB of memory (estimate: "
+                f"{per:,} bytes each), more than half the {available / 2**30:.1f} GiB this machine has "
+                "available; use fewer"
+            )
+
+    for name, ds in (config.get("datasets") or {}).items():
+        syn = ds.get("synthetic") if isinstance(ds, dict) else None
+        if not isinstance(syn, dict):
+            continue
+        total = sum(int(n) for bats in (syn.get("impacts") or {}).values() for n in (bats or {}).values())
+        if total == 0:
+            problems.append(f"datasets.{name}.synthetic.impacts: no impacts (every count is 0): nothing to fit")
+        check(f"datasets.{name}.synthetic.impacts", total, impact_bytes(ds), "impacts")
+    datasets = config.get("datasets") or {}
+    for name, st in (config.get("studies") or {}).items():
+        ds = datasets.get(st.get("dataset")) if isinstance(st, dict) else None
+        if isinstance(ds, dict) and isinstance(ds.get("synthetic"), dict):
+            sweep = st.get("sweep") or {}
+            values = sweep.get("values") or []
+            one, truth = study_impacts(ds, sweep.get("parameter"), values, st["truth_impacts"])
+            where = f"studies.{name}"
+            if sweep.get("parameter") == "impacts_per_bat":
+                check(f"{where}.sweep.values", one, impact_bytes(ds), "impacts in one replicate")
+            check(f"{where}.truth_impacts", truth, impact_bytes(ds), "impacts")
+            total = int(st["replicates"]) * max(len(values), 1)
+            check(f"{where}.replicates", total, STUDY_BYTES_PER_REPLICATE, "replicates (all sweep points)")
+            batches = -(-total // int(st["batch_size"]))
+            if batches > MAX_STUDY_BATCHES:
+                problems.append(
+                    f"{where}.replicates: {total:,} replicates in batches of {int(st['batch_size'])} make "
+                    f"{batches:,} batch jobs, more than the {MAX_STUDY_BATCHES:,} a job graph can hold in reasonable "
+                    "time and memory; use fewer replicates or a larger batch_size"
+                )
+    for name, sc in ((config.get("implications") or {}).get("scenarios") or {}).items():
+        if "sweep" in sc:
+            check(
+                f"implications.scenarios.{name}.sweep.D_in.num",
+                int(sc["sweep"]["D_in"]["num"]),
+                BYTES_PER_CASE,
+                "cases",
+            )
+        elif "launch" in sc:
+            sizes = [len(v) if isinstance(v, list) else 1 for k, v in sc["launch"].items() if k != "combine"]
+            grid = sc["launch"].get("combine", "grid") == "grid"
+            count = math.prod(sizes) if grid else max(sizes)
+            check(f"implications.scenarios.{name}.launch", count, BYTES_PER_CASE, "cases")
+    return problems
+
+
+def _path(error) -> str:
+    return ".".join(str(p) for p in error.absolute_path) or "<top level>"
+
+
+def _message(error) -> str:
+    if error.validator == "additionalProperties":
+        allowed = sorted(error.schema.get("properties", {}))
+        extra = sorted(set(error.instance) - set(allowed))
+        pattern = error.schema.get("patternProperties")
+        if pattern:
+            return f"{_path(error)}: key(s) {', '.join(map(repr, extra))} not allowed ({error.message})"
+        where = _path(error)
+        return "; ".join(
+            f"{where + '.' if where != '<top level>' else ''}{k}: unknown key (allowed: {', '.join(allowed)})"
+            for k in extra
+        )
+    if error.validator == "oneOf" and not error.context:  # more than one form matches
+        forms = [" + ".join(f.get("required", [])) or "?" for f in error.validator_value]
+        return f"{_path(error)}: give exactly one of {', '.join(forms)}, not several"
+    if error.validator in ("oneOf", "anyOf") and error.context:
+        relevant = [e for e in error.context if e.validator != "type"]
+        if relevant and len(relevant) < len(error.context):  # a number or a list: the form it has
+            return "; ".join(sorted({_message(e) for e in relevant}))
+        inner = sorted({_message(e) for e in error.context})
+        return f"{_path(error)}: matches none of the allowed forms: " + " | ".join(inner)
+    if error.validator in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"):
+        about = error.schema.get("description")
+        return f"{_path(error)}: {error.message}" + (f" ({about})" if about else "")
+    return f"{_path(error)}: {error.message}"
+
+
+def _resolve(schema, root):
+    """Follow a local ``$ref`` (``#/$defs/name``)."""
+    while "$ref" in schema and schema["$ref"].startswith("#/"):
+        target = root
+        for part in schema["$ref"][2:].split("/"):
+            target = target[part]
+        schema = {**target, **{k: v for k, v in schema.items() if k != "$ref"}}
+    return schema
+
+
+def fill_defaults(instance: object, schema: dict, root: dict | None = None) -> object:
+    """Fill missing keys that have a ``default`` in ``schema`` (recursively, in place).
+
+    Each default is stated once, on the key it belongs to: a missing object whose
+    properties have defaults is created empty and filled, so no object restates the
+    defaults of its members.
+    """
+    root = schema if root is None else root
+    schema = _resolve(schema, root)
+    if not isinstance(instance, dict) or schema.get("type") != "object":
+        return instance
+    props = schema.get("properties", {})
+    # keys that choose one form of the object (oneOf/anyOf: synthetic | impacts) are never created
+    optional_forms = set(schema.get("required", ()))
+    for form in (*schema.get("oneOf", ()), *schema.get("anyOf", ())):
+        optional_forms.update(form.get("required", ()))
+    for key, sub in props.items():
+        sub = _resolve(sub, root)
+        if key not in instance and "default" in sub:
+            instance[key] = copy.deepcopy(sub["default"])
+        elif (
+            key not in instance
+            and sub.get("type") == "object"
+            and key not in optional_forms
+            and not sub.get("required")  # an object with required keys is the user's to give
+        ):
+            if any("default" in _resolve(v, root) for v in sub.get("properties", {}).values()):
+                instance[key] = {}
+        if key in instance:
+            fill_defaults(instance[key], sub, root)
+    if isinstance(schema.get("additionalProperties"), dict):
+        for key, val in instance.items():
+            if key not in props:
+                fill_defaults(val, schema["additionalProperties"], root)
+    return instance
+
+
+def validate_config(config: dict, schema: dict, source: str = "config", available: int | None = None) -> dict:
+    """Check ``config`` against ``schema``; fill defaults; raise :class:`ConfigError` listing all problems.
+
+    Beyond the schema: names of datasets and scenarios (the whole name, reserved names) and
+    counts the machine cannot hold (``available`` bytes of memory; default: what it has now).
+    """
+    import jsonschema
+
+    validator = jsonschema.Draft202012Validator(schema)
+    errors = sorted(validator.iter_errors(config), key=lambda e: (list(map(str, e.absolute_path)), e.message))
+    lines = [_message(e) for e in errors] + _names(config) + _finite(config)
+    if not lines:
+        lines = _synthetic_keys(config) + _offsets(config)
+    if not lines:
+        fill_defaults(config, schema)
+        lines = _studies(config) + _sizes(config, _available_memory() if available is None else available)
+    if lines:
+        raise ConfigError(f"{source} is not valid:\n  " + "\n  ".join(lines))
+    return config
+
+
+def load_config(path: str | os.PathLike[str] | None = None, schema_path: str | os.PathLike[str] | None = None) -> dict:
+    """Return the workflow's config file (default ``config/config.yaml``), validated, with the schema's defaults.
+
+    For callers outside Snakemake (tests, benchmarks, examples) that need the same values
+    the workflow uses. Paths default to the repository checkout this package lives in.
+    """
+    from pathlib import Path
+
+    import yaml
+
+    root = Path(__file__).resolve().parents[3]
+    path = Path(path) if path else root / "config" / "config.yaml"
+    schema_path = Path(schema_path) if schema_path else root / "workflow" / "schemas" / "config.schema.yaml"
+    with open(schema_path) as fh:
+        schema = yaml.safe_load(fh)
+    with open(path) as fh:
+        config = yaml.safe_load(fh)
+    return validate_config(config, schema, source=str(path))

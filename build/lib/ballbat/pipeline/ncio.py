@@ -1,0 +1,122 @@
+"""NetCDF input and output with units, metadata and provenance.
+
+:func:`write_dataset` is the one way the workflow writes results: it checks that every
+variable has ``units`` and ``long_name``, sets the CF-style global attributes
+(Conventions, title, source, history, references) and the provenance records, and writes
+atomically (a temporary file in the same directory, renamed into place), so a failed job
+never leaves a half-written file. :func:`read_dataset` loads a file fully and checks it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import xarray as xr
+
+from .. import __version__
+from .atomic import atomic_target
+from .provenance import data_inputs, provenance_attrs
+
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Mapping
+
+CONVENTIONS = "CF-1.10"
+REFERENCES = (
+    "J. R. Kensrud, A. M. Nathan and L. V. Smith, 'Oblique collisions of baseballs and "
+    "softballs with a bat', Am. J. Phys. 85, 503 (2017), doi:10.1119/1.4982793"
+)
+
+
+class MetadataError(ValueError):
+    """A dataset lacks the metadata every results file must carry."""
+
+
+def check_metadata(ds: xr.Dataset, where: str = "dataset") -> None:
+    """Raise :class:`MetadataError` naming every variable without ``units`` or ``long_name``."""
+    missing = []
+    for name, var in {**ds.data_vars, **ds.coords}.items():
+        if var.dtype.kind in "OSU":  # labels: long_name only
+            if "long_name" not in var.attrs:
+                missing.append(f"{name}: long_name")
+            continue
+        for attr in ("units", "long_name"):
+            if attr not in var.attrs:
+                missing.append(f"{name}: {attr}")
+    if missing:
+        raise MetadataError(f"{where}: variables lack metadata: " + "; ".join(missing))
+
+
+def write_dataset(
+    ds: xr.Dataset,
+    path: str | os.PathLike[str],
+    *,
+    title: str,
+    rule: str,
+    inputs: Mapping[str, object],
+    config: dict,
+    history: str | None = None,
+) -> Path:
+    """Write ``ds`` to NetCDF at ``path`` with metadata and provenance, atomically."""
+    path = Path(path)
+    check_metadata(ds, str(path))
+    ds = ds.copy()
+    ds.attrs = {
+        **{k: v for k, v in ds.attrs.items() if not k.startswith("provenance_")},
+        "Conventions": CONVENTIONS,
+        "title": title,
+        "source": f"ballbat {__version__}, rule {rule}",
+        "history": history or f"written by ballbat {__version__} rule {rule} (times are in the workflow logs)",
+        "references": REFERENCES,
+        **provenance_attrs(rule, inputs, config),
+    }
+    encoding = {}
+    for name, var in ds.variables.items():
+        if name in ds.coords:  # CF: coordinates have no missing values, so no _FillValue
+            encoding[name] = {"_FillValue": None}
+            if var.dtype.kind in "OU":
+                encoding[name]["dtype"] = str
+        elif var.dtype.kind == "f":
+            encoding[name] = {"_FillValue": np.nan}
+        elif var.dtype.kind in "OU":
+            encoding[name] = {"dtype": str}
+    with atomic_target(path) as tmp:
+        ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=encoding)
+    return path
+
+
+def write_job_output(ds: xr.Dataset, job: object, output: str, title: str, config: dict | None = None) -> Path:
+    """Write ``ds`` to a Snakemake job's output ``output``, with the job's provenance.
+
+    ``job`` is the ``snakemake`` object of a rule's script: its rule name, its data inputs
+    (:func:`~ballbat.pipeline.provenance.data_inputs`) and, unless ``config`` is given, its
+    params are recorded.
+    """
+    return write_dataset(
+        ds,
+        job.output[output],
+        title=title,
+        rule=job.rule,
+        inputs=data_inputs(job.input),
+        config=dict(job.params) if config is None else config,
+    )
+
+
+def read_dataset(path: str | os.PathLike[str], require: tuple[str, ...] = ()) -> xr.Dataset:
+    """Load a results file fully into memory and check the variables ``require`` names."""
+    with xr.open_dataset(path, engine="netcdf4") as ds:
+        ds = ds.load()
+    missing = [v for v in require if v not in ds.variables]
+    if missing:
+        raise MetadataError(f"{path}: missing variable(s) {', '.join(missing)}")
+    return ds
+
+
+def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
+    """Write a text file atomically (temporary file renamed into place)."""
+    path = Path(path)
+    with atomic_target(path) as tmp:
+        tmp.write_text(text, newline="")
+    return path

@@ -1,0 +1,139 @@
+"""Provenance: what produced a results file (inputs, config, code, software).
+
+Every NetCDF file the workflow writes carries these records as JSON-string attributes
+(NetCDF attributes cannot hold dicts, bools or None). Nothing here reads the clock:
+the same inputs, config and code give byte-identical files.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import platform
+import subprocess
+from functools import lru_cache
+from importlib import metadata
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from .. import __version__
+
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Mapping
+
+#: Distributions whose versions every file records.
+STACK = ("numpy", "scipy", "xarray", "netCDF4", "lmfit", "matplotlib", "snakemake")
+
+PACKAGE_DIR = Path(__file__).resolve().parent.parent  # src/ballbat
+
+
+def sha256_file(path: str | os.PathLike[str], chunk: int = 1 << 20) -> str:
+    """Hex sha256 of a file's bytes."""
+    h = hashlib.sha256()
+    with open(path, "rb") as fh:
+        while block := fh.read(chunk):
+            h.update(block)
+    return h.hexdigest()
+
+
+def package_sources(package_dir: Path = PACKAGE_DIR) -> list[Path]:
+    """Return the package's Python source files, sorted."""
+    return sorted(p for p in package_dir.rglob("*.py") if "__pycache__" not in p.parts)
+
+
+@lru_cache(maxsize=1)
+def package_source_hash() -> str:
+    """sha256 over the package's source files (relative path and bytes of each)."""
+    h = hashlib.sha256()
+    for p in package_sources():
+        h.update(str(p.relative_to(PACKAGE_DIR)).encode())
+        h.update(b"\0")
+        h.update(p.read_bytes())
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+@lru_cache(maxsize=4)
+def git_state(where: str | None = None) -> dict:
+    """Commit and dirtiness of the git checkout holding ``where`` (default: the package)."""
+    cwd = str(where or PACKAGE_DIR)
+    try:
+        commit = subprocess.run(
+            ["git", "rev-parse", "HEAD"], cwd=cwd, capture_output=True, text=True, timeout=10, check=True
+        ).stdout.strip()
+        status = subprocess.run(
+            ["git", "status", "--porcelain", "--untracked-files=no"],
+            cwd=cwd,
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=True,
+        ).stdout
+    except (OSError, subprocess.SubprocessError):
+        return {"commit": "unknown", "dirty": "unknown"}
+    return {"commit": commit, "dirty": bool(status.strip())}
+
+
+def software_versions() -> dict:
+    """Versions of ballbat, Python and the scientific stack (read from metadata, no imports)."""
+    out = {"ballbat": __version__, "ballbat_source_sha256": package_source_hash(), "python": platform.python_version()}
+    for dist in STACK:
+        try:
+            out[dist] = metadata.version(dist)
+        except metadata.PackageNotFoundError:
+            out[dist] = "not installed"
+    return out
+
+
+def _jsonable(obj):
+    if isinstance(obj, dict):
+        return {str(k): _jsonable(v) for k, v in obj.items()}
+    if isinstance(obj, list | tuple):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, Path):
+        return str(obj)
+    if hasattr(obj, "item") and callable(obj.item):  # numpy scalars
+        return obj.item()
+    return obj
+
+
+def dumps(obj: object) -> str:
+    """Canonical JSON (sorted keys) of a provenance record."""
+    return json.dumps(_jsonable(obj), sort_keys=True, separators=(",", ": "))
+
+
+def provenance_attrs(
+    rule: str, inputs: dict | list, config: dict, workdir: str | os.PathLike[str] | None = None
+) -> dict:
+    """NetCDF global attributes recording what produced a file.
+
+    Parameters
+    ----------
+    rule : name of the workflow rule (or function) that wrote the file.
+    inputs : input files (a list, or a mapping name -> path or list of paths); each is
+        recorded with its sha256.
+    config : the config values the rule used.
+    workdir : where to look for the git checkout (default: the package's own).
+    """
+    if isinstance(inputs, dict):
+        items = []
+        for name, val in inputs.items():
+            vals = [val] if isinstance(val, str | Path) else list(val)
+            items += [(name, v) for v in vals]
+    else:
+        items = [(None, v) for v in inputs]
+    files = [{"name": name, "path": str(path), "sha256": sha256_file(path)} for name, path in items]
+    git = git_state(str(workdir) if workdir else None)
+    return {
+        "provenance_rule": rule,
+        "provenance_inputs": dumps(files),
+        "provenance_config": dumps(config),
+        "provenance_software": dumps(software_versions()),
+        "provenance_git": dumps(git),
+    }
+
+
+def data_inputs(named_input: Mapping[str, object]) -> dict:
+    """Return a Snakemake job's named inputs without the code files (recorded by the source hash)."""
+    return {k: v for k, v in named_input.items() if k != "code"}

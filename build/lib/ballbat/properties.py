@@ -1,0 +1,309 @@
+"""Ball and bat properties (Tables I and II of Kensrud et al. 2017) and recoil factors.
+
+The property tables live in CSV files in the paper's units (``config/balls.csv`` and
+``config/bats.csv``); :func:`load_balls` and :func:`load_bats` read them, check every row
+and return SI dataclasses. :func:`recoil_normal` and :func:`recoil_tangential` are the
+kinematic recoil factors r_y (Eq. ry) and r_x (Eq. rx).
+
+References
+----------
+.. [1] J. R. Kensrud, A. M. Nathan and L. V. Smith, "Oblique collisions of baseballs and
+   softballs with a bat", Am. J. Phys. 85, 503 (2017).
+"""
+
+from __future__ import annotations
+
+import csv
+import math
+import re
+from dataclasses import dataclass
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .units import INCH, OUNCE, OZ_IN2
+
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Sequence
+
+    import numpy as np
+    from numpy.typing import ArrayLike
+
+
+class InputError(ValueError):
+    """Bad user input; the message names the file, the row, the column and the problem.
+
+    ``problems`` holds every problem found (a file is checked whole, not up to the first
+    problem).
+    """
+
+    def __init__(self, problems: list[str]):
+        self.problems = list(problems)
+        super().__init__("\n".join(self.problems))
+
+
+@dataclass(frozen=True)
+class Ball:
+    """A ball type, SI units. ``alpha`` is I_ball / (m r^2) (Eq. iball)."""
+
+    ball: str
+    name: str
+    m: float  # kg
+    r: float  # m
+    alpha: float = 0.4
+    psi_max: float = math.nan  # rad, Table I (experiment's range, not a property)
+    D_max: float = math.nan  # m, Table I
+
+
+@dataclass(frozen=True)
+class Bat:
+    """A bat at its impact location, SI units (Table II)."""
+
+    bat: str
+    name: str
+    M: float  # kg
+    I0: float  # kg m^2, about the centre of mass, perpendicular to the axis
+    Iz: float  # kg m^2, about the long axis
+    b: float  # m, impact location from the centre of mass
+    R: float  # m, bat radius at the impact location
+
+
+#: Columns of the ball table: name -> (unit factor to SI, required, must be positive).
+BALL_COLUMNS = {
+    "ball": (None, True, False),
+    "name": (None, False, False),
+    "m_oz": (OUNCE, True, True),
+    "m_oz_sd": (OUNCE, False, False),
+    "r_in": (INCH, True, True),
+    "r_in_sd": (INCH, False, False),
+    "alpha": (1.0, False, True),
+    "psi_max_deg": (math.pi / 180, False, True),
+    "D_max_in": (INCH, False, True),
+}
+
+#: Columns of the bat table: name -> (unit factor to SI, required, must be positive).
+BAT_COLUMNS = {
+    "bat": (None, True, False),
+    "name": (None, False, False),
+    "M_oz": (OUNCE, True, True),
+    "I0_oz_in2": (OZ_IN2, True, True),
+    "Iz_oz_in2": (OZ_IN2, True, True),
+    "b_in": (INCH, True, False),
+    "R_in": (INCH, True, True),
+}
+
+
+#: A number written with a decimal comma (European spreadsheets), e.g. ``68,7`` or ``-1,5e3``.
+_DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$")
+
+
+def read_csv_rows(path: str | os.PathLike[str]) -> tuple[list[str], list[tuple[int, list[str]]]]:
+    """Return the header and the non-blank rows (line number, cells) of a CSV file as labs make them.
+
+    Accepted as they come from spreadsheets: a UTF-8 byte-order mark (Excel's "CSV UTF-8"),
+    semicolon-separated files with decimal commas (European Excel: the commas are read as
+    decimal points), and trailing columns with neither a name nor a value (Excel's stray
+    separators). Refused with one message that says what the file is: a directory, a file
+    that is not UTF-8 (naming the line and byte), a column with values but no name.
+    """
+    path = Path(path)
+    if path.is_dir():
+        raise InputError([f"{path}: is a directory, not a CSV file"])
+    if not path.exists():
+        raise InputError([f"{path}: file not found"])
+    raw = path.read_bytes()  # /dev/null and other non-regular files are read as they are
+    try:
+        text = raw.decode("utf-8-sig")
+    except UnicodeDecodeError as exc:
+        line = raw[: exc.start].count(b"\n") + 1
+        raise InputError(
+            [
+                f"{path}: not UTF-8 text: byte 0x{raw[exc.start]:02x} on line {line} cannot be decoded "
+                "(a Latin-1 or Windows export?); save the file as 'CSV UTF-8'"
+            ]
+        ) from None
+    lines = text.splitlines()
+    first = next((ln for ln in lines if ln.strip()), "")
+    semicolon = first.count(";") > first.count(",")
+    reader = csv.reader(lines, delimiter=";" if semicolon else ",")
+    header = None
+    rows: list[tuple[int, list[str]]] = []
+    for cells in reader:
+        if not any(c.strip() for c in cells):
+            continue
+        cells = [c.strip() for c in cells]
+        if semicolon:  # decimal commas: 68,7 -> 68.7
+            cells = [c.replace(",", ".") if _DECIMAL_COMMA.match(c) else c for c in cells]
+        if header is None:
+            header = cells
+            continue
+        rows.append((reader.line_num, cells))
+    if header is None:
+        return [], []
+    # Trailing columns without a name: dropped when they hold nothing, refused when they hold values.
+    while header and header[-1] == "":
+        k = len(header) - 1
+        filled = [line for line, cells in rows if k < len(cells) and cells[k] != ""]
+        if filled:
+            raise InputError([f"{path}: column {k + 1} has values (line {filled[0]}, ...) but no name in the header"])
+        header = header[:-1]
+        rows = [(line, cells[:k] if len(cells) > k else cells) for line, cells in rows]
+    return header, rows
+
+
+#: Key of a row's surplus cells in :func:`read_csv_table` (cannot clash with a column name).
+EXTRA = "\0extra"
+
+
+def read_csv_table(path: str | os.PathLike[str], required: Sequence[str]) -> tuple[list[str], list[tuple[str, dict]]]:
+    """Return the header and the rows (``"row N"``, {column: text}) of a CSV file as labs make them.
+
+    :func:`read_csv_rows` reads the file; a row with more cells than the header has columns
+    keeps their number under :data:`EXTRA`. An empty file is an :class:`InputError` that names
+    the ``required`` columns.
+    """
+    header, lines = read_csv_rows(path)
+    if not header:
+        raise InputError([f"{path}: empty file (expected a header line with {', '.join(required)})"])
+    rows = []
+    for line, cells in lines:
+        row = {h: (cells[i] if i < len(cells) else "") for i, h in enumerate(header)}
+        if len(cells) > len(header):
+            row[EXTRA] = str(len(cells) - len(header))
+        rows.append((f"row {line}", row))
+    return header, rows
+
+
+def cell_text(v: object) -> str:
+    """Return a NetCDF cell as the text a CSV cell would hold (NaN and None as empty)."""
+    if isinstance(v, bytes):
+        v = v.decode()
+    if isinstance(v, str):
+        return v.strip()
+    if v is None or (isinstance(v, float | np.floating) and math.isnan(v)):
+        return ""
+    if isinstance(v, np.integer | int):
+        return str(int(v))
+    return repr(float(v))
+
+
+def _read_table(path: Path, columns: dict, key: str) -> list[dict]:
+    """Read a property CSV, checking every row; raise one InputError listing all problems."""
+    path = Path(path)
+    problems: list[str] = []
+    header, lines = read_csv_rows(path)
+    rows = [dict(zip(header, cells, strict=False)) for _, cells in lines]
+    missing = [c for c, (_, req, _) in columns.items() if req and c not in header]
+    unknown = [c for c in header if c not in columns]
+    if missing:
+        problems.append(f"{path}: missing column(s) {', '.join(missing)}")
+    if unknown:
+        problems.append(f"{path}: unknown column(s) {', '.join(unknown)}; expected {', '.join(columns)}")
+    if missing:
+        raise InputError(problems)
+    out, seen = [], {}
+    for i, row in enumerate(rows, start=2):  # row 1 is the header
+        rec = {}
+        for col, (factor, req, positive) in columns.items():
+            raw = row.get(col, "")
+            if factor is None:
+                if req and not raw:
+                    problems.append(f"{path}: row {i}, column {col}: empty")
+                rec[col] = raw
+                continue
+            if raw == "":
+                if req:
+                    problems.append(f"{path}: row {i}, column {col}: empty")
+                rec[col] = None
+                continue
+            try:
+                val = float(raw)
+            except ValueError:
+                problems.append(f"{path}: row {i}, column {col}: {raw!r} is not a number")
+                continue
+            if not math.isfinite(val):
+                problems.append(f"{path}: row {i}, column {col}: {raw!r} is not finite")
+            elif positive and val <= 0:
+                problems.append(f"{path}: row {i}, column {col}: {raw} must be positive")
+            rec[col] = val * factor
+        k = rec.get(key)
+        if k:
+            if k in seen:
+                problems.append(f"{path}: row {i}, column {key}: {k!r} duplicates row {seen[k]}")
+            seen[k] = i
+        out.append(rec)
+    if not rows:
+        problems.append(f"{path}: no rows")
+    if problems:
+        raise InputError(problems)
+    return out
+
+
+def load_balls(path: str | os.PathLike[str]) -> dict[str, Ball]:
+    """Read a ball table (Table I layout, paper units) into SI :class:`Ball` records."""
+    balls = {}
+    for rec in _read_table(path, BALL_COLUMNS, "ball"):
+        balls[rec["ball"]] = Ball(
+            ball=rec["ball"],
+            name=rec["name"] or rec["ball"],
+            m=rec["m_oz"],
+            r=rec["r_in"],
+            alpha=rec["alpha"] if rec["alpha"] is not None else 0.4,
+            psi_max=rec["psi_max_deg"] if rec["psi_max_deg"] is not None else math.nan,
+            D_max=rec["D_max_in"] if rec["D_max_in"] is not None else math.nan,
+        )
+    return balls
+
+
+def load_bats(path: str | os.PathLike[str]) -> dict[str, Bat]:
+    """Read a bat table (Table II layout, paper units) into SI :class:`Bat` records."""
+    return {
+        rec["bat"]: Bat(
+            bat=rec["bat"],
+            name=rec["name"] or rec["bat"],
+            M=rec["M_oz"],
+            I0=rec["I0_oz_in2"],
+            Iz=rec["Iz_oz_in2"],
+            b=rec["b_in"],
+            R=rec["R_in"],
+        )
+        for rec in _read_table(path, BAT_COLUMNS, "bat")
+    }
+
+
+def recoil_normal(m: ArrayLike, M: ArrayLike, I0: ArrayLike, b: ArrayLike) -> np.ndarray:
+    """Return the normal recoil factor r_y of the bat (Eq. ry of Kensrud et al. 2017).
+
+    Parameters
+    ----------
+    m : ball mass, kg.   M : bat mass, kg.
+    I0 : bat moment of inertia about its centre of mass, kg m^2.
+    b : impact location measured from the bat's centre of mass, m.
+
+    Notes
+    -----
+    r_y = m (1/M + b^2/I0).
+    """
+    return m * (1.0 / M + b**2 / I0)
+
+
+def recoil_tangential(
+    m: ArrayLike, M: ArrayLike, I0: ArrayLike, Iz: ArrayLike, b: ArrayLike, R: ArrayLike, alpha: ArrayLike = 0.4
+) -> np.ndarray:
+    """Tangential recoil factor r_x of the bat (Eq. rx of Kensrud et al. 2017).
+
+    Notes
+    -----
+    r_x = m alpha/(1 + alpha) (1/M + b^2/I0 + R^2/Iz), with R the bat radius at impact
+    and Iz the bat's moment of inertia about its long axis.
+    """
+    return m * alpha / (1.0 + alpha) * (1.0 / M + b**2 / I0 + R**2 / Iz)
+
+
+def recoil_factors(ball: Ball, bat: Bat) -> tuple[float, float]:
+    """(r_x, r_y) for a ball hitting a bat."""
+    r_x = recoil_tangential(ball.m, bat.M, bat.I0, bat.Iz, bat.b, bat.R, ball.alpha)
+    r_y = recoil_normal(ball.m, bat.M, bat.I0, bat.b)
+    return r_x, r_y

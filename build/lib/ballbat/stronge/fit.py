@@ -1,0 +1,285 @@
+"""Fit of Stronge's eta^2 to the Eq. (vtf) data of one ball (Sec. V.A, Fig. 9 of Kensrud et al.).
+
+The data are ``y = (v_ball,t + r omega)/v_bat,n`` against ``x = tan(psi)/(1 + r_x)``
+(Eq. vtf); the model is ``y = (1 + e_x(psi; eta2, e_y, mu, r_x, r_y)) x`` with e_x from
+:func:`ballbat.stronge.model.stronge_ex` in the bat's frame, each impact with its own recoil
+factors. The paper fitted eta^2 = 4.75 (baseball) and 6.30 (softball) with e_y = mu = 0.5.
+
+Uncertainties (documented in docs/stronge.md, "The eta^2 fit"):
+
+* ``robust=False`` (default): the standard error is lmfit's, from the covariance of the
+  least-squares fit. With ``scale_covar=True`` (default) the covariance is scaled by the
+  reduced chi-square, as the paper's error bars are "estimates based on the fluctuation of
+  the data about a smooth line"; with ``sigma=None`` this is the only meaningful choice.
+* ``robust=True`` (the workflow's fit, :func:`ballbat.stronge.analysis.fit_ball`): the
+  standard error is the HC3 sandwich, centred within ``strata`` (the bats:
+  :func:`ballbat.linefit.sandwich_cov`), with Bell-McCaffrey degrees of freedom
+  (:func:`ballbat.linefit.sandwich_dof`). One eta^2 does not describe bats of different e_x
+  exactly, so the scatter about the curve is neither the same for every impact nor noise
+  alone: the part common to a bat is the same whenever its impacts are repeated.
+* The profile-likelihood interval is where chi^2(eta2) (minimised over the free nuisance
+  parameters, if any) exceeds its minimum by Delta. Not robust: ``chi2.ppf(level, 1)``
+  (3.84 for 95 %), multiplied by the reduced chi-square of the best fit when
+  ``scale_covar=True``, the same scaling as the covariance. Robust: t_nu^2 (quantile of
+  Student's t with the Bell-McCaffrey nu) times the ratio of the robust to the unscaled
+  variance. Either way the interval is +-(quantile) standard errors for a model linear in
+  eta2, and follows the curvature of chi^2 otherwise.
+
+lmfit and scipy.stats are imported inside :func:`fit_eta2` only.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from numpy.typing import ArrayLike
+
+from .model import stronge_ex
+
+__all__ = ["Eta2Fit", "Eta2FitError", "fit_eta2"]
+
+
+class Eta2FitError(RuntimeError):
+    """The eta^2 fit failed; the message names the inputs."""
+
+
+@dataclass(frozen=True)
+class Eta2Fit:
+    """Result of :func:`fit_eta2`. Errors of fixed parameters are NaN."""
+
+    eta2: float
+    eta2_err: float
+    eta2_ci_low: float  # profile-likelihood interval (NaN if it does not close within bounds)
+    eta2_ci_high: float
+    e_y: float
+    e_y_err: float
+    mu: float
+    mu_err: float
+    chisqr: float
+    redchi: float
+    n: int
+    nfree: int
+    dof: float  # degrees of freedom of eta2_err (nfree, or Bell-McCaffrey's when robust)
+    robust: bool
+    level: float
+    delta_chi2: float  # the chi^2 rise that defines the interval (after scaling)
+    scale_covar: bool
+    success: bool
+    message: str
+
+
+def _describe(psi, e_y, mu, vary_e_y, vary_mu) -> str:
+    psi = np.asarray(psi, dtype=float)
+    with np.errstate(invalid="ignore"):
+        rng = f"{np.nanmin(np.degrees(psi)):.3g}..{np.nanmax(np.degrees(psi)):.3g} deg" if psi.size else "empty"
+    return (
+        f"n={psi.size} impacts, psi {rng}, e_y={e_y:g} ({'free' if vary_e_y else 'fixed'}),"
+        f" mu={mu:g} ({'free' if vary_mu else 'fixed'})"
+    )
+
+
+def _jacobian(residual, at: dict[str, float], names: list[str]) -> np.ndarray:
+    """Central-difference Jacobian (n, len(names)) of ``residual(eta2, e_y, mu)`` at ``at``."""
+    cols = []
+    for k in names:
+        h = 1e-6 * max(abs(at[k]), 1e-3)
+        up, down = dict(at), dict(at)
+        up[k] += h
+        down[k] -= h
+        cols.append(
+            (residual(up["eta2"], up["e_y"], up["mu"]) - residual(down["eta2"], down["e_y"], down["mu"])) / (2 * h)
+        )
+    return np.stack(cols, axis=1)
+
+
+def fit_eta2(
+    psi: ArrayLike,
+    x: ArrayLike,
+    y: ArrayLike,
+    r_x: ArrayLike,
+    r_y: ArrayLike,
+    sigma: ArrayLike | None = None,
+    e_y: float = 0.5,
+    mu: float = 0.5,
+    alpha: ArrayLike = 0.4,
+    vary_e_y: bool = False,
+    vary_mu: bool = False,
+    eta2_bounds: tuple[float, float] = (1.0, 30.0),
+    scale_covar: bool = True,
+    level: float = 0.95,
+    robust: bool = False,
+    strata: ArrayLike | None = None,
+    interval: bool = True,
+) -> Eta2Fit:
+    """Fit eta^2 (and optionally e_y, mu) of Stronge's model to Eq. (vtf) data.
+
+    Parameters
+    ----------
+    psi : incidence angle of each impact, rad.
+    x : ``tan(psi)/(1 + r_x)`` of each impact (the bracket of Eq. vtf).
+    y : ``(v_ball,t + r omega)/v_bat,n`` of each impact (the LHS of Eq. vtf).
+    r_x, r_y : recoil factors of each impact's bat (Eqs. rx and ry); broadcast to psi.
+    sigma : uncertainty of each y (None: unweighted).
+    e_y, mu : values (fixed) or starting values (when ``vary_e_y``/``vary_mu``).
+    alpha : I_ball/(m r^2).
+    eta2_bounds : search range of eta^2. The scan that picks the starting value and the
+        profile interval are confined to it.
+    scale_covar : scale the covariance (and the profile threshold) by the reduced chi^2
+        (not robust).
+    level : confidence level of the profile-likelihood interval.
+    robust : standard errors from the sandwich centred within ``strata``, with
+        Bell-McCaffrey degrees of freedom (module docstring).
+    strata : a label per impact (its bat) for ``robust``; None: one uncentred stratum.
+    interval : compute the profile-likelihood interval (False: NaN, for fits whose value
+        alone is wanted, such as a replicate study's noise-free truth).
+
+    Returns
+    -------
+    Eta2Fit
+
+    Raises
+    ------
+    ValueError
+        Inputs of different lengths, non-finite values or too few impacts.
+    Eta2FitError
+        lmfit reports failure or returns a non-finite eta^2.
+
+    Notes
+    -----
+    Model: Eq. (vtf) of Kensrud et al. (2017) with e_x from Stronge's contact model
+    (Sec. V.A), ``y = (1 + e_x) x``. Because e_x(eta2) is not monotonic over all eta2 (for
+    eta2 < 3.5 the tangential vibration can go through more than half a period), the
+    starting value is the best of a logarithmic scan of ``eta2_bounds``; the local
+    least-squares fit (lmfit, Levenberg-Marquardt) starts there.
+    """
+    import lmfit
+    from scipy.optimize import brentq
+    from scipy.stats import chi2
+    from scipy.stats import t as t_dist
+
+    from ..linefit import sandwich_cov, sandwich_dof
+
+    psi = np.asarray(psi, dtype=float).ravel()
+    what = _describe(psi, e_y, mu, vary_e_y, vary_mu)
+    n = psi.size
+    try:
+        x, y = (np.asarray(a, dtype=float).ravel() for a in (x, y))
+        r_x, r_y, alpha = (np.broadcast_to(np.asarray(a, dtype=float), psi.shape) for a in (r_x, r_y, alpha))
+        sig = np.ones(n) if sigma is None else np.broadcast_to(np.asarray(sigma, dtype=float), psi.shape)
+    except ValueError as exc:
+        raise ValueError(f"fit_eta2: inputs do not match psi ({what}): {exc}") from None
+    if x.size != n or y.size != n:
+        raise ValueError(f"fit_eta2: psi, x and y must have the same length; got {n}, {x.size}, {y.size}")
+    for name, a in (("psi", psi), ("x", x), ("y", y), ("r_x", r_x), ("r_y", r_y), ("sigma", sig)):
+        if not np.all(np.isfinite(a)):
+            raise ValueError(f"fit_eta2: {name} has non-finite values ({what})")
+    if np.any(sig <= 0):
+        raise ValueError(f"fit_eta2: sigma must be positive ({what})")
+    nvary = 1 + int(vary_e_y) + int(vary_mu)
+    if n <= nvary:
+        raise ValueError(f"fit_eta2: need more than {nvary} impacts ({what})")
+
+    def residual(eta2_, e_, mu_):
+        ex = stronge_ex(psi, eta2_, e_, mu_, r_x, r_y, alpha)
+        return (y - (1.0 + ex) * x) / sig
+
+    def chisq(eta2_, e_, mu_):
+        r = residual(eta2_, e_, mu_)
+        return float(r @ r)
+
+    lo_b, hi_b = (float(b) for b in eta2_bounds)
+    scan = np.geomspace(lo_b, hi_b, 48)
+    # one call of the closed-form model for the whole scan (elementwise: the same numbers as one call per value)
+    ex_scan = stronge_ex(psi, scan[:, None], e_y, mu, r_x, r_y, alpha)
+    res_scan = (y - (1.0 + ex_scan) * x) / sig
+    start = scan[int(np.argmin([float(r @ r) for r in res_scan]))]
+
+    params = lmfit.Parameters()
+    params.add("eta2", value=start, min=lo_b, max=hi_b)
+    params.add("e_y", value=e_y, min=0.05, max=1.0, vary=vary_e_y)
+    params.add("mu", value=mu, min=1e-3, max=10.0, vary=vary_mu)
+
+    def fcn(p):
+        return residual(p["eta2"].value, p["e_y"].value, p["mu"].value)
+
+    try:
+        res = lmfit.minimize(fcn, params, method="leastsq", scale_covar=scale_covar)
+    except (ValueError, RuntimeError) as exc:  # pragma: no cover - lmfit internals
+        raise Eta2FitError(f"fit_eta2: lmfit raised {exc!r} ({what})") from exc
+    best = res.params["eta2"].value
+    if not res.success or not np.isfinite(best):
+        raise Eta2FitError(f"fit_eta2: fit failed ({res.message}) ({what})")
+
+    def err(name):
+        p = res.params[name]
+        return float(p.stderr) if (p.vary and p.stderr is not None) else np.nan
+
+    chi_min = float(res.chisqr)
+    nfree = int(res.nfree)
+    redchi = chi_min / nfree
+    e_best, mu_best = res.params["e_y"].value, res.params["mu"].value
+    errs = {k: err(k) for k in ("eta2", "e_y", "mu")}
+    dof = float(nfree)
+    if robust:
+        if strata is not None and np.shape(strata) != psi.shape:
+            raise ValueError(f"fit_eta2: strata must have one label per impact ({what})")
+        names = [k for k in ("eta2", "e_y", "mu") if res.params[k].vary]
+        J = _jacobian(residual, {k: res.params[k].value for k in ("eta2", "e_y", "mu")}, names)
+        cov = sandwich_cov(J, residual(best, e_best, mu_best), strata)
+        errs.update({k: float(np.sqrt(cov[i, i])) for i, k in enumerate(names)})
+        dof = sandwich_dof(J, strata, 0)
+        var_unscaled = float(np.linalg.inv(J.T @ J)[0, 0])
+        delta = float(t_dist.ppf(0.5 + level / 2.0, dof)) ** 2 * errs["eta2"] ** 2 / var_unscaled
+    else:
+        delta = float(chi2.ppf(level, 1)) * (redchi if scale_covar else 1.0)
+
+    if vary_e_y or vary_mu:
+
+        def profile(h):
+            q = res.params.copy()
+            q["eta2"].set(value=h, vary=False)
+            r = lmfit.minimize(fcn, q, method="leastsq")
+            return float(r.chisqr)
+    else:
+
+        def profile(h):
+            return chisq(h, e_best, mu_best)
+
+    def crossing(direction):
+        step = errs["eta2"]
+        step = step if np.isfinite(step) and step > 0 else 0.05 * best
+        inner = best
+        for _ in range(40):
+            outer = best + direction * 2.0 * step
+            outer = min(max(outer, lo_b), hi_b)
+            if profile(outer) - chi_min > delta:
+                g = lambda h: profile(h) - chi_min - delta  # noqa: E731
+                return brentq(g, min(inner, outer), max(inner, outer), xtol=1e-8 * best)
+            if outer in (lo_b, hi_b):
+                return np.nan
+            inner, step = outer, 2.0 * step
+        return np.nan
+
+    ci_low, ci_high = (crossing(-1.0), crossing(+1.0)) if interval else (np.nan, np.nan)
+    return Eta2Fit(
+        eta2=float(best),
+        eta2_err=errs["eta2"],
+        eta2_ci_low=float(ci_low),
+        eta2_ci_high=float(ci_high),
+        e_y=float(e_best),
+        e_y_err=errs["e_y"],
+        mu=float(mu_best),
+        mu_err=errs["mu"],
+        chisqr=chi_min,
+        redchi=redchi,
+        n=n,
+        nfree=nfree,
+        dof=dof,
+        robust=bool(robust),
+        level=float(level),
+        delta_chi2=delta,
+        scale_covar=bool(scale_covar),
+        success=bool(res.success),
+        message=str(res.message),
+    )

@@ -1,0 +1,770 @@
+"""Replicate studies: the whole chain on many synthetic experiments (coverage and design).
+
+A study takes a synthetic dataset's settings and runs the chain the workflow runs
+(:func:`ballbat.synthetic.simulate_experiment`; when the dataset renders camera tracks,
+:func:`ballbat.tracks.render.render_tracks` and :func:`ballbat.tracks.reduce.reduce_tracks`;
+:func:`ballbat.analysis.normalize`, :func:`ballbat.analysis.reconstruct`,
+:func:`ballbat.fitting.analyze_impacts` and Stronge's eta^2 fit,
+:func:`ballbat.stronge.fit.fit_eta2`) on independent replicate experiments, in memory and
+in batches (:func:`run_batch`: one process per batch, one NetCDF file per batch, nothing per
+replicate). Seeds: replicate ``k`` draws its experiment and its tracks from
+``numpy.random.SeedSequence(seed, spawn_key=(k,))``, the same ``k`` at every sweep point
+(common random numbers: the sweep's points differ by their setting, not by their luck).
+
+Every quantity of ``paper_comparison.csv`` with an uncertainty and a synthetic truth is
+recorded (value, standard error, truth, degrees of freedom), in the table's units. The truth
+of a fitted quantity is, as in the workflow, the same estimator applied to the noise-free
+truth of the same replicate with the same weights; for eta^2 it is the eta^2 fitted to the
+noise-free impacts (the synthetic experiment is not drawn from Stronge's model, so eta^2 has
+no truth of its own).
+
+:func:`coverage` measures, per sweep point and quantity: the bias in units of the standard
+error, the ratio of the empirical spread to the mean reported standard error, and the
+fraction of 68 % and 95 % intervals (Student's t with the fit's degrees of freedom) that
+cover the truth, each with its uncertainty. :func:`design` turns a sweep into what a lab
+needs before it books the machine: the spread of e_x per bat at each setting and the number
+of impacts per bat needed to tell two bats ``delta_e_x`` apart.
+"""
+
+from __future__ import annotations
+
+import copy
+import math
+from dataclasses import dataclass, replace
+from typing import TYPE_CHECKING
+
+import numpy as np
+import xarray as xr
+
+from .pipeline.products import Var, build_dataset
+from .sweeps import point_dataset
+
+if TYPE_CHECKING:
+    from collections.abc import Callable, Iterable, Sequence
+
+    from .properties import Ball, Bat
+
+#: The quantities of paper_comparison.csv a study records (those with an uncertainty and a truth).
+STUDY_QUANTITIES = (
+    "e_x",
+    "e_x_pooled",
+    "spin_theta_slope",
+    "speed_theta_slope",
+    "tan_ratio_slope",
+    "e_y_implied",
+    "mu_k_lower_bound",
+    "eta2",
+)
+
+
+@dataclass(frozen=True)
+class StudySettings:
+    """One study, as in the config's ``studies.<name>`` (paper units).
+
+    Attributes
+    ----------
+    dataset : dict
+        The synthetic dataset's config block (``synthetic`` and optional ``render``).
+    replicates : int
+        Replicate experiments per sweep point.
+    seed : int
+        The study's seed (every replicate's seeds derive from it).
+    batch_size : int
+        Replicates per batch job.
+    parameter : str or None
+        Swept setting (a key of :data:`ballbat.sweeps.SWEEP_PARAMETERS`), None for no sweep.
+    values : tuple of float
+        Its values (one point, NaN, without a sweep).
+    v_ref_mph, mu_k_example : float
+        The workflow's ``normalize.v_ref_mph`` and ``analysis.mu_k_example``.
+    stronge : dict
+        The workflow's ``stronge`` section (``e_y``, ``mu``, ``vary_e_y``, ``vary_mu``).
+    truth_impacts : int
+        Impacts per ball and bat of the large noise-free experiment that gives the design's
+        truth (:func:`population_truth`).
+    """
+
+    dataset: dict
+    replicates: int
+    seed: int
+    batch_size: int
+    parameter: str | None
+    values: tuple
+    v_ref_mph: float
+    mu_k_example: float
+    stronge: dict
+    truth_impacts: int
+
+    @classmethod
+    def from_config(cls, config: dict, name: str) -> StudySettings:
+        """Return the settings of study ``name`` from the validated workflow config."""
+        s = config["studies"][name]
+        ds = config["datasets"][s["dataset"]]
+        sweep = s.get("sweep")
+        return cls(
+            dataset=copy.deepcopy(ds),
+            replicates=int(s["replicates"]),
+            seed=int(s["seed"]),
+            batch_size=int(s["batch_size"]),
+            parameter=sweep["parameter"] if sweep else None,
+            values=tuple(float(v) for v in sweep["values"]) if sweep else (math.nan,),
+            v_ref_mph=float(config["normalize"]["v_ref_mph"]),
+            mu_k_example=float(config["analysis"]["mu_k_example"]),
+            stronge={k: config["stronge"][k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")},
+            truth_impacts=int(s["truth_impacts"]),
+        )
+
+    @property
+    def n_points(self) -> int:
+        """Sweep points (1 without a sweep)."""
+        return len(self.values)
+
+    @property
+    def total(self) -> int:
+        """Replicates over all sweep points."""
+        return self.replicates * self.n_points
+
+    @property
+    def n_batches(self) -> int:
+        """Batch jobs."""
+        return -(-self.total // self.batch_size)
+
+    def batch_range(self, batch: int) -> range:
+        """Global replicate indices of batch ``batch`` (point = index // replicates)."""
+        if not 0 <= batch < self.n_batches:
+            raise ValueError(f"batch {batch} out of range (0..{self.n_batches - 1})")
+        return range(batch * self.batch_size, min((batch + 1) * self.batch_size, self.total))
+
+
+def study_config(params: dict) -> dict:
+    """Rebuild the minimal workflow config a study needs from the rules' ``study`` params.
+
+    Parameters
+    ----------
+    params : dict
+        ``study``, ``dataset``, ``normalize``, ``analysis`` and ``stronge`` (the workflow's
+        ``get_study_config``).
+
+    Returns
+    -------
+    dict
+        A config whose ``studies`` hold the one study under every name asked for.
+    """
+    from collections import defaultdict
+
+    return {
+        "studies": defaultdict(lambda: params["study"]),
+        "datasets": defaultdict(lambda: params["dataset"]),
+        **{k: params[k] for k in ("normalize", "analysis", "stronge")},
+    }
+
+
+def replicate_seeds(seed: int, replicate: int) -> tuple[int, int]:
+    """Seeds of one replicate's experiment and tracks, independent streams of the study's seed."""
+    state = np.random.SeedSequence(seed, spawn_key=(replicate,)).generate_state(2, dtype=np.uint32)
+    return int(state[0]), int(state[1])
+
+
+# ---------------------------------------------------------------------------------------
+# one replicate
+
+
+def _source(dataset: dict, seeds: tuple[int, int], balls: dict[str, Ball], bats: dict[str, Bat]) -> xr.Dataset:
+    """Simulate one experiment and, when the dataset renders tracks, render and reduce them."""
+    from .synthetic import SyntheticSettings, simulate_experiment
+
+    sim = simulate_experiment(SyntheticSettings(**{**dataset["synthetic"], "seed": seeds[0]}), balls, bats)
+    render = dataset.get("render") or {}
+    if not render.get("enabled", False):
+        return sim
+    from .tracks.data import camera_block
+    from .tracks.io import cameras_from_config
+    from .tracks.reduce import reduce_tracks, reduction_dataset
+    from .tracks.render import render_tracks, settings_from_config
+    from .tracks.stage import SIMULATED_TRUTH
+
+    cfg = {**render, "seed": seeds[1]}
+    truth = {k: sim[f"truth_{k}"].values for k in SIMULATED_TRUTH if f"truth_{k}" in sim}
+    r = np.array([balls[b].r for b in sim["ball"].values.astype(str)])
+    tracks = render_tracks(
+        truth, r, settings_from_config(cfg), sim["impact"].values.astype(str), sim["ball"].values, sim["bat"].values
+    )
+    cameras, rig = cameras_from_config(camera_block(cfg))
+    return reduction_dataset(reduce_tracks(tracks, cameras, rig))
+
+
+def _truth_source(src: xr.Dataset) -> xr.Dataset:
+    """Return the same impacts with their noise-free truth in place of the measured values."""
+    from .designs import MEASURED
+
+    out = src.copy()
+    for k in MEASURED:
+        out[k] = src[f"truth_{k}"]
+    return out
+
+
+def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> tuple[float, float, float, float]:
+    """eta^2 of one ball (value, standard error, truth, degrees of freedom); NaN if not fitted."""
+    from .linefit import MIN_FIT_IMPACTS
+    from .stronge.analysis import fit_ball, vtf_data
+
+    sel = (rec["flag"].values == 0) & (rec["ball"].values.astype(str) == ball)
+    if sel.sum() < MIN_FIT_IMPACTS:
+        return math.nan, math.nan, math.nan, 0
+    kw = {k: stronge[k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")}
+    d = vtf_data(rec, sel)
+    try:
+        fit = fit_ball(d, **kw)
+        truth = fit_ball(vtf_data(rec_truth, sel), sigma=d.sigma, interval=False, **kw).eta2
+    except (ValueError, RuntimeError):
+        return math.nan, math.nan, math.nan, 0
+    return fit.eta2, fit.eta2_err, truth, fit.dof
+
+
+def run_replicate(
+    settings: StudySettings, dataset: dict, replicate: int, balls: dict[str, Ball], bats: dict[str, Bat]
+) -> list[dict]:
+    """Run the chain on one replicate experiment; return one row per recorded quantity.
+
+    Parameters
+    ----------
+    settings : StudySettings
+    dataset : dict
+        The dataset's config block at this sweep point (:func:`point_dataset`).
+    replicate : int
+        Replicate number within the point (seeds: :func:`replicate_seeds`).
+    balls, bats : dict
+        Property tables.
+
+    Returns
+    -------
+    list of dict
+        ``quantity, ball, bat, value, uncertainty, truth, dof`` (the table's units).
+    """
+    from .analysis import normalize, reconstruct
+    from .compare import fit_rows
+    from .fitting import analyze_impacts, results_dataset
+
+    src = _source(dataset, replicate_seeds(settings.seed, replicate), balls, bats)
+    rec = reconstruct(normalize(src, v_ref_mph=settings.v_ref_mph), balls, bats)
+    res = analyze_impacts(rec, settings.mu_k_example, systematic=False)  # no study quantity is a systematic
+    fit = results_dataset(res)
+    rows = []
+    dof_of = {"spin_theta_slope": 2, "speed_theta_slope": 2}  # fitted parameters; others: 1
+    for row in fit_rows(fit):
+        q = row["quantity"]
+        if q not in STUDY_QUANTITIES:
+            continue
+        var = "tan_ratio_slope" if q == "e_y_implied" else q
+        n = fit[f"{var}_n"].sel(ball=row["ball"]) if q != "mu_k_lower_bound" else None
+        if n is not None and "bat" in n.dims:
+            n = n.sel(bat=row["bat"])
+        dof = math.inf if n is None else int(n) - dof_of.get(var, 1)
+        rows.append({**{k: row[k] for k in ("quantity", "ball", "bat", "value", "uncertainty", "truth")}, "dof": dof})
+    if "eta2" in STUDY_QUANTITIES:
+        rec_truth = reconstruct(normalize(_truth_source(src), v_ref_mph=settings.v_ref_mph), balls, bats)
+        for ball in res.balls:
+            v, e, t, dof = _eta2(rec, rec_truth, ball, settings.stronge)
+            rows.append(
+                {"quantity": "eta2", "ball": ball, "bat": "", "value": v, "uncertainty": e, "truth": t, "dof": dof}
+            )
+    return rows
+
+
+# ---------------------------------------------------------------------------------------
+# a batch: the file of one job
+
+BATCH_TABLE = {
+    "value": Var(("replicate", "quantity"), "1", "estimate, in the unit of its quantity (attribute units of quantity)"),
+    "uncertainty": Var(("replicate", "quantity"), "1", "reported uncertainty of the estimate (same unit)"),
+    "truth": Var(("replicate", "quantity"), "1", "the same estimator on the replicate's noise-free truth (same unit)"),
+    "dof": Var(("replicate", "quantity"), "1", "degrees of freedom of the uncertainty (inf: normal)"),
+    "point": Var(("replicate",), "1", "sweep point of the replicate (index into setting)"),
+    "seed_replicate": Var(("replicate",), "1", "replicate number within its point (its seeds' spawn key)"),
+}
+
+
+def _labels(rows: list[dict]) -> list[str]:
+    return [f"{r['quantity']}:{r['ball']}:{r['bat']}" for r in rows]
+
+
+def run_batch(
+    settings: StudySettings,
+    batch: int,
+    balls: dict[str, Ball],
+    bats: dict[str, Bat],
+    progress: Callable[[int, int], None] | None = None,
+) -> xr.Dataset:
+    """Run the replicates of batch ``batch``; return its dataset (dims replicate x quantity).
+
+    Parameters
+    ----------
+    settings : StudySettings
+    batch : int
+        Batch number (:meth:`StudySettings.batch_range`).
+    balls, bats : dict
+        Property tables.
+    progress : callable, optional
+        Called with (done, total) after each replicate (for the log).
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    indices = settings.batch_range(batch)
+    table: dict[str, int] = {}
+    records = []
+    for done, g in enumerate(indices, 1):
+        point, rep = divmod(g, settings.replicates)
+        dataset = point_dataset(settings.dataset, settings.parameter, settings.values[point])
+        rows = run_replicate(settings, dataset, rep, balls, bats)
+        for label in _labels(rows):
+            table.setdefault(label, len(table))
+        records.append((g, point, rep, rows))
+        if progress is not None:
+            progress(done, len(indices))
+    labels = list(table)
+    nq = len(labels)
+    arrays = {k: np.full((len(records), nq), np.nan) for k in ("value", "uncertainty", "truth", "dof")}
+    for i, (_, _, _, rows) in enumerate(records):
+        for label, r in zip(_labels(rows), rows, strict=True):
+            j = table[label]
+            for k in arrays:
+                v = r[k]
+                arrays[k][i, j] = np.nan if v is None else float(v)
+    parts = [lab.split(":") for lab in labels]
+    values = {
+        **arrays,
+        "point": np.array([p for _, p, _, _ in records], dtype=np.int64),
+        "seed_replicate": np.array([r for _, _, r, _ in records], dtype=np.int64),
+    }
+    coords = _coords(settings, labels, parts)
+    coords["replicate"] = (
+        Var(("replicate",), "1", "replicate number over the whole study"),
+        np.array([g for g, _, _, _ in records], dtype=np.int64),
+    )
+    return build_dataset(BATCH_TABLE, values, coords, _attrs(settings, batch))
+
+
+def _coords(settings: StudySettings, labels: list[str], parts: list[list[str]]) -> dict:
+    from .compare import FIT_QUANTITIES
+
+    unit = {q: FIT_QUANTITIES[q][1] if q in FIT_QUANTITIES else "1" for q in STUDY_QUANTITIES}
+    return {
+        "quantity": (Var(("quantity",), None, "quantity:ball:bat, as in paper_comparison.csv"), np.array(labels)),
+        "quantity_name": (Var(("quantity",), None, "quantity"), np.array([p[0] for p in parts])),
+        "ball": (Var(("quantity",), None, "ball type"), np.array([p[1] for p in parts])),
+        "bat": (Var(("quantity",), None, "bat (empty: per ball)"), np.array([p[2] for p in parts])),
+        "table_unit": (Var(("quantity",), None, "unit of the quantity"), np.array([unit[p[0]] for p in parts])),
+    }
+
+
+def _attrs(settings: StudySettings, batch: int | None = None) -> dict:
+    attrs = {
+        "study_seed": settings.seed,
+        "replicates_per_point": settings.replicates,
+        "sweep_parameter": settings.parameter or "",
+        "sweep_values": np.asarray(settings.values, dtype=float),
+    }
+    if batch is not None:
+        attrs["batch"] = batch
+    return attrs
+
+
+# ---------------------------------------------------------------------------------------
+# the truth a replicate's estimate is judged against
+
+#: Quantities judged against the truth of their own replicate (the same impacts noise-free):
+#: the largest tan(psi - theta) of the impacts is a property of those impacts only.
+CONDITIONAL_TRUTH = ("mu_k_lower_bound",)
+
+
+def population_truth(settings: StudySettings, point: int, balls: dict[str, Ball], bats: dict[str, Bat]) -> dict:
+    """Truth of every quantity for the experiment design at sweep point ``point``.
+
+    A pooled e_x, a slope or eta^2 describes the population the impacts are drawn from (the
+    bats in the design's proportions, psi and bat speed drawn as configured), not the handful
+    of impacts of one replicate: where the model does not describe each bat exactly (pooled
+    over bats of different e_x, a straight line through curved data), the impacts a replicate
+    happens to draw move the estimate as much as the noise does, and the standard error from
+    the scatter accounts for both. The truth is therefore the estimator on a large noise-free
+    experiment of the same design (about ``settings.truth_impacts`` impacts per ball and bat,
+    in the design's proportions), the same for every replicate of the point. e_x of one bat
+    is the same either way (the model is exact); :data:`CONDITIONAL_TRUTH` keep their own.
+
+    Returns
+    -------
+    dict
+        ``quantity:ball:bat`` label -> truth.
+    """
+    ds = point_dataset(settings.dataset, settings.parameter, settings.values[point])
+    counts = [n for per_bat in ds["synthetic"]["impacts"].values() for n in per_bat.values() if n > 0]
+    k = max(1, math.ceil(settings.truth_impacts / min(counts)))
+    ds["synthetic"]["impacts"] = {
+        b: {t: int(n) * k for t, n in per.items()} for b, per in ds["synthetic"]["impacts"].items()
+    }
+    big = replace(
+        settings, seed=int(np.random.SeedSequence(settings.seed, spawn_key=(2**31 - 1, point)).generate_state(1)[0])
+    )
+    rows = run_replicate(big, ds, 0, balls, bats)
+    return dict(zip(_labels(rows), (r["truth"] for r in rows), strict=True))
+
+
+#: The truth file of a study (``results/{study}/truth.nc``; dims point x quantity).
+TRUTH_TABLE = {
+    "truth": Var(
+        ("point", "quantity"),
+        "1",
+        "the estimator on the design's large noise-free experiment (unit of its quantity; NaN: not fitted)",
+    ),
+    "setting": Var(("point",), "1", "value of the swept setting (NaN: no sweep)"),
+}
+
+
+def truth_dataset(settings: StudySettings, balls: dict[str, Ball], bats: dict[str, Bat]) -> xr.Dataset:
+    """:func:`population_truth` of every sweep point, as a dataset (its own job: it runs beside the batches).
+
+    Returns
+    -------
+    xarray.Dataset
+        ``truth`` (point x quantity, labels as the batches'), ``setting``.
+    """
+    truths = [population_truth(settings, p, balls, bats) for p in range(settings.n_points)]
+    labels = list(dict.fromkeys(lab for t in truths for lab in t))
+    values = {
+        "truth": np.array([[np.nan if t.get(lab) is None else float(t[lab]) for lab in labels] for t in truths]),
+        "setting": np.asarray(settings.values, dtype=float),
+    }
+    coords = _coords(settings, labels, [lab.split(":") for lab in labels])
+    coords["point"] = (Var(("point",), "1", "sweep point"), np.arange(settings.n_points, dtype=np.int64))
+    return build_dataset(TRUTH_TABLE, values, coords, {**_attrs(settings), "truth_impacts": settings.truth_impacts})
+
+
+def truths_from_dataset(ds: xr.Dataset) -> list[dict]:
+    """Return the per-point ``label -> truth`` mappings of :func:`truth_dataset` (what :func:`coverage` takes)."""
+    labels = ds["quantity"].values.astype(str)
+    return [dict(zip(labels, map(float, row), strict=True)) for row in ds["truth"].values]
+
+
+# ---------------------------------------------------------------------------------------
+# aggregation
+
+
+def combine(batches: Iterable[xr.Dataset]) -> xr.Dataset:
+    """Concatenate batch datasets along ``replicate`` (sorted; quantities aligned by label)."""
+    batches = list(batches)
+    if not batches:
+        raise ValueError("no batches to combine")
+    labels = list(dict.fromkeys(lab for b in batches for lab in b["quantity"].values.tolist()))
+    parts = [b.reindex(quantity=labels) for b in batches]
+    out = xr.concat(parts, dim="replicate", data_vars="minimal", coords="minimal", compat="override", join="outer")
+    return out.sortby("replicate")
+
+
+def _t(q: float, dof: np.ndarray) -> np.ndarray:
+    from scipy import stats
+
+    dof = np.asarray(dof, dtype=float)
+    z = stats.norm.ppf(0.5 + q / 2)
+    with np.errstate(all="ignore"):
+        t = stats.t.ppf(0.5 + q / 2, np.where(np.isfinite(dof) & (dof > 0), dof, 1.0))
+    return np.where(np.isfinite(dof), np.where(dof > 0, t, np.nan), z)
+
+
+#: The coverage table (dims point x quantity).
+COVERAGE_TABLE = {
+    "n_replicates": Var(("point", "quantity"), "1", "replicates with a value, an uncertainty and a truth"),
+    "bias_over_se": Var(("point", "quantity"), "1", "mean of (value - truth) / uncertainty"),
+    "bias_over_se_err": Var(("point", "quantity"), "1", "standard error of bias_over_se"),
+    "spread_over_se": Var(("point", "quantity"), "1", "standard deviation of (value - truth) / mean uncertainty"),
+    "spread_over_se_err": Var(("point", "quantity"), "1", "standard error of spread_over_se"),
+    "coverage_68": Var(("point", "quantity"), "1", "fraction of 68 % intervals (t quantile) that cover the truth"),
+    "coverage_68_err": Var(("point", "quantity"), "1", "binomial standard error of coverage_68"),
+    "coverage_95": Var(("point", "quantity"), "1", "fraction of 95 % intervals (t quantile) that cover the truth"),
+    "coverage_95_err": Var(("point", "quantity"), "1", "binomial standard error of coverage_95"),
+    "mean_uncertainty": Var(("point", "quantity"), "1", "mean reported uncertainty (unit of the quantity)"),
+    "spread": Var(("point", "quantity"), "1", "standard deviation of value - truth (unit of the quantity)"),
+    "mean_value": Var(("point", "quantity"), "1", "mean estimate (unit of the quantity)"),
+    "mean_truth": Var(("point", "quantity"), "1", "mean truth (unit of the quantity)"),
+    "mean_dof": Var(("point", "quantity"), "1", "mean degrees of freedom of the uncertainty"),
+    "setting": Var(("point",), "1", "value of the swept setting (NaN: no sweep)"),
+}
+
+
+#: Fewest replicates that judge a coverage: the binomial standard error of a 95 % coverage from
+#: n replicates is sqrt(0.95 x 0.05 / n), 2.2 points at n = 100. Intervals 16 % too narrow
+#: (1.645 instead of 1.96 standard errors) cover 90 %, which 100 replicates tell from 95 % at
+#: 2.3 standard errors; fewer cannot, and their table gets a warning (``coverage_warning``).
+MIN_COVERAGE_REPLICATES = 100
+
+
+def coverage_warning(n: int) -> str:
+    """Return the warning a quantity with ``n`` replicates gets in the coverage table ("" when enough)."""
+    if n >= MIN_COVERAGE_REPLICATES:
+        return ""
+    se = 100 * math.sqrt(0.95 * 0.05 / max(n, 1))
+    return (
+        f"only {n} replicates: a 95 % coverage is known to +-{se:.1f} points (binomial), too coarse to tell "
+        f"honest intervals from intervals 16 % too narrow (90 % coverage); use at least {MIN_COVERAGE_REPLICATES}"
+    )
+
+
+class EmptySweepPoint(ValueError):
+    """A sweep point at which no replicate gave a usable estimate of any quantity."""
+
+
+def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Dataset:
+    """Coverage of every quantity at every sweep point (from :func:`combine`'s replicates).
+
+    ``truths``: per sweep point, the design's truth of each quantity (:func:`population_truth`);
+    None judges every estimate against its own replicate's truth. A point at which no replicate
+    has a usable estimate of any quantity raises :class:`EmptySweepPoint` naming it; a quantity
+    with fewer than :data:`MIN_COVERAGE_REPLICATES` replicates gets a warning (``warning``).
+    """
+    values = np.atleast_1d(np.asarray(rep.attrs["sweep_values"], dtype=float))
+    npt, nq = values.size, rep.sizes["quantity"]
+    out = {k: np.full((npt, nq), np.nan) for k in COVERAGE_TABLE if k != "setting"}
+    point = rep["point"].values
+    for p in range(npt):
+        sel = point == p
+        v, e, t, dof = (rep[k].values[sel] for k in ("value", "uncertainty", "truth", "dof"))
+        if truths is not None:
+            labels = rep["quantity"].values.astype(str)
+            names = rep["quantity_name"].values.astype(str)
+            pop = np.array([truths[p].get(lab, np.nan) for lab in labels])
+            use = np.array([nm not in CONDITIONAL_TRUTH for nm in names])
+            t = np.where(use[None, :], pop[None, :], t)
+        ok = np.isfinite(v) & np.isfinite(e) & np.isfinite(t) & (e > 0)
+        n = ok.sum(axis=0)
+        if not n.any():
+            what = f"{rep.attrs.get('sweep_parameter') or 'setting'} = {values[p]:g}" if np.isfinite(values[p]) else ""
+            raise EmptySweepPoint(
+                f"sweep point {p}{f' ({what})' if what else ''}: none of its {int(sel.sum())} replicates gave a "
+                "usable estimate (value, uncertainty and truth) of any quantity; the setting is beyond what the "
+                "chain can fit: drop the point or change it"
+            )
+        out["n_replicates"][p] = n
+        with np.errstate(all="ignore"):
+            d = np.where(ok, v - t, np.nan)
+            z = d / np.where(ok, e, np.nan)
+            out["bias_over_se"][p] = np.nanmean(z, axis=0)
+            out["bias_over_se_err"][p] = np.nanstd(z, axis=0, ddof=1) / np.sqrt(n)
+            mean_e = np.nanmean(np.where(ok, e, np.nan), axis=0)
+            spread = np.nanstd(d, axis=0, ddof=1)
+            out["spread"][p] = spread
+            out["mean_uncertainty"][p] = mean_e
+            out["spread_over_se"][p] = spread / mean_e
+            out["spread_over_se_err"][p] = spread / mean_e / np.sqrt(2.0 * np.maximum(n - 1, 1))
+            for q in (68, 95):
+                half = _t(q / 100, dof) * e
+                hit = np.where(ok, np.abs(d) <= half, False)
+                frac = hit.sum(axis=0) / n
+                out[f"coverage_{q}"][p] = frac
+                out[f"coverage_{q}_err"][p] = np.sqrt(frac * (1 - frac) / n)
+            out["mean_value"][p] = np.nanmean(np.where(ok, v, np.nan), axis=0)
+            out["mean_truth"][p] = np.nanmean(np.where(ok, t, np.nan), axis=0)
+            out["mean_dof"][p] = np.nanmean(np.where(ok, dof, np.nan), axis=0)
+    out["setting"] = values
+    coords = {k: _copy_coord(rep, k) for k in ("quantity", "quantity_name", "ball", "bat", "table_unit")}
+    coords["point"] = (Var(("point",), "1", "sweep point"), np.arange(npt, dtype=np.int64))
+    from .compare import STANDARD_ERROR, UNCERTAINTY_NOTES
+
+    kinds = np.array([UNCERTAINTY_NOTES.get(str(q), STANDARD_ERROR) for q in rep["quantity_name"].values])
+    coords["error_kind"] = (Var(("quantity",), None, "what the quantity's uncertainty is"), kinds)
+    warn = np.array([[coverage_warning(int(n)) for n in row] for row in out["n_replicates"]], dtype=str)
+    coords["warning"] = (Var(("point", "quantity"), None, "why the coverage cannot be judged (empty: it can)"), warn)
+    attrs = {k: rep.attrs[k] for k in ("study_seed", "replicates_per_point", "sweep_parameter") if k in rep.attrs}
+    return build_dataset(COVERAGE_TABLE, out, coords, attrs)
+
+
+def _copy_coord(ds: xr.Dataset, name: str) -> tuple:
+    v = ds[name]
+    return (Var(("quantity",), None, v.attrs.get("long_name", name)), v.values.astype(str))
+
+
+COVERAGE_COLUMNS = (
+    "setting",
+    "quantity",
+    "ball",
+    "bat",
+    "unit",
+    "n_replicates",
+    "bias_over_se",
+    "bias_over_se_err",
+    "spread_over_se",
+    "spread_over_se_err",
+    "coverage_68",
+    "coverage_68_err",
+    "coverage_95",
+    "coverage_95_err",
+    "mean_uncertainty",
+    "spread",
+    "mean_dof",
+    "error_kind",
+    "warning",
+)
+
+
+def _csv_text(header: Sequence[str], rows: Iterable[Sequence]) -> str:
+    """Return CSV text: strings as they are, numbers as in paper_comparison.csv (empty when not finite)."""
+    import csv
+    import io
+
+    from .compare import format_number
+
+    buf = io.StringIO()
+    w = csv.writer(buf, lineterminator="\n")
+    w.writerow(header)
+    for row in rows:
+        w.writerow([x if isinstance(x, str) else format_number(x) for x in row])
+    return buf.getvalue()
+
+
+def coverage_csv(cov: xr.Dataset) -> str:
+    """Return the coverage table as CSV text (one row per sweep point and quantity)."""
+    labels = {
+        "quantity": "quantity_name",
+        "ball": "ball",
+        "bat": "bat",
+        "unit": "table_unit",
+        "error_kind": "error_kind",
+    }
+
+    def row(p, j):
+        for k in COVERAGE_COLUMNS:
+            if k == "setting":
+                yield cov["setting"].values[p]
+            elif k == "warning":
+                yield str(cov["warning"].values[p, j])
+            elif k in labels:
+                yield str(cov[labels[k]].values[j])
+            else:
+                yield cov[k].values[p, j]
+
+    points, quantities = range(cov.sizes["point"]), range(cov.sizes["quantity"])
+    return _csv_text(COVERAGE_COLUMNS, (list(row(p, j)) for p in points for j in quantities))
+
+
+# ---------------------------------------------------------------------------------------
+# design
+
+
+def impacts_required(
+    sigma: float, n_at: float, delta: float, confidence: float = 0.95, power: float = 0.8, n_max: int = 100_000
+) -> float:
+    """Impacts per bat needed to tell two bats ``delta`` apart in e_x.
+
+    Two bats measured with n impacts each, e_x of each with standard deviation
+    ``sigma * sqrt(n_at / n)`` (the spread found with ``n_at`` impacts, scaling as 1/sqrt(n));
+    a two-sided test at ``confidence`` detects a difference ``delta`` with probability
+    ``power`` when ``delta >= sqrt(2) * sigma_n * (t_{(1+c)/2} + t_{power})`` with the
+    Student-t quantiles of 2 (n - 1) degrees of freedom.
+
+    Returns
+    -------
+    float
+        The smallest such n (at least 3), NaN when ``sigma`` is not finite, inf beyond ``n_max``.
+    """
+    from scipy import stats
+
+    if not (math.isfinite(sigma) and sigma > 0 and math.isfinite(n_at) and n_at > 0):
+        return math.nan
+    s1 = sigma * math.sqrt(n_at)
+
+    def enough(n: int) -> bool:
+        dof = 2 * (n - 1)
+        k = stats.t.ppf(0.5 + confidence / 2, dof) + stats.t.ppf(power, dof)
+        return math.sqrt(2.0 / n) * s1 * k <= delta
+
+    if not enough(n_max):
+        return math.inf
+    lo, hi = 2, n_max  # enough(hi) holds; find the smallest
+    while hi - lo > 1:
+        mid = (lo + hi) // 2
+        lo, hi = (lo, mid) if enough(mid) else (mid, hi)
+    return float(max(hi, 3))
+
+
+DESIGN_TABLE = {
+    "impacts_per_bat": Var(("point", "pair"), "1", "impacts of the ball on the bat at the sweep point"),
+    "sigma_e_x": Var(("point", "pair"), "1", "standard deviation of e_x over the replicates"),
+    "sigma_e_x_err": Var(("point", "pair"), "1", "standard error of sigma_e_x"),
+    "mean_se_e_x": Var(("point", "pair"), "1", "mean reported standard error of e_x"),
+    "impacts_required": Var(
+        ("point", "pair"), "1", "impacts per bat to tell two such bats delta_e_x apart (confidence, power)"
+    ),
+    "setting": Var(("point",), "1", "value of the swept setting"),
+}
+
+
+def design(cov: xr.Dataset, settings: StudySettings, delta_e_x: float, confidence: float, power: float) -> xr.Dataset:
+    """Spread of e_x per bat and ball at each sweep point and the impacts a lab would need.
+
+    Parameters
+    ----------
+    cov : xarray.Dataset
+        :func:`coverage` of the study.
+    settings : StudySettings
+    delta_e_x : float
+        Difference in e_x between two bats to detect.
+    confidence, power : float
+        Of the two-sided test.
+
+    Returns
+    -------
+    xarray.Dataset
+        Dims point x pair (a pair is one ball on one bat).
+    """
+    sel = np.flatnonzero(cov["quantity_name"].values == "e_x")
+    balls = cov["ball"].values[sel].astype(str)
+    bats = cov["bat"].values[sel].astype(str)
+    npt = cov.sizes["point"]
+    out = {k: np.full((npt, sel.size), np.nan) for k in DESIGN_TABLE if k != "setting"}
+    for p in range(npt):
+        ds = point_dataset(settings.dataset, settings.parameter, settings.values[p])
+        for j, q in enumerate(sel):
+            n_at = float(ds["synthetic"]["impacts"][balls[j]][bats[j]])
+            sigma = float(cov["spread"].values[p, q])
+            n = float(cov["n_replicates"].values[p, q])
+            out["impacts_per_bat"][p, j] = n_at
+            out["sigma_e_x"][p, j] = sigma
+            out["sigma_e_x_err"][p, j] = sigma / math.sqrt(2 * max(n - 1, 1))
+            out["mean_se_e_x"][p, j] = float(cov["mean_uncertainty"].values[p, q])
+            out["impacts_required"][p, j] = impacts_required(sigma, n_at, delta_e_x, confidence, power)
+    out["setting"] = cov["setting"].values
+    coords = {
+        "point": (Var(("point",), "1", "sweep point"), np.arange(npt, dtype=np.int64)),
+        "pair": (Var(("pair",), None, "ball:bat"), np.array([f"{b}:{t}" for b, t in zip(balls, bats, strict=True)])),
+        "ball": (Var(("pair",), None, "ball type"), balls),
+        "bat": (Var(("pair",), None, "bat"), bats),
+    }
+    attrs = {
+        "sweep_parameter": settings.parameter or "",
+        "delta_e_x": float(delta_e_x),
+        "confidence": float(confidence),
+        "power": float(power),
+    }
+    return build_dataset(DESIGN_TABLE, out, coords, attrs)
+
+
+DESIGN_COLUMNS = (
+    "parameter",
+    "setting",
+    "ball",
+    "bat",
+    "impacts_per_bat",
+    "sigma_e_x",
+    "sigma_e_x_err",
+    "mean_se_e_x",
+    "impacts_required",
+)
+
+
+def design_csv(des: xr.Dataset) -> str:
+    """Return the design table as CSV text (one row per sweep point, ball and bat)."""
+
+    def row(p, j):
+        head = [des.attrs["sweep_parameter"], des["setting"].values[p], str(des["ball"].values[j])]
+        return head + [str(des["bat"].values[j])] + [des[k].values[p, j] for k in DESIGN_COLUMNS[4:]]
+
+    return _csv_text(DESIGN_COLUMNS, (row(p, j) for p in range(des.sizes["point"]) for j in range(des.sizes["pair"])))

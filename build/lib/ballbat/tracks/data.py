@@ -1,0 +1,164 @@
+"""Settings and containers of raw camera tracks (Sec. II).
+
+Two cameras look along the bat's axis at impact: ``swing`` (Camera 1) tracks the dot on the
+bat's end cap (``bat_tip``) and the ball's centre (``ball``); ``spin`` (Camera 2) tracks the
+ball's centre and two dots on the ball (``dot_a``, ``dot_b``). Pixels: x to the right, y
+downward; the swing goes towards +x, or towards -x when the camera is ``mirror``.
+
+In memory the tracks of one camera are dense arrays ``(impact, frame column)`` with NaN
+where a point was not tracked; column ``k`` of impact ``i`` is frame ``frame0[i] + k`` of
+that camera (frame origins are arbitrary and the cameras are not synchronised).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..units import INCH
+
+#: Points each camera tracks.
+POINTS = {"swing": ("bat_tip", "ball"), "spin": ("ball", "dot_a", "dot_b")}
+CAMERAS = tuple(POINTS)
+
+
+@dataclass(frozen=True)
+class Camera:
+    """Settings of one camera.
+
+    Parameters
+    ----------
+    fps : float
+        Frame rate (frames per second).
+    m_per_px : float
+        Pixel scale in the plane of the swing (m per pixel).
+    mirror : bool
+        True when the swing goes towards -x on the image.
+    m_per_px_err : float
+        Relative standard uncertainty of ``m_per_px`` (a systematic shared by every impact).
+    """
+
+    fps: float
+    m_per_px: float
+    mirror: bool = False
+    m_per_px_err: float = 0.0
+
+    @property
+    def sign(self) -> float:
+        """+1 when the swing goes towards +x on the image, -1 when mirrored."""
+        return -1.0 if self.mirror else 1.0
+
+
+@dataclass(frozen=True)
+class Rig:
+    """Distances from the swing machine's pivot axis (m)."""
+
+    pivot_to_tip: float
+    pivot_to_impact: float
+
+    @classmethod
+    def from_inches(cls, pivot_to_tip_in: float, pivot_to_impact_in: float) -> Rig:
+        """Return a rig from the config's inches."""
+        return cls(pivot_to_tip_in * INCH, pivot_to_impact_in * INCH)
+
+
+@dataclass
+class CameraTracks:
+    """Dense tracks of one camera: ``x[point]``, ``y[point]`` of shape (impact, column), pixels."""
+
+    frame0: np.ndarray
+    x: dict[str, np.ndarray]
+    y: dict[str, np.ndarray]
+
+    @property
+    def n_columns(self) -> int:
+        """Number of frame columns."""
+        return next(iter(self.x.values())).shape[1]
+
+    def frames(self) -> np.ndarray:
+        """Frame number of every column, (impact, column)."""
+        return self.frame0[:, None] + np.arange(self.n_columns)[None, :]
+
+
+@dataclass
+class Tracks:
+    """Tracks of a set of impacts: ids, ball and bat per impact, and both cameras' tracks.
+
+    ``truth`` holds per-impact true values of rendered (synthetic) tracks, keyed by the
+    variable name they get in the reduced file (``truth_v_bat``...); empty for a lab's data.
+    """
+
+    impact_id: np.ndarray
+    ball: np.ndarray
+    bat: np.ndarray
+    cameras: dict[str, CameraTracks]
+    truth: dict[str, np.ndarray] = field(default_factory=dict)
+
+    @property
+    def n(self) -> int:
+        """Number of impacts."""
+        return len(self.impact_id)
+
+
+def to_long(tracks: Tracks) -> dict[str, np.ndarray]:
+    """Long-format rows ``impact_id, camera, point, frame, x_px, y_px`` (untracked cells omitted)."""
+    cols: dict[str, list] = {k: [] for k in ("impact_id", "camera", "point", "frame", "x_px", "y_px")}
+    for cam, ct in tracks.cameras.items():
+        frames = ct.frames()
+        for p in POINTS[cam]:
+            ok = np.isfinite(ct.x[p]) & np.isfinite(ct.y[p])
+            ii, kk = np.nonzero(ok)
+            cols["impact_id"].append(tracks.impact_id[ii])
+            cols["camera"].append(np.full(ii.size, cam))
+            cols["point"].append(np.full(ii.size, p))
+            cols["frame"].append(frames[ii, kk])
+            cols["x_px"].append(ct.x[p][ii, kk])
+            cols["y_px"].append(ct.y[p][ii, kk])
+    out = {k: np.concatenate(v) for k, v in cols.items()}
+    order = np.lexsort((out["frame"], out["point"], out["camera"], out["impact_id"]))
+    return {k: v[order] for k, v in out.items()}
+
+
+def to_dense(
+    impact_index: np.ndarray,
+    camera: np.ndarray,
+    point: np.ndarray,
+    frame: np.ndarray,
+    x: np.ndarray,
+    y: np.ndarray,
+    n: int,
+) -> dict[str, CameraTracks]:
+    """Dense per-camera arrays from long rows (already checked: no repeated frames, known names).
+
+    ``impact_index`` is each row's impact as an index 0..n-1. An impact without rows of a
+    camera gets ``frame0`` 0 and all-NaN columns.
+    """
+    out = {}
+    for cam, points in POINTS.items():
+        sel = camera == cam
+        ii, ff = impact_index[sel], frame[sel].astype(np.int64)
+        frame0 = np.full(n, np.iinfo(np.int64).max, dtype=np.int64)
+        np.minimum.at(frame0, ii, ff)
+        frame0[frame0 == np.iinfo(np.int64).max] = 0
+        col = ff - frame0[ii]
+        width = int(col.max()) + 1 if col.size else 1
+        xs, ys = {}, {}
+        for p in points:
+            xs[p] = np.full((n, width), np.nan)
+            ys[p] = np.full((n, width), np.nan)
+            ps = point[sel] == p
+            xs[p][ii[ps], col[ps]] = x[sel][ps]
+            ys[p][ii[ps], col[ps]] = y[sel][ps]
+        out[cam] = CameraTracks(frame0, xs, ys)
+    return out
+
+
+def camera_block(cfg: dict) -> dict:
+    """``cameras`` and ``rig`` of a ``tracks`` or ``render`` block, with only the reduction's settings."""
+    keep = ("fps", "m_per_px", "mirror", "m_per_px_err")
+    return {
+        "cameras": {n: {k: v for k, v in c.items() if k in keep} for n, c in cfg["cameras"].items()},
+        "rig": dict(cfg["rig"]),
+        **({"min_frames": cfg["min_frames"]} if "min_frames" in cfg else {}),
+    }

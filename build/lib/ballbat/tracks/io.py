@@ -1,0 +1,269 @@
+"""Read a lab's raw camera tracks (CSV or NetCDF) and write rendered ones (docs/tracks.md).
+
+``tracks.csv`` is long: ``impact_id,camera,point,frame,x_px,y_px``, one row per tracked
+point per frame (a NetCDF file holds the same variables along one dimension ``row``).
+``impacts.csv`` has one row per impact: ``impact_id,bat,ball``. A NetCDF tracks file that
+also holds ``impact_id``, ``bat`` and ``ball`` along a dimension ``impact`` (as the
+rendered synthetic tracks do) needs no impacts file. Everything is checked before
+anything is computed, and every problem is reported at once
+(:class:`~ballbat.properties.InputError`).
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+import xarray as xr
+
+from ..pipeline.products import Var, build_dataset
+from ..properties import InputError, cell_text, read_csv_table
+from .data import POINTS, Camera, Rig, Tracks, to_dense, to_long
+from .validate import (
+    IMPACT_COLUMNS,
+    TRACK_COLUMNS,
+    check_cameras,
+    check_header,
+    check_impact_rows,
+    check_track_rows,
+)
+
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Sequence
+
+_NC = (".nc", ".nc4", ".netcdf")
+
+
+def _read_nc(path: Path, dim: str, columns) -> tuple[list[str], list[tuple[str, dict]]]:
+    try:
+        with xr.open_dataset(path) as ds:
+            ds = ds.load()
+    except (OSError, ValueError) as exc:
+        raise InputError([f"{path}: cannot be read as NetCDF ({exc})"]) from None
+    if dim not in ds.dims:
+        raise InputError([f"{path}: no dimension {dim!r} (expected variables {', '.join(columns)} along it)"])
+    header = [str(k) for k, v in ds.variables.items() if v.dims == (dim,) and k != dim]
+    cols = {k: ds[k].values for k in header}
+    if dim == "impact" and "impact_id" not in header and "impact" in ds.coords:
+        header.insert(0, "impact_id")  # rendered tracks: the impact ids are the dimension's coordinate
+        cols["impact_id"] = ds["impact"].values
+    rows = [(f"{dim} {i}", {k: cell_text(v[i]) for k, v in cols.items()}) for i in range(ds.sizes[dim])]
+    return header, rows
+
+
+def read_table(
+    path: str | os.PathLike[str], required: Sequence[str], dim: str
+) -> tuple[list[str], list[tuple[str, dict]]]:
+    """Header and rows (label, {column: text}) of a CSV or NetCDF file; problems raised whole."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError([f"{path}: file not found"])
+    if path.suffix.lower() in _NC:
+        return _read_nc(path, dim, required)
+    return read_csv_table(path, required)
+
+
+def _truth_from_nc(path: Path) -> dict[str, np.ndarray]:
+    if path.suffix.lower() not in _NC:
+        return {}
+    with xr.open_dataset(path) as ds:
+        return {k: ds[k].values for k in ds.data_vars if k.startswith("truth_") and ds[k].dims == ("impact",)}
+
+
+def cameras_from_config(cfg: dict, where: str = "tracks") -> tuple[dict[str, Camera], Rig]:
+    """Camera settings and rig of a tracked dataset's config block, checked whole.
+
+    Parameters
+    ----------
+    cfg : dict
+        The block (``cameras``, ``rig``; other keys are ignored).
+    where : str
+        Config key of the block, for messages.
+
+    Returns
+    -------
+    (cameras, rig)
+    """
+    problems = check_cameras(cfg, where)
+    if problems:
+        raise InputError(problems)
+    cams = {
+        name: Camera(
+            fps=float(c["fps"]),
+            m_per_px=float(c["m_per_px"]),
+            mirror=bool(c["mirror"]),
+            m_per_px_err=float(c.get("m_per_px_err", 0.0)),
+        )
+        for name, c in cfg["cameras"].items()
+    }
+    rig = Rig.from_inches(cfg["rig"]["pivot_to_tip_in"], cfg["rig"]["pivot_to_impact_in"])
+    return cams, rig
+
+
+def load_tracks(
+    tracks_path: str | os.PathLike[str],
+    impacts_path: str | os.PathLike[str] | None = None,
+    balls: dict | None = None,
+    bats: dict | None = None,
+) -> Tracks:
+    """Read and check a tracks file and its impacts file; return dense tracks.
+
+    Parameters
+    ----------
+    tracks_path : path-like
+        ``tracks.csv`` or ``.nc`` (long format).
+    impacts_path : path-like, optional
+        ``impacts.csv`` (``impact_id,bat,ball``); default: the tracks NetCDF file's own
+        ``impact`` table.
+    balls, bats : dict, optional
+        Property tables; balls and bats not in them are reported.
+
+    Returns
+    -------
+    Tracks
+
+    Raises
+    ------
+    ballbat.properties.InputError
+        Every problem of both files at once.
+    """
+    tracks_path = Path(tracks_path)
+    problems: list[str] = []
+    ipath = Path(impacts_path) if impacts_path is not None else tracks_path
+    impacts: dict | None = None
+    irows: list = []
+    try:
+        iheader, irows = read_table(ipath, IMPACT_COLUMNS, "impact")
+        hp = check_header(ipath, iheader, IMPACT_COLUMNS)
+        if impacts_path is None:  # the NetCDF's own impact table may hold more (truth_*)
+            hp = [p for p in hp if "unknown column" not in p]
+        problems += hp
+        if not hp:
+            impacts, rp = check_impact_rows(ipath, irows, balls, bats)
+            problems += rp
+    except InputError as exc:
+        problems += exc.problems
+    if not problems and impacts is not None and tracks_path.suffix.lower() in _NC:
+        fast = _fast_nc(tracks_path, impacts)
+        if fast is not None:  # well-formed: skip the row-by-row checks (they would find nothing)
+            return _assemble(fast, irows, ipath if impacts_path is None else None)
+    try:
+        header, rows = read_table(tracks_path, TRACK_COLUMNS, "row")
+    except InputError as exc:
+        raise InputError(problems + exc.problems) from None
+    hp = check_header(tracks_path, header, TRACK_COLUMNS)
+    problems += hp
+    if hp:
+        raise InputError(problems)
+    cols, rp = check_track_rows(tracks_path, rows, impacts, ipath)
+    problems += rp
+    if problems:
+        raise InputError(problems)
+    return _assemble({k: np.asarray(cols[k]) for k in TRACK_COLUMNS}, irows, ipath if impacts_path is None else None)
+
+
+def _fast_nc(path: Path, impacts: dict) -> dict | None:
+    """Return the long columns of a NetCDF tracks file when every vectorised check passes, else None."""
+    try:
+        with xr.open_dataset(path) as ds:
+            if "row" not in ds.dims or any(c not in ds or ds[c].dims != ("row",) for c in TRACK_COLUMNS):
+                return None
+            cols = {c: ds[c].values for c in TRACK_COLUMNS}
+    except (OSError, ValueError):
+        return None
+    cam, point, iid = (cols[c].astype(str) for c in ("camera", "point", "impact_id"))
+    frame = cols["frame"].astype(float)
+    ok = np.isfinite(frame) & (frame == np.round(frame)) & np.isfinite(cols["x_px"].astype(float))
+    ok &= np.isfinite(cols["y_px"].astype(float))
+    pairs = {(c, p) for c, pts in POINTS.items() for p in pts}
+    ok &= np.isin(np.char.add(np.char.add(cam, "/"), point), [f"{c}/{p}" for c, p in pairs])
+    ok &= np.isin(iid, list(impacts))
+    if not ok.all():
+        return None
+    key = np.char.add(np.char.add(np.char.add(iid, "/"), np.char.add(cam, "/")), np.char.add(point, "/"))
+    full = np.char.add(key, frame.astype(np.int64).astype(str))
+    if np.unique(full).size != full.size:
+        return None
+    if set(np.unique(key)) != {f"{i}/{c}/{p}/" for i in impacts for c, p in pairs}:
+        return None  # a camera or point missing somewhere: the row checks say where
+    return {
+        "impact_id": iid,
+        "camera": cam,
+        "point": point,
+        "frame": frame.astype(np.int64),
+        "x_px": cols["x_px"].astype(float),
+        "y_px": cols["y_px"].astype(float),
+    }
+
+
+def _assemble(cols: dict, irows, truth_path) -> Tracks:
+    ids = [row["impact_id"] for _, row in irows]
+    index = {iid: i for i, iid in enumerate(ids)}
+    n = len(ids)
+    uniq, inv = np.unique(np.asarray(cols["impact_id"]).astype(str), return_inverse=True)
+    cams = to_dense(
+        np.array([index[u] for u in uniq], dtype=np.int64)[inv],
+        np.asarray(cols["camera"]).astype(str),
+        np.asarray(cols["point"]).astype(str),
+        np.asarray(cols["frame"], dtype=np.int64),
+        np.asarray(cols["x_px"], dtype=float),
+        np.asarray(cols["y_px"], dtype=float),
+        n,
+    )
+    truth = _truth_from_nc(truth_path) if truth_path is not None else {}
+    return Tracks(
+        impact_id=np.array(ids, dtype=str),
+        ball=np.array([row["ball"] for _, row in irows], dtype=str),
+        bat=np.array([row["bat"] for _, row in irows], dtype=str),
+        cameras=cams,
+        truth=truth,
+    )
+
+
+def tracks_dataset(tracks: Tracks) -> xr.Dataset:
+    """Return the rendered tracks as NetCDF: long rows (dimension ``row``) and the impact table (``impact``).
+
+    Parameters
+    ----------
+    tracks : Tracks
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    from .reduce import _truth_meta
+
+    rows = to_long(tracks)
+    table = {
+        "camera": Var(("row",), None, "camera of the row (swing: Camera 1, spin: Camera 2)"),
+        "point": Var(("row",), None, "tracked point (bat_tip, ball, dot_a, dot_b)"),
+        "frame": Var(("row",), "1", "frame number of that camera (origin arbitrary)"),
+        "x_px": Var(("row",), "1", "image x of the point (pixels, to the right)"),
+        "y_px": Var(("row",), "1", "image y of the point (pixels, downward)"),
+        "impact_id": Var(("row",), None, "impact of the row"),
+        "bat": Var(("impact",), None, "bat (key of the bat table)"),
+        "ball": Var(("impact",), None, "ball type (key of the ball table)"),
+    }
+    values = {
+        "camera": rows["camera"].astype(str),
+        "point": rows["point"].astype(str),
+        "frame": rows["frame"].astype(np.int64),
+        "x_px": rows["x_px"],
+        "y_px": rows["y_px"],
+        "impact_id": rows["impact_id"].astype(str),
+        "bat": tracks.bat.astype(str),
+        "ball": tracks.ball.astype(str),
+    }
+    for k, v in tracks.truth.items():
+        units, long_name = _truth_meta(k)
+        table[k] = Var(("impact",), units, long_name, {"ballbat_role": "truth"})
+        values[k] = v
+    ds = build_dataset(
+        table,
+        values,
+        coords={"impact": (Var(("impact",), None, "impact id"), tracks.impact_id.astype(str))},
+        attrs={"n_impacts": int(tracks.n), "n_rows": int(rows["frame"].size)},
+    )
+    return ds

@@ -1,0 +1,900 @@
+"""Reduce raw camera tracks to the impacts the chain analyses (Sec. II).
+
+Per impact, all impacts at once (dense arrays, masked sums; no Python loop over impacts):
+
+1. **Impact** (each camera): the ball's rest position is the median of its first
+   :data:`N_REST` tracked frames; the first frame from which the ball stays further than a
+   threshold (``max(THRESHOLD_FLOOR_PX, THRESHOLD_SIGMA x`` the rest scatter)) is the
+   impact frame; the last frame before it at rest is ``rest_frame``.
+2. **Free flight** (each camera): from ``ceil(CONTACT_MAX fps)`` frames after impact,
+   x = a + v_x u and y + g u^2/2 = b + v_y u, a linear least-squares fit with the
+   residual scatter as noise. Earlier frames that agree with the flight (within
+   :data:`SEPARATION_SIGMA` sigma) are added; the first one is the separation frame; u is
+   the time from separation (half a frame before it). Swing camera: v_ball and the launch
+   angle (to the horizontal, in the swing direction).
+3. **Bat** (swing camera, frames up to one before ``rest_frame`` only: the bat slows in the
+   collision): the tip dot's positions give the swing direction (principal axis: the
+   swing-plane angle beta) and, along it, u(t) = a + L sin(Omega (t - tau)) (a circle about
+   the pivot seen edge-on, L = pivot_to_tip), fitted by Gauss-Newton with a loose prior
+   tau ~ rest frame +- 1 frame; v_bat = Omega pivot_to_impact. theta = launch - beta.
+4. **Spin** (spin camera, frames after separation): each dot's angle about the fitted
+   ball centre, unwrapped frame to frame, fitted by one straight line per dot with a
+   common slope omega (counter-clockwise on the image for a +x swing is backspin, > 0).
+
+Uncertainties are the fits' own: residual scatter times the square root of the
+(co)variance of the fitted parameters. A relative pixel-scale uncertainty
+(``Camera.m_per_px_err``) is a systematic shared by all impacts of the camera: it scales
+v_bat and v_ball together and is reported apart (``*_err_scale``).
+
+Exclusions (flag > 0, values kept where they could be computed): no impact found; too
+few frames for a fit; a dot whose distance from the ball's centre is not constant (the
+dots do not rotate about the centre: a tilted spin axis); a spin too fast for the frame
+rate to unwrap. Exclude, never drop.
+"""
+
+from __future__ import annotations
+
+import enum
+import warnings
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+import xarray as xr
+
+from ..pipeline.products import Var, build_dataset, flag_attrs
+from .data import Camera, CameraTracks, Rig, Tracks
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    from numpy.typing import ArrayLike
+
+G = 9.80665
+#: Frames at rest whose median is the ball's rest position.
+N_REST = 5
+#: Motion threshold in pixels: at least this, and THRESHOLD_SIGMA times the rest scatter.
+THRESHOLD_FLOOR_PX = 3.0
+THRESHOLD_SIGMA = 8.0
+#: Longest contact (s): "under a millisecond" (Sec. II).
+CONTACT_MAX = 1.0e-3
+#: Typical ball-bat contact time (s), 0.6-0.9 ms: places the contact's start before the
+#: time the free flight extrapolates back to the rest position (its midpoint).
+CONTACT_TYPICAL = 0.75e-3
+#: A frame within this many sigma of the flight fit is already in free flight.
+SEPARATION_SIGMA = 4.0
+#: Sd of the prior on the bat's alignment time tau, in frames (the rest frame is its centre).
+TAU_PRIOR_FRAMES = 0.6
+#: Gauss-Newton iterations of the tip fit.
+GN_ITERATIONS = 6
+#: Apparent spin per frame beyond which unwrapping is ambiguous (rad per frame).
+UNWRAP_LIMIT = 0.75 * np.pi
+#: A dot rotates about the centre when the scatter of its distance from the centre is
+#: what the tracking noise alone gives (F test, false-alarm probability
+#: RADIUS_FALSE_ALARM per dot), or below RADIUS_TOLERANCE x its mean radius.
+RADIUS_TOLERANCE = 0.05
+RADIUS_FALSE_ALARM = 1e-3
+
+
+class ReduceFlag(enum.IntEnum):
+    """Why an impact is excluded by the reduction (0: usable)."""
+
+    OK = 0
+    NO_IMPACT = 1
+    TOO_FEW_FRAMES = 2
+    DOT_NOT_ROTATING_ABOUT_CENTRE = 3
+    SPIN_TOO_FAST = 4
+
+
+#: Name of the flag the rest of the chain reads (the source stage's exclusions).
+FLAG_VAR = "ingest_flag"
+
+
+@dataclass(frozen=True)
+class ReduceOptions:
+    """Fewest frames per fit (the fits need at least two more than their parameters)."""
+
+    min_tip_frames: int = 5
+    min_flight_frames: int = 5
+    min_spin_frames: int = 4
+
+
+# ---------------------------------------------------------------------------------------
+# masked helpers (arrays are (impact, column); w is a 0/1 float mask)
+
+
+def _msum(a, w):
+    return np.sum(np.where(w > 0, a, 0.0), axis=1)
+
+
+def _first(mask):
+    """Index of the first True column, -1 if none."""
+    any_ = mask.any(axis=1)
+    return np.where(any_, np.argmax(mask, axis=1), -1)
+
+
+def _last(mask):
+    any_ = mask.any(axis=1)
+    return np.where(any_, mask.shape[1] - 1 - np.argmax(mask[:, ::-1], axis=1), -1)
+
+
+def _take(a, idx):
+    return np.take_along_axis(a, np.clip(idx, 0, a.shape[1] - 1)[:, None], axis=1)[:, 0]
+
+
+@dataclass
+class Onset:
+    """Impact found in one camera's ball track (columns; -1 where not found)."""
+
+    onset: np.ndarray
+    rest: np.ndarray
+    rest_x: np.ndarray
+    rest_y: np.ndarray
+    found: np.ndarray
+
+
+def _rest_scatter(x: np.ndarray, y: np.ndarray, rest: np.ndarray) -> np.ndarray:
+    """Tracking scatter per coordinate (px) from successive differences of the frames at rest.
+
+    Differences of neighbouring rest frames do not depend on the rest position, so a few
+    frames give an unbiased estimate (the deviations from a median of five frames include
+    exact zeros and underestimate it). Their mean is removed, so a track that is already
+    moving steadily (no rest filmed) shows a small scatter and no rest.
+    """
+    pair = rest[:, 1:] & rest[:, :-1]
+    n = pair.sum(axis=1)
+    with np.errstate(all="ignore"):
+        dx = np.where(pair, np.diff(x, axis=1), 0.0)
+        dy = np.where(pair, np.diff(y, axis=1), 0.0)
+        mx = dx.sum(axis=1) / np.maximum(n, 1)
+        my = dy.sum(axis=1) / np.maximum(n, 1)
+        ss = np.sum(np.where(pair, (dx - mx[:, None]) ** 2 + (dy - my[:, None]) ** 2, 0.0), axis=1)
+        return np.where(n > 1, np.sqrt(ss / (4 * np.maximum(n - 1, 1))), np.nan)
+
+
+def find_onset(x: np.ndarray, y: np.ndarray) -> Onset:
+    """First column from which the ball stays away from its rest position (pixels).
+
+    Parameters
+    ----------
+    x, y : ndarray
+        Ball centre, (impact, column) pixels, NaN where not tracked.
+
+    Returns
+    -------
+    Onset
+    """
+    valid = np.isfinite(x) & np.isfinite(y)
+    rank = np.cumsum(valid, axis=1)
+    early = valid & (rank <= N_REST)
+    cols = np.arange(x.shape[1])[None, :]
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        x0 = np.nanmedian(np.where(early, x, np.nan), axis=1)
+        y0 = np.nanmedian(np.where(early, y, np.nan), axis=1)
+    # Two passes: the tracking scatter from the first frames, then from every frame at rest
+    # before the impact that pass found (more frames, a steadier threshold).
+    rest_frames = early
+    for _ in range(2):
+        sig = _rest_scatter(x, y, rest_frames)
+        thr = np.maximum(THRESHOLD_FLOOR_PX, THRESHOLD_SIGMA * np.nan_to_num(sig))
+        d = np.hypot(x - x0[:, None], y - y0[:, None])
+        moving = valid & (d > thr[:, None])
+        ok_after = moving | ~valid
+        stays = np.flip(np.cumprod(np.flip(ok_after, axis=1), axis=1), axis=1).astype(bool)
+        onset = _first(moving & stays)
+        before = cols < onset[:, None]
+        rest_frames = np.where((onset > 0)[:, None], valid & ~moving & before, early)
+    rest = _last(valid & ~moving & (cols < np.where(onset < 0, 0, onset)[:, None]))
+    n_rest = np.sum(valid & ~moving & before, axis=1)
+    n_moving_before = np.sum(moving & before, axis=1)
+    # a real rest: at least two frames at rest and none away from rest before the impact
+    found = (onset > 0) & (rest >= 0) & (n_rest >= 2) & (n_moving_before == 0)
+    return Onset(np.where(found, onset, -1), np.where(found, rest, -1), x0, y0, found)
+
+
+@dataclass
+class Flight:
+    """Free-flight fit of one camera's ball track (physical frame, m and s)."""
+
+    vx: np.ndarray
+    vy: np.ndarray
+    vx_var: np.ndarray
+    x0: np.ndarray
+    y0: np.ndarray
+    t_ref: np.ndarray
+    sigma: np.ndarray
+    n: np.ndarray
+    separation: np.ndarray
+    mask: np.ndarray
+    u_mean: np.ndarray
+    sxx: np.ndarray
+
+    def centre(self, t: ArrayLike) -> tuple[np.ndarray, np.ndarray]:
+        """Fitted centre at times ``t`` (impact, column)."""
+        u = t - self.t_ref[:, None]
+        return self.x0[:, None] + self.vx[:, None] * u, self.y0[:, None] + self.vy[:, None] * u - 0.5 * G * u**2
+
+
+def _line_fit(u, X, Y, w):
+    """X = a + b u and Y + g u^2/2 = c + d u on the same frames; pooled residual scatter."""
+    n = _msum(np.ones_like(u), w)
+    with np.errstate(all="ignore"):
+        um = _msum(u, w) / n
+        du = u - um[:, None]
+        sxx = _msum(du**2, w)
+        Yc = Y + 0.5 * G * u**2
+        bx = _msum(du * X, w) / sxx
+        by = _msum(du * Yc, w) / sxx
+        ax = _msum(X, w) / n - bx * um
+        ay = _msum(Yc, w) / n - by * um
+        rx = X - ax[:, None] - bx[:, None] * u
+        ry = Yc - ay[:, None] - by[:, None] * u
+        ss = _msum(rx**2 + ry**2, w)
+        sigma = np.sqrt(ss / (2 * n - 4))
+        return ax, bx, ay, by, sigma, sigma**2 / sxx, n, np.hypot(rx, ry), um, sxx
+
+
+def fit_flight(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: float) -> Flight:
+    """Fit free flight after the contact; find the separation frame from the data.
+
+    Parameters
+    ----------
+    X, Y : ndarray
+        Ball centre (m) in the physical frame (X along the swing, Y up), NaN untracked.
+    t : ndarray
+        Time of each column (s).
+    onset : Onset
+        The impact found in this camera.
+    fps : float
+        Frame rate.
+
+    Returns
+    -------
+    Flight
+    """
+    valid = np.isfinite(X) & np.isfinite(Y)
+    cols = np.arange(X.shape[1])[None, :]
+    n_c = int(np.ceil(CONTACT_MAX * fps - 1e-9))
+    on = onset.onset[:, None]
+    first = valid & onset.found[:, None] & (cols >= on + n_c)
+    t_ref = _take(t, _first(first))
+    u = t - t_ref[:, None]
+    ax, bx, ay, by, sigma, var, n, res, um, sxx = _line_fit(u, X, Y, first.astype(float))
+    # separation: the first frame from which every frame agrees with the flight (earlier
+    # frames of the contact window lag behind it); the fit itself keeps to the safe frames
+    cand = valid & onset.found[:, None] & (cols >= on) & (cols < on + n_c)
+    agree = cand & (res < SEPARATION_SIGMA * sigma[:, None])
+    last_bad = _last(cand & ~agree)
+    sep_col = np.where(last_bad >= 0, last_bad + 1, onset.onset)
+    sep_col = np.where(onset.found, np.minimum(sep_col, _first(first)), -1)
+    mask = first
+    t_ref = _take(t, sep_col) - 0.5 / fps
+    u = t - t_ref[:, None]
+    ax, bx, ay, by, sigma, var, n, res, um, sxx = _line_fit(u, X, Y, mask.astype(float))
+    return Flight(bx, by, var, ax, ay, t_ref, sigma, n.astype(int), sep_col, mask, um, sxx)
+
+
+@dataclass
+class Swing:
+    """Tip-dot fit: angular speed of the bat before impact and the swing direction."""
+
+    omega: np.ndarray
+    omega_err: np.ndarray
+    beta: np.ndarray
+    beta_err: np.ndarray
+    tau: np.ndarray
+    a: np.ndarray
+    ux: np.ndarray
+    uy: np.ndarray
+    cx: np.ndarray
+    cy: np.ndarray
+    rms: np.ndarray
+    n: np.ndarray
+    mask: np.ndarray
+
+
+def radius_scatter_limit(noise: ArrayLike, noise_dof: ArrayLike, n: ArrayLike) -> np.ndarray:
+    """Largest rms of a dot's distance from the ball's centre that tracking noise explains.
+
+    The distance's scatter over ``n`` frames is the tracking noise (per coordinate, estimated
+    from the free-flight fit with ``noise_dof`` degrees of freedom) plus the fitted centre's
+    own error (about noise x sqrt(2 / n)). The ratio of its sample variance (``n - 1``
+    degrees of freedom) to the estimated noise variance follows an F distribution; it
+    exceeds the returned limit squared with probability :data:`RADIUS_FALSE_ALARM`.
+
+    Parameters
+    ----------
+    noise : ndarray
+        Tracking noise (m) per impact.
+    noise_dof : ndarray
+        Degrees of freedom of that estimate.
+    n : ndarray
+        Frames of the dot.
+
+    Returns
+    -------
+    ndarray
+        NaN where ``n`` < 2 or the noise has no degree of freedom.
+    """
+    from scipy import stats
+
+    n = np.asarray(n, dtype=float)
+    dof2 = np.asarray(noise_dof, dtype=float)
+    ok = (n >= 2) & (dof2 >= 1)
+    q = stats.f.isf(RADIUS_FALSE_ALARM, np.maximum(n - 1, 1), np.maximum(dof2, 1))
+    with np.errstate(all="ignore"):
+        lim = np.asarray(noise, dtype=float) * np.sqrt((1 + 2 / np.maximum(n, 1)) * q)
+    return np.where(ok, lim, np.nan)
+
+
+def contact_start(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, flight: Flight) -> np.ndarray:
+    """Time the contact began (s), from the ball's rest position and its free flight.
+
+    The free flight extrapolated back passes the rest position at the impulse-weighted mean
+    time of the contact, its midpoint for a symmetric force pulse; the contact began half a
+    typical contact time (:data:`CONTACT_TYPICAL`) earlier. This is steadier than the last
+    frame at rest, which lags behind the impact by up to a frame or two when the tracking
+    is noisy (the ball must first move clear of the noise).
+
+    Parameters
+    ----------
+    X, Y : ndarray
+        Ball centre (m), physical frame, NaN untracked.
+    t : ndarray
+        Time of each column (s).
+    onset : Onset
+        The impact found in this camera.
+    flight : Flight
+        Its free-flight fit.
+
+    Returns
+    -------
+    ndarray
+        NaN where no impact was found.
+    """
+    X = np.asarray(X, dtype=float)
+    Y = np.asarray(Y, dtype=float)
+    cols = np.arange(X.shape[1])[None, :]
+    at_rest = np.isfinite(X) & np.isfinite(Y) & (cols <= onset.rest[:, None]) & onset.found[:, None]
+    w = at_rest.astype(float)
+    with np.errstate(all="ignore"):
+        n = w.sum(axis=1)
+        xr, yr = _msum(X, w) / n, _msum(Y, w) / n
+        u = ((xr - flight.x0) * flight.vx + (yr - flight.y0) * flight.vy) / (flight.vx**2 + flight.vy**2)
+    return np.where(onset.found & (n > 0), flight.t_ref + u - 0.5 * CONTACT_TYPICAL, np.nan)
+
+
+def fit_swing(
+    X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: float, L: float, t_contact: ArrayLike
+) -> Swing:
+    """Fit the tip dot's pre-impact motion (a circle of radius L about the pivot, seen edge-on).
+
+    Parameters
+    ----------
+    X, Y : ndarray
+        Tip dot (m) in the physical frame, NaN untracked.
+    t : ndarray
+        Time of each column (s).
+    onset : Onset
+        The impact found in the swing camera (its ball track).
+    fps : float
+        Frame rate.
+    L : float
+        Pivot-to-tip distance (m).
+    t_contact : ndarray
+        Start of the contact (:func:`contact_start`): only earlier frames are fitted (the
+        bat slows in the collision), and the tip is aligned with the impact then (the prior
+        of the alignment time tau).
+
+    Returns
+    -------
+    Swing
+    """
+    valid = np.isfinite(X) & np.isfinite(Y)
+    t_contact = np.asarray(t_contact, dtype=float)
+    found = onset.found & np.isfinite(t_contact)
+    mask = valid & found[:, None] & (t < np.where(found, t_contact, -np.inf)[:, None])
+    w = mask.astype(float)
+    n = _msum(np.ones_like(X), w)
+    with np.errstate(all="ignore"):
+        cx, cy = _msum(X, w) / n, _msum(Y, w) / n
+        dx, dy = X - cx[:, None], Y - cy[:, None]
+        sxx, syy, sxy = _msum(dx * dx, w), _msum(dy * dy, w), _msum(dx * dy, w)
+        phi = 0.5 * np.arctan2(2 * sxy, sxx - syy)  # principal axis
+        ux, uy = np.cos(phi), np.sin(phi)
+        # orient along the motion: later frames further along
+        tm = _msum(t, w) / n
+        forward = _msum((t - tm[:, None]) * (dx * ux[:, None] + dy * uy[:, None]), w) >= 0
+        ux, uy = np.where(forward, ux, -ux), np.where(forward, uy, -uy)
+        along = dx * ux[:, None] + dy * uy[:, None]
+        perp = -dx * uy[:, None] + dy * ux[:, None]
+        beta = np.arctan2(uy, ux)
+        s_perp = np.sqrt(_msum(perp**2, w) / (n - 2))
+        # Student-t: with few frames the scatter estimate is itself uncertain (sd of t with n - 2 dof)
+        beta_err = s_perp / np.sqrt(_msum(along**2, w)) * np.sqrt((n - 2) / np.maximum(n - 4, 1))
+
+        tau0 = np.where(found, t_contact, 0.0)
+        st = tm - tau0
+        slope = _msum((t - tm[:, None]) * along, w) / _msum((t - tm[:, None]) ** 2, w)
+        om = slope / L
+        a = -L * np.sin(om * st)  # start: u = a + L sin(om (t - tau0)) through the centroid
+        tau = tau0.copy()
+        prior = np.full_like(om, 1e12)  # first iterations: tau held at its prior
+        sigma_tau = TAU_PRIOR_FRAMES / fps
+        for it in range(GN_ITERATIONS):
+            arg = om[:, None] * (t - tau[:, None])
+            c = np.cos(arg)
+            r = along - (a[:, None] + L * np.sin(arg))
+            J = np.stack([np.ones_like(t), L * (t - tau[:, None]) * c, -L * om[:, None] * c], axis=-1)
+            J = np.where(mask[..., None], J, 0.0)
+            r = np.where(mask, r, 0.0)
+            A = np.einsum("ikp,ikq->ipq", J, J)
+            b = np.einsum("ikp,ik->ip", J, r)
+            A[:, 2, 2] += prior
+            b[:, 2] += prior * (tau0 - tau)
+            ok = n >= 4
+            A[~ok] = np.eye(3)
+            b[~ok] = 0.0
+            step = np.linalg.solve(A, b[..., None])[..., 0]
+            a, om, tau = a + step[:, 0], om + step[:, 1], tau + step[:, 2]
+            if it == 1:
+                rr = np.where(mask, along - (a[:, None] + L * np.sin(om[:, None] * (t - tau[:, None]))), 0.0)
+                s2 = np.sum(rr**2, axis=1) / (n - 2)
+                prior = s2 / sigma_tau**2
+        rr = np.where(mask, along - (a[:, None] + L * np.sin(om[:, None] * (t - tau[:, None]))), 0.0)
+        s2 = np.sum(rr**2, axis=1) / (n - 3)
+        arg = om[:, None] * (t - tau[:, None])
+        c = np.cos(arg)
+        J = np.stack([np.ones_like(t), L * (t - tau[:, None]) * c, -L * om[:, None] * c], axis=-1)
+        J = np.where(mask[..., None], J, 0.0)
+        A = np.einsum("ikp,ikq->ipq", J, J)
+        A[:, 2, 2] += s2 / sigma_tau**2
+        A[~(n >= 4)] = np.eye(3)
+        cov = np.linalg.inv(A) * s2[:, None, None]
+        omega_err = np.sqrt(cov[:, 1, 1] * (n - 3) / np.maximum(n - 5, 1))  # Student-t, as for beta
+        rms = np.sqrt(np.sum(rr**2, axis=1) / n)
+    return Swing(om, omega_err, beta, beta_err, tau, a, ux, uy, cx, cy, rms, n.astype(int), mask)
+
+
+@dataclass
+class Spin:
+    """Dot-angle fit: spin, and each dot's radius about the ball's centre."""
+
+    omega: np.ndarray
+    omega_err: np.ndarray
+    rms: np.ndarray
+    n: np.ndarray
+    radius: dict
+    radius_sd: dict
+    angle: dict
+    intercept: dict
+    mask: dict
+    max_step: np.ndarray
+
+
+def _unwrap(phi, mask):
+    """Unwrap angles along columns over the masked (tracked) frames only; gaps keep the last angle."""
+    cols = np.arange(phi.shape[1])[None, :]
+    idx = np.where(mask, cols, -1)
+    prev = np.maximum.accumulate(idx, axis=1)
+    prev_before = np.concatenate([np.full((phi.shape[0], 1), -1), prev[:, :-1]], axis=1)
+    has_prev = mask & (prev_before >= 0)
+    p_prev = np.take_along_axis(phi, np.clip(prev_before, 0, None), axis=1)
+    gap = np.where(has_prev, cols - prev_before, 1)
+    d = np.where(has_prev, np.angle(np.exp(1j * (phi - p_prev))), 0.0)
+    first = _first(mask)
+    start = _take(phi, first)
+    out = start[:, None] + np.cumsum(d, axis=1)
+    per_frame = np.where(has_prev, np.abs(d) / gap, 0.0)
+    return np.where(mask, out, np.nan), per_frame.max(axis=1)
+
+
+def fit_spin(ct_x: ArrayLike, ct_y: ArrayLike, t: ArrayLike, flight: Flight, cam: Camera) -> Spin:
+    """Fit the dots' angles about the fitted ball centre after separation.
+
+    Parameters
+    ----------
+    ct_x, ct_y : dict
+        Dot positions in the physical frame (m), ``dot_a`` and ``dot_b``.
+    t : ndarray
+        Time of each column (s).
+    flight : Flight
+        Free-flight fit of the spin camera's ball track.
+    cam : Camera
+        The spin camera.
+
+    Returns
+    -------
+    Spin
+    """
+    cx, cy = flight.centre(t)
+    cols = np.arange(t.shape[1])[None, :]
+    after = (cols >= flight.separation[:, None]) & (flight.separation[:, None] >= 0)
+    sxt = sxy = 0.0
+    n_tot = 0
+    res_parts = []
+    radius, radius_sd, angle, intercept, masks = {}, {}, {}, {}, {}
+    max_step = np.zeros(t.shape[0])
+    sums = {}
+    with np.errstate(all="ignore"):
+        for p in ("dot_a", "dot_b"):
+            dx, dy = ct_x[p] - cx, ct_y[p] - cy
+            m = after & np.isfinite(dx) & np.isfinite(dy)
+            w = m.astype(float)
+            n = _msum(np.ones_like(t), w)
+            rho = np.hypot(dx, dy)
+            radius[p] = _msum(rho, w) / n
+            radius_sd[p] = np.sqrt(_msum((rho - radius[p][:, None]) ** 2, w) / (n - 1))
+            phi, step = _unwrap(np.arctan2(dy, dx), m)
+            max_step = np.maximum(max_step, step)
+            tm = _msum(t, w) / n
+            pm = _msum(phi, w) / n
+            W = radius[p] ** 2  # angle noise ~ tracking noise / radius: weight ~ radius^2
+            sums[p] = (n, tm, pm, W)
+            sxt = sxt + W * _msum((t - tm[:, None]) * (phi - pm[:, None]), w)
+            sxy = sxy + W * _msum((t - tm[:, None]) ** 2, w)
+            n_tot = n_tot + n
+            angle[p], masks[p] = phi, m
+        omega = sxt / sxy
+        ss = 0.0
+        for p in ("dot_a", "dot_b"):
+            n, tm, pm, W = sums[p]
+            intercept[p] = pm - omega * tm
+            r = angle[p] - intercept[p][:, None] - omega[:, None] * t
+            ss = ss + W * _msum(r**2, masks[p].astype(float))
+            res_parts.append(r)
+        s2 = ss / (n_tot - 3)
+        # the fitted centre's errors are common to all frames and both dots: propagate its
+        # covariance (intercept and velocity of each coordinate) through the dot angles
+        u = t - flight.t_ref[:, None]
+        gx0 = gvx = gy0 = gvy = 0.0
+        for p in ("dot_a", "dot_b"):
+            n, tm, pm, W = sums[p]
+            w = masks[p].astype(float)
+            dx, dy = ct_x[p] - cx, ct_y[p] - cy
+            rho2 = dx**2 + dy**2
+            wk = W[:, None] * (t - tm[:, None]) / sxy[:, None]
+            gx0 = gx0 + _msum(wk * dy / rho2, w)
+            gvx = gvx + _msum(wk * u * dy / rho2, w)
+            gy0 = gy0 - _msum(wk * dx / rho2, w)
+            gvy = gvy - _msum(wk * u * dx / rho2, w)
+        c2, um, sx = flight.sigma**2, flight.u_mean, flight.sxx
+        var_c = c2 * (
+            (gx0**2 + gy0**2) * (1 / flight.n + um**2 / sx)
+            + (gvx**2 + gvy**2) / sx
+            - 2 * (gx0 * gvx + gy0 * gvy) * um / sx
+        )
+        omega_err = np.sqrt(s2 / sxy + var_c)
+        rms = np.sqrt(
+            sum(
+                _msum((angle[p] - intercept[p][:, None] - omega[:, None] * t) ** 2, masks[p].astype(float))
+                for p in masks
+            )
+            / n_tot
+        )
+    return Spin(
+        omega, omega_err, rms, np.asarray(n_tot).astype(int), radius, radius_sd, angle, intercept, masks, max_step
+    )
+
+
+@dataclass
+class Reduction:
+    """Everything the reduction found, per impact (for the results file and the QA figure)."""
+
+    tracks: Tracks
+    cameras: dict
+    rig: Rig
+    onset: dict
+    flight: dict
+    swing: Swing
+    spin: Spin
+    times: dict
+    phys: dict
+    values: dict
+    flag: np.ndarray
+    reason: np.ndarray
+
+
+def physical(ct: CameraTracks, cam: Camera, point: str) -> tuple[np.ndarray, np.ndarray]:
+    """Pixel track -> physical frame (m): X along the swing direction's horizontal, Y up."""
+    return cam.sign * ct.x[point] * cam.m_per_px, -ct.y[point] * cam.m_per_px
+
+
+def reduce_tracks(
+    tracks: Tracks, cameras: dict[str, Camera], rig: Rig, options: ReduceOptions | None = None
+) -> Reduction:
+    """Reduce every impact's tracks to v_bat, v_ball, theta, omega with fitted uncertainties.
+
+    Parameters
+    ----------
+    tracks : Tracks
+        Dense tracks of both cameras.
+    cameras : dict
+        ``swing`` and ``spin`` :class:`Camera` settings.
+    rig : Rig
+        Pivot-to-tip and pivot-to-impact distances.
+    options : ReduceOptions, optional
+        Fewest frames per fit.
+
+    Returns
+    -------
+    Reduction
+        The fits, the values (SI) and the flag and reason of every impact.
+    """
+    opt = options or ReduceOptions()
+    n = tracks.n
+    onset, flight, times, phys = {}, {}, {}, {}
+    for name in ("swing", "spin"):
+        ct, cam = tracks.cameras[name], cameras[name]
+        t = np.broadcast_to(np.arange(ct.n_columns)[None, :] / cam.fps, (n, ct.n_columns))
+        times[name] = t
+        onset[name] = find_onset(ct.x["ball"], ct.y["ball"])
+        X, Y = physical(ct, cam, "ball")
+        phys[(name, "ball")] = (X, Y)
+        flight[name] = fit_flight(X, Y, t, onset[name], cam.fps)
+    Xt, Yt = physical(tracks.cameras["swing"], cameras["swing"], "bat_tip")
+    phys[("swing", "bat_tip")] = (Xt, Yt)
+    t_contact = contact_start(*phys[("swing", "ball")], times["swing"], onset["swing"], flight["swing"])
+    swing = fit_swing(Xt, Yt, times["swing"], onset["swing"], cameras["swing"].fps, rig.pivot_to_tip, t_contact)
+    dots = {p: physical(tracks.cameras["spin"], cameras["spin"], p) for p in ("dot_a", "dot_b")}
+    for p, v in dots.items():
+        phys[("spin", p)] = v
+    spin = fit_spin(
+        {p: v[0] for p, v in dots.items()},
+        {p: v[1] for p, v in dots.items()},
+        times["spin"],
+        flight["spin"],
+        cameras["spin"],
+    )
+
+    fs = flight["swing"]
+    with np.errstate(all="ignore"):
+        v_ball = np.hypot(fs.vx, fs.vy)
+        v_ball_err = np.sqrt(fs.vx_var)  # same design for both components: isotropic
+        launch = np.arctan2(fs.vy, fs.vx)
+        launch_err = np.sqrt(fs.vx_var) / v_ball
+        theta = launch - swing.beta
+        theta = np.angle(np.exp(1j * theta))
+        theta_err = np.hypot(launch_err, swing.beta_err)
+        v_bat = swing.omega * rig.pivot_to_impact
+        v_bat_err = swing.omega_err * rig.pivot_to_impact
+    rel = cameras["swing"].m_per_px_err
+    values = {
+        "v_bat": v_bat,
+        "v_bat_err": v_bat_err,
+        "v_ball": v_ball,
+        "v_ball_err": v_ball_err,
+        "theta": theta,
+        "theta_err": theta_err,
+        "omega": spin.omega,
+        "omega_err": spin.omega_err,
+        "v_bat_err_scale": np.abs(v_bat) * rel,
+        "v_ball_err_scale": np.abs(v_ball) * rel,
+        "swing_plane_angle": swing.beta,
+        "swing_plane_angle_err": swing.beta_err,
+        "launch_angle": launch,
+        "launch_angle_err": launch_err,
+    }
+
+    flag = np.zeros(n, dtype=np.int8)
+    reason = np.full(n, "ok", dtype=object)
+    fps_spin = cameras["spin"].fps
+
+    def mark(cond, code, texts):
+        new = cond & (flag == 0)
+        flag[new] = code
+        for i in np.flatnonzero(new):
+            reason[i] = texts(i)
+
+    for name in ("swing", "spin"):
+        mark(
+            ~onset[name].found,
+            ReduceFlag.NO_IMPACT,
+            lambda i, name=name: (
+                f"no impact found in the {name} camera: its ball track never leaves a rest position "
+                "(needs >= 2 frames at rest, then motion to the end of the track)"
+            ),
+        )
+    mark(
+        swing.n < opt.min_tip_frames,
+        ReduceFlag.TOO_FEW_FRAMES,
+        lambda i: f"{swing.n[i]} pre-impact frame(s) of bat_tip in the swing camera, fewer than {opt.min_tip_frames}",
+    )
+    for name in ("swing", "spin"):
+        mark(
+            flight[name].n < opt.min_flight_frames,
+            ReduceFlag.TOO_FEW_FRAMES,
+            lambda i, name=name: (
+                f"{flight[name].n[i]} free-flight frame(s) of the ball in the {name} camera, "
+                f"fewer than {opt.min_flight_frames}"
+            ),
+        )
+    for p in ("dot_a", "dot_b"):
+        n_p = spin.mask[p].sum(axis=1)
+        mark(
+            n_p < opt.min_spin_frames,
+            ReduceFlag.TOO_FEW_FRAMES,
+            lambda i, p=p, n_p=n_p: (
+                f"{n_p[i]} frame(s) of {p} after separation in the spin camera, fewer than {opt.min_spin_frames}"
+            ),
+        )
+    noise = flight["spin"].sigma
+    noise_dof = 2 * flight["spin"].n - 4  # two coordinates, four fitted parameters
+    for p in ("dot_a", "dot_b"):
+        allowed = np.maximum(
+            RADIUS_TOLERANCE * spin.radius[p], radius_scatter_limit(noise, noise_dof, spin.mask[p].sum(axis=1))
+        )
+        mark(
+            spin.radius_sd[p] > allowed,
+            ReduceFlag.DOT_NOT_ROTATING_ABOUT_CENTRE,
+            lambda i, p=p, allowed=allowed: (
+                f"{p}'s distance from the ball's centre varies by "
+                f"{1e3 * spin.radius_sd[p][i]:.1f} mm rms (mean {1e3 * spin.radius[p][i]:.1f} mm, allowed "
+                f"{1e3 * allowed[i]:.1f} mm): the dots do not rotate about the centre (tilted spin axis?)"
+            ),
+        )
+    mark(
+        spin.max_step > UNWRAP_LIMIT,
+        ReduceFlag.SPIN_TOO_FAST,
+        lambda i: (
+            f"a dot turns up to {spin.max_step[i]:.2f} rad between frames (limit {UNWRAP_LIMIT:.2f}): "
+            f"spin too fast for {fps_spin:g} fps to unwrap"
+        ),
+    )
+    return Reduction(tracks, cameras, rig, onset, flight, swing, spin, times, phys, values, flag, reason.astype(str))
+
+
+def _frame(ct: CameraTracks, col):
+    return np.where(col >= 0, ct.frame0 + col, -1).astype(np.int64)
+
+
+def _v(units, long_name, role=None, **extra):
+    attrs = dict(extra)
+    if role:
+        attrs["ballbat_role"] = role
+    return Var(("impact",), units, long_name, attrs)
+
+
+_MEAS = {
+    "v_bat": ("m s-1", "bat speed at the impact point"),
+    "v_ball": ("m s-1", "exit speed of the ball"),
+    "theta": ("rad", "angle of the batted ball from the bat's direction of travel"),
+    "omega": ("rad s-1", "spin of the batted ball (positive: backspin, Fig. 2)"),
+}
+
+
+def reduction_table(truth_names: Sequence[str] = ()) -> dict[str, Var]:
+    """Return the declared variables of ``reduce.nc``."""
+    table: dict[str, Var] = {}
+    for k, (u, what) in _MEAS.items():
+        anc = f"{k}_err {k}_err_scale" if k in ("v_bat", "v_ball") else f"{k}_err"
+        table[k] = _v(u, f"measured {what} (from the camera tracks)", "measurement", ancillary_variables=anc)
+        table[f"{k}_err"] = _v(u, f"standard uncertainty of measured {what} (from the fit)", "uncertainty")
+    for k in ("v_bat", "v_ball"):
+        table[f"{k}_err_scale"] = _v(
+            "m s-1",
+            f"systematic uncertainty of measured {_MEAS[k][1]} from the swing camera's pixel scale "
+            "(common to every impact)",
+            "systematic",
+        )
+    table["swing_plane_angle"] = _v("rad", "angle of the bat's velocity above the horizontal before impact")
+    table["swing_plane_angle_err"] = _v("rad", "standard uncertainty of the swing-plane angle")
+    table["launch_angle"] = _v("rad", "angle of the batted ball above the horizontal (in the swing direction)")
+    table["launch_angle_err"] = _v("rad", "standard uncertainty of the launch angle")
+    for cam in ("swing", "spin"):
+        table[f"impact_frame_{cam}"] = _v("1", f"first {cam}-camera frame with the ball moving (-1: none)")
+        table[f"separation_frame_{cam}"] = _v("1", f"first {cam}-camera frame of the ball's free flight (-1: none)")
+        table[f"n_frames_flight_{cam}"] = _v("1", f"{cam}-camera frames in the ball's free-flight fit")
+        table[f"flight_rms_{cam}"] = _v(
+            "m", f"rms distance of the ball's tracked centre from its fitted free flight, {cam} camera"
+        )
+    table["n_frames_tip"] = _v("1", "swing-camera frames before impact in the bat-tip fit")
+    table["tip_rms"] = _v("m", "rms residual of the bat-tip fit along the swing")
+    table["bat_alignment_time"] = _v(
+        "s", "fitted time the bat is aligned with the swing camera, from its frame origin (tau)"
+    )
+    for cam in ("swing", "spin"):
+        table[f"frame0_{cam}"] = _v("1", f"{cam}-camera frame number of time 0 of the fitted motions")
+        table[f"flight_t_ref_{cam}"] = _v("s", f"separation time in the {cam} camera (reference of its flight fit)")
+        for c, what in (("x", "along the swing"), ("y", "upward")):
+            table[f"flight_{c}0_{cam}"] = _v("m", f"fitted ball position {what} at separation, {cam} camera")
+            table[f"flight_v{c}_{cam}"] = _v("m s-1", f"fitted ball velocity {what} at separation, {cam} camera")
+    table["tip_offset"] = _v("m", "fitted tip position along the swing at the alignment time (from the tip centroid)")
+    table["tip_centroid_x"] = _v("m", "centroid of the fitted tip positions along the image x (swing-positive)")
+    table["tip_centroid_y"] = _v("m", "centroid of the fitted tip positions, upward")
+    table["bat_angular_speed"] = _v("rad s-1", "fitted angular speed of the bat about the pivot before impact")
+    for p in ("dot_a", "dot_b"):
+        table[f"{p}_phase"] = _v("rad", f"fitted angle of {p} about the ball's centre at time 0 (unwrapped)")
+    table["n_frames_spin"] = _v("1", "spin-camera dot frames in the spin fit (both dots)")
+    table["dot_angle_rms"] = _v("rad", "rms residual of the dot angles about the fitted spin")
+    for p in ("dot_a", "dot_b"):
+        table[f"{p}_radius"] = _v("m", f"mean distance of {p} from the ball's centre after separation")
+        table[f"{p}_radius_sd"] = _v("m", f"standard deviation of the distance of {p} from the ball's centre")
+    table[FLAG_VAR] = Var(
+        ("impact",), "1", "exclusion flag set when the camera tracks were reduced (0: usable)", flag_attrs(ReduceFlag)
+    )
+    table[f"{FLAG_VAR}_reason"] = Var(("impact",), None, "why the impact is excluded (ok if it is not)")
+    for k in truth_names:
+        table[k] = _v(*_truth_meta(k), "truth")
+    return table
+
+
+def _truth_meta(k):
+    base = k[len("truth_") :]
+    known = {
+        **{m: (u, f"true {w}") for m, (u, w) in _MEAS.items()},
+        "psi": ("rad", "true impact angle psi between bat velocity and normal"),
+        "e_x": ("1", "true tangential coefficient of restitution e_x"),
+        "e_y": ("1", "true normal coefficient of restitution e_y"),
+        "swing_plane": ("rad", "true swing-plane angle (rendering)"),
+        "launch_angle": ("rad", "true launch angle to the horizontal (rendering)"),
+        "contact_time": ("s", "true contact time (rendering)"),
+        "bat_slowdown": ("1", "true fraction of the bat's angular speed lost in the collision (rendering)"),
+        "spin_axis_tilt": ("rad", "true tilt of the spin axis from the line of sight (rendering)"),
+        "dot_a_radius": ("m", "true distance of dot_a from the spin axis (rendering)"),
+        "dot_b_radius": ("m", "true distance of dot_b from the spin axis (rendering)"),
+    }
+    return known.get(base, ("1", f"true {base}"))
+
+
+def reduction_dataset(red: Reduction) -> xr.Dataset:
+    """Return the reduced impacts as the chain reads them (dimension ``impact``), with fit diagnostics.
+
+    Parameters
+    ----------
+    red : Reduction
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    tr = red.tracks
+    values = dict(red.values)
+    for cam in ("swing", "spin"):
+        ct = tr.cameras[cam]
+        values[f"impact_frame_{cam}"] = _frame(ct, red.onset[cam].onset)
+        values[f"separation_frame_{cam}"] = _frame(ct, red.flight[cam].separation)
+        values[f"n_frames_flight_{cam}"] = red.flight[cam].n
+        values[f"flight_rms_{cam}"] = red.flight[cam].sigma * np.sqrt(
+            2 * np.maximum(red.flight[cam].n - 2, 0) / np.maximum(red.flight[cam].n, 1)
+        )
+    for cam in ("swing", "spin"):
+        fl = red.flight[cam]
+        values[f"frame0_{cam}"] = tr.cameras[cam].frame0.astype(np.int64)
+        values[f"flight_t_ref_{cam}"] = fl.t_ref
+        values[f"flight_x0_{cam}"], values[f"flight_y0_{cam}"] = fl.x0, fl.y0
+        values[f"flight_vx_{cam}"], values[f"flight_vy_{cam}"] = fl.vx, fl.vy
+    values["tip_offset"] = red.swing.a
+    values["tip_centroid_x"], values["tip_centroid_y"] = red.swing.cx, red.swing.cy
+    values["bat_angular_speed"] = red.swing.omega
+    for p in ("dot_a", "dot_b"):
+        values[f"{p}_phase"] = red.spin.intercept[p]
+    values["n_frames_tip"] = red.swing.n
+    values["tip_rms"] = red.swing.rms
+    values["bat_alignment_time"] = red.swing.tau
+    values["n_frames_spin"] = red.spin.n
+    values["dot_angle_rms"] = red.spin.rms
+    for p in ("dot_a", "dot_b"):
+        values[f"{p}_radius"] = red.spin.radius[p]
+        values[f"{p}_radius_sd"] = red.spin.radius_sd[p]
+    values[FLAG_VAR] = red.flag
+    values[f"{FLAG_VAR}_reason"] = red.reason
+    truth = {k: v for k, v in tr.truth.items() if k.startswith("truth_")}
+    values.update(truth)
+    n = tr.n
+    coords = {
+        "impact": (Var(("impact",), "1", "impact number"), np.arange(n, dtype=np.int64)),
+        "impact_id": (Var(("impact",), None, "impact id given in the tracks"), tr.impact_id.astype(str)),
+        "ball": (Var(("impact",), None, "ball type (key of the ball table)"), tr.ball.astype(str)),
+        "bat": (Var(("impact",), None, "bat (key of the bat table)"), tr.bat.astype(str)),
+    }
+    attrs = {"n_impacts": int(n), "n_excluded": int((red.flag != 0).sum())}
+    for cam, c in red.cameras.items():
+        attrs[f"{cam}_fps"] = float(c.fps)
+        attrs[f"{cam}_m_per_px"] = float(c.m_per_px)
+        attrs[f"{cam}_mirror"] = int(bool(c.mirror))
+        attrs[f"{cam}_m_per_px_rel_err"] = float(c.m_per_px_err)
+    attrs["pivot_to_tip_m"] = float(red.rig.pivot_to_tip)
+    attrs["pivot_to_impact_m"] = float(red.rig.pivot_to_impact)
+    return build_dataset(reduction_table(sorted(truth)), values, coords, attrs)

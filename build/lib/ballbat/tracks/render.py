@@ -1,0 +1,295 @@
+"""Synthetic raw camera tracks rendered from the truth of a synthetic experiment (Sec. II).
+
+Geometry (docs/tracks.md). Both cameras look along the bat's axis at impact, so their
+image plane is the scattering plane. In a physical frame with X along the swing and Y up
+(the image is X mirrored when the camera is ``mirror``), for an impact at t = 0:
+
+* the bat's velocity points at the swing-plane angle beta above the horizontal; the tip
+  dot sits on the bat's axis, so on the image it is a distance ``bat_axis_to_ball`` from
+  the ball's centre along -n (n at psi above the bat's path) and moves along the swing
+  direction by ``pivot_to_tip * sin(Omega t)`` (a circle about the pivot seen edge-on),
+  Omega = v_bat / pivot_to_impact before impact and Omega (1 - slowdown) after;
+* the ball rests on the tee, is accelerated uniformly for the contact time t_c (under a
+  millisecond), and then flies freely under gravity with the true exit velocity at the
+  launch angle beta + theta;
+* two adjacent corner dots of a 1.5-inch square spin about the spin axis, which passes
+  through the ball's centre within the square (offset from its centre); the axis points
+  at the camera except for a few impacts where it is tilted (their dots trace ellipses
+  not centred on the ball and must be excluded); a dot on the far side is hidden.
+
+Frames are sampled with a random sub-frame phase of the impact, Gaussian pixel noise is
+added, points outside the view are missing, and each camera's track ends when the ball
+leaves its view. Vectorised over impacts and frames.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..units import DEGREE, INCH
+from .data import POINTS, Camera, CameraTracks, Rig, Tracks
+
+G = 9.80665
+#: Side of the square of dots drawn around the spin axis (Sec. II): 1.5 in.
+DOT_SQUARE = 1.5 * INCH
+
+
+@dataclass(frozen=True)
+class RenderCamera:
+    """A camera of the synthetic rig: its settings plus view and noise.
+
+    Parameters
+    ----------
+    camera : Camera
+        Frame rate, pixel scale, mirror.
+    width_px, height_px : int
+        Size of the view.
+    tee_px : tuple of float
+        Pixel position of the ball on the tee.
+    pixel_noise_px : float
+        Standard deviation of the tracking noise of every point, per coordinate.
+    pre_impact_frames : int
+        Frames recorded before the impact.
+    max_frames : int
+        Longest track (frames) a camera records.
+    """
+
+    camera: Camera
+    width_px: int = 1200
+    height_px: int = 800
+    tee_px: tuple[float, float] = (540.0, 480.0)
+    pixel_noise_px: float = 2.0
+    pre_impact_frames: int = 20
+    max_frames: int = 200
+
+
+@dataclass(frozen=True)
+class RenderSettings:
+    """Settings of the rendering (SI inside; see :func:`settings_from_config`)."""
+
+    swing: RenderCamera
+    spin: RenderCamera
+    rig: Rig
+    seed: int = 0
+    swing_plane: tuple[float, float] = (-5 * DEGREE, 10 * DEGREE)
+    contact_time: tuple[float, float] = (0.6e-3, 0.9e-3)
+    bat_slowdown: tuple[float, float] = (0.10, 0.25)
+    bat_axis_to_ball: float = 0.07
+    axis_offset: float = 5e-3
+    tilted_fraction: float = 0.03
+    tilt: tuple[float, float] = (15 * DEGREE, 40 * DEGREE)
+    extra: dict = field(default_factory=dict)
+
+
+def settings_from_config(cfg: dict) -> RenderSettings:
+    """Render settings from a dataset's ``render`` config block (paper units: in, deg, ms, mm).
+
+    Parameters
+    ----------
+    cfg : dict
+        The block as in config/config.yaml (``cameras``, ``rig`` and the optional keys).
+
+    Returns
+    -------
+    RenderSettings
+    """
+    cams = {}
+    for name, c in cfg["cameras"].items():
+        cams[name] = RenderCamera(
+            camera=Camera(
+                fps=float(c["fps"]),
+                m_per_px=float(c["m_per_px"]),
+                mirror=bool(c.get("mirror", False)),
+                m_per_px_err=float(c.get("m_per_px_err", 0.0)),
+            ),
+            width_px=int(c.get("width_px", 1200)),
+            height_px=int(c.get("height_px", 800)),
+            tee_px=tuple(float(v) for v in c.get("tee_px", (540.0, 480.0))),
+            pixel_noise_px=float(c.get("pixel_noise_px", 2.0)),
+            pre_impact_frames=int(c.get("pre_impact_frames", 20)),
+            max_frames=int(c.get("max_frames", 200)),
+        )
+    rig = Rig.from_inches(cfg["rig"]["pivot_to_tip_in"], cfg["rig"]["pivot_to_impact_in"])
+    deg = lambda k, d: tuple(v * DEGREE for v in cfg.get(k, d))  # noqa: E731
+    return RenderSettings(
+        swing=cams["swing"],
+        spin=cams["spin"],
+        rig=rig,
+        seed=int(cfg.get("seed", 0)),
+        swing_plane=deg("swing_plane_deg", (-5.0, 10.0)),
+        contact_time=tuple(v * 1e-3 for v in cfg.get("contact_ms", (0.6, 0.9))),
+        bat_slowdown=tuple(cfg.get("bat_slowdown", (0.10, 0.25))),
+        bat_axis_to_ball=float(cfg.get("bat_axis_to_ball_mm", 70.0)) * 1e-3,
+        axis_offset=float(cfg.get("axis_offset_mm", 5.0)) * 1e-3,
+        tilted_fraction=float(cfg.get("tilted_fraction", 0.03)),
+        tilt=deg("tilt_deg", (15.0, 40.0)),
+    )
+
+
+def _ball_motion(t, v, launch, t_c):
+    """Ball centre (X, Y) and rotation fraction clock: uniform acceleration, then free flight."""
+    vx, vy = v * np.cos(launch), v * np.sin(launch)
+    tc = t_c[:, None]
+    during = (t > 0) & (t < tc)
+    after = t >= tc
+    s = np.where(during, t**2 / (2 * tc), np.where(after, t - tc / 2, 0.0))  # distance / speed
+    tf = np.where(after, t - tc, 0.0)
+    X = vx[:, None] * s
+    Y = vy[:, None] * s - 0.5 * G * tf**2
+    return X, Y, s
+
+
+def _sample_times(n, cam: RenderCamera, t_end, rng):
+    """Frame times (impact at t = 0, random sub-frame phase) and integer frame origins."""
+    fps = cam.camera.fps
+    phase = rng.uniform(0.0, 1.0, n)
+    ncol = int(min(cam.max_frames, cam.pre_impact_frames + np.ceil(np.max(t_end) * fps) + 2))
+    k = np.arange(ncol)[None, :] - cam.pre_impact_frames
+    t = (k + phase[:, None]) / fps
+    frame0 = rng.integers(0, 5000, n)
+    return t, frame0
+
+
+def _to_pixels(X, Y, cam: RenderCamera, noise):
+    m = cam.camera.m_per_px
+    x = cam.tee_px[0] + cam.camera.sign * X / m + noise[0]
+    y = cam.tee_px[1] - Y / m + noise[1]
+    return x, y
+
+
+def _exit_time(v, launch, t_c, cam: RenderCamera):
+    """Time the ball leaves the view, ignoring gravity (an upper bound on the columns needed, + margin)."""
+    m = cam.camera.m_per_px
+    vx_px = np.abs(v * np.cos(launch)) / m
+    vy_px = np.abs(v * np.sin(launch)) / m
+    right = np.where(cam.camera.sign * np.cos(launch) >= 0, cam.width_px - cam.tee_px[0], cam.tee_px[0])
+    up = np.where(np.sin(launch) >= 0, cam.tee_px[1], cam.height_px - cam.tee_px[1])
+    with np.errstate(divide="ignore"):
+        t = np.minimum(right / vx_px, up / vy_px)
+    return 1.2 * t + t_c + 3.0 / cam.camera.fps
+
+
+def render_tracks(
+    truth: dict[str, np.ndarray],
+    ball_radius: np.ndarray,
+    settings: RenderSettings,
+    impact_id: np.ndarray,
+    ball: np.ndarray,
+    bat: np.ndarray,
+) -> Tracks:
+    """Render both cameras' tracks of every impact.
+
+    Parameters
+    ----------
+    truth : dict
+        Per-impact true values (SI): ``v_bat``, ``v_ball``, ``theta``, ``omega``, ``psi``
+        and any further ``truth_*`` to keep (copied to :attr:`Tracks.truth`).
+    ball_radius : ndarray
+        Radius of each impact's ball (m).
+    settings : RenderSettings
+    impact_id, ball, bat : ndarray
+        Identity of each impact.
+
+    Returns
+    -------
+    Tracks
+        Dense noisy tracks, and the truth (``truth_*``) including the rendering's own
+        draws (swing-plane angle, launch angle, spin-axis tilt, dot radii, contact time).
+    """
+    rng = np.random.default_rng(settings.seed)
+    n = len(impact_id)
+    v_bat, v_ball = np.asarray(truth["v_bat"], float), np.asarray(truth["v_ball"], float)
+    theta, omega, psi = (np.asarray(truth[k], float) for k in ("theta", "omega", "psi"))
+    r = np.asarray(ball_radius, float)
+
+    beta = rng.uniform(*settings.swing_plane, n)
+    launch = beta + theta
+    t_c = rng.uniform(*settings.contact_time, n)
+    slow = rng.uniform(*settings.bat_slowdown, n)
+    tilted = rng.uniform(size=n) < settings.tilted_fraction
+    chi = np.where(tilted, rng.uniform(*settings.tilt, n), 0.0)
+    zeta = rng.uniform(0, 2 * np.pi, n)
+    # dots: two adjacent corners of the square; the spin axis is offset from its centre
+    off_r = settings.axis_offset * np.sqrt(rng.uniform(size=n))
+    off_a = rng.uniform(0, 2 * np.pi, n)
+    rot0 = rng.uniform(0, 2 * np.pi, n)
+    h = DOT_SQUARE / 2
+    corners = np.array([[h, h], [-h, h]])  # dot_a, dot_b in the square's frame
+    dots = {}
+    for j, p in enumerate(("dot_a", "dot_b")):
+        cx = corners[j, 0] - off_r * np.cos(off_a)
+        cy = corners[j, 1] - off_r * np.sin(off_a)
+        rho = np.hypot(cx, cy)
+        dots[p] = (rho, np.arctan2(cy, cx) + rot0)
+
+    axis = np.stack([np.sin(chi) * np.cos(zeta), np.sin(chi) * np.sin(zeta), np.cos(chi)])
+    e1 = np.stack([np.cos(zeta) * np.cos(chi), np.sin(zeta) * np.cos(chi), -np.sin(chi)])
+    e2 = np.stack([-np.sin(zeta), np.cos(zeta), np.zeros(n)])
+
+    omega_bat = v_bat / settings.rig.pivot_to_impact
+    L = settings.rig.pivot_to_tip
+    cams = {}
+    for name, cam in (("swing", settings.swing), ("spin", settings.spin)):
+        t, frame0 = _sample_times(n, cam, _exit_time(v_ball, launch, t_c, cam), rng)
+        X, Y, s = _ball_motion(t, v_ball, launch, t_c)
+        pts = {"ball": (X, Y)}
+        if name == "swing":
+            ang = np.where(t < 0, omega_bat[:, None] * t, omega_bat[:, None] * (1 - slow[:, None]) * t)
+            u = L * np.sin(ang)
+            nx, ny = np.cos(beta + psi), np.sin(beta + psi)
+            tx0 = -settings.bat_axis_to_ball * nx
+            ty0 = -settings.bat_axis_to_ball * ny
+            pts["bat_tip"] = (tx0[:, None] + u * np.cos(beta)[:, None], ty0[:, None] + u * np.sin(beta)[:, None])
+        else:
+            turn = omega[:, None] * s  # rotation angle (s is distance / speed: same clock)
+            for p, (rho, phi0) in dots.items():
+                gamma = np.arcsin(np.clip(rho / r, -1, 1))
+                phi = phi0[:, None] + turn
+                c, sn = np.cos(phi), np.sin(phi)
+                comp = [
+                    r[:, None]
+                    * (
+                        np.cos(gamma)[:, None] * axis[i][:, None]
+                        + np.sin(gamma)[:, None] * (c * e1[i][:, None] + sn * e2[i][:, None])
+                    )
+                    for i in range(3)
+                ]
+                hidden = comp[2] < 0
+                pts[p] = (np.where(hidden, np.nan, X + comp[0]), np.where(hidden, np.nan, Y + comp[1]))
+        xs, ys = {}, {}
+        sd = cam.pixel_noise_px
+        for p in POINTS[name]:
+            Xp, Yp = pts[p]
+            noise = rng.standard_normal((2, *Xp.shape)) * sd
+            x, y = _to_pixels(Xp, Yp, cam, noise)
+            out = ~((x >= 0) & (x < cam.width_px) & (y >= 0) & (y < cam.height_px))
+            x[out] = np.nan
+            y[out] = np.nan
+            xs[p], ys[p] = x, y
+        # the track ends when the ball leaves the view (after impact)
+        gone = (t > 0) & np.isnan(xs["ball"])
+        ended = np.cumsum(gone, axis=1) > 0
+        for p in POINTS[name]:
+            xs[p][ended] = np.nan
+            ys[p][ended] = np.nan
+        cams[name] = CameraTracks(frame0.astype(np.int64), xs, ys)
+
+    keep = {f"truth_{k}": np.asarray(v) for k, v in truth.items()}
+    keep.update(
+        truth_swing_plane=beta,
+        truth_launch_angle=launch,
+        truth_contact_time=t_c,
+        truth_bat_slowdown=slow,
+        truth_spin_axis_tilt=chi,
+        truth_dot_a_radius=dots["dot_a"][0],
+        truth_dot_b_radius=dots["dot_b"][0],
+    )
+    return Tracks(
+        impact_id=np.asarray(impact_id).astype(str),
+        ball=np.asarray(ball).astype(str),
+        bat=np.asarray(bat).astype(str),
+        cameras=cams,
+        truth=keep,
+    )

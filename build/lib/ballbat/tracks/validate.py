@@ -1,0 +1,253 @@
+"""Checks of a lab's tracks, impacts and camera settings: every problem at once.
+
+Each message names the file (or config key), the row (CSV line number, header = line 1;
+NetCDF index) and the column, and says what is wrong, in the style of
+:mod:`ballbat.ingest`. The functions return lists of problems; :mod:`.io` raises them
+together as one :class:`~ballbat.properties.InputError`.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+from ..properties import EXTRA
+from .data import CAMERAS, POINTS
+
+if TYPE_CHECKING:
+    import os
+
+#: Columns of a tracks file (long format, one row per tracked point per frame).
+TRACK_COLUMNS = ("impact_id", "camera", "point", "frame", "x_px", "y_px")
+#: Columns of an impacts file.
+IMPACT_COLUMNS = ("impact_id", "bat", "ball")
+#: Keys of a camera's settings and of the rig.
+CAMERA_KEYS = {"fps", "m_per_px", "mirror", "m_per_px_err"}
+CAMERA_REQUIRED = ("fps", "m_per_px", "mirror")
+RIG_KEYS = ("pivot_to_tip_in", "pivot_to_impact_in")
+
+
+def check_header(path: str | os.PathLike[str], header: list[str], required: tuple[str, ...]) -> list[str]:
+    """Missing, unknown and repeated columns."""
+    problems = []
+    missing = [c for c in required if c not in header]
+    if missing:
+        problems.append(f"{path}: missing column(s) {', '.join(missing)} (required: {', '.join(required)})")
+    unknown = [c for c in header if c not in required]
+    if unknown:
+        problems.append(f"{path}: unknown column(s) {', '.join(map(repr, unknown))} (allowed: {', '.join(required)})")
+    repeated = sorted({c for c in header if header.count(c) > 1})
+    if repeated:
+        problems.append(f"{path}: column(s) {', '.join(repeated)} appear more than once")
+    return problems
+
+
+def check_impact_rows(
+    path: str | os.PathLike[str], rows: list, balls: dict | None = None, bats: dict | None = None
+) -> tuple[dict[str, str], list[str]]:
+    """Impact rows: ids unique and present, bat and ball given (and in the tables when known).
+
+    Returns ``({impact_id: row label}, problems)``.
+    """
+    problems: list[str] = []
+    seen: dict[str, str] = {}
+    if not rows:
+        problems.append(f"{path}: no impacts (only a header)")
+    for label, row in rows:
+        at = f"{path}: {label}"
+        if EXTRA in row:
+            problems.append(f"{at}: {row[EXTRA]} more cell(s) than the header has columns")
+        iid = row.get("impact_id", "")
+        if not iid:
+            problems.append(f"{at}, column impact_id: empty")
+        elif iid in seen:
+            problems.append(f"{at}, column impact_id: {iid!r} duplicates {seen[iid]}")
+        else:
+            seen[iid] = label
+        for key, table in (("bat", bats), ("ball", balls)):
+            name = row.get(key, "")
+            if not name:
+                problems.append(f"{at}, column {key}: empty")
+            elif table is not None and name not in table:
+                problems.append(
+                    f"{at}, column {key}: {key} {name!r} is not in the {key} table (known: {', '.join(sorted(table))})"
+                )
+    return seen, problems
+
+
+def _number(raw: str, at: str, problems: list[str], integer: bool = False) -> float:
+    if raw == "":
+        problems.append(f"{at}: empty")
+        return math.nan
+    try:
+        val = float(raw)
+    except ValueError:
+        problems.append(f"{at}: {raw!r} is not a number")
+        return math.nan
+    if not math.isfinite(val):
+        problems.append(f"{at}: {raw!r} is not finite")
+        return math.nan
+    if integer and val != int(val):
+        problems.append(f"{at}: {raw!r} is not a whole frame number")
+        return math.nan
+    return val
+
+
+def check_track_rows(
+    path: str | os.PathLike[str],
+    rows: list,
+    impacts: dict[str, str] | None,
+    impacts_path: str | os.PathLike[str] | None = None,
+) -> tuple[dict, list[str]]:
+    """Track rows: known camera and point names, whole frame numbers, finite pixels, no frame twice.
+
+    Parameters
+    ----------
+    path : path-like
+        The tracks file (for messages).
+    rows : list of (label, {column: text})
+        Its rows.
+    impacts : dict or None
+        Impact ids of the impacts file (id -> row label); None skips that check.
+    impacts_path : path-like, optional
+        The impacts file (for messages).
+
+    Returns
+    -------
+    (columns, problems)
+        ``columns`` maps each column to a list of parsed values, plus ``label``.
+    """
+    problems: list[str] = []
+    out: dict[str, list] = {c: [] for c in (*TRACK_COLUMNS, "label")}
+    seen: dict[tuple, str] = {}
+    unknown_impacts: dict[str, list[str]] = {}
+    if not rows:
+        problems.append(f"{path}: no tracks (only a header)")
+    for label, row in rows:
+        at = f"{path}: {label}"
+        bad = False
+        if EXTRA in row:
+            problems.append(f"{at}: {row[EXTRA]} more cell(s) than the header has columns")
+        iid = row.get("impact_id", "")
+        if not iid:
+            problems.append(f"{at}, column impact_id: empty")
+            bad = True
+        elif impacts is not None and iid not in impacts:
+            unknown_impacts.setdefault(iid, []).append(label)
+            bad = True
+        cam = row.get("camera", "")
+        if cam not in POINTS:
+            problems.append(
+                f"{at}, column camera: "
+                + (f"unknown camera {cam!r}" if cam else "empty")
+                + f" (known: {', '.join(CAMERAS)})"
+            )
+            bad = True
+        point = row.get("point", "")
+        if cam in POINTS and point not in POINTS[cam]:
+            problems.append(
+                f"{at}, column point: "
+                + (f"unknown point {point!r} for the {cam} camera" if point else "empty")
+                + f" (known: {', '.join(POINTS[cam])})"
+            )
+            bad = True
+        n0 = len(problems)
+        frame = _number(row.get("frame", ""), f"{at}, column frame", problems, integer=True)
+        x = _number(row.get("x_px", ""), f"{at}, column x_px", problems)
+        y = _number(row.get("y_px", ""), f"{at}, column y_px", problems)
+        bad = bad or len(problems) > n0
+        if bad:
+            continue
+        key = (iid, cam, point, int(frame))
+        if key in seen:
+            problems.append(
+                f"{at}, column frame: frame {int(frame)} of {point} in the {cam} camera of impact {iid!r} "
+                f"appears twice (also {seen[key]})"
+            )
+            continue
+        seen[key] = label
+        for c, v in zip((*TRACK_COLUMNS, "label"), (iid, cam, point, int(frame), x, y, label), strict=True):
+            out[c].append(v)
+    for iid, labels in unknown_impacts.items():
+        where = ", ".join(labels[:3]) + (f" and {len(labels) - 3} more" if len(labels) > 3 else "")
+        problems.append(
+            f"{path}: {where}, column impact_id: impact {iid!r} is not in {impacts_path} (add a row impact_id,bat,ball)"
+        )
+    if impacts is not None:
+        have: dict[str, set] = {}
+        for iid, cam, point in {(k[0], k[1], k[2]) for k in seen}:
+            have.setdefault(iid, set()).add((cam, point))
+        for iid, label in impacts.items():
+            got = have.get(iid)
+            if not got and iid not in unknown_impacts:
+                problems.append(f"{impacts_path}: {label}: impact {iid!r} has no tracks in {path}")
+                continue
+            for cam in CAMERAS:
+                pts = [p for p in POINTS[cam] if (cam, p) in got]
+                if not pts:
+                    problems.append(
+                        f"{path}: impact {iid!r} ({impacts_path}: {label}): the {cam} camera is missing "
+                        f"(no rows with camera {cam}; each impact needs both cameras)"
+                    )
+                elif len(pts) < len(POINTS[cam]):
+                    miss = [p for p in POINTS[cam] if p not in pts]
+                    problems.append(
+                        f"{path}: impact {iid!r} ({impacts_path}: {label}): the {cam} camera has no rows of "
+                        f"point(s) {', '.join(miss)}"
+                    )
+    return out, problems
+
+
+def check_cameras(cfg: object, where: str) -> list[str]:
+    """Camera settings (``cameras``) and rig (``rig``) of a tracked dataset's config block."""
+    problems: list[str] = []
+    cams = cfg.get("cameras") if isinstance(cfg, dict) else None
+    if not isinstance(cams, dict):
+        return [f"{where}.cameras: missing (give swing and spin: fps, m_per_px, mirror)"]
+    for name in cams:
+        if name not in POINTS:
+            problems.append(f"{where}.cameras.{name}: unknown camera (known: {', '.join(CAMERAS)})")
+    for name in CAMERAS:
+        c = cams.get(name)
+        at = f"{where}.cameras.{name}"
+        if c is None:
+            problems.append(f"{at}: camera missing (give fps, m_per_px, mirror)")
+            continue
+        if not isinstance(c, dict):
+            problems.append(f"{at}: expected a mapping of fps, m_per_px, mirror")
+            continue
+        for k in CAMERA_REQUIRED:
+            if k not in c:
+                problems.append(f"{at}.{k}: missing")
+        for k in c:
+            if k not in CAMERA_KEYS:
+                problems.append(f"{at}.{k}: unknown setting (known: {', '.join(sorted(CAMERA_KEYS))})")
+        for k in ("fps", "m_per_px"):
+            if k in c and not (_is_number(c[k]) and c[k] > 0):
+                problems.append(f"{at}.{k}: {c[k]!r} must be a positive number")
+        if "m_per_px_err" in c and not (_is_number(c["m_per_px_err"]) and c["m_per_px_err"] >= 0):
+            problems.append(f"{at}.m_per_px_err: {c['m_per_px_err']!r} must be a number >= 0 (relative uncertainty)")
+        if "mirror" in c and not isinstance(c["mirror"], bool):
+            problems.append(f"{at}.mirror: {c['mirror']!r} must be true or false")
+    rig = cfg.get("rig")
+    if not isinstance(rig, dict):
+        problems.append(f"{where}.rig: missing (give {', '.join(RIG_KEYS)})")
+        return problems
+    for k in RIG_KEYS:
+        if k not in rig:
+            problems.append(f"{where}.rig.{k}: missing")
+        elif not (_is_number(rig[k]) and rig[k] > 0):
+            problems.append(f"{where}.rig.{k}: {rig[k]!r} must be a positive number (inches)")
+    for k in rig:
+        if k not in RIG_KEYS:
+            problems.append(f"{where}.rig.{k}: unknown setting (known: {', '.join(RIG_KEYS)})")
+    if all(_is_number(rig.get(k)) for k in RIG_KEYS) and rig["pivot_to_impact_in"] > rig["pivot_to_tip_in"]:
+        problems.append(
+            f"{where}.rig: pivot_to_impact_in {rig['pivot_to_impact_in']} is beyond pivot_to_tip_in "
+            f"{rig['pivot_to_tip_in']} (the impact point lies between the pivot and the tip)"
+        )
+    return problems
+
+
+def _is_number(v) -> bool:
+    return isinstance(v, int | float) and not isinstance(v, bool) and math.isfinite(v)

@@ -1,0 +1,329 @@
+"""Results workbooks: a dataset's (or the implications') results as a spreadsheet in the field's units.
+
+A bat-testing lab writes its report in a spreadsheet, in mph, degrees, rpm, inches and feet.
+:func:`dataset_workbook` gathers the NetCDF results of one dataset (impacts, e_x per bat and
+ball, the Sec. IV quantities, eta^2) and its paper comparison into one ``.xlsx`` file, one sheet
+per table; :func:`implications_workbook` does the same for the batted-ball scenarios. Every
+sheet has the column names of ``docs/nomenclature.md`` in its first row and their units in the
+second; the last sheet records the provenance of every file it was made from.
+
+The workbook is byte-identical on rerun: its document properties carry a fixed timestamp and
+the zip entries a fixed date (openpyxl would write the current time into both).
+
+References
+----------
+.. [1] J. R. Kensrud, A. M. Nathan and L. V. Smith, Am. J. Phys. 85, 503 (2017).
+"""
+
+from __future__ import annotations
+
+import datetime as _dt
+import io
+import json
+import zipfile
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .pipeline.atomic import atomic_target
+from .units import from_si
+
+if TYPE_CHECKING:
+    import os
+    from collections.abc import Sequence
+
+    import xarray as xr
+
+#: The fixed time written into the workbook's properties and zip entries (reruns are byte-identical).
+FIXED_TIME = _dt.datetime(2017, 5, 3)  # the paper's publication month
+
+
+@dataclass(frozen=True)
+class Column:
+    """One column of a sheet: the results variable, its header, and the unit it is shown in."""
+
+    var: str
+    unit: str  # a unit of ballbat.units.TO_SI ("1" for numbers without units, "" for text)
+    header: str | None = None  # default: ``var``
+
+    @property
+    def name(self) -> str:
+        """Return the header of the column."""
+        return self.header or self.var
+
+
+#: The impacts sheet (reconstruct.nc), paper units.
+IMPACT_COLUMNS = (
+    Column("impact", "1"),
+    Column("impact_id", ""),
+    Column("ball", ""),
+    Column("bat", ""),
+    Column("v_bat", "mph"),
+    Column("v_bat_err", "mph"),
+    Column("v_ball", "mph"),
+    Column("v_ball_err", "mph"),
+    Column("theta", "deg"),
+    Column("theta_err", "deg"),
+    Column("omega", "rpm"),
+    Column("omega_err", "rpm"),
+    Column("omega_norm", "rpm"),
+    Column("v_ball_norm", "mph"),
+    Column("psi", "deg"),
+    Column("D", "in"),
+    Column("r_x", "1"),
+    Column("r_y", "1"),
+    Column("flag", "1"),
+    Column("flag_reason", ""),
+)
+
+#: e_x per bat x ball and pooled (fit_ex.nc): the fields of each fit (value, standard error,
+#: 95 % interval, impacts, reduced chi-square), headed by their names in fit_ex.nc.
+FIT_FIELDS = (
+    Column("", "1", "e_x"),
+    Column("_err", "1", "e_x_err"),
+    Column("_ci_low", "1", "e_x_ci_low"),
+    Column("_ci_high", "1", "e_x_ci_high"),
+    Column("_n", "1", "e_x_n"),
+    Column("_redchi", "1", "e_x_redchi"),
+)
+
+#: Sec. IV quantities per ball (fit_ex.nc): (variable, unit, its standard error or None).
+SEC4_COLUMNS = (
+    ("tan_ratio_slope", "1", "tan_ratio_slope_err"),
+    ("e_y_implied", "1", "e_y_implied_err"),
+    ("mu_k_lower_bound", "1", "mu_k_lower_bound_err"),
+    ("spin_theta_slope", "rpm/deg", "spin_theta_slope_err"),
+    ("speed_theta_slope", "mph/deg", "speed_theta_slope_err"),
+    ("gross_slip_psi", "deg", None),
+    ("gross_slip_theta", "deg", None),
+    ("gross_slip_omega", "rpm", None),
+)
+
+#: Stronge's model per ball (stronge.nc).
+STRONGE_COLUMNS = (
+    Column("eta2", "1"),
+    Column("eta2_err", "1"),
+    Column("eta2_ci_low", "1"),
+    Column("eta2_ci_high", "1"),
+    Column("eta2_dof", "1"),
+    Column("eta2_n", "1"),
+    Column("eta2_redchi", "1"),
+    Column("e_y", "1"),
+    Column("mu", "1"),
+    Column("omega_ratio", "1"),
+    Column("psi_stick_boundary", "deg"),
+    Column("psi_gross_slip_boundary", "deg"),
+)
+
+#: A batted-ball scenario's cases (implications/{scenario}.nc).
+SCENARIO_COLUMNS = (
+    Column("case", "1"),
+    Column("D", "in"),
+    Column("psi", "deg"),
+    Column("exit_speed", "mph"),
+    Column("launch_angle", "deg"),
+    Column("spray_angle", "deg"),
+    Column("backspin", "rpm"),
+    Column("sidespin", "rpm"),
+    Column("carry", "ft"),
+    Column("apex", "ft"),
+    Column("hang_time", "s"),
+    Column("landing_x", "ft"),
+    Column("landing_y", "ft"),
+    Column("exceeds_mu", "1"),
+)
+
+
+def _cell(value: object, unit: str) -> object:
+    """Return a spreadsheet cell value: numbers in ``unit`` (NaN as an empty cell), text as is."""
+    if isinstance(value, bytes):
+        value = value.decode()
+    if isinstance(value, str):
+        return value
+    v = float(value)
+    if not np.isfinite(v):
+        return None
+    if unit in ("", "1", "s"):
+        return int(v) if float(v).is_integer() and isinstance(value, np.integer | int) else v
+    return float(from_si(v, unit))
+
+
+def _header(ws: object, names: Sequence[str], units: Sequence[str]) -> None:
+    """Write the two header rows: the column names, then their units (empty for text)."""
+    ws.append(list(names))
+    ws.append(list(units))
+    ws.freeze_panes = "A3"
+
+
+def _table_sheet(wb: object, title: str, ds: xr.Dataset, columns: Sequence[Column], dim: str) -> None:
+    """Add a sheet with one row per element of ``dim`` and the ``columns`` present in ``ds``."""
+    cols = [c for c in columns if c.var in ds.variables]
+    ws = wb.create_sheet(title)
+    _header(ws, [c.name for c in cols], [c.unit for c in cols])
+    for i in range(ds.sizes[dim]):
+        ws.append([_cell(ds[c.var].values[i] if ds[c.var].dims else ds[c.var].values, c.unit) for c in cols])
+
+
+def _provenance_sheet(wb: object, sources: dict[str, xr.Dataset]) -> None:
+    """Add the provenance sheet: for every source file its rule, inputs (with sha256), config and software."""
+    ws = wb.create_sheet("provenance")
+    ws.append(["file", "record", "key", "value"])
+    ws.append(["", "", "", ""])
+    for name, ds in sources.items():
+        ws.append([name, "title", "", str(ds.attrs.get("title", ""))])
+        ws.append([name, "rule", "", str(ds.attrs.get("provenance_rule", ""))])
+        for f in json.loads(ds.attrs.get("provenance_inputs", "[]")):
+            ws.append([name, "input", str(f.get("path")), str(f.get("sha256"))])
+        for record in ("config", "software", "git"):
+            values = json.loads(ds.attrs.get(f"provenance_{record}", "{}"))
+            for key in sorted(values):
+                ws.append([name, record, key, json.dumps(values[key], sort_keys=True)])
+
+
+def _fixed_bytes(wb: object) -> bytes:
+    """Return the workbook as bytes with fixed timestamps (properties and zip entries)."""
+    wb.properties.created = FIXED_TIME
+    wb.properties.modified = FIXED_TIME
+    wb.properties.creator = "ballbat"
+    wb.properties.lastModifiedBy = "ballbat"
+    raw = io.BytesIO()
+    wb.save(raw)
+    out = io.BytesIO()
+    with zipfile.ZipFile(raw) as zin, zipfile.ZipFile(out, "w", zipfile.ZIP_DEFLATED) as zout:
+        for info in sorted(zin.infolist(), key=lambda i: i.filename):
+            data = zin.read(info.filename)
+            if info.filename == "docProps/core.xml":  # openpyxl stamps "modified" with the clock on save
+                data = _fix_core_times(data)
+            fixed = zipfile.ZipInfo(info.filename, date_time=FIXED_TIME.timetuple()[:6])
+            fixed.compress_type = zipfile.ZIP_DEFLATED
+            fixed.external_attr = 0o644 << 16
+            zout.writestr(fixed, data)
+    return out.getvalue()
+
+
+def _fix_core_times(xml: bytes) -> bytes:
+    """Return docProps/core.xml with its created/modified times set to :data:`FIXED_TIME`."""
+    import re
+
+    stamp = FIXED_TIME.strftime("%Y-%m-%dT%H:%M:%SZ").encode()
+    return re.sub(rb"(<dcterms:(?:created|modified)[^>]*>)[^<]*(</dcterms:)", rb"\g<1>" + stamp + rb"\g<2>", xml)
+
+
+def _write(wb: object, path: str | os.PathLike[str]) -> None:
+    data = _fixed_bytes(wb)
+    with atomic_target(path) as tmp:
+        tmp.write_bytes(data)
+
+
+def dataset_workbook(
+    path: str | os.PathLike[str],
+    impacts: xr.Dataset,
+    fit: xr.Dataset,
+    stronge: xr.Dataset,
+    comparison: list[dict],
+) -> None:
+    """Write one dataset's results workbook.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The ``.xlsx`` file to write (atomically).
+    impacts, fit, stronge : xarray.Dataset
+        ``reconstruct.nc``, ``fit_ex.nc`` and ``stronge.nc`` of the dataset.
+    comparison : list of dict
+        The rows of ``paper_comparison.csv`` (:func:`ballbat.compare.read_csv`).
+
+    Notes
+    -----
+    Sheets: ``impacts`` (one row per impact, flags and reasons kept), ``e_x`` (per bat and
+    ball, then pooled per ball as bat ``pooled``), ``sec4`` (Eq. ratio, implied e_y, the mu_k
+    bound, Figs. 3-4 slopes, the gross-slip example), ``eta2`` (Stronge's model),
+    ``paper_comparison``, ``warnings`` (those of a measured file) and ``provenance``.
+    """
+    from openpyxl import Workbook
+
+    wb = Workbook()
+    wb.remove(wb.active)
+    _table_sheet(wb, "impacts", impacts, IMPACT_COLUMNS, "impact")
+
+    ws = wb.create_sheet("e_x")
+    _header(ws, ["ball", "bat", *(c.name for c in FIT_FIELDS), "e_x_status"], ["", "", *("1" for _ in FIT_FIELDS), "1"])
+    for ball in fit["ball"].values.astype(str):
+        for bat in fit["bat"].values.astype(str):
+            f = fit.sel(ball=ball, bat=bat)
+            if int(f["e_x_n"]) == 0:
+                continue
+            ws.append([ball, bat, *(_cell(f[f"e_x{c.var}"].values, "1") for c in FIT_FIELDS), int(f["e_x_status"])])
+        p = fit.sel(ball=ball)
+        ws.append(
+            [
+                ball,
+                "pooled",
+                *(_cell(p[f"e_x_pooled{c.var}"].values, "1") for c in FIT_FIELDS),
+                int(p["e_x_pooled_status"]),
+            ]
+        )
+
+    ws = wb.create_sheet("sec4")
+    names, units = ["ball"], [""]
+    for var, unit, err in SEC4_COLUMNS:
+        names += [var] + ([err] if err else [])
+        units += [unit] + ([unit] if err else [])
+    _header(ws, names, units)
+    for ball in fit["ball"].values.astype(str):
+        f = fit.sel(ball=ball)
+        row = [ball]
+        for var, unit, err in SEC4_COLUMNS:
+            row.append(_cell(f[var].values, unit))
+            if err:
+                row.append(_cell(f[err].values, unit))
+        ws.append(row)
+
+    _table_sheet(
+        wb,
+        "eta2",
+        stronge.assign_coords(ball_name=stronge["ball"]),
+        (Column("ball_name", "", "ball"), *STRONGE_COLUMNS),
+        "ball",
+    )
+
+    ws = wb.create_sheet("paper_comparison")
+    if comparison:
+        keys = list(comparison[0])
+        ws.append(keys)
+        ws.append(["" for _ in keys])
+        for row in comparison:
+            ws.append([_number_or_text(row[k]) for k in keys])
+    ws = wb.create_sheet("warnings")
+    ws.append(["warning"])
+    ws.append([""])
+    for text in (w for w in impacts.attrs.get("ingest_warnings", "").split("\n") if w):
+        ws.append([text])
+    _provenance_sheet(wb, {"reconstruct.nc": impacts, "fit_ex.nc": fit, "stronge.nc": stronge})
+    _write(wb, path)
+
+
+def _number_or_text(value: object) -> object:
+    if value is None or value == "":
+        return None
+    try:
+        return float(value)
+    except (TypeError, ValueError):
+        return value
+
+
+def implications_workbook(path: str | os.PathLike[str], scenarios: dict[str, xr.Dataset]) -> None:
+    """Write the batted-ball scenarios' workbook: one sheet per scenario, then the provenance.
+
+    Each case is a row: D and psi (D sweeps), exit speed, launch and spray angles, backspin and
+    sidespin, carry, apex, hang time and landing point, in mph, deg, rpm, in, ft and s.
+    """
+    from openpyxl import Workbook
+
+    wb = Workbook()
+    wb.remove(wb.active)
+    for name in sorted(scenarios):
+        _table_sheet(wb, name[:31], scenarios[name], SCENARIO_COLUMNS, "case")
+    _provenance_sheet(wb, {f"{name}.nc": ds for name, ds in sorted(scenarios.items())})
+    _write(wb, path)
