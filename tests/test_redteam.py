@@ -310,9 +310,9 @@ def test_one_impact_label():
 
 
 def test_netcdf_rows_are_counted_from_one(tmp_path):
-    from ballbat.ingest import read_impacts_table
-
     import xarray as xr
+
+    from ballbat.ingest import read_impacts_table
 
     with MAPLE.open(newline="") as fh:
         rows = list(csv.DictReader(fh))

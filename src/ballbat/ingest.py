@@ -507,7 +507,14 @@ _MISTAKES = (
 
 
 def swapped_speeds(
-    path: str | os.PathLike[str], data: dict, usable: np.ndarray, groups: np.ndarray, r, alpha, r_x, r_y
+    path: str | os.PathLike[str],
+    data: dict,
+    usable: np.ndarray,
+    groups: np.ndarray,
+    r: ArrayLike,
+    alpha: ArrayLike,
+    r_x: ArrayLike,
+    r_y: ArrayLike,
 ) -> list[str]:
     """Problems naming bat x ball pairs whose impacts imply a median e_y below :data:`E_Y_MIN` (SI ``data``).
 
