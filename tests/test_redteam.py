@@ -432,11 +432,18 @@ def test_package_data_is_declared():
 @pytest.mark.slow
 def test_pip_install_outside_the_checkout(tmp_path):
     """`pip install .` into a fresh venv (dependencies from this environment), then `ballbat fly` elsewhere."""
+    import shutil
+
+    src = tmp_path / "checkout"  # a copy: setuptools builds in the source tree (build/)
+    for part in ("pyproject.toml", "README.md", "src", "config", "workflow/schemas"):
+        copy = shutil.copytree if (ROOT / part).is_dir() else shutil.copy2
+        (src / part).parent.mkdir(parents=True, exist_ok=True)
+        copy(ROOT / part, src / part, **({"symlinks": True} if copy is shutil.copytree else {}))
     venv = tmp_path / "venv"
     subprocess.run([sys.executable, "-m", "venv", str(venv)], check=True, timeout=120)
     py = venv / "bin" / "python"
     subprocess.run(
-        [str(py), "-m", "pip", "install", "--quiet", "--disable-pip-version-check", "--no-deps", str(ROOT)],
+        [str(py), "-m", "pip", "install", "--quiet", "--disable-pip-version-check", "--no-deps", str(src)],
         check=True,
         timeout=300,
         capture_output=True,
