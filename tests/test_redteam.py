@@ -392,11 +392,25 @@ def test_fly_csv_binary_file(tmp_path):
 
 
 def test_summary_of_a_truncated_file(tmp_path):
+    import xarray as xr
+
+    ds = xr.Dataset({"x": ("impact", np.arange(5000.0))})
     for name in ("reconstruct", "fit_ex", "stronge"):
-        (tmp_path / f"{name}.nc").write_bytes(b"\x89HDF\r\n\x1a\n" + bytes(100))  # an HDF5 file cut short
+        ds.to_netcdf(tmp_path / f"{name}.nc", engine="netcdf4")
+    whole = (tmp_path / "stronge.nc").read_bytes()
+    (tmp_path / "stronge.nc").write_bytes(whole[: len(whole) // 3])  # cut short, as a killed copy leaves it
     out = ballbat("summary", tmp_path)
     assert out.returncode == 2 and "Traceback" not in out.stderr
-    assert len(out.stderr.strip().splitlines()) == 1 and "reconstruct.nc cannot be read" in out.stderr, out.stderr
+    assert len(out.stderr.strip().splitlines()) == 1 and "stronge.nc cannot be read" in out.stderr, out.stderr
+
+
+def test_summary_of_files_without_the_variables(tmp_path):
+    import xarray as xr
+
+    for name in ("reconstruct", "fit_ex", "stronge"):
+        xr.Dataset({"x": ("impact", [1.0])}).to_netcdf(tmp_path / f"{name}.nc", engine="netcdf4")
+    out = ballbat("summary", tmp_path)
+    assert out.returncode == 2 and "Traceback" not in out.stderr and "lacks" in out.stderr, out.stderr
 
 
 def test_closed_pipe_is_quiet(tmp_path):

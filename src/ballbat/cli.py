@@ -401,7 +401,13 @@ def cmd_summary(args: argparse.Namespace) -> int:
     folder = Path(args.folder)
     if not folder.is_dir():
         raise UsageError(f"argument folder: {folder}: not a directory")
-    print("\n".join(summary_lines(folder)))
+    try:
+        lines = summary_lines(folder)
+    except KeyError as exc:  # a file of another version of the workflow
+        raise UsageError(
+            f"argument folder: {folder}: a results file lacks {exc} (made by another version?); rerun the workflow"
+        ) from None
+    print("\n".join(lines))
     return 0
 
 

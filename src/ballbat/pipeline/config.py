@@ -107,9 +107,10 @@ def _names(config: dict) -> list[str]:
         for name in table:
             if not isinstance(name, str):
                 kind = "a boolean (as yes, no, on, off)" if isinstance(name, bool) else "a number"
+                example = "'yes'" if isinstance(name, bool) else f"'{name}'"
                 problems.append(
                     f"{where}.{name}: YAML reads this name as {kind}, not text; a name must be text: "
-                    "quote it in the YAML file (e.g. '123') or choose a name that starts with a letter"
+                    f"quote it in the YAML file ({example}) or choose a name that starts with a letter"
                 )
             elif not NAME.fullmatch(str(name)):
                 problems.append(f"{where}.{name!r}: a name may hold only letters, digits, _ and - (it names {folder})")
