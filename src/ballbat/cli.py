@@ -98,14 +98,14 @@ def _range_problem(val: float, limits: dict, unit: str) -> str | None:
         return f"{val!r} is not a finite number"
     lo, hi = limits.get("minimum"), limits.get("maximum")
     xlo, xhi = limits.get("exclusiveMinimum"), limits.get("exclusiveMaximum")
-    if (lo is not None and val < lo) or (hi is not None and val > hi) or (xlo is not None and val <= xlo):
-        left = f"[{lo:g}" if lo is not None else f"({xlo:g}"
-        right = f"{hi:g}]" if hi is not None else f"{xhi:g})"
-        about = limits.get("description", "")
-        return f"{val:g} {unit} is outside {left}, {right} {unit}" + (f" ({about})" if about else "")
-    if xhi is not None and val >= xhi:
-        return f"{val:g} {unit} is outside the range, below {xhi:g} {unit}"
-    return None
+    below = (lo is not None and val < lo) or (xlo is not None and val <= xlo)
+    above = (hi is not None and val > hi) or (xhi is not None and val >= xhi)
+    if not (below or above):
+        return None
+    left = f"[{lo:g}" if lo is not None else f"({xlo:g}" if xlo is not None else "(-inf"
+    right = f"{hi:g}]" if hi is not None else f"{xhi:g})" if xhi is not None else "inf)"
+    about = limits.get("description", "")
+    return f"{val:g} {unit} is outside {left}, {right} {unit}" + (f" ({about})" if about else "")
 
 
 # --------------------------------------------------------------------------------------
