@@ -7,12 +7,16 @@ from ballbat.tracks.stage import excluded_listing, reduce_stage
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     inp = snakemake.input
+    # a file the config names but that is missing is no input (common.smk: existing); reading it
+    # by its configured name fails this job alone, with a message naming the file
+    named = snakemake.config["datasets"][snakemake.wildcards.dataset]
+    tables = {k: named.get(k, snakemake.config["tables"][k]) for k in ("balls", "bats")}
     ds = reduce_stage(
-        inp.tracks,
-        inp.get("impacts"),
+        inp.get("tracks") or named["tracks"]["file"],
+        inp.get("impacts") or named.get("tracks", {}).get("impacts"),
         snakemake.params.settings,
-        inp.balls,
-        inp.bats,
+        inp.get("balls") or tables["balls"],
+        inp.get("bats") or tables["bats"],
         where=snakemake.params.where,
     )
     excluded = excluded_listing(ds)
