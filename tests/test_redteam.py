@@ -100,6 +100,11 @@ CONFIG_CASES = [
         lambda c: _paper(c)["flight"].update(wind_mph=[1e6, 0]),
         "flight.wind_mph.0: 1000000.0 is greater than the maximum of 100",
     ),
+    (
+        "camera at 1e9 fps",
+        lambda c: c["datasets"]["synthetic"]["render"]["cameras"]["swing"].update(fps=1e9),
+        "cameras.swing.fps: 1000000000.0 is greater than the maximum of 1000000",
+    ),
     ("bat speed nan", lambda c: _paper(c)["sweep"].update(bat_mph=float("nan")), "sweep.bat_mph: nan is not a finite"),
     ("D_in.num 1 drops stop", lambda c: _paper(c)["sweep"]["D_in"].update(num=1), "stop = 2.5 would be dropped"),
     (
