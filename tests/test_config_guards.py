@@ -60,7 +60,7 @@ def test_counts_beyond_the_machine_are_refused_up_front(base, schema):
 def test_launch_grids_count_every_combination(base, schema):
     base["implications"]["scenarios"]["grid"] = {
         "ball": "baseball",
-        "launch": {"exit_speed_mph": list(range(600)), "launch_deg": list(range(600))},
+        "launch": {"exit_speed_mph": [1 + i / 10 for i in range(600)], "launch_deg": [i / 10 for i in range(600)]},
     }
     assert "implications.scenarios.grid.launch: 360,000 cases" in problems(base, schema, available=24 * 2**30)
 

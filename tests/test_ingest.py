@@ -113,7 +113,7 @@ def test_netcdf_same_content(tmp_path):
     b, _ = ingest.ingest(tmp_path / "maple.nc", BALLS, MAPLE_BATS)
     for v in ("v_bat", "v_ball", "theta", "omega", "omega_err", "ingest_flag"):
         np.testing.assert_allclose(a[v].values, b[v].values)
-    assert b["source_row"].values[3] == "impact 3"
+    assert b["source_row"].values[3] == "entry 4"
     # a variable whose units contradict its name
     ds = xr.Dataset(data)
     ds["v_bat_mph"].attrs["units"] = "m s-1"

@@ -35,6 +35,23 @@ NORMALIZE_TABLE = {
 }
 
 
+def impact_labels(ds: xr.Dataset) -> np.ndarray:
+    """Return each impact's label for messages: ``impact <id> (<where in the source file>)``.
+
+    The id is ``impact_id`` (a measured file's own, or a tracked impact's); an impact without
+    one (a synthetic experiment in the direct-noise mode) is numbered from 1 (``impact #31``),
+    never by its 0-based index. The place in the file (``row 32``: its CSV line, the header
+    being line 1) is added where the impacts came from a file (``source_row``).
+    """
+    n = ds.sizes["impact"]
+    ids = ds["impact_id"].values.astype(str) if "impact_id" in ds else np.array([f"#{i + 1}" for i in range(n)])
+    rows = ds["source_row"].values.astype(str) if "source_row" in ds else np.full(n, "")
+    out = [
+        f"impact at {r}" if i == r else f"impact {i}" + (f" ({r})" if r else "") for i, r in zip(ids, rows, strict=True)
+    ]
+    return np.array(out, dtype=str)
+
+
 def normalize(ds: xr.Dataset, v_ref_mph: float) -> xr.Dataset:
     """Add spin and exit speed normalised to the reference bat speed (Sec. II, Figs. 3-4).
 

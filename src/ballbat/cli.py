@@ -18,6 +18,9 @@ from __future__ import annotations
 import argparse
 import csv
 import json
+import math
+import os
+import re
 import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
@@ -25,8 +28,9 @@ from typing import TYPE_CHECKING, NoReturn
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-#: The repository checkout this package runs from (config/ and workflow/ live there).
-ROOT = Path(__file__).resolve().parents[2]
+#: The config schema and the default property tables, shipped with the package (``data/`` links
+#: to ``workflow/schemas/`` and ``config/`` of the checkout, so there is one copy of each).
+DATA = Path(__file__).resolve().parent / "data"
 
 EXAMPLES = {
     "check": """examples:
@@ -58,7 +62,15 @@ class UsageError(Exception):
 
 
 class _Parser(argparse.ArgumentParser):
-    """An argument parser whose errors are one line (no usage block) and exit with status 2."""
+    """An argument parser whose errors are one line (no usage block) and exit with status 2.
+
+    A value that starts with ``-`` and a digit (``--elevation -1e6``, ``--wind -5,3``) or reads
+    ``-inf``/``-nan`` is a value, not an option (argparse's own test misses exponents).
+    """
+
+    def __init__(self, *args: object, **kwargs: object) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = re.compile(r"^-(\.?\d|inf|nan)", re.IGNORECASE)
 
     def error(self, message: str) -> NoReturn:
         """Report ``message`` as one line on stderr and exit 2."""
@@ -69,15 +81,43 @@ def _schema_defaults() -> dict:
     """Return the defaults the config schema gives the air and the flight (the workflow's own)."""
     import yaml
 
-    schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
+    schema = yaml.safe_load((DATA / "config.schema.yaml").read_text())
     air = schema["properties"]["implications"]["properties"]["air"]["properties"]
     flight = schema["$defs"]["flight"]["properties"]
     tables = schema["properties"]["tables"]["properties"]
     return {
         "air": {k: v["default"] for k, v in air.items()},
         "flight": {k: v["default"] for k, v in flight.items()},
-        "tables": {k: str(ROOT / v["default"]) for k, v in tables.items()},
+        "tables": {k: str(DATA / Path(v["default"]).name) for k, v in tables.items()},
+        "limits": schema["$defs"],
     }
+
+
+def _finite(text: str) -> float:
+    """Parse a number that must be finite (``nan``, ``inf`` and ``1e400`` are not)."""
+    try:
+        val = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(val):
+        raise argparse.ArgumentTypeError(f"{text!r} is not a finite number")
+    return val
+
+
+def _range_problem(val: float, limits: dict, unit: str) -> str | None:
+    """Return why ``val`` lies outside the schema's range ``limits`` (None when inside)."""
+    if not math.isfinite(val):
+        return f"{val!r} is not a finite number"
+    lo, hi = limits.get("minimum"), limits.get("maximum")
+    xlo, xhi = limits.get("exclusiveMinimum"), limits.get("exclusiveMaximum")
+    below = (lo is not None and val < lo) or (xlo is not None and val <= xlo)
+    above = (hi is not None and val > hi) or (xhi is not None and val >= xhi)
+    if not (below or above):
+        return None
+    left = f"[{lo:g}" if lo is not None else f"({xlo:g}" if xlo is not None else "(-inf"
+    right = f"{hi:g}]" if hi is not None else f"{xhi:g})" if xhi is not None else "inf)"
+    about = limits.get("description", "")
+    return f"{val:g} {unit} is outside {left}, {right} {unit}" + (f" ({about})" if about else "")
 
 
 # --------------------------------------------------------------------------------------
@@ -86,8 +126,9 @@ def _schema_defaults() -> dict:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Validate a measured impacts file as the ingest rule does; print every problem and warning."""
+    from .fitting import fit_problems
     from .ingest import excluded_listing, ingest
-    from .properties import InputError
+    from .properties import InputError, load_balls, load_bats
 
     defaults = _schema_defaults()["tables"]
     if args.kind == "tracks" and args.file is None:
@@ -111,6 +152,12 @@ def cmd_check(args: argparse.Namespace) -> int:
         for problem in exc.problems:
             print(problem)
         print(f"{path}: not usable: {len(exc.problems)} problem(s)", file=sys.stderr)
+        return 1
+    problems = fit_problems(ds, load_balls(args.balls or defaults["balls"]), load_bats(args.bats or defaults["bats"]))
+    if problems:  # what the workflow's fit_ex would stop on: the same chain and test (issue 19)
+        for text in [*problems, *warnings]:
+            print(f"{path}: {text}" if text.startswith("the fit") else f"warning: {text}")
+        print(f"{path}: not usable: {len(problems)} problem(s)", file=sys.stderr)
         return 1
     for text in warnings:
         print(f"warning: {text}")
@@ -297,13 +344,21 @@ def cmd_import_tracks(args: argparse.Namespace) -> int:
 # --------------------------------------------------------------------------------------
 # fly
 
-#: ``fly`` options that take one number per ball: name -> (unit, help).
+#: ``fly`` options that take one number per ball: name -> (unit, help, the schema's range of it).
 FLY_NUMBERS = {
-    "speed": ("mph", "exit speed (required)"),
-    "angle": ("deg", "launch angle above the horizontal (required)"),
-    "backspin": ("rpm", "backspin; negative is topspin (default 0)"),
-    "sidespin": ("rpm", "sidespin; positive curves towards third base (default 0)"),
-    "spray": ("deg", "spray angle from centre field towards first base (default 0)"),
+    "speed": ("mph", "exit speed (required)", "exit_speed_mph"),
+    "angle": ("deg", "launch angle above the horizontal (required)", "launch_deg"),
+    "backspin": ("rpm", "backspin; negative is topspin (default 0)", "spin_rpm"),
+    "sidespin": ("rpm", "sidespin; positive curves towards third base (default 0)", "spin_rpm"),
+    "spray": ("deg", "spray angle from centre field towards first base (default 0)", "spray_deg"),
+}
+#: ``fly`` options of the conditions: option -> (attribute, unit, the schema's range of it).
+FLY_CONDITIONS = {
+    "--temperature": ("temperature", "deg F", "temperature_F"),
+    "--elevation": ("elevation", "ft", "elevation_ft"),
+    "--humidity": ("humidity", "%", "humidity_pct"),
+    "--pressure": ("pressure", "inHg", "pressure_inHg"),
+    "--spin-decay": ("spin_decay", "s", "tau_s"),
 }
 
 
@@ -312,36 +367,84 @@ def _wind(text: str) -> tuple[float, float]:
         wx, wy = (float(v) for v in text.split(","))
     except ValueError:
         raise argparse.ArgumentTypeError(f"invalid wind {text!r}: give 'x,y' in mph") from None
+    if not (math.isfinite(wx) and math.isfinite(wy)):
+        raise argparse.ArgumentTypeError(f"invalid wind {text!r}: both components must be finite numbers of mph")
     return wx, wy
 
 
-def _read_balls_csv(path: Path) -> dict[str, list[float]]:
-    """Return the columns of a ``fly --csv`` file (names as the options), one value per ball."""
-    if not path.is_file():
+def _read_balls_csv(path: Path, limits: dict) -> dict[str, list[float]]:
+    """Return the columns of a ``fly --csv`` file (names as the options), one value per ball.
+
+    Read as the workflow reads a lab's CSV (:func:`ballbat.properties.read_csv_rows`: comma or
+    semicolon, a byte-order mark, UTF-8 only). Every cell of a column the header names must hold
+    a finite number: a blank cell is an error naming its row and column, never 0.
+    """
+    from .properties import InputError, read_csv_rows
+
+    if path.is_dir():
+        raise UsageError(f"argument --csv: {path}: is a directory, not a CSV file")
+    if not path.exists():
         raise UsageError(f"argument --csv: {path}: no such file")
-    with open(path, newline="", encoding="utf-8-sig") as fh:
-        rows = list(csv.DictReader(fh))
-    if not rows:
+    try:
+        header, lines = read_csv_rows(path)
+    except InputError as exc:
+        raise UsageError(f"argument --csv: {exc.problems[0]}") from None
+    if not header:
+        raise UsageError(f"argument --csv: {path}: empty file (expected a header line speed,angle,...)")
+    if not lines:
         raise UsageError(f"argument --csv: {path}: no rows")
-    unknown = sorted(set(rows[0]) - set(FLY_NUMBERS))
+    unknown = sorted(set(header) - set(FLY_NUMBERS))
     if unknown:
         raise UsageError(
             f"argument --csv: {path}: unknown column(s) {', '.join(unknown)} (allowed: {', '.join(FLY_NUMBERS)})"
         )
-    missing = [c for c in ("speed", "angle") if c not in rows[0]]
+    missing = [c for c in ("speed", "angle") if c not in header]
     if missing:
         raise UsageError(f"argument --csv: {path}: missing column(s) {', '.join(missing)}")
+    repeated = sorted({c for c in header if header.count(c) > 1})
+    if repeated:
+        raise UsageError(f"argument --csv: {path}: column(s) {', '.join(repeated)} appear more than once")
     cols: dict[str, list[float]] = {k: [] for k in FLY_NUMBERS}
-    for line, row in enumerate(rows, start=2):
+    for line, cells in lines:
+        at = f"argument --csv: {path}, row {line}"
+        if len(cells) > len(header):
+            raise UsageError(f"{at}: {len(cells) - len(header)} more cell(s) than the header has columns")
+        row = dict(zip(header, cells, strict=False))
         for k in FLY_NUMBERS:
-            raw = (row.get(k) or "").strip()
-            if not raw and k not in ("speed", "angle"):
-                raw = "0"
+            if k not in header:  # a column the file does not have: the option's default
+                cols[k].append(0.0)
+                continue
+            raw = row.get(k, "")
+            if not raw:
+                raise UsageError(f"{at}, column {k}: empty (give a value; 0 {FLY_NUMBERS[k][0]} is a value too)")
             try:
-                cols[k].append(float(raw))
+                val = float(raw)
             except ValueError:
-                raise UsageError(f"argument --csv: {path}, line {line}, column {k}: {raw!r} is not a number") from None
+                raise UsageError(f"{at}, column {k}: {raw!r} is not a number") from None
+            if not math.isfinite(val):
+                raise UsageError(f"{at}, column {k}: {raw!r} is not a finite number")
+            why = _range_problem(val, limits[FLY_NUMBERS[k][2]], FLY_NUMBERS[k][0])
+            if why:
+                raise UsageError(f"{at}, column {k}: {why}")
+            cols[k].append(val)
     return cols
+
+
+def _check_ranges(args: argparse.Namespace, cols: dict[str, list[float]], limits: dict) -> None:
+    """Refuse any ball or condition outside the config schema's physical ranges, naming the argument."""
+    if not args.csv:  # a CSV file's cells are checked as they are read, naming row and column
+        for k, (unit, _, ref) in FLY_NUMBERS.items():
+            why = _range_problem(cols[k][0], limits[ref], unit)
+            if why:
+                raise UsageError(f"argument --{k}: {why}")
+    for opt, (attr, unit, ref) in FLY_CONDITIONS.items():
+        why = _range_problem(getattr(args, attr), limits[ref], unit)
+        if why:
+            raise UsageError(f"argument {opt}: {why}")
+    for val in args.wind:
+        why = _range_problem(val, limits["wind_component_mph"], "mph")
+        if why:
+            raise UsageError(f"argument --wind: {why}")
 
 
 def fly_table(args: argparse.Namespace) -> list[dict]:
@@ -351,22 +454,16 @@ def fly_table(args: argparse.Namespace) -> list[dict]:
     from .flight import air_density, fly
     from .units import DEGREE, FOOT, INHG_IN_MMHG, MPH, RPM, fahrenheit_to_celsius
 
+    limits = _schema_defaults()["limits"]
     if args.csv:
-        cols = _read_balls_csv(Path(args.csv))
+        cols = _read_balls_csv(Path(args.csv), limits)
     else:
         missing = [f"--{k}" for k in ("speed", "angle") if getattr(args, k) is None]
         if missing:
             raise UsageError(f"argument {missing[0]}: required (or give --csv FILE)")
         cols = {k: [getattr(args, k) or 0.0] for k in FLY_NUMBERS}
+    _check_ranges(args, cols, limits)
     speed = np.asarray(cols["speed"], dtype=float)
-    if np.any(speed <= 0) or not np.all(np.isfinite(speed)):
-        raise UsageError("argument --speed: must be a positive number of mph")
-    if not 0 <= args.humidity <= 100:
-        raise UsageError("argument --humidity: must lie in 0-100 %")
-    if args.pressure <= 0:
-        raise UsageError("argument --pressure: must be positive (inHg)")
-    if args.spin_decay <= 0:
-        raise UsageError("argument --spin-decay: must be positive (s)")
     rho = air_density(
         fahrenheit_to_celsius(args.temperature),
         args.pressure * INHG_IN_MMHG,
@@ -421,13 +518,24 @@ def cmd_fly(args: argparse.Namespace) -> int:
 
 def summary_lines(folder: Path) -> list[str]:
     """Return the headline numbers of a dataset's results folder as lines of a terminal table."""
+    from .analysis import impact_labels
     from .pipeline.ncio import read_dataset
 
     need = {name: folder / f"{name}.nc" for name in ("reconstruct", "fit_ex", "stronge")}
     missing = [str(p) for p in need.values() if not p.is_file()]
     if missing:
         raise UsageError(f"argument folder: {folder} lacks {', '.join(missing)} (run the workflow first)")
-    rec, fit, st = (read_dataset(p) for p in need.values())
+    read = []
+    for path in need.values():
+        try:
+            read.append(read_dataset(path))
+        except Exception as exc:  # any damage (truncated, not NetCDF) gets the same answer
+            why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise UsageError(
+                f"argument folder: {path} cannot be read ({why}): damaged or cut short; "
+                "rerun the workflow to rebuild it"
+            ) from None
+    rec, fit, st = read
     lines = [f"{folder.name}: {rec.sizes['impact']} impacts, {int((rec['flag'].values != 0).sum())} not used (flagged)"]
     lines += ["", f"{'ball':<10} {'bat':<20} {'e_x':>7} {'± se':>7} {'95 % interval':>17} {'n':>4}"]
     for ball in fit["ball"].values.astype(str):
@@ -448,9 +556,11 @@ def summary_lines(folder: Path) -> list[str]:
             f"{ball:<10} {float(s['eta2']):7.3f} {float(s['eta2_err']):7.3f} {f'[{lo:.3f}, {hi:.3f}]':>17} "
             f"{int(s['eta2_n']):4d}"
         )
-    reasons = rec["flag_reason"].values[rec["flag"].values != 0].astype(str)
+    bad = rec["flag"].values != 0
+    reasons = rec["flag_reason"].values[bad].astype(str)
     if reasons.size:
-        lines += ["", "not used:"] + [f"  {r}" for r in reasons]
+        labels = impact_labels(rec)[bad]
+        lines += ["", "not used:"] + [f"  {lab}: {r}" for lab, r in zip(labels, reasons, strict=True)]
     return lines
 
 
@@ -459,7 +569,13 @@ def cmd_summary(args: argparse.Namespace) -> int:
     folder = Path(args.folder)
     if not folder.is_dir():
         raise UsageError(f"argument folder: {folder}: not a directory")
-    print("\n".join(summary_lines(folder)))
+    try:
+        lines = summary_lines(folder)
+    except KeyError as exc:  # a file of another version of the workflow
+        raise UsageError(
+            f"argument folder: {folder}: a results file lacks {exc} (made by another version?); rerun the workflow"
+        ) from None
+    print("\n".join(lines))
     return 0
 
 
@@ -492,21 +608,23 @@ def parser() -> argparse.ArgumentParser:
     p = sub.add_parser(
         "fly", help="carry, hang time and apex of batted balls", epilog=EXAMPLES["fly"], formatter_class=fmt
     )
-    for name, (unit, text) in FLY_NUMBERS.items():
-        p.add_argument(f"--{name}", type=float, metavar=unit.upper(), help=f"{text}, {unit}")
+    for name, (unit, text, _) in FLY_NUMBERS.items():
+        p.add_argument(f"--{name}", type=_finite, metavar=unit.upper(), help=f"{text}, {unit}")
     p.add_argument("--csv", metavar="FILE", help="many balls: a CSV with columns named like the options above")
     p.add_argument(
-        "--temperature", type=float, default=air["temperature_F"], help="air temperature, deg F (default %(default)s)"
+        "--temperature", type=_finite, default=air["temperature_F"], help="air temperature, deg F (default %(default)s)"
     )
-    p.add_argument("--elevation", type=float, default=air["elevation_ft"], help="elevation, ft (default %(default)s)")
+    p.add_argument("--elevation", type=_finite, default=air["elevation_ft"], help="elevation, ft (default %(default)s)")
     p.add_argument(
-        "--humidity", type=float, default=air["humidity_pct"], help="relative humidity, %% (default %(default)s)"
+        "--humidity", type=_finite, default=air["humidity_pct"], help="relative humidity, %% (default %(default)s)"
     )
-    p.add_argument("--pressure", type=float, default=air["pressure_inHg"], help="pressure, inHg (default %(default)s)")
+    p.add_argument(
+        "--pressure", type=_finite, default=air["pressure_inHg"], help="pressure, inHg (default %(default)s)"
+    )
     p.add_argument("--wind", type=_wind, default=tuple(flight["wind_mph"]), help="wind 'x,y', mph (default 0,0)")
     p.add_argument(
         "--spin-decay",
-        type=float,
+        type=_finite,
         default=flight["tau_s"],
         metavar="SECONDS",
         help="spin-decay time (default %(default)s s)",
@@ -554,10 +672,16 @@ def main(argv: Sequence[str] | None = None) -> int:
     """Run the ``ballbat`` command; return its exit status."""
     args = parser().parse_args(argv)
     try:
-        return args.func(args)
+        status = args.func(args)
+        sys.stdout.flush()
     except UsageError as exc:
         print(f"ballbat {args.command}: error: {exc}", file=sys.stderr)
         return 2
+    except BrokenPipeError:  # the reader left (`ballbat summary ... | head`): stop quietly, as cat does
+        devnull = os.open(os.devnull, os.O_WRONLY)
+        os.dup2(devnull, sys.stdout.fileno())  # nothing left to flush at exit
+        return 141  # 128 + SIGPIPE, the status of a Unix tool the pipe ended
+    return status
 
 
 if __name__ == "__main__":

@@ -86,6 +86,12 @@ OPTIONAL = ("impact_id", *(f"{c}_err" for c in MEASURED_COLUMNS))
 
 #: Range of e_x (Eq. omega) that real ball-bat impacts can show; used only to spot unit mistakes.
 E_X_PLAUSIBLE = (-0.5, 1.0)
+#: Least median normal COR e_y the impacts of a bat x ball pair may imply (Eq. vballn: the
+#: ball's normal exit speed v_ball cos(psi - theta) = (1 + e_y) / (1 + r_y) v_bat cos psi).
+#: Balls on bats have e_y of 0.3-0.6 (the paper: 0.32 and 0.45 for its balls; the maple
+#: example's impacts imply 0.42-0.47); with v_bat and v_ball swapped they imply 0.07-0.41,
+#: median 0.15, so a median below 0.2 betrays that mistake.
+E_Y_MIN = 0.2
 #: Fastest bat (at the impact point) and batted ball, mph, that count as measured: swing
 #: machines and the fastest swings stay below 100 mph at the impact point and the hardest-hit
 #: balls below 125 mph, so faster values point to a unit mistake (km/h read as mph).
@@ -131,7 +137,7 @@ def _read_netcdf(path: Path) -> tuple[list[str], list[tuple[str, dict]]]:
     if problems:
         raise InputError(problems)
     cols = {k: ds[k].values for k in header}
-    rows = [(f"impact {i}", {k: cell_text(cols[k][i]) for k in header}) for i in range(ds.sizes[dim])]
+    rows = [(f"entry {i + 1}", {k: cell_text(cols[k][i]) for k in header}) for i in range(ds.sizes[dim])]
     return header, rows
 
 
@@ -139,7 +145,7 @@ def read_impacts_table(path: str | os.PathLike[str]) -> tuple[list[str], list[tu
     """Header and rows (label, {column: text}) of a CSV or NetCDF impacts file.
 
     A CSV row's label is its line number (``row 5``; the header is line 1); a NetCDF row's
-    is its index along the impact dimension (``impact 3``).
+    is its place along the impact dimension, counted from 1 (``entry 4``).
     """
     path = Path(path)
     if path.suffix.lower() in (".nc", ".nc4", ".netcdf") and path.is_file():
@@ -196,6 +202,7 @@ def check_rows(
     out: dict = {c: [] for c in ("label", "bat", "ball", "impact_id", *MEASURED_COLUMNS, *errs)}
     seen_ids: dict[str, str] = {}
     seen_rows: dict[tuple, str] = {}
+    zeros: dict[str, list[str]] = {c: [] for c in errs}
     for label, row in rows:
         at = f"{path}: {label}"
         if EXTRA in row:
@@ -225,6 +232,8 @@ def check_rows(
             e = _number(row.get(c, ""), f"{at}, column {c}", problems)
             if e < 0:
                 problems.append(f"{at}, column {c}: {row[c]} is negative; an uncertainty must be >= 0")
+            elif e == 0:
+                zeros[c].append(label)
             out[c].append(e)
         iid = row.get("impact_id", "") if "impact_id" in header else label
         if "impact_id" in header:
@@ -248,6 +257,15 @@ def check_rows(
             )
         else:
             seen_rows[key] = label
+    for c, labels in zeros.items():
+        if not labels:
+            continue
+        where = "every row" if len(labels) == len(rows) else ", ".join(labels[:5]) + (" ..." if len(labels) > 5 else "")
+        problems.append(
+            f"{path}: column {c}: zero uncertainty in {where}: a zero standard uncertainty says the measurement is "
+            "exact, which none is (the weighted fits would divide by it); give the real uncertainties, or leave "
+            "the column out (the fits are then unweighted)"
+        )
     return {k: np.asarray(v) for k, v in out.items()}, problems
 
 
@@ -323,6 +341,7 @@ class _Checks:
     ratio_high: np.ndarray  # v_ball / v_bat > 2 / (1 + r_y)
     ratio_low: np.ndarray  # ok and v_ball / v_bat < cos psi / (1 + r_y)
     e_x_out: np.ndarray  # use_ex and implied e_x outside E_X_PLAUSIBLE
+    e_y: np.ndarray  # implied through Eq. vballn
 
 
 def _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y) -> _Checks:
@@ -334,7 +353,9 @@ def _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y) -> _Check
         ratio = v_ball / v_bat
         e_x = omega / spin_bracket(v_bat, psi, r, r_x, alpha) - 1.0
         use_ex = ok & (np.abs(psi) >= PSI_MIN_FOR_E_X)
+        e_y = (1.0 + r_y) * ratio * np.cos(psi - theta) / np.cos(psi) - 1.0
         return _Checks(
+            e_y=np.broadcast_to(e_y, psi.shape),
             psi=psi,
             ok=ok,
             ratio=ratio,
@@ -357,6 +378,7 @@ def implausible_rows(
     r_y: ArrayLike,
     groups: ArrayLike,
     sigma: dict | None = None,
+    coarse: ArrayLike | None = None,
 ) -> np.ndarray:
     """Return, per impact, why its measurement is implausible ("" when it is not); SI inputs.
 
@@ -376,12 +398,15 @@ def implausible_rows(
       omega - (1 + e_x) x with the group's median (1 + e_x), more than :data:`OUTLIER_Z` robust
       standard deviations from the group's median residual, the spread (1.4826 MAD) taken over
       the file's groups of at least :data:`OUTLIER_MIN_GROUP` impacts (spin in rad/s or of the
-      wrong sign in some rows).
+      wrong sign in some rows). A group of fewer than :data:`OUTLIER_MIN_GROUP` impacts is
+      judged against its ``coarse`` group (the ball's impacts on every bat) when that has enough:
+      bats differ in e_x by a tenth, a row in km/h or rad/s by a factor of 1.6 or 10.
 
     Impacts psi cannot reconstruct are left to :func:`exclusions` ("" here).
     """
     v_bat, v_ball, theta, omega = (np.asarray(a, dtype=float) for a in (v_bat, v_ball, theta, omega))
     groups = np.asarray(groups)
+    coarse = None if coarse is None else np.asarray(coarse)
     c = _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y)
     psi, ok, ratio, e_x, use_ex = c.psi, c.ok, c.ratio, c.e_x, c.use_ex
     out = np.full(v_bat.shape, "", dtype=object)
@@ -407,12 +432,15 @@ def implausible_rows(
         dev = np.full(v_bat.shape, np.nan)
         for g in np.unique(groups):
             sel = ok & (groups == g)
-            fit = use_ex & (groups == g)
-            if sel.sum() < OUTLIER_MIN_GROUP or not fit.any():
+            ref = sel
+            if sel.sum() < OUTLIER_MIN_GROUP and coarse is not None and sel.any():
+                ref = ok & (coarse == coarse[np.flatnonzero(sel)[0]])
+            fit = use_ex & ref
+            if ref.sum() < OUTLIER_MIN_GROUP or not fit.any():
                 continue
             slope = np.median(y[fit] / xx[fit])
             res = y[sel] - slope * xx[sel]
-            dev[sel] = np.abs(res - np.median(res))
+            dev[sel] = np.abs(res - np.median(y[ref] - slope * xx[ref]))
             if name in own:  # the residual's own standard uncertainty from the stated ones
                 sd = own[name]
                 if sd is None:
@@ -436,6 +464,7 @@ def implausible_rows(
             words.append(f"v_ball/v_bat = {ratio[i]:.2f} exceeds 2/(1 + r_y), the most any collision gives")
         elif c.ratio_low[i]:
             words.append(f"v_ball/v_bat = {ratio[i]:.2f} is below cos(psi)/(1 + r_y), the least any collision gives")
+
         if c.e_x_out[i]:
             lo, hi = E_X_PLAUSIBLE
             words.append(f"implied e_x = {e_x[i]:.2f} (Eq. omega) is outside [{lo:g}, {hi:g}], where impacts lie")
@@ -467,9 +496,49 @@ _MISTAKES = (
         lambda d: {**d, "v_bat": d["v_bat"] / MPH, "v_ball": d["v_ball"] / MPH},
     ),
     ("theta_deg", "angle in radians, not degrees", lambda d: {**d, "theta": d["theta"] / DEGREE}),
+    (
+        "v_bat_mph, v_ball_mph",
+        "the two speed columns swapped (v_bat_mph holds the exit speeds)",
+        lambda d: {**d, "v_bat": d["v_ball"], "v_ball": d["v_bat"]},
+    ),
     # last: on a tie the mistakes above are the likelier
     ("omega_rpm", "spin with the opposite sign (omega > 0 is backspin, Fig. 2)", lambda d: {**d, "omega": -d["omega"]}),
 )
+
+
+def swapped_speeds(
+    path: str | os.PathLike[str],
+    data: dict,
+    usable: np.ndarray,
+    groups: np.ndarray,
+    r: ArrayLike,
+    alpha: ArrayLike,
+    r_x: ArrayLike,
+    r_y: ArrayLike,
+) -> list[str]:
+    """Problems naming bat x ball pairs whose impacts imply a median e_y below :data:`E_Y_MIN` (SI ``data``).
+
+    Such impacts came out slower, against the bat's speed, than any ball-bat collision sends
+    a ball: most often the columns v_bat_mph and v_ball_mph are swapped; the message says
+    what the median would be with them swapped back.
+    """
+    c = _collision_checks(data["v_bat"], data["v_ball"], data["theta"], data["omega"], r, alpha, r_x, r_y)
+    back = _collision_checks(data["v_ball"], data["v_bat"], data["theta"], data["omega"], r, alpha, r_x, r_y)
+    problems = []
+    for g in np.unique(groups):
+        sel = usable & (groups == g) & c.ok & np.isfinite(c.e_y)
+        if sel.sum() < 3:
+            continue
+        med = float(np.median(c.e_y[sel]))
+        if med < E_Y_MIN:
+            other = back.e_y[sel & back.ok]
+            then = f"; swapped back it would be {np.median(other):.2f}" if other.size else ""
+            problems.append(
+                f"{path}: {g}: the {int(sel.sum())} usable impacts imply a median e_y of {med:.2f} (Eq. vballn), "
+                f"below the {E_Y_MIN:g} no ball-bat collision goes under: the exit speeds are too slow for the bat "
+                f"speeds. Are the columns v_bat_mph and v_ball_mph swapped{then}?"
+            )
+    return problems
 
 
 def _score(checks: dict) -> float:
@@ -568,6 +637,7 @@ def ingest(
         r_y,
         np.char.add(ball_ids, bat_ids),
         sigma=sigma,
+        coarse=ball_ids,
     )
     bad = why != ""
     flag = np.where(bad, ImpactFlag.IMPLAUSIBLE, flag).astype(np.int8)
@@ -585,6 +655,10 @@ def ingest(
 
     warnings: list[str] = []
     usable = flag == 0
+    pairs = np.array([f"ball {str(b)!r} on bat {str(t)!r}" for b, t in zip(ball_ids, bat_ids, strict=True)], dtype=str)
+    swapped = swapped_speeds(impacts_path, data, usable, pairs, r, alpha, r_x, r_y)
+    if swapped:
+        raise InputError(swapped)
     groups = sorted({(str(b), str(t)) for b, t in zip(ball_ids, bat_ids, strict=True)})
     counts = {g: int((usable & (ball_ids == g[0]) & (bat_ids == g[1])).sum()) for g in groups}
     for (b, t), k in counts.items():
@@ -653,8 +727,8 @@ def ingest(
 
 def excluded_listing(ds: xr.Dataset) -> list[str]:
     """One line per excluded impact: id, where it is in the file, and why."""
+    from .analysis import impact_labels
+
     bad = np.flatnonzero(ds["ingest_flag"].values != 0)
-    return [
-        f"impact {ds['impact_id'].values[i]} ({ds['source_row'].values[i]}): {ds['ingest_flag_reason'].values[i]}"
-        for i in bad
-    ]
+    labels = impact_labels(ds)
+    return [f"{labels[i]}: {ds['ingest_flag_reason'].values[i]}" for i in bad]

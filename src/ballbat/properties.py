@@ -111,9 +111,9 @@ def read_csv_rows(path: str | os.PathLike[str]) -> tuple[list[str], list[tuple[i
     path = Path(path)
     if path.is_dir():
         raise InputError([f"{path}: is a directory, not a CSV file"])
-    if not path.is_file():
+    if not path.exists():
         raise InputError([f"{path}: file not found"])
-    raw = path.read_bytes()
+    raw = path.read_bytes()  # /dev/null and other non-regular files are read as they are
     try:
         text = raw.decode("utf-8-sig")
     except UnicodeDecodeError as exc:

@@ -7,7 +7,14 @@ from pathlib import Path
 import yaml
 
 from ballbat.pipeline.codedeps import module_files
-from ballbat.pipeline.config import BYTES_PER_CASE, drop_nulls, impact_bytes, validate_config
+from ballbat.pipeline.config import (
+    BYTES_PER_CASE,
+    STUDY_BYTES_PER_REPLICATE,
+    drop_nulls,
+    impact_bytes,
+    study_impacts,
+    validate_config,
+)
 from ballbat.pipeline.guards import remove_broken, remove_temporaries, warnings_summary
 from ballbat.pipeline.provenance import sha256_file
 from ballbat.tracks.data import camera_block
@@ -153,8 +160,8 @@ def get_tracks_inputs(wildcards):
     if "tracks" in d and "dir" in d["tracks"]:
         out = f"results/{wildcards.dataset}/imported"
         return {"tracks": f"{out}_tracks.nc", "cameras": f"{out}_cameras.yaml"}
-    if "tracks" in d:
-        return {"tracks": d["tracks"]["file"], "impacts": d["tracks"]["impacts"]}
+    if "tracks" in d:  # a missing file fails this dataset's reduce job only (existing), not the DAG
+        return {"tracks": existing(d["tracks"]["file"]), "impacts": existing(d["tracks"]["impacts"])}
     return {"tracks": f"results/{wildcards.dataset}/tracks.nc"}
 
 
@@ -279,10 +286,7 @@ def get_study_batches(wildcards):
 
 def _study_impacts(s):
     """Impacts of the largest replicate of a study, and of its noise-free design (per point)."""
-    pairs = sum(len(v) for v in s.dataset["synthetic"]["impacts"].values())
-    most = max(max(v.values()) for v in s.dataset["synthetic"]["impacts"].values())
-    counts = [int(v) for v in s.values] if s.parameter == "impacts_per_bat" else [most]
-    return pairs * max(counts), pairs * max(s.truth_impacts, max(counts))
+    return study_impacts(s.dataset, s.parameter, s.values, s.truth_impacts)
 
 
 def study_batch_mem_mb(wildcards):
@@ -296,12 +300,6 @@ def study_truth_mem_mb(wildcards):
     measured 1.8 GB for the calibration study's 70000 rendered impacts)."""
     s = study_settings(wildcards.study)
     return 500 + math.ceil(_study_impacts(s)[1] * impact_bytes(s.dataset) / 1e6)
-
-
-#: The aggregate's memory per replicate: 4 numbers of 8 bytes per quantity (21 quantities in the
-#: paper's design: 0.7 kB), copied about 3 times while the batches are combined; 4 kB leaves room
-#: for more bats. Measured: 190 MB in all for the calibration study's 1000 replicates.
-STUDY_BYTES_PER_REPLICATE = 4_000
 
 
 def study_aggregate_mem_mb(wildcards):

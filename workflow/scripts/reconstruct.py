@@ -1,6 +1,6 @@
 """Rule reconstruct: adapter around ballbat.analysis.reconstruct."""
 
-from ballbat.analysis import reconstruct
+from ballbat.analysis import impact_labels, reconstruct
 from ballbat.pipeline.ncio import read_dataset, write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
@@ -13,8 +13,9 @@ with logged(snakemake.log[0], snakemake.rule) as log:
     )
     bad = int((ds["flag"] != 0).sum())
     log.info("%d of %d impacts not used (flagged, kept in the file)", bad, ds.sizes["impact"])
+    labels = impact_labels(ds)
     for i in (ds["flag"].values != 0).nonzero()[0]:
-        log.info("not used: impact %d: %s", int(ds["impact"].values[i]), ds["flag_reason"].values[i])
+        log.info("not used: %s: %s", labels[i], ds["flag_reason"].values[i])
     write_job_output(
         ds,
         snakemake,

@@ -13,12 +13,16 @@ with logged(snakemake.log[0], snakemake.rule) as log:
     settings = snakemake.params.settings
     if "cameras" in inp.keys():  # a folder of tool files: the camera settings found in them
         settings = with_found_settings(settings, yaml.safe_load(open(inp.cameras)))
+    # a file the config names but that is missing is no input (common.smk: existing); reading it
+    # by its configured name fails this job alone, with a message naming the file
+    named = snakemake.config["datasets"][snakemake.wildcards.dataset]
+    tables = {k: named.get(k, snakemake.config["tables"][k]) for k in ("balls", "bats")}
     ds = reduce_stage(
-        inp.tracks,
-        inp.get("impacts"),
+        inp.get("tracks") or named["tracks"]["file"],
+        inp.get("impacts") or named.get("tracks", {}).get("impacts"),
         settings,
-        inp.balls,
-        inp.bats,
+        inp.get("balls") or tables["balls"],
+        inp.get("bats") or tables["bats"],
         where=snakemake.params.where,
     )
     for line in ds.attrs["reduce_checks"].splitlines():

@@ -49,6 +49,24 @@ def impact_bytes(dataset: dict) -> int:
 #: Share of the machine's available memory one job may plan to use.
 MEMORY_SHARE = 0.5
 
+#: A study's aggregate memory per replicate: 4 numbers of 8 bytes per quantity (21 quantities in
+#: the paper's design: 0.7 kB), copied about 3 times while the batches are combined; 4 kB leaves
+#: room for more bats. Measured: 190 MB in all for the calibration study's 1000 replicates.
+STUDY_BYTES_PER_REPLICATE = 4_000
+#: Most batch jobs one study may have: Snakemake builds its job graph before running anything,
+#: and at 10^5 jobs that takes minutes and gigabytes (10^7 replicates had not finished after 300 s
+#: at 4.2 GB); a larger study needs a larger ``batch_size``.
+MAX_STUDY_BATCHES = 10_000
+
+
+def study_impacts(dataset: dict, parameter: str | None, values: list, truth_impacts: int) -> tuple[int, int]:
+    """Impacts of a study's largest replicate, and of its noise-free design (the truth job), per sweep point."""
+    impacts = dataset["synthetic"]["impacts"]
+    pairs = sum(len(v or {}) for v in impacts.values())
+    most = max((int(n) for v in impacts.values() for n in (v or {}).values()), default=0)
+    counts = [int(v) for v in values] if parameter == "impacts_per_bat" else [most]
+    return pairs * max(counts), pairs * max(int(truth_impacts), max(counts))
+
 
 def drop_nulls(config: dict) -> dict:
     """Drop datasets, scenarios and studies set to null (``datasets: {synthetic: null}`` in an override).
@@ -82,9 +100,19 @@ def _names(config: dict) -> list[str]:
             "results/implications/{name}.*",
         ),
     )
+    groups += (("studies", config.get("studies") or {}, (), "results/studies/{name}/"),)
     for where, table, reserved, folder in groups:
+        if not isinstance(table, dict):
+            continue
         for name in table:
-            if not NAME.fullmatch(str(name)):
+            if not isinstance(name, str):
+                kind = "a boolean (as yes, no, on, off)" if isinstance(name, bool) else "a number"
+                example = "'yes'" if isinstance(name, bool) else f"'{name}'"
+                problems.append(
+                    f"{where}.{name}: YAML reads this name as {kind}, not text; a name must be text: "
+                    f"quote it in the YAML file ({example}) or choose a name that starts with a letter"
+                )
+            elif not NAME.fullmatch(str(name)):
                 problems.append(f"{where}.{name!r}: a name may hold only letters, digits, _ and - (it names {folder})")
             elif name in reserved:
                 problems.append(
@@ -115,6 +143,68 @@ def _studies(config: dict) -> list[str]:
         else:
             sweep = study.get("sweep") or {}
             problems += check_sweep(ds, sweep.get("parameter"), sweep.get("values", ()), where)
+    return problems
+
+
+def _synthetic_keys(config: dict) -> list[str]:
+    """Check that the per-ball and per-bat mappings of each synthetic dataset name the balls and bats it draws.
+
+    ``impacts`` names the balls and, under each, the bats; ``e_x`` must give every one of these
+    pairs and no other, ``e_y`` every ball, and ``psi_deg`` only these balls: a misspelt name
+    (``psi_deg: {basebal: ...}``) would otherwise be ignored and the default used silently.
+    """
+    problems = []
+    for name, ds in (config.get("datasets") or {}).items():
+        syn = ds.get("synthetic") if isinstance(ds, dict) else None
+        if not isinstance(syn, dict):
+            continue
+        where = f"datasets.{name}.synthetic"
+        impacts = {b: set(v or {}) for b, v in (syn.get("impacts") or {}).items()}
+        balls = ", ".join(map(str, impacts)) or "none"
+        for key in ("e_x", "e_y", "psi_deg"):
+            for ball in syn.get(key) or {}:
+                if ball not in impacts:
+                    problems.append(
+                        f"{where}.{key}.{ball}: unknown ball (the balls of {where}.impacts: {balls}); a misspelt name?"
+                    )
+        for ball, bats in impacts.items():
+            e_x = (syn.get("e_x") or {}).get(ball)
+            if e_x is None:
+                problems.append(f"{where}.e_x: no entry for ball {ball} (it has impacts); give its true e_x per bat")
+            else:
+                for bat in sorted(set(e_x) - bats, key=str):
+                    problems.append(
+                        f"{where}.e_x.{ball}.{bat}: unknown bat (the bats of {where}.impacts.{ball}: "
+                        f"{', '.join(map(str, bats))}); a misspelt name?"
+                    )
+                for bat in sorted(bats - set(e_x), key=str):
+                    problems.append(f"{where}.e_x.{ball}: no entry for bat {bat} (it has impacts); give its true e_x")
+            if ball not in (syn.get("e_y") or {}):
+                problems.append(f"{where}.e_y: no entry for ball {ball} (it has impacts); give its true e_y")
+    return problems
+
+
+def _finite(node: object, where: str = "") -> list[str]:
+    """Name every number that is not finite (``.nan``, ``.inf``): no range check can hold it."""
+    if isinstance(node, dict):
+        return [p for k, v in node.items() for p in _finite(v, f"{where}.{k}" if where else str(k))]
+    if isinstance(node, list):
+        return [p for i, v in enumerate(node) for p in _finite(v, f"{where}[{i}]")]
+    if isinstance(node, float) and not math.isfinite(node):
+        return [f"{where}: {node} is not a finite number"]
+    return []
+
+
+def _offsets(config: dict) -> list[str]:
+    """Refuse a D sweep of one offset that names a stop it would drop."""
+    problems = []
+    for name, sc in ((config.get("implications") or {}).get("scenarios") or {}).items():
+        d = (sc.get("sweep") or {}).get("D_in") if isinstance(sc, dict) else None
+        if isinstance(d, dict) and d.get("num") == 1 and d.get("start") != d.get("stop"):
+            problems.append(
+                f"implications.scenarios.{name}.sweep.D_in: num 1 gives the one offset start = {d['start']} in, "
+                f"so stop = {d['stop']} would be dropped; give num >= 2, or stop equal to start"
+            )
     return problems
 
 
@@ -156,8 +246,22 @@ def _sizes(config: dict, available: int) -> list[str]:
     for name, st in (config.get("studies") or {}).items():
         ds = datasets.get(st.get("dataset")) if isinstance(st, dict) else None
         if isinstance(ds, dict) and isinstance(ds.get("synthetic"), dict):
-            pairs = sum(len(b or {}) for b in (ds["synthetic"].get("impacts") or {}).values())
-            check(f"studies.{name}.truth_impacts", pairs * int(st["truth_impacts"]), impact_bytes(ds), "impacts")
+            sweep = st.get("sweep") or {}
+            values = sweep.get("values") or []
+            one, truth = study_impacts(ds, sweep.get("parameter"), values, st["truth_impacts"])
+            where = f"studies.{name}"
+            if sweep.get("parameter") == "impacts_per_bat":
+                check(f"{where}.sweep.values", one, impact_bytes(ds), "impacts in one replicate")
+            check(f"{where}.truth_impacts", truth, impact_bytes(ds), "impacts")
+            total = int(st["replicates"]) * max(len(values), 1)
+            check(f"{where}.replicates", total, STUDY_BYTES_PER_REPLICATE, "replicates (all sweep points)")
+            batches = -(-total // int(st["batch_size"]))
+            if batches > MAX_STUDY_BATCHES:
+                problems.append(
+                    f"{where}.replicates: {total:,} replicates in batches of {int(st['batch_size'])} make "
+                    f"{batches:,} batch jobs, more than the {MAX_STUDY_BATCHES:,} a job graph can hold in reasonable "
+                    "time and memory; use fewer replicates or a larger batch_size"
+                )
     for name, sc in ((config.get("implications") or {}).get("scenarios") or {}).items():
         if "sweep" in sc:
             check(
@@ -194,8 +298,14 @@ def _message(error) -> str:
         forms = [" + ".join(f.get("required", [])) or "?" for f in error.validator_value]
         return f"{_path(error)}: give exactly one of {', '.join(forms)}, not several"
     if error.validator in ("oneOf", "anyOf") and error.context:
+        relevant = [e for e in error.context if e.validator != "type"]
+        if relevant and len(relevant) < len(error.context):  # a number or a list: the form it has
+            return "; ".join(sorted({_message(e) for e in relevant}))
         inner = sorted({_message(e) for e in error.context})
         return f"{_path(error)}: matches none of the allowed forms: " + " | ".join(inner)
+    if error.validator in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"):
+        about = error.schema.get("description")
+        return f"{_path(error)}: {error.message}" + (f" ({about})" if about else "")
     return f"{_path(error)}: {error.message}"
 
 
@@ -256,7 +366,9 @@ def validate_config(config: dict, schema: dict, source: str = "config", availabl
 
     validator = jsonschema.Draft202012Validator(schema)
     errors = sorted(validator.iter_errors(config), key=lambda e: (list(map(str, e.absolute_path)), e.message))
-    lines = [_message(e) for e in errors] + _names(config)
+    lines = [_message(e) for e in errors] + _names(config) + _finite(config)
+    if not lines:
+        lines = _synthetic_keys(config) + _offsets(config)
     if not lines:
         fill_defaults(config, schema)
         lines = _studies(config) + _sizes(config, _available_memory() if available is None else available)
