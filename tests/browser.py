@@ -66,7 +66,7 @@ class Browser:
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
             pass_fds=(3, 4),
-            preexec_fn=lambda: _pipe_to_3_and_4(to_chrome_r, from_chrome_w),  # noqa: PLW1509
+            preexec_fn=lambda: _pipe_to_3_and_4(to_chrome_r, from_chrome_w),
         )
         os.close(to_chrome_r)
         os.close(from_chrome_w)
@@ -81,9 +81,11 @@ class Browser:
         )
 
     def __enter__(self) -> Browser:
+        """Return the browser (closed at the end of the ``with`` block)."""
         return self
 
     def __exit__(self, *exc: object) -> None:
+        """Close the browser."""
         self.close()
 
     def close(self) -> None:

@@ -34,6 +34,9 @@ if TYPE_CHECKING:
 
     import xarray as xr
 
+#: The dash of a range (en dash).
+DASH = "\u2013"
+
 #: Excluded impacts named one by one on the front page; more are counted and left to the workbook.
 MAX_NAMED_EXCLUSIONS = 8
 
@@ -224,7 +227,7 @@ def per_ball_rows(fit: xr.Dataset, stronge: xr.Dataset) -> list[list[str]]:
         s = stronge.sel(ball=ball)
         eta2, err = float(s["eta2"]), float(s["eta2_err"])
         d = decimals_for(err)
-        interval = "n/a" if d is None else f"{fixed(s['eta2_ci_low'], d)} – {fixed(s['eta2_ci_high'], d)}"
+        interval = "n/a" if d is None else f"{fixed(s['eta2_ci_low'], d)} {DASH} {fixed(s['eta2_ci_high'], d)}"
         paper = f"{paper_eta2[ball]:g}" if ball in paper_eta2 else "—"
         e_y = mu_k = "n/a"
         if ball in fit["ball"].values.astype(str):
@@ -238,7 +241,7 @@ def per_ball_rows(fit: xr.Dataset, stronge: xr.Dataset) -> list[list[str]]:
 
 
 def fit_warnings(fit: xr.Dataset) -> list[str]:
-    """A line per e_x fit without a value for a reason other than having no impacts (status > 1)."""
+    """Return a line per e_x fit without a value for a reason other than having no impacts (status > 1)."""
     lines = []
     for name in ("e_x", "e_x_pooled"):
         var = fit.get(f"{name}_status")
@@ -252,7 +255,7 @@ def fit_warnings(fit: xr.Dataset) -> list[str]:
 
 
 def thumbnail_uri(png: str | os.PathLike[str], width: int = THUMBNAIL_WIDTH) -> str:
-    """A PNG figure shrunk to ``width`` pixels, as a data URI (for embedding in the front page)."""
+    """Return a PNG figure shrunk to ``width`` pixels, as a data URI (for embedding in the front page)."""
     from PIL import Image
 
     with Image.open(png) as im:
@@ -265,12 +268,12 @@ def thumbnail_uri(png: str | os.PathLike[str], width: int = THUMBNAIL_WIDTH) -> 
 
 
 def result_link(path: str) -> str:
-    """The report's link to a result's own page (what Snakemake's report opens for a figure)."""
+    """Return the report's link to a result's own page (what Snakemake's report opens for a figure)."""
     return f"javascript:app.showResultInfo('{quote(str(path))}')"
 
 
 def commit_date(commit: str, repo: str | os.PathLike[str] = ".") -> str | None:
-    """The date (YYYY-MM-DD) of a git commit, or None when git or the commit is not there."""
+    """Return the date (YYYY-MM-DD) of a git commit, or None when git or the commit is not there."""
     if not commit or commit == "unknown":
         return None
     try:
@@ -305,7 +308,7 @@ def dataset_section(
     fig5: str | None = None,
     thumbnail: str | None = None,
 ) -> list[str]:
-    """The headline tables of one dataset, and its Fig. 5 thumbnail linking to the figure's page."""
+    """Return the headline tables of one dataset, and its Fig. 5 thumbnail linking to the figure's page."""
     title = f"Dataset {escape(name)}"
     lines = [title, "-" * len(title), ""]
     header = ["ball", "bat", "e_x", "stat.", "syst.", "paper"] + (["truth"] if "truth_e_x" in fit else [])
@@ -346,7 +349,7 @@ def front_page(
     git: Mapping[str, object],
     date: str | None,
 ) -> str:
-    """The front page's reStructuredText.
+    """Return the front page's reStructuredText.
 
     ``datasets``: name -> {"kind": str, "impacts": reconstruct.nc, "fit": fit_ex.nc,
     "stronge": stronge.nc, and optionally "fig5": the figure's path and "thumbnail": its data URI}.
@@ -383,7 +386,8 @@ def study_line(name: str, coverage: xr.Dataset, design: xr.Dataset | None = None
     n_rep = coverage.attrs.get("replicates_per_point", "?")
     nq = coverage.sizes["quantity"]
     if ok.any():
-        cov = f"95 % intervals cover the truth in {100 * c95[ok].min():.1f}–{100 * c95[ok].max():.1f} % of replicates"
+        low, high = 100 * c95[ok].min(), 100 * c95[ok].max()
+        cov = f"95 % intervals cover the truth in {low:.1f}{DASH}{high:.1f} % of replicates"
     else:
         cov = "no coverage (no quantity had a value, an uncertainty and a truth)"
     line = f"**{escape(name)}** ({n_rep} replicates per point, {nq} quantities): {cov} (target 95 %)"
@@ -396,7 +400,7 @@ def study_line(name: str, coverage: xr.Dataset, design: xr.Dataset | None = None
     for ball in dict.fromkeys(balls):
         r = req[(balls == ball) & np.isfinite(req)]
         if r.size:
-            parts.append(f"{ball} {r.min():.0f}–{r.max():.0f}" if r.min() != r.max() else f"{ball} {r.min():.0f}")
+            parts.append(f"{ball} {r.min():.0f}{DASH}{r.max():.0f}" if r.min() != r.max() else f"{ball} {r.min():.0f}")
     need = ", ".join(parts) if parts else "not determined"
     return (
         f"{line}; impacts per bat to tell two bats Δe_x = {float(a['delta_e_x']):g} apart"
@@ -405,7 +409,7 @@ def study_line(name: str, coverage: xr.Dataset, design: xr.Dataset | None = None
 
 
 def studies_page(studies: Mapping[str, tuple[xr.Dataset, xr.Dataset | None]]) -> str:
-    """The studies' part of the front page: one line per study."""
+    """Return the studies' part of the front page: one line per study."""
     lines = ["Replicate studies", "-" * 17, ""]
     lines += [f"- {study_line(name, cov, des)}" for name, (cov, des) in studies.items()]
     return "\n".join(lines) + "\n"

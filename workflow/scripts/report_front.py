@@ -8,9 +8,9 @@ from ballbat.pipeline.ncio import atomic_write_text, read_dataset
 from ballbat.pipeline.runlog import logged
 
 with logged(snakemake.log[0], snakemake.rule):
+    inp = snakemake.input
     if snakemake.rule == "report_front":
         kinds = snakemake.params.kinds
-        inp = snakemake.input
         datasets = {
             name: {
                 "kind": kinds[name],
@@ -22,17 +22,15 @@ with logged(snakemake.log[0], snakemake.rule):
             }
             for i, name in enumerate(kinds)
         }
-        scenarios = {name: read_dataset(path) for name, path in zip(snakemake.params.scenarios, inp.scenarios)}
+        scenarios = {name: read_dataset(p) for name, p in zip(snakemake.params.scenarios, inp.scenarios, strict=True)}
         git = json.loads(next(iter(datasets.values()))["fit"].attrs["provenance_git"]) if datasets else {}
         logs = warnings_summary("results", list(kinds), ["implications"] if scenarios else [])
         text = front_page(datasets, scenarios, logs, git, commit_date(str(git.get("commit", ""))))
     else:
+        designs = snakemake.params.designs
         studies = {
-            name: (
-                read_dataset(cov),
-                read_dataset(snakemake.params.designs[name]) if name in snakemake.params.designs else None,
-            )
-            for name, cov in zip(snakemake.params.studies, snakemake.input.coverage)
+            name: (read_dataset(cov), read_dataset(designs[name]) if name in designs else None)
+            for name, cov in zip(snakemake.params.studies, inp.coverage, strict=True)
         }
         text = studies_page(studies)
     atomic_write_text(snakemake.output.rst, text)
