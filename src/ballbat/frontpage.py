@@ -332,7 +332,7 @@ def dataset_section(
             f".. figure:: {chunks[0]}",
             *(f"   {c}" for c in chunks[1:]),
             "   :alt: Fig. 5 of dataset " + name,
-            "   :class: thumbnail",
+            "   :figclass: thumbnail",
             *([target.rstrip("\n")] if target else []),
             "",
             f"   Fig. 5 of **{escape(name)}**: spin against the bracket of Eq. (omega), slopes 1 + e_x per ball;"
