@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 import xarray as xr
 from browser import Browser, chromium_path
+
 from workflow_helpers import assert_not_blank, make_workdir, snakemake
 
 pytestmark = pytest.mark.slow
