@@ -117,6 +117,8 @@ def test_exclusion_reasons_group_and_take_the_ingest_reason():
     groups = fp.exclusion_reasons(impacts())
     assert groups == {"psi undefined": ["B02"], "dot not rotating": ["B03"]}
     assert fp.exclusion_reasons(impacts(flags=(0, 0), ingest=(0, 0))) == {}
+    as_variable = impacts().reset_coords("impact_id")  # as ballbat's files hold it: a data variable
+    assert fp.exclusion_reasons(as_variable) == {"psi undefined": ["B02"], "dot not rotating": ["B03"]}
 
 
 def test_dataset_line_counts_and_names_exclusions():
@@ -171,6 +173,12 @@ def test_front_page_renders_numbers_before_warnings():
     assert "e_x (softball, metal_rough): too few" in html
     assert "commit <tt" in html or "commit <code" in html
     assert "0123456789ab" in html and "clean tree" in html
+    assert "pixel-scale systematic" in html and "the synthetic experiment was drawn with" in html
+
+
+def test_notes_follow_the_columns():
+    text = "\n".join(fp.dataset_section("lab", fit(systematic=False, truth=False), stronge()))
+    assert "syst. —: none is estimated here" in text and "truth:" not in text and "pixel-scale" not in text
 
 
 def test_front_page_does_not_repeat_a_logged_warning():

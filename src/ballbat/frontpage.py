@@ -139,7 +139,7 @@ def exclusion_reasons(impacts: xr.Dataset) -> dict[str, list[str]]:
     meaning = _flag_meanings(impacts["flag"])
     ingest = impacts["ingest_flag"].values if "ingest_flag" in impacts else None
     ingest_meaning = _flag_meanings(impacts["ingest_flag"]) if ingest is not None else {}
-    ids = impacts["impact_id"].values.astype(str) if "impact_id" in impacts.coords else impacts["impact"].values
+    ids = impacts["impact_id"].values.astype(str) if "impact_id" in impacts.variables else impacts["impact"].values
     groups: dict[str, list[str]] = {}
     for i in np.flatnonzero(flag != 0):
         if ingest is not None and int(ingest[i]) != 0:
@@ -318,12 +318,17 @@ def dataset_section(
         per_ball_rows(fit, stronge),
         "η² of Stronge's model (Sec. V.A); e_y implied by Eq. ratio and the μ_k bound (Sec. IV)",
     )
-    lines += [
-        "stat.: standard error; syst.: the swing camera's pixel-scale systematic (tracked data), shared by"
-        " every impact and not in the standard error. The truth column (synthetic data) is the value"
-        " the experiment was drawn with.",
-        "",
-    ]
+    has_syst = any(r[4] != "—" for r in e_x_rows(fit))
+    note = ["stat.: the standard error."]
+    if has_syst:
+        note.append(
+            "syst.: the swing camera's pixel-scale systematic, shared by every impact, not in the standard error."
+        )
+    else:
+        note.append("syst. —: none is estimated here (the pixel-scale systematic comes with camera tracks).")
+    if "truth_e_x" in fit:
+        note.append("truth: the value the synthetic experiment was drawn with.")
+    lines += [" ".join(note), ""]
     if thumbnail:
         target = f"   :target: {result_link(fig5)}\n" if fig5 else ""
         # docutils limits a source line's length (10000), so a data URI spans lines (whitespace is dropped).
