@@ -178,7 +178,9 @@ def test_front_page_renders_numbers_before_warnings():
 
 def test_notes_follow_the_columns():
     text = "\n".join(fp.dataset_section("lab", fit(systematic=False, truth=False), stronge()))
-    assert "syst. —: none is estimated here" in text and "truth:" not in text and "pixel-scale" not in text
+    assert (
+        "syst. —: none is estimated here" in text and "truth:" not in text and "not in the standard error" not in text
+    )
 
 
 def test_front_page_does_not_repeat_a_logged_warning():
