@@ -59,8 +59,17 @@ def _front_text(page) -> str:
     return page.evaluate("document.querySelector('.prose').innerText")
 
 
-def _datasets(root: Path) -> list[str]:
-    return sorted(p.parent.name for p in (root / "results").glob("*/fit_ex.nc"))
+def _config(page) -> dict:
+    """The run's configuration as the front page shows it, unfolded (JSON)."""
+    page.evaluate("document.querySelector('.prose details').open = true")
+    config = json.loads(page.evaluate("document.querySelector('.prose details pre').innerText"))
+    page.evaluate("document.querySelector('.prose details').open = false")
+    return config
+
+
+def _datasets(page) -> list[str]:
+    """The datasets of the report's run (not whatever else results/ holds)."""
+    return sorted(_config(page)["datasets"])
 
 
 def _close(shown: str, value: float) -> bool:
@@ -80,7 +89,7 @@ def test_front_page_shows_e_x_and_eta2_before_the_configuration(page, report_roo
     assert not page.evaluate("document.querySelector('.prose details').open")  # folded
     assert '"datasets"' not in page.evaluate("document.querySelector('.prose').innerText")  # the JSON is hidden
     checked = 0
-    for name in _datasets(report_root):
+    for name in _datasets(page):  # unfolded, the configuration is the run's, as JSON
         fit = xr.open_dataset(report_root / "results" / name / "fit_ex.nc")
         stronge = xr.open_dataset(report_root / "results" / name / "stronge.nc")
         section = text.index(f"Dataset {name}\n")
@@ -108,6 +117,7 @@ def test_front_page_shows_e_x_and_eta2_before_the_configuration(page, report_roo
     assert checked >= 9  # the default run: 7 bat x ball pairs and 2 balls' eta^2
     shot = page.screenshot(report_root / "results" / "report-front.png")
     assert_not_blank(shot)
+    assert not page.evaluate("document.querySelector('.prose details').open")
 
 
 def test_every_figure_loads(page, report_root):
@@ -142,8 +152,8 @@ def test_every_figure_loads(page, report_root):
 
 def test_a_caption_shows_its_fitted_number(page, report_root):
     """Fig. 5's page (opened from the front page's thumbnail) quotes the pooled e_x of fit_ex.nc."""
-    name = _datasets(report_root)[0]
     _front_text(page)
+    name = _datasets(page)[0]
     page.evaluate("document.querySelector('.prose .thumbnail a').click()")
     page.wait_for("document.body.innerText.includes('Fig. 5 of the paper')")
     text = page.evaluate("document.body.innerText")
