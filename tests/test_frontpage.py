@@ -238,3 +238,9 @@ def test_study_lines():
     assert f"(95 % confidence, 80 % power): baseball 27{fp.DASH}31, softball 18." in line
     assert fp.study_line("calibration", cov).endswith("(target 95 %).")
     assert "Replicate studies" in render(fp.studies_page({"calibration": (cov, None)}))
+
+
+def test_names_render_literally():
+    sc = xr.Dataset(coords={"case": np.arange(2)}, attrs={"kind": "launch", "ball": "ball_", "bat": "*odd*"})
+    html = render(fp.scenario_line("my_run_", sc))
+    assert "<strong>my_run_</strong> (launch conditions): ball_ on the *odd* bat; 2 cases." in html

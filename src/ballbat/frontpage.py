@@ -153,7 +153,7 @@ def exclusion_reasons(impacts: xr.Dataset) -> dict[str, list[str]]:
 def dataset_line(name: str, kind: str, impacts: xr.Dataset) -> str:
     """One line: the dataset, its kind, its impacts per ball and the excluded ones with why."""
     balls = impacts["ball"].values.astype(str)
-    per = ", ".join(f"{int(np.count_nonzero(balls == b))} {b}" for b in dict.fromkeys(balls))
+    per = ", ".join(f"{int(np.count_nonzero(balls == b))} {escape(b)}" for b in dict.fromkeys(balls))
     n = impacts.sizes["impact"]
     groups = exclusion_reasons(impacts)
     k = sum(len(v) for v in groups.values())
@@ -164,11 +164,8 @@ def dataset_line(name: str, kind: str, impacts: xr.Dataset) -> str:
     for reason, ids in groups.items():
         shown = ", ".join(ids[:MAX_NAMED_EXCLUSIONS])
         more = f" and {len(ids) - MAX_NAMED_EXCLUSIONS} more" if len(ids) > MAX_NAMED_EXCLUSIONS else ""
-        parts.append(
-            f"{reason} ({len(ids)}: impact {shown}{more})"
-            if len(ids) == 1
-            else f"{reason} ({len(ids)}: impacts {shown}{more})"
-        )
+        noun = "impact" if len(ids) == 1 else "impacts"
+        parts.append(f"{reason} ({len(ids)}: {noun} {shown}{more})")
     return line + ": " + "; ".join(parts) + " (every impact and its reason: the workbook's impacts sheet)."
 
 
@@ -179,7 +176,8 @@ def scenario_line(name: str, scenario: xr.Dataset) -> str:
     e_x = a.get("e_x")
     e_x_text = f", e_x = {float(e_x):.3g}" if e_x is not None else ""
     return (
-        f"**{escape(name)}** ({kind}): {a.get('ball', '?')} on the {_words(str(a.get('bat', '?')))} bat{e_x_text};"
+        f"**{escape(name)}** ({kind}): {escape(a.get('ball', '?'))} on the {escape(_words(str(a.get('bat', '?'))))}"
+        f" bat{e_x_text};"
         f" {scenario.sizes.get('case', 0)} cases."
     )
 
@@ -212,7 +210,7 @@ def e_x_rows(fit: xr.Dataset) -> list[list[str]]:
             has_syst = math.isfinite(syst) and syst > 0
             v, s, y = round_pm(value, stat, syst) if has_syst else (*round_pm(value, stat), "—")
             paper = _paper("e_x", ball, bat) if var == "e_x" else _paper("e_x_pooled", ball)
-            row = [ball, _words(bat), f"**{v}**", f"± {s}", f"± {y}" if has_syst else "—", paper]
+            row = [escape(ball), escape(_words(bat)), f"**{v}**", f"± {s}", f"± {y}" if has_syst else "—", paper]
             if truth:
                 row.append(fixed(float(f[f"truth_{var}"]), 3))
             rows.append(row)
@@ -236,7 +234,7 @@ def per_ball_rows(fit: xr.Dataset, stronge: xr.Dataset) -> list[list[str]]:
             mu_k = "≥ " + pm(float(f["mu_k_lower_bound"]), float(f["mu_k_lower_bound_err"]))
         paper_mu = _published("mu_k_lower_bound", ball)
         paper_mu_text = "—" if paper_mu is None else f"≥ {paper_mu[0]:g}"
-        rows.append([ball, f"**{pm(eta2, err)}**", interval, paper, e_y, mu_k, paper_mu_text])
+        rows.append([escape(ball), f"**{pm(eta2, err)}**", interval, paper, e_y, mu_k, paper_mu_text])
     return rows
 
 
