@@ -229,13 +229,22 @@ def test_study_lines():
         attrs={"replicates_per_point": 200},
     )
     des = xr.Dataset(
-        {"impacts_required": (("point", "pair"), np.array([[50.0, 40.0, 20.0], [31.0, 27.0, 18.0]]))},
+        {
+            "impacts_required": (("point", "pair"), np.array([[50.0, 40.0, 20.0], [31.0, 27.0, 18.0]])),
+            "setting": ("point", np.array([5.0, 10.0])),
+        },
         coords={"ball": ("pair", ["baseball", "baseball", "softball"])},
-        attrs={"delta_e_x": 0.02, "confidence": 0.95, "power": 0.8},
+        attrs={"delta_e_x": 0.02, "confidence": 0.95, "power": 0.8, "sweep_parameter": "impacts_per_bat"},
     )
-    line = fp.study_line("design", cov, des)
+    swept = cov.assign(setting=("point", [5.0, 10.0])).assign_attrs(sweep_parameter="impacts_per_bat")
+    line = fp.study_line("design", swept, des)
+    assert f"(200 replicates per point, impacts\\_per\\_bat 5{fp.DASH}10, 2 quantities)" in line
     assert f"95 % intervals cover the truth in 93.0{fp.DASH}96.0 % of replicates" in line
-    assert f"(95 % confidence, 80 % power): baseball 27{fp.DASH}31, softball 18." in line
+    assert (
+        f"(95 % confidence, 80 % power, from the spread at impacts\\_per\\_bat = 10): baseball 27{fp.DASH}31,"
+        " softball 18." in line
+    )
+    assert "impacts_per_bat 5" in render(line)
     assert fp.study_line("calibration", cov).endswith("(target 95 %).")
     assert "Replicate studies" in render(fp.studies_page({"calibration": (cov, None)}))
 

@@ -393,7 +393,12 @@ def study_line(name: str, coverage: xr.Dataset, design: xr.Dataset | None = None
         cov = f"95 % intervals cover the truth in {low:.1f}{DASH}{high:.1f} % of replicates"
     else:
         cov = "no coverage (no quantity had a value, an uncertainty and a truth)"
-    line = f"**{escape(name)}** ({n_rep} replicates per point, {nq} quantities): {cov} (target 95 %)"
+    param = str(coverage.attrs.get("sweep_parameter") or "")
+    sweep = ""
+    if param and "setting" in coverage:
+        values = coverage["setting"].values
+        sweep = f", {escape(param)} {values.min():g}{DASH}{values.max():g}"
+    line = f"**{escape(name)}** ({n_rep} replicates per point{sweep}, {nq} quantities): {cov} (target 95 %)"
     if design is None:
         return line + "."
     a = design.attrs
@@ -403,11 +408,15 @@ def study_line(name: str, coverage: xr.Dataset, design: xr.Dataset | None = None
     for ball in dict.fromkeys(balls):
         r = req[(balls == ball) & np.isfinite(req)]
         if r.size:
-            parts.append(f"{ball} {r.min():.0f}{DASH}{r.max():.0f}" if r.min() != r.max() else f"{ball} {r.min():.0f}")
+            span = f"{r.min():.0f}{DASH}{r.max():.0f}" if r.min() != r.max() else f"{r.min():.0f}"
+            parts.append(f"{escape(ball)} {span}")
     need = ", ".join(parts) if parts else "not determined"
+    where = ""
+    if "setting" in design and a.get("sweep_parameter"):
+        where = f", from the spread at {escape(a['sweep_parameter'])} = {design['setting'].values[-1]:g}"
     return (
         f"{line}; impacts per bat to tell two bats Δe_x = {float(a['delta_e_x']):g} apart"
-        f" ({100 * float(a['confidence']):g} % confidence, {100 * float(a['power']):g} % power): {need}."
+        f" ({100 * float(a['confidence']):g} % confidence, {100 * float(a['power']):g} % power{where}): {need}."
     )
 
 
