@@ -23,6 +23,7 @@ include: "workflow/rules/implications.smk"
 include: "workflow/rules/plots.smk"
 include: "workflow/rules/workbook.smk"
 include: "workflow/rules/studies.smk"
+include: "workflow/rules/report.smk"
 
 
 # Cheap jobs (drawing, tabulating) run where Snakemake runs, never as cluster jobs.
@@ -44,6 +45,8 @@ localrules:
     tracks_qa,
     studies,
     study_design,
+    report_front,
+    report_front_studies,
 
 
 # Once Snakemake holds the folder's lock, no running job of ours owns a temporary file any more.
@@ -65,3 +68,4 @@ rule all:
     default_target: True
     input:
         final_targets(),
+        "results/report/front.rst",

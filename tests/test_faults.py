@@ -167,3 +167,6 @@ def test_warnings_reach_every_product_and_the_end_of_the_run(clean, tmp_path):
     assert "n_warnings,,,,,1," in (res / "paper_comparison.csv").read_text()
     book = openpyxl.load_workbook(res / "results.xlsx")
     assert "only v_bat_mph_err" in str(book["warnings"]["A3"].value)
+    # the report's front page lists it once, with the log that has it (escaped for reStructuredText)
+    front = (wd / "results" / "report" / "front.rst").read_text()
+    assert front.count("only v\\_bat\\_mph\\_err") == 1 and "results/warn/logs/ingest.log" in front

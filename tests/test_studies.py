@@ -241,6 +241,13 @@ def test_study_rules_through_snakemake(tmp_path):
     for png in ("calibration/coverage.png", "design/coverage.png", "design/design.png"):
         assert_not_blank(res / png)
     assert_cf(sorted(str(p) for p in res.rglob("*.nc")), tmp_path / "cf.json")
+    # the report's front page: one line per study (rule report_front_studies), shown when the report holds them
+    front = (res / "front.rst").read_text()
+    assert "**calibration** (4 replicates per point, 21 quantities): 95 % intervals cover the truth in" in front
+    assert "**design** (3 replicates per point" in front and "impacts per bat to tell two bats" in front
+    snakemake(wd, "--report", "results/report.html", "studies", "--configfile", str(small))
+    html = (wd / "results" / "report.html").read_text()
+    assert "Replicate studies" in html and "What was run" not in html  # no dataset ran: no run's front page
     # replicates are the same experiments whatever the batch size
     b = xr.concat([xr.open_dataset(res / "calibration" / "batches" / f"batch{i}.nc") for i in (0, 1)], "replicate")
     small.write_text(small.read_text().replace("batch_size: 3", "batch_size: 4"))

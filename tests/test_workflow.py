@@ -139,6 +139,8 @@ def test_rerun_is_noop_and_byte_identical(run_dir):
 
 DATASET_PLOTS = {f"plot_fig{n}": 1 for n in (3, 4, 5, 6, 9, 10)}
 ALL_PLOTS = {**DATASET_PLOTS, "plot_fig11": 1, "plot_launch": 1}
+#: The report's front page follows every product of the run (its warnings are every job's).
+FRONT = {"report_front": 1}
 
 
 def _jobs_after_edit(run_dir, path):
@@ -159,6 +161,7 @@ def test_code_edit_reruns_only_dependents(run_dir):
     # the Sec. IV orchestration: not the Stronge fit, which shares only the line fit and the designs
     stronge_plots = {"plot_fig9": 1, "plot_fig10": 1}
     assert _jobs_after_edit(run_dir, pkg / "fitting.py") == {
+        **FRONT,
         "fit_ex": 1,
         "compare": 1,
         "implications": 1,
@@ -170,6 +173,7 @@ def test_code_edit_reruns_only_dependents(run_dir):
         "implications_workbook": 1,
     }
     assert _jobs_after_edit(run_dir, pkg / "linefit.py") == {
+        **FRONT,
         "fit_ex": 1,
         "compare": 1,
         "implications": 1,
@@ -182,6 +186,7 @@ def test_code_edit_reruns_only_dependents(run_dir):
         "implications_workbook": 1,
     }
     assert _jobs_after_edit(run_dir, pkg / "kinematics.py") == {
+        **FRONT,
         "simulate": 1,
         "normalize": 1,
         "reconstruct": 1,
@@ -198,6 +203,7 @@ def test_code_edit_reruns_only_dependents(run_dir):
         "implications_workbook": 1,
     }
     assert _jobs_after_edit(run_dir, pkg / "flight.py") == {
+        **FRONT,
         "implications": 2,
         "implications_compare": 1,
         "plot_fig11": 1,
@@ -205,7 +211,7 @@ def test_code_edit_reruns_only_dependents(run_dir):
         "comparison_html": 1,
         "implications_workbook": 1,
     }
-    assert _jobs_after_edit(run_dir, pkg / "workbook.py") == {"workbook": 1, "implications_workbook": 1}
+    assert _jobs_after_edit(run_dir, pkg / "workbook.py") == {"workbook": 1, "implications_workbook": 1, **FRONT}
     assert planned_jobs(run_dir) == {}  # restoring the text restores the state
     (run_dir / "README.md").write_text("an unrelated edit\n")
     assert planned_jobs(run_dir) == {}
@@ -358,7 +364,8 @@ def test_report_builds(run_dir):
 def test_plot_edit_reruns_only_plots(run_dir):
     """Restyling a figure (editing plotting.py) never reruns a fit: only the plot jobs are planned."""
     pkg = run_dir / "src" / "ballbat"
-    assert _jobs_after_edit(run_dir, pkg / "plotting.py") == ALL_PLOTS
-    assert _jobs_after_edit(run_dir, pkg / "reporting.py") == {**ALL_PLOTS, "comparison_html": 2}
+    assert _jobs_after_edit(run_dir, pkg / "plotting.py") == {**ALL_PLOTS, **FRONT}
+    assert _jobs_after_edit(run_dir, pkg / "reporting.py") == {**ALL_PLOTS, "comparison_html": 2, **FRONT}
+    assert _jobs_after_edit(run_dir, pkg / "frontpage.py") == FRONT  # the front page alone
     assert _jobs_after_edit(run_dir, run_dir / "workflow" / "report" / "fig3.rst") == {}  # captions: report only
     assert planned_jobs(run_dir) == {}

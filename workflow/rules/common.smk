@@ -149,6 +149,13 @@ def uses_tracks(name):
 TRACKED = [d for d in DATASETS if uses_tracks(d)]
 
 
+def dataset_kind(name):
+    """What a dataset is, in words (the report's front page)."""
+    if uses_tracks(name):
+        return "camera tracks" if "tracks" in config["datasets"][name] else "synthetic, rendered camera tracks"
+    return "measured" if is_measured(name) else "synthetic"
+
+
 def get_render_settings(wildcards):
     return dataset_config(wildcards)["render"]
 

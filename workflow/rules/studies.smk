@@ -114,4 +114,4 @@ rule study_design:
 rule studies:
     """Every study of the config (`make study`)."""
     input:
-        study_targets(),
+        study_targets() + (["results/studies/front.rst"] if STUDIES else []),

@@ -1,0 +1,166 @@
+"""The report in a real browser: headless Chromium opens results/report.html (issues 21 and 23).
+
+`make test-report` installs Debian's chromium, builds the default run's report and runs this
+file with BALLBAT_REPORT_ROOT set to the repository (its screenshot: results/report-front.png).
+Without that variable the tests build the default workflow's report in a temporary copy; they
+are skipped when Chromium is not installed (failed instead when BALLBAT_REQUIRE_BROWSER is set).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+from pathlib import Path
+
+import pytest
+import xarray as xr
+from browser import Browser, chromium_path
+
+from workflow_helpers import assert_not_blank, make_workdir, snakemake
+
+pytestmark = pytest.mark.slow
+
+#: The browser window's width in CSS pixels (issue 23: the front page reads well at 1400 px).
+WIDTH = 1400
+
+
+@pytest.fixture(scope="module")
+def report_root(tmp_path_factory) -> Path:
+    given = os.environ.get("BALLBAT_REPORT_ROOT")
+    if given:
+        root = Path(given)
+        assert (root / "results" / "report.html").is_file(), f"{root}/results/report.html: not built (make report)"
+        return root
+    if chromium_path() is None:
+        pytest.skip("no chromium (make test-report installs Debian's)")
+    wd = make_workdir(tmp_path_factory.mktemp("report"))
+    snakemake(wd, "-c2")
+    snakemake(wd, "--report", "results/report.html")
+    return wd
+
+
+@pytest.fixture(scope="module")
+def page(report_root):
+    if chromium_path() is None:
+        if os.environ.get("BALLBAT_REQUIRE_BROWSER"):
+            pytest.fail("BALLBAT_REQUIRE_BROWSER is set but there is no chromium")
+        pytest.skip("no chromium (make test-report installs Debian's)")
+    with Browser(width=WIDTH, height=1000) as b:
+        b.open((report_root / "results" / "report.html").resolve().as_uri())
+        b.wait_for("document.querySelector('.prose h1.title') !== null")  # React has drawn the page
+        yield b
+
+
+def _front_text(page) -> str:
+    page.evaluate("app.setView({content: 'rulegraph', navbarMode: 'menu'})")
+    page.wait_for("document.querySelector('.prose h1.title') !== null")
+    return page.evaluate("document.querySelector('.prose').innerText")
+
+
+def _config(page) -> dict:
+    """The run's configuration as the front page shows it, unfolded (JSON)."""
+    page.evaluate("document.querySelector('.prose details').open = true")
+    config = json.loads(page.evaluate("document.querySelector('.prose details pre').innerText"))
+    page.evaluate("document.querySelector('.prose details').open = false")
+    return config
+
+
+def _datasets(page) -> list[str]:
+    """The datasets of the report's run (not whatever else results/ holds)."""
+    return sorted(_config(page)["datasets"])
+
+
+def _close(shown: str, value: float) -> bool:
+    """The number as shown equals ``value`` rounded to the shown decimal places."""
+    places = len(shown.split(".")[1]) if "." in shown else 0
+    return math.isfinite(value) and abs(float(shown) - value) <= 0.5001 * 10.0**-places
+
+
+NUM = r"(-?\d+(?:\.\d+)?)"
+
+
+def test_front_page_shows_e_x_and_eta2_before_the_configuration(page, report_root):
+    """The rendered front page's text: e_x of each bat with its uncertainty, and eta^2, as in the NetCDF files."""
+    assert page.evaluate("window.innerWidth") == WIDTH
+    text = _front_text(page)
+    config_at = text.index("Configuration")
+    assert not page.evaluate("document.querySelector('.prose details').open")  # folded
+    assert '"datasets"' not in page.evaluate("document.querySelector('.prose').innerText")  # the JSON is hidden
+    checked = 0
+    for name in _datasets(page):  # unfolded, the configuration is the run's, as JSON
+        fit = xr.open_dataset(report_root / "results" / name / "fit_ex.nc")
+        stronge = xr.open_dataset(report_root / "results" / name / "stronge.nc")
+        section = text.index(f"Dataset {name}\n")
+        for ball in fit["ball"].values.astype(str):
+            for bat in fit["bat"].values.astype(str):
+                f = fit.sel(ball=ball, bat=bat)
+                if not math.isfinite(float(f["e_x"])):
+                    continue
+                row = re.compile(
+                    rf"^{ball}\t{bat.replace('_', ' ')}\t{NUM}\t± {NUM}\t(?:± {NUM}|—)", re.MULTILINE
+                ).search(text, section)
+                assert row, (name, ball, bat)
+                assert row.start() < config_at
+                assert _close(row[1], float(f["e_x"])), (ball, bat, row[0])
+                assert _close(row[2], float(f["e_x_err"])), (ball, bat, row[0])
+                if "e_x_err_scale" in f and float(f["e_x_err_scale"]) > 0:
+                    assert row[3] and _close(row[3], float(f["e_x_err_scale"])), (ball, bat, row[0])
+                checked += 1
+            s = stronge.sel(ball=ball)
+            row = re.compile(rf"^{ball}\t{NUM} ± {NUM}\t{NUM} . {NUM}", re.MULTILINE).search(text, section)
+            assert row and row.start() < config_at, (name, ball)
+            assert _close(row[1], float(s["eta2"])) and _close(row[2], float(s["eta2_err"])), row[0]
+            assert _close(row[3], float(s["eta2_ci_low"])) and _close(row[4], float(s["eta2_ci_high"])), row[0]
+            checked += 1
+    assert checked >= 9  # the default run: 7 bat x ball pairs and 2 balls' eta^2
+    shot = page.screenshot(report_root / "results" / "report-front.png")
+    assert_not_blank(shot)
+    assert not page.evaluate("document.querySelector('.prose details').open")
+
+
+def test_every_figure_loads(page, report_root):
+    """Every image result of the report, shown as the report shows it, decodes (no broken image)."""
+    _front_text(page)
+    thumbs = page.evaluate(
+        "Promise.all(Array.from(document.querySelectorAll('.prose img'))"
+        ".map(i => i.decode().then(() => i.naturalWidth, () => 0)))"
+    )
+    assert thumbs and all(w > 100 for w in thumbs), thumbs  # the Fig. 5 thumbnail(s)
+    widths = page.evaluate(
+        """(async () => {
+            const out = {};
+            for (const [path, entry] of Object.entries(results)) {
+                if (!entry.mime_type.startsWith('image/')) continue;
+                app.setView({content: 'img', contentPath: entry.data_uri, resultPath: path});
+                let img = null;
+                for (let k = 0; k < 100 && !img; k++) {
+                    await new Promise(r => setTimeout(r, 20));
+                    img = Array.from(document.querySelectorAll('img')).find(i => i.src === entry.data_uri);
+                }
+                out[path] = img ? await img.decode().then(() => img.naturalWidth, () => 0) : -1;
+            }
+            return out;
+        })()"""
+    )
+    on_disk = {str(p.relative_to(report_root)) for p in (report_root / "results").glob("**/figures/*.png")}
+    assert on_disk <= set(widths), on_disk - set(widths)  # every figure is in the report
+    broken = {p: w for p, w in widths.items() if w <= 0}
+    assert not broken, broken
+
+
+def test_a_caption_shows_its_fitted_number(page, report_root):
+    """Fig. 5's page (opened from the front page's thumbnail) quotes the pooled e_x of fit_ex.nc."""
+    _front_text(page)
+    name = _datasets(page)[0]
+    page.evaluate("document.querySelector('.prose .thumbnail a').click()")
+    page.wait_for("document.body.innerText.includes('Fig. 5 of the paper')")
+    text = page.evaluate("document.body.innerText")
+    fit = xr.open_dataset(report_root / "results" / name / "fit_ex.nc")
+    shown = re.search(rf"baseball: 1 \+ e_x = {NUM}.*?e_x = {NUM}", text, re.DOTALL)
+    assert shown, text[:2000]
+    e_x = float(fit["e_x_pooled"].sel(ball="baseball"))
+    assert _close(shown[2], e_x) and _close(shown[1], 1 + e_x), (shown[0], e_x)
+    prov = json.loads(fit.attrs["provenance_git"])
+    assert prov["commit"][:12] in _front_text(page) or prov["commit"] == "unknown"

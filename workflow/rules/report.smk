@@ -1,0 +1,47 @@
+# The report's front page (workflow/report/workflow.rst pulls these in): the run's headline
+# numbers, written from the NetCDF files (ballbat.frontpage), as the figure captions are.
+
+
+rule report_front:
+    """Write the report's front page: what was run, e_x and eta^2 beside the paper's, warnings, provenance.
+
+    It comes last (every other product of the run is its input), so the warnings of every job are in.
+    """
+    input:
+        impacts=expand("results/{dataset}/reconstruct.nc", dataset=DATASETS),
+        fit=expand("results/{dataset}/fit_ex.nc", dataset=DATASETS),
+        stronge=expand("results/{dataset}/stronge.nc", dataset=DATASETS),
+        fig5=expand("results/{dataset}/figures/fig5.png", dataset=DATASETS),
+        scenarios=expand("results/implications/{scenario}.nc", scenario=SCENARIOS),
+        rest=final_targets(),
+        code=code("report_front.py"),
+    output:
+        rst="results/report/front.rst",
+    log:
+        "results/report/logs/front.log",
+    conda:
+        ENV
+    params:
+        kinds={d: dataset_kind(d) for d in DATASETS},
+        scenarios=SCENARIOS,
+    script:
+        "../scripts/report_front.py"
+
+
+rule report_front_studies:
+    """Write the studies' lines of the report's front page: coverage range and a design's impacts per bat."""
+    input:
+        coverage=expand("results/studies/{study}/coverage.nc", study=STUDIES),
+        design=[t for t in study_targets() if t.endswith("design.nc")],
+        code=code("report_front.py"),
+    output:
+        rst="results/studies/front.rst",
+    log:
+        "results/studies/logs/front.log",
+    conda:
+        ENV
+    params:
+        studies=STUDIES,
+        designs={Path(t).parent.name: t for t in study_targets() if t.endswith("design.nc")},
+    script:
+        "../scripts/report_front.py"
