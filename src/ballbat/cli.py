@@ -18,6 +18,8 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
+from . import __version__
+
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
@@ -303,6 +305,7 @@ def parser() -> argparse.ArgumentParser:
     d = _schema_defaults()
     air, flight = d["air"], d["flight"]
     top = _Parser(prog="ballbat", description=__doc__.split("\n\n")[0])
+    top.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = top.add_subparsers(dest="command", required=True, parser_class=_Parser)
     fmt = argparse.RawDescriptionHelpFormatter
 

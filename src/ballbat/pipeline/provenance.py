@@ -26,6 +26,8 @@ if TYPE_CHECKING:
 STACK = ("numpy", "scipy", "xarray", "netCDF4", "lmfit", "matplotlib", "snakemake")
 
 PACKAGE_DIR = Path(__file__).resolve().parent.parent  # src/ballbat
+#: What of a workflow checkout is the workflow's own source (beside the package).
+WORKFLOW_PARTS = ("Snakefile", "workflow")
 
 
 def sha256_file(path: str | os.PathLike[str], chunk: int = 1 << 20) -> str:
@@ -48,6 +50,43 @@ def package_source_hash() -> str:
     h = hashlib.sha256()
     for p in package_sources():
         h.update(str(p.relative_to(PACKAGE_DIR)).encode())
+        h.update(b"\0")
+        h.update(p.read_bytes())
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+def workflow_root() -> Path | None:
+    """Return the directory holding ``Snakefile`` and ``workflow/``.
+
+    That is the working directory of a workflow job, else the checkout the package was installed
+    from; ``None`` if neither has them.
+    """
+    for where in (Path.cwd(), PACKAGE_DIR.parent.parent):
+        if (where / "Snakefile").is_file() and (where / "workflow" / "rules").is_dir():
+            return where.resolve()
+    return None
+
+
+def workflow_sources(root: Path) -> list[Path]:
+    """Return the workflow's own files under ``root`` (Snakefile, rules, scripts, schemas, envs, report), sorted."""
+    files = [root / "Snakefile"]
+    files += [p for p in (root / "workflow").rglob("*") if p.is_file() and "__pycache__" not in p.parts]
+    return sorted(files)
+
+
+@lru_cache(maxsize=4)
+def workflow_source_hash(root: str | None = None) -> str:
+    """sha256 over the workflow's own files (relative path and bytes of each), like the package's.
+
+    ``"unknown"`` when no workflow checkout is found (ballbat used as a library).
+    """
+    top = Path(root) if root else workflow_root()
+    if top is None:
+        return "unknown"
+    h = hashlib.sha256()
+    for p in workflow_sources(top):
+        h.update(p.relative_to(top).as_posix().encode())
         h.update(b"\0")
         h.update(p.read_bytes())
         h.update(b"\0")
@@ -77,7 +116,12 @@ def git_state(where: str | None = None) -> dict:
 
 def software_versions() -> dict:
     """Versions of ballbat, Python and the scientific stack (read from metadata, no imports)."""
-    out = {"ballbat": __version__, "ballbat_source_sha256": package_source_hash(), "python": platform.python_version()}
+    out = {
+        "ballbat": __version__,
+        "ballbat_source_sha256": package_source_hash(),
+        "workflow_source_sha256": workflow_source_hash(),
+        "python": platform.python_version(),
+    }
     for dist in STACK:
         try:
             out[dist] = metadata.version(dist)
