@@ -10,14 +10,11 @@ from validate_crate import seed_cache, validate
 
 from ballbat.pipeline import crate as crate_mod
 from ballbat.pipeline.provenance import sha256_file, workflow_source_hash
-from workflow_helpers import make_workdir, snakemake
 
 
 @pytest.fixture(scope="module")
-def run_dir(tmp_path_factory):
-    work = make_workdir(tmp_path_factory.mktemp("crate"))
-    snakemake(work, "-c2")
-    return work
+def run_dir(default_run):
+    return default_run
 
 
 @pytest.fixture(scope="module")

@@ -7,6 +7,7 @@ the same inputs, config and code give byte-identical files.
 
 from __future__ import annotations
 
+import datetime
 import hashlib
 import json
 import platform
@@ -112,6 +113,27 @@ def git_state(where: str | None = None) -> dict:
     except (OSError, subprocess.SubprocessError):
         return {"commit": "unknown", "dirty": "unknown"}
     return {"commit": commit, "dirty": bool(status.strip())}
+
+
+@lru_cache(maxsize=8)
+def commit_time(commit: str, where: str | None = None) -> datetime.datetime | None:
+    """Return the committer date of ``commit`` (naive UTC), or ``None`` when git does not know it."""
+    if not commit or commit == "unknown":
+        return None
+    try:
+        out = subprocess.run(
+            ["git", "show", "-s", "--format=%ct", commit],
+            cwd=str(where or PACKAGE_DIR),
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=True,
+        ).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return None
+    if not out.isdigit():
+        return None
+    return datetime.datetime.fromtimestamp(int(out), tz=datetime.UTC).replace(tzinfo=None)
 
 
 def software_versions() -> dict:
