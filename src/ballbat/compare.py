@@ -263,11 +263,20 @@ def to_markdown(table: list[dict], title: str) -> str:
     lines = [f"# {title}", "", "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     for r in table:
         cells = [r[c] or "" if c in ("quantity", "ball", "bat", "unit") else format_number(r[c]) for c in COLUMNS]
+        if r.get("value") is not None and r.get("uncertainty") is not None:
+            # rounded as the field does (the CSV keeps 6 significant digits)
+            rounded = format_measurement(r["value"], r["uncertainty"], r.get("systematic"))
+            for c, text in zip(("value", "uncertainty", "systematic"), rounded, strict=True):
+                cells[COLUMNS.index(c)] = text
         lines.append("| " + " | ".join(cells) + " |")
     present = {r["quantity"] for r in table if r.get("uncertainty") is not None}
     notes = [f"- `{q}`: uncertainty is {UNCERTAINTY_NOTES[q]}" for q in UNCERTAINTY_NOTES if q in present]
     if any(r.get("systematic") is not None for r in table):
         notes.append("- `systematic`: from the swing camera's pixel-scale uncertainty, apart from the standard error")
+    notes.append(
+        "- `value`, `uncertainty`, `systematic`: rounded as the field does (the uncertainty to two significant "
+        "digits, the value to match); paper_comparison.csv has them to 6 significant digits"
+    )
     if notes:
         lines += [
             "",

@@ -203,3 +203,42 @@ def provenance_attrs(
 def data_inputs(named_input: Mapping[str, object]) -> dict:
     """Return a Snakemake job's named inputs without the code files (recorded by the source hash)."""
     return {k: v for k, v in named_input.items() if k != "code"}
+
+
+def provenance_record(rule: str, inputs: dict | list, config: dict) -> dict:
+    """Return the provenance of :func:`provenance_attrs` as one JSON-ready dict (keys without the prefix)."""
+    attrs = provenance_attrs(rule, inputs, config)
+    return {
+        "rule": rule,
+        **{k.removeprefix("provenance_"): json.loads(v) for k, v in attrs.items() if k != "provenance_rule"},
+    }
+
+
+def job_provenance(job: object) -> tuple[str, dict, dict]:
+    """Return a Snakemake job's (rule, data inputs, params): what the provenance of its products records."""
+    return job.rule, data_inputs(job.input), dict(job.params)
+
+
+def png_text(rule: str, inputs: dict | list, config: dict) -> dict[str, str]:
+    """Return a figure's provenance as PNG text chunks (``provenance_*`` keys, JSON values; no time)."""
+    return provenance_attrs(rule, inputs, config)
+
+
+def write_sidecar(
+    path: str | os.PathLike[str], products: list[str | os.PathLike[str]], rule: str, inputs: dict | list, config: dict
+) -> Path:
+    """Write the provenance of text tables (CSV, Markdown) to the JSON file ``path``, atomically.
+
+    The tables stay plain for every reader (a comment line is not CSV); the sidecar names each
+    table with its sha256, so that a reader can check the pair belongs together.
+    """
+    from .atomic import atomic_target
+
+    record = {
+        "describes": [{"path": str(p), "sha256": sha256_file(p)} for p in products],
+        **provenance_record(rule, inputs, config),
+    }
+    path = Path(path)
+    with atomic_target(path) as tmp:
+        tmp.write_text(dumps(record) + "\n")
+    return path
