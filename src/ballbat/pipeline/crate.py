@@ -389,6 +389,8 @@ def build_crate(
             {
                 "@type": "SoftwareApplication",
                 "name": f"rule {rule}",
+                "description": f"the workflow's rule {rule} (its script and rule file), ballbat {__version__}",
+                "softwareVersion": __version__,
                 "hasPart": has_part,
                 "softwareRequirements": soft_ids,
             },
@@ -423,6 +425,7 @@ def build_crate(
         props = {
             "@type": "CreateAction",
             "name": f"job {job.name}",
+            "description": f"one execution of rule {job.rule}: its inputs and config values in, its outputs out",
             "instrument": tools[job.rule],
             "object": objects,
             "result": result,
@@ -461,6 +464,7 @@ def build_crate(
         {
             "@type": "CreateAction",
             "name": f"snakemake run of the ballbat workflow {__version__}",
+            "description": "the run: the config files and the merged config in, every job's outputs out",
             "instrument": main,
             "object": run_objects,
             "result": all_results,
@@ -488,13 +492,23 @@ def build_crate(
         "The products of one run of the ballbat workflow (results/), described as a Provenance Run Crate: "
         "the workflow, every job with its inputs, config values and outputs, every file's sha256."
     )
+    b.context(LICENSE, {"@type": "CreativeWork", "name": "MIT License", "identifier": "MIT"})
     root["license"] = {"@id": LICENSE}
     root["datePublished"] = _iso(ended)
     root["conformsTo"] = [{"@id": ident} for ident in PROFILES]
     root["mainEntity"] = main
-    root["mentions"] = [run]
+    root["mentions"] = [run, *job_actions]
     _ = package_source_hash, workflow_source_hash  # recorded through software_versions()
-    return b.crate.metadata.generate()
+    return _single_values(b.crate.metadata.generate())
+
+
+def _single_values(doc: dict) -> dict:
+    """Return the JSON-LD with one-element lists as single values (RO-Crate 1.1's recommendation)."""
+    for entity in doc["@graph"]:
+        for key, value in list(entity.items()):
+            if key != "@type" and isinstance(value, list) and len(value) == 1:
+                entity[key] = value[0]
+    return doc
 
 
 def write_run_crate(
