@@ -310,12 +310,14 @@ def test_summary_command(run_dir):
     assert out.returncode == 0, out.stderr
     fit = xr.open_dataset(run_dir / "results" / "small" / "fit_ex.nc")
     st = xr.open_dataset(run_dir / "results" / "small" / "stronge.nc")
+    assert "e_x_err_scale" not in fit  # direct noise, no camera tracks: no pixel-scale systematic
     f = fit.sel(ball="baseball", bat="wood")
-    e = format_measurement(float(f.e_x), float(f.e_x_err), float(f.e_x_err_scale))[0]  # rounded to its errors
+    e = format_measurement(float(f.e_x), float(f.e_x_err))[0]  # rounded to its error
     assert any(line.split()[:3] == ["baseball", "wood", e] for line in out.stdout.splitlines())
     f = fit.sel(ball="softball")
-    p = format_measurement(float(f.e_x_pooled), float(f.e_x_pooled_err), float(f.e_x_pooled_err_scale))[0]
+    p = format_measurement(float(f.e_x_pooled), float(f.e_x_pooled_err))[0]
     assert any(line.split()[:3] == ["softball", "pooled", p] for line in out.stdout.splitlines())
+    assert "± syst" not in out.stdout
     assert f"{float(st.eta2.sel(ball='baseball')):.3f}" in out.stdout
     assert out.stdout.startswith("small: 36 impacts, 0 not used")
 
@@ -336,8 +338,8 @@ def test_figures_drawn(run_dir):
     assert f"baseball: {slope:.3g} ± " in text3 and "paper 179 rpm/deg" in text3
     assert "Impacts shown: 36 of 36 (0 flagged" in text3
     f = fit.sel(ball="softball")
-    e_x, err, syst = format_measurement(float(f.e_x_pooled), float(f.e_x_pooled_err), float(f.e_x_pooled_err_scale))
-    assert f"e_x = {e_x} ± {err} (stat) ± {syst} (syst)" in (figs / "fig5.rst").read_text()
+    e_x, err = format_measurement(float(f.e_x_pooled), float(f.e_x_pooled_err))  # no tracks: no systematic
+    assert f"e_x = {e_x} ± {err} (n = " in (figs / "fig5.rst").read_text()
     assert "Longest carry" in (imp / "paper_fig11.rst").read_text()
     eta2 = float(xr.open_dataset(run_dir / "results" / "small" / "stronge.nc").eta2.sel(ball="baseball"))
     assert f"baseball: η² = {eta2:.3g} ± " in (figs / "fig9.rst").read_text()

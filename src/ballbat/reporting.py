@@ -136,9 +136,9 @@ def fig5_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
         if not math.isfinite(v):
             continue
         lines.append(
-            f"- {ball}: e_x = {_ex_text(fit, 'e_x_pooled', ball=ball)}, "
-            f"slope 1 + e_x = {_ex_text(fit, 'e_x_pooled', 1.0, ball=ball).split(' (stat)')[0]}"
-            f" (n = {int(fit['e_x_pooled_n'].sel(ball=ball))}); paper slope {_paper('fig5_slope', ball, '.4g')}."
+            f"- {ball}: e_x = {_ex_text(fit, 'e_x_pooled', ball=ball)} (n = {int(fit['e_x_pooled_n'].sel(ball=ball))});"
+            f" slope 1 + e_x = {_ex_text(fit, 'e_x_pooled', 1.0, ball=ball).split(' (stat)')[0]},"
+            f" paper slope {_paper('fig5_slope', ball, '.4g')}."
         )
     lines += ["", "e_x per bat (Table II):", ""]
     for ball in fit["ball"].values.astype(str):

@@ -267,11 +267,15 @@ def _copy_snapshot(results: Path, workdir: Path, extra: Iterable[str], builder: 
         p = Path(path) if Path(path).is_absolute() else workdir / path
         if p.is_file() and not p.resolve().is_relative_to(results.resolve()):
             wanted[builder.snapshot_path(path).removeprefix(f"{SNAPSHOT}/")] = p
-    for rel, src in sorted(wanted.items()):
-        dest = tmp / rel
-        dest.parent.mkdir(parents=True, exist_ok=True)
-        shutil.copyfile(src, dest)
-    tmp.chmod(0o777 & ~_umask())
+    try:
+        for rel, src in sorted(wanted.items()):
+            dest = tmp / rel
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(src, dest)
+        tmp.chmod(0o777 & ~_umask())
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
     return tmp
 
 
