@@ -1,4 +1,4 @@
-"""Shared fixtures: the repository's property tables (Tables I and II of the paper)."""
+"""Shared fixtures: the repository's property tables (Tables I and II of the paper), and one default workflow run."""
 
 from pathlib import Path
 
