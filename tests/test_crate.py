@@ -149,6 +149,7 @@ def test_failed_crate_leaves_none(tmp_path, monkeypatch):
     results.mkdir()
     (results / "ro-crate-metadata.json").write_text("{}")
     (results / "a.nc").write_bytes(b"x")
+    (results / ".workflow.snapshot.old123").mkdir()  # what an earlier crate cut short left
 
     def boom(*args, **kwargs):
         raise RuntimeError("disk full")

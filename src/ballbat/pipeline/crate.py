@@ -535,6 +535,9 @@ def write_run_crate(
     work = Path(workdir or Path.cwd()).resolve()
     target = results / METADATA_NAME
     target.unlink(missing_ok=True)
+    for stale in results.glob(f".{SNAPSHOT}.*"):  # left by a crate cut short (we hold Snakemake's lock)
+        if stale.is_dir():
+            shutil.rmtree(stale, ignore_errors=True)
     builder = _Builder(results, work)
     extra = [*configfiles, *(p for j in jobs for p in j.inputs)]
     tmp = _copy_snapshot(results, work, extra, builder)
