@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.ballbat-installed
 CORES ?= 2
 
-.PHONY: install run test test-slurm test-report study report bench lint lock clean
+.PHONY: install run test test-slurm test-report test-citation validate-crate study report bench lint lock clean
 
 # Create the virtual environment and install the pinned stack plus ballbat (editable).
 $(STAMP): pyproject.toml requirements.lock
@@ -41,6 +41,22 @@ test-slurm: $(SLURM_VENV)/.installed
 study: install
 	$(BIN)/snakemake -c$(CORES) all studies
 	$(BIN)/snakemake -c$(CORES) --report results/report.html all studies
+
+# The last run's Provenance Run Crate (results/ro-crate-metadata.json) against roc-validator's
+# provenance-run-crate-0.5 profile, offline (its cache seeded from tests/data/jsonld/).
+validate-crate: install
+	$(BIN)/python tests/validate_crate.py results
+
+# CITATION.cff through `cffconvert --validate`. cffconvert pins jsonschema 3 (the workflow needs 4),
+# so it lives in an environment of its own, like the SLURM plugin.
+CFF_VENV ?= .venv-cff
+$(CFF_VENV)/.installed: requirements-cff.lock
+	test -x $(CFF_VENV)/bin/python || $(PYTHON) -m venv $(CFF_VENV)
+	$(CFF_VENV)/bin/python -m pip install --quiet --disable-pip-version-check -r requirements-cff.lock
+	touch $@
+
+test-citation: $(CFF_VENV)/.installed
+	$(CFF_VENV)/bin/cffconvert --validate -i CITATION.cff
 
 report: run
 	$(BIN)/snakemake -c$(CORES) --report results/report.html

@@ -54,9 +54,11 @@ onstart:
     remove_stale_temporaries()
 
 
-# Every warning of the run's jobs, printed at its end, success or not.
+# Every warning of the run's jobs, printed at its end, success or not; after a success, the run's
+# Provenance Run Crate (results/ro-crate-metadata.json; common.smk: write_crate).
 onsuccess:
     print_warnings("results", DATASETS, SCENARIOS)
+    write_crate()
 
 
 onerror:

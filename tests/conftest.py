@@ -1,4 +1,4 @@
-"""Shared fixtures: the repository's property tables (Tables I and II of the paper)."""
+"""Shared fixtures: the repository's property tables (Tables I and II of the paper), and one default workflow run."""
 
 from pathlib import Path
 
@@ -29,3 +29,13 @@ def balls():
 @pytest.fixture(scope="session")
 def bats():
     return load_bats(ROOT / "config" / "bats.csv")
+
+
+@pytest.fixture(scope="session")
+def default_run(tmp_path_factory):
+    """A copy of the workflow run once with the default config (`snakemake -c2`), shared by the tests that read it."""
+    from workflow_helpers import make_workdir, snakemake
+
+    work = make_workdir(tmp_path_factory.mktemp("default_run"))
+    snakemake(work, "-c2")
+    return work

@@ -12,7 +12,7 @@ import pytest
 import xarray as xr
 import yaml
 
-from ballbat.compare import read_csv
+from ballbat.compare import format_measurement, read_csv
 from ballbat.pipeline.provenance import sha256_file
 from workflow_helpers import ROOT, assert_cf, assert_not_blank, make_workdir, planned_jobs, snakemake
 
@@ -284,11 +284,11 @@ def test_workbook_in_the_fields_units(run_dir):
     np.testing.assert_allclose(imp[("omega", "rpm")], rec.omega.values * 60 / (2 * np.pi), rtol=1e-12)
     np.testing.assert_allclose(imp[("D", "in")], rec.D.values / 0.0254, rtol=1e-12)
     assert set(imp.xs("flag_reason", axis=1, level=0).iloc[:, 0]) == {"ok"}  # text column: no unit
-    ex = pd.read_excel(res / "results.xlsx", sheet_name="e_x", header=[0, 1])
-    wood = ex[(ex.iloc[:, 0] == "baseball") & (ex.iloc[:, 1] == "wood")]
-    assert float(wood[("e_x", "1")].iloc[0]) == pytest.approx(float(fit.e_x.sel(ball="baseball", bat="wood")))
-    pooled = ex[(ex.iloc[:, 0] == "softball") & (ex.iloc[:, 1] == "pooled")]
-    assert int(pooled[("e_x_n", "1")].iloc[0]) == int(fit.e_x_pooled_n.sel(ball="softball"))
+    ex = pd.read_excel(res / "results.xlsx", sheet_name="e_x", header=0, skiprows=[1])  # dimensionless: no unit
+    wood = ex[(ex["ball"] == "baseball") & (ex["bat"] == "wood")]
+    assert float(wood["e_x"].iloc[0]) == pytest.approx(float(fit.e_x.sel(ball="baseball", bat="wood")))
+    pooled = ex[(ex["ball"] == "softball") & (ex["bat"] == "pooled")]
+    assert int(pooled["e_x_n"].iloc[0]) == int(fit.e_x_pooled_n.sel(ball="softball"))
     sec4 = pd.read_excel(res / "results.xlsx", sheet_name="sec4", header=[0, 1])
     slope = float(fit.spin_theta_slope.sel(ball="baseball")) * 60 / (2 * np.pi) * np.pi / 180
     assert float(sec4[("spin_theta_slope", "rpm/deg")].iloc[0]) == pytest.approx(slope, rel=1e-12)
@@ -316,10 +316,14 @@ def test_summary_command(run_dir):
     assert out.returncode == 0, out.stderr
     fit = xr.open_dataset(run_dir / "results" / "small" / "fit_ex.nc")
     st = xr.open_dataset(run_dir / "results" / "small" / "stronge.nc")
-    e = float(fit.e_x.sel(ball="baseball", bat="wood"))
-    assert any(line.split()[:3] == ["baseball", "wood", f"{e:.3f}"] for line in out.stdout.splitlines())
-    p = float(fit.e_x_pooled.sel(ball="softball"))
-    assert any(line.split()[:3] == ["softball", "pooled", f"{p:.3f}"] for line in out.stdout.splitlines())
+    assert "e_x_err_scale" not in fit  # direct noise, no camera tracks: no pixel-scale systematic
+    f = fit.sel(ball="baseball", bat="wood")
+    e = format_measurement(float(f.e_x), float(f.e_x_err))[0]  # rounded to its error
+    assert any(line.split()[:3] == ["baseball", "wood", e] for line in out.stdout.splitlines())
+    f = fit.sel(ball="softball")
+    p = format_measurement(float(f.e_x_pooled), float(f.e_x_pooled_err))[0]
+    assert any(line.split()[:3] == ["softball", "pooled", p] for line in out.stdout.splitlines())
+    assert "± syst" not in out.stdout
     assert f"{float(st.eta2.sel(ball='baseball')):.3f}" in out.stdout
     assert out.stdout.startswith("small: 36 impacts, 0 not used")
 
@@ -339,8 +343,9 @@ def test_figures_drawn(run_dir):
     text3 = (figs / "fig3.rst").read_text()
     assert f"baseball: {slope:.3g} ± " in text3 and "paper 179 rpm/deg" in text3
     assert "Impacts shown: 36 of 36 (0 flagged" in text3
-    e_x = float(fit.e_x_pooled.sel(ball="softball"))
-    assert f"e_x = {e_x:.3f} ± " in (figs / "fig5.rst").read_text()
+    f = fit.sel(ball="softball")
+    e_x, err = format_measurement(float(f.e_x_pooled), float(f.e_x_pooled_err))  # no tracks: no systematic
+    assert f"e_x = {e_x} ± {err} (n = " in (figs / "fig5.rst").read_text()
     assert "Longest carry" in (imp / "paper_fig11.rst").read_text()
     eta2 = float(xr.open_dataset(run_dir / "results" / "small" / "stronge.nc").eta2.sel(ball="baseball"))
     assert f"baseball: η² = {eta2:.3g} ± " in (figs / "fig9.rst").read_text()

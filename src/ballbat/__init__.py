@@ -5,4 +5,4 @@ Bat", Am. J. Phys. 85, 503 (2017). Importing the package is deliberately cheap: 
 module imports only what it needs, so that workflow jobs start fast.
 """
 
-__version__ = "0.1.0"
+__version__ = "0.2.0"

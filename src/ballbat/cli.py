@@ -25,6 +25,8 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
+from . import __version__
+
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
@@ -537,7 +539,12 @@ def summary_lines(folder: Path) -> list[str]:
             ) from None
     rec, fit, st = read
     lines = [f"{folder.name}: {rec.sizes['impact']} impacts, {int((rec['flag'].values != 0).sum())} not used (flagged)"]
-    lines += ["", f"{'ball':<10} {'bat':<20} {'e_x':>7} {'± se':>7} {'95 % interval':>17} {'n':>4}"]
+    from .compare import format_measurement, total_uncertainty
+
+    scale = "e_x_err_scale" in fit
+    head = f"{'ball':<10} {'bat':<20} {'e_x':>8} {'± stat':>8}"
+    head += f" {'± syst':>8} {'± total':>8}" if scale else ""
+    lines += ["", head + f" {'95 % interval (stat)':>22} {'n':>4}"]
     for ball in fit["ball"].values.astype(str):
         for bat in [*fit["bat"].values.astype(str), "pooled"]:
             f = fit.sel(ball=ball) if bat == "pooled" else fit.sel(ball=ball, bat=bat)
@@ -546,8 +553,22 @@ def summary_lines(folder: Path) -> list[str]:
             if n == 0:
                 continue
             v, e = float(f[pre]), float(f[f"{pre}_err"])
-            lo, hi = float(f[f"{pre}_ci_low"]), float(f[f"{pre}_ci_high"])
-            lines.append(f"{ball:<10} {bat:<20} {v:7.3f} {e:7.3f} {f'[{lo:.3f}, {hi:.3f}]':>17} {n:4d}")
+            sys_ = float(f[f"{pre}_err_scale"]) if scale else None
+            errs = (e, sys_, total_uncertainty(e, sys_)) if scale else (e,)
+            # rounded as the field does: the errors to two significant digits, the value to match
+            cells = format_measurement(v, *errs)
+            lo, hi = (
+                format_measurement(float(f[f"{pre}_ci_low"]), e, sys_)[0],
+                format_measurement(float(f[f"{pre}_ci_high"]), e, sys_)[0],
+            )
+            lines.append(
+                f"{ball:<10} {bat:<20} " + " ".join(f"{c:>8}" for c in cells) + f" {f'[{lo}, {hi}]':>22} {n:4d}"
+            )
+    if scale:
+        lines += [
+            "syst: the pixel-scale systematic of the swing camera, shared by every impact of a bat "
+            "(not in stat); total: both in quadrature."
+        ]
     lines += ["", f"{'ball':<10} {'eta^2':>7} {'± se':>7} {'95 % interval':>17} {'n':>4}"]
     for ball in st["ball"].values.astype(str):
         s = st.sel(ball=ball)
@@ -587,6 +608,7 @@ def parser() -> argparse.ArgumentParser:
     d = _schema_defaults()
     air, flight = d["air"], d["flight"]
     top = _Parser(prog="ballbat", description=__doc__.split("\n\n")[0])
+    top.add_argument("--version", action="version", version=f"%(prog)s {__version__}")
     sub = top.add_subparsers(dest="command", required=True, parser_class=_Parser)
     fmt = argparse.RawDescriptionHelpFormatter
 

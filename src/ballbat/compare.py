@@ -65,6 +65,52 @@ def format_number(x: float | None) -> str:
     return "" if not math.isfinite(x) else f"{x:.6g}"
 
 
+def uncertainty_decimals(*errors: float | None, digits: int = 2) -> int | None:
+    """Return the decimals that show the finest of ``errors`` to ``digits`` significant digits.
+
+    The field's rule: an uncertainty to two significant digits, the value to the same decimal
+    place. With a statistical and a systematic error the finer one sets the place. ``None``
+    when no error is finite and positive. (0.00996 rounds to 0.010: two digits, three decimals.)
+    """
+    places = []
+    for e in errors:
+        if e is None or not math.isfinite(float(e)) or float(e) <= 0:
+            continue
+        e = float(e)
+        d = digits - 1 - math.floor(math.log10(e))
+        if round(e, d) >= 10 ** (digits - d):  # rounding carried into a new digit (0.00996 -> 0.010)
+            d -= 1
+        places.append(d)
+    return max(places) if places else None
+
+
+def format_measurement(value: float, *errors: float | None, digits: int = 2) -> list[str]:
+    """Return ``value`` and each of ``errors`` as text rounded as the field does (:func:`uncertainty_decimals`).
+
+    Errors that are missing or not finite come back as empty strings; with no usable error the
+    value is given to 3 significant digits.
+    """
+    d = uncertainty_decimals(*errors, digits=digits)
+    v = float(value)
+    if not math.isfinite(v):
+        return ["", *("" for _ in errors)]
+    if d is None:
+        return [f"{v:.3g}", *("" for _ in errors)]
+    d = max(d, 0)
+    out = [f"{v:.{d}f}"]
+    for e in errors:
+        ok = e is not None and math.isfinite(float(e)) and float(e) > 0
+        out.append(f"{float(e):.{d}f}" if ok else "")
+    return out
+
+
+def total_uncertainty(statistical: float, systematic: float | None) -> float:
+    """Return the statistical and systematic errors added in quadrature (the statistical one if no systematic)."""
+    if systematic is None or not math.isfinite(float(systematic)):
+        return float(statistical)
+    return math.hypot(float(statistical), float(systematic))
+
+
 def _pick(ds, var, ball, bat):
     if var not in ds:
         return None
@@ -217,11 +263,20 @@ def to_markdown(table: list[dict], title: str) -> str:
     lines = [f"# {title}", "", "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
     for r in table:
         cells = [r[c] or "" if c in ("quantity", "ball", "bat", "unit") else format_number(r[c]) for c in COLUMNS]
+        if r.get("value") is not None and r.get("uncertainty") is not None:
+            # rounded as the field does (the CSV keeps 6 significant digits)
+            rounded = format_measurement(r["value"], r["uncertainty"], r.get("systematic"))
+            for c, text in zip(("value", "uncertainty", "systematic"), rounded, strict=True):
+                cells[COLUMNS.index(c)] = text
         lines.append("| " + " | ".join(cells) + " |")
     present = {r["quantity"] for r in table if r.get("uncertainty") is not None}
     notes = [f"- `{q}`: uncertainty is {UNCERTAINTY_NOTES[q]}" for q in UNCERTAINTY_NOTES if q in present]
     if any(r.get("systematic") is not None for r in table):
         notes.append("- `systematic`: from the swing camera's pixel-scale uncertainty, apart from the standard error")
+    notes.append(
+        "- `value`, `uncertainty`, `systematic`: rounded as the field does (the uncertainty to two significant "
+        "digits, the value to match); paper_comparison.csv has them to 6 significant digits"
+    )
     if notes:
         lines += [
             "",

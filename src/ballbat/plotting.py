@@ -35,7 +35,7 @@ from .units import from_si
 
 if TYPE_CHECKING:
     import os
-    from collections.abc import Sequence
+    from collections.abc import Mapping, Sequence
 
     import xarray as xr
 
@@ -669,19 +669,24 @@ def design_figure(des: xr.Dataset) -> Figure:
     return fig
 
 
-def save_figure(fig: Figure, path: str | os.PathLike[str]) -> Path:
-    """Save ``fig`` as PNG atomically, without timestamp or software metadata (same data, same bytes)."""
+def save_figure(fig: Figure, path: str | os.PathLike[str], provenance: Mapping[str, str] | None = None) -> Path:
+    """Save ``fig`` as PNG atomically, without timestamp or software metadata (same data, same bytes).
+
+    ``provenance`` (:func:`ballbat.pipeline.provenance.png_text`: the rule, each input with its
+    sha256, the config, the versions, the commit) goes into PNG text chunks, one per key.
+    """
     path = Path(path)
     with atomic_target(path, suffix=".png") as tmp:
-        fig.savefig(tmp, format="png", dpi=DPI, metadata={"Software": None})
+        fig.savefig(tmp, format="png", dpi=DPI, metadata={"Software": None, **(provenance or {})})
     return path
 
 
-def draw(figure: str, inputs: dict, outputs: dict) -> dict[str, Figure]:
+def draw(figure: str, inputs: dict, outputs: dict, provenance: Mapping[str, str] | None = None) -> dict[str, Figure]:
     """Draw ``figure`` (a key of :data:`FIGURES`) from NetCDF ``inputs`` into PNG ``outputs``.
 
     ``inputs`` maps the figure's input names to paths; ``outputs`` maps each of its output
     names to a PNG path, and ``numbers`` to the caption fragment (reStructuredText).
+    ``provenance`` goes into each PNG's text chunks (:func:`save_figure`).
     """
     try:
         names, pngs, numbers = FIGURES[figure]
@@ -691,7 +696,7 @@ def draw(figure: str, inputs: dict, outputs: dict) -> dict[str, Figure]:
     figs = {}
     for out, func in pngs.items():
         figs[out] = func(**data)
-        save_figure(figs[out], outputs[out])
+        save_figure(figs[out], outputs[out], provenance)
     if "numbers" in outputs:
         atomic_write_text(outputs["numbers"], numbers(**data) + "\n")
     return figs

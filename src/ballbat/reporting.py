@@ -18,7 +18,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .compare import COLUMNS, read_csv
+from .compare import COLUMNS, format_measurement, read_csv, total_uncertainty
 from .pipeline.ncio import atomic_write_text
 from .published import per_ball
 from .units import from_si
@@ -110,23 +110,51 @@ def fig4_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     )
 
 
+def _ex_text(fit: xr.Dataset, pre: str, offset: float = 0.0, **sel: str) -> str:
+    """Return e_x (plus ``offset``) with its errors as text.
+
+    The standard error and, for tracked data, the pixel-scale systematic and the total, rounded
+    as the field does (errors to two significant digits, the value to match).
+    """
+    f = fit.sel(**sel)
+    v, e = float(f[pre]) + offset, float(f[f"{pre}_err"])
+    syst = float(f[f"{pre}_err_scale"]) if f"{pre}_err_scale" in f else math.nan
+    if not math.isfinite(syst):
+        value, err = format_measurement(v, e)
+        return f"{value} ± {err}" if err else value
+    value, err, sys_, total = format_measurement(v, e, syst, total_uncertainty(e, syst))
+    return f"{value} ± {err} (stat) ± {sys_} (syst) = {value} ± {total} (total)"
+
+
 def fig5_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
-    """Pooled and per-bat e_x (Fig. 5, Eq. ex, Table II)."""
-    lines = ["Slopes 1 + e_x of the pooled fits through the origin (standard errors):", ""]
+    """Pooled and per-bat e_x (Fig. 5, Eq. ex, Table II), with the pixel-scale systematic of tracked data."""
+    tracked = "e_x_err_scale" in fit and bool(np.isfinite(fit["e_x_err_scale"].values).any())
+    what = "standard errors and the pixel-scale systematic" if tracked else "standard errors"
+    lines = [f"Slopes 1 + e_x of the pooled fits through the origin ({what}):", ""]
     for ball in fit["ball"].values.astype(str):
-        v, e = float(fit["e_x_pooled"].sel(ball=ball)), float(fit["e_x_pooled_err"].sel(ball=ball))
+        v = float(fit["e_x_pooled"].sel(ball=ball))
         if not math.isfinite(v):
             continue
         lines.append(
-            f"- {ball}: 1 + e_x = {_pm(1 + v, e, '.3f')}, e_x = {_pm(v, e, '.3f')}"
-            f" (n = {int(fit['e_x_pooled_n'].sel(ball=ball))}); paper slope {_paper('fig5_slope', ball, '.4g')}."
+            f"- {ball}: e_x = {_ex_text(fit, 'e_x_pooled', ball=ball)} (n = {int(fit['e_x_pooled_n'].sel(ball=ball))});"
+            f" slope 1 + e_x = {_ex_text(fit, 'e_x_pooled', 1.0, ball=ball).split(' (stat)')[0]},"
+            f" paper slope {_paper('fig5_slope', ball, '.4g')}."
         )
     lines += ["", "e_x per bat (Table II):", ""]
     for ball in fit["ball"].values.astype(str):
         for bat in fit["bat"].values.astype(str):
-            v, e = float(fit["e_x"].sel(ball=ball, bat=bat)), float(fit["e_x_err"].sel(ball=ball, bat=bat))
+            v = float(fit["e_x"].sel(ball=ball, bat=bat))
             if math.isfinite(v):
-                lines.append(f"- {ball}, {bat}: {_pm(v, e, '.3f')} (n = {int(fit['e_x_n'].sel(ball=ball, bat=bat))})")
+                lines.append(
+                    f"- {ball}, {bat}: {_ex_text(fit, 'e_x', ball=ball, bat=bat)}"
+                    f" (n = {int(fit['e_x_n'].sel(ball=ball, bat=bat))})"
+                )
+    if tracked:
+        lines += [
+            "",
+            "The systematic is the pixel-scale uncertainty of the swing camera, shared by every impact "
+            "of a bat; it is not in the standard error and the two add in quadrature to the total.",
+        ]
     return "\n".join([*lines, "", *_header(impacts)])
 
 

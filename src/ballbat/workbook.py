@@ -7,8 +7,18 @@ per table; :func:`implications_workbook` does the same for the batted-ball scena
 sheet has the column names of ``docs/nomenclature.md`` in its first row and their units in the
 second; the last sheet records the provenance of every file it was made from.
 
-The workbook is byte-identical on rerun: its document properties carry a fixed timestamp and
-the zip entries a fixed date (openpyxl would write the current time into both).
+Units ``1`` (dimensionless numbers) are shown as a blank unit cell. Cells keep the full
+precision of the NetCDF files; number formats show them as the field rounds them: an estimate
+and its errors with the error to two significant digits (the finest error of the row setting
+the decimals), other numbers to a fixed number of decimals per unit. The e_x sheet gives the
+statistical standard error, the pixel-scale systematic (``e_x_err_scale``, camera-tracked data)
+and their total in quadrature.
+
+The workbook is byte-identical on rerun: its document properties and the zip entries carry the
+date of the git commit the results were made with (``SOURCE_DATE_EPOCH`` when set; the paper's
+publication date when neither is known), not the clock (openpyxl would write the current time).
+Its custom document properties carry its provenance: every input file with its sha256, the
+ballbat version, the sha256 of the package's and the workflow's source, the git commit.
 
 References
 ----------
@@ -26,17 +36,50 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .compare import total_uncertainty
 from .pipeline.atomic import atomic_target
 from .units import from_si
 
 if TYPE_CHECKING:
     import os
-    from collections.abc import Sequence
+    from collections.abc import Mapping, Sequence
 
     import xarray as xr
 
-#: The fixed time written into the workbook's properties and zip entries (reruns are byte-identical).
+#: The time written into the workbook's properties and zip entries when no commit date is known.
 FIXED_TIME = _dt.datetime(2017, 5, 3)  # the paper's publication month
+#: Decimals shown for a number without an error of its own, by unit.
+UNIT_DECIMALS = {"mph": 1, "deg": 1, "rpm": 0, "in": 2, "ft": 1, "s": 2, "mph/deg": 3, "rpm/deg": 1, "1": 3}
+
+
+def _number_format(decimals: int | None) -> str:
+    """Return an Excel number format with ``decimals`` decimals ("General" for None)."""
+    if decimals is None:
+        return "General"
+    return "0" if decimals <= 0 else "0." + "0" * decimals
+
+
+def _unit_label(unit: str) -> str:
+    """Return the unit as the header shows it: blank for dimensionless numbers ("1")."""
+    return "" if unit == "1" else unit
+
+
+def document_time(fit_attrs: dict | None = None) -> _dt.datetime:
+    """Return the time the workbook's properties carry.
+
+    That is ``SOURCE_DATE_EPOCH`` when set, else the date of the git commit recorded in the
+    results (``provenance_git``), else :data:`FIXED_TIME`.
+    """
+    import os
+
+    if os.environ.get("SOURCE_DATE_EPOCH", "").strip().isdigit():
+        stamp = _dt.datetime.fromtimestamp(int(os.environ["SOURCE_DATE_EPOCH"]), tz=_dt.UTC)
+        return stamp.replace(tzinfo=None)
+    from .pipeline.provenance import commit_time
+
+    commit = json.loads((fit_attrs or {}).get("provenance_git", "{}")).get("commit", "unknown")
+    when = commit_time(commit)
+    return when if when is not None else FIXED_TIME
 
 
 @dataclass(frozen=True)
@@ -137,6 +180,8 @@ SCENARIO_COLUMNS = (
 
 def _cell(value: object, unit: str) -> object:
     """Return a spreadsheet cell value: numbers in ``unit`` (NaN as an empty cell), text as is."""
+    if isinstance(value, np.ndarray) and value.ndim == 0:
+        value = value[()]  # a 0-d array (one cell of a .sel): its scalar, so that counts stay integers
     if isinstance(value, bytes):
         value = value.decode()
     if isinstance(value, str):
@@ -150,19 +195,63 @@ def _cell(value: object, unit: str) -> object:
 
 
 def _header(ws: object, names: Sequence[str], units: Sequence[str]) -> None:
-    """Write the two header rows: the column names, then their units (empty for text)."""
+    """Write the two header rows: the column names, then their units (empty for text and for "1")."""
     ws.append(list(names))
-    ws.append(list(units))
+    ws.append([_unit_label(u) for u in units])
     ws.freeze_panes = "A3"
+
+
+def _format_row(ws: object, row: Sequence[object], units: Sequence[str], groups: Sequence[Group]) -> None:
+    """Append ``row`` and give its number cells their formats.
+
+    Each group's columns are shown with the decimals of its errors (:func:`ballbat.compare.
+    uncertainty_decimals`); other number columns with :data:`UNIT_DECIMALS` of their unit.
+    """
+    from .compare import uncertainty_decimals
+
+    ws.append(list(row))
+    cells = ws[ws.max_row]
+    done = set()
+    for errors, members in groups:
+        d = uncertainty_decimals(*(row[c] for c in errors if isinstance(row[c], float)))
+        for c in members:
+            if isinstance(row[c], float):
+                cells[c].number_format = _number_format(d)
+                done.add(c)
+    for c, value in enumerate(row):
+        if c in done or isinstance(value, str) or value is None:
+            continue
+        if isinstance(value, int):
+            cells[c].number_format = "0"
+        else:
+            cells[c].number_format = _number_format(UNIT_DECIMALS.get(units[c], 3))
+
+
+#: (columns of the errors that set the decimals, columns shown with them)
+Group = tuple[list[int], list[int]]
+
+
+def _error_groups(names: Sequence[str]) -> list[Group]:
+    """Return the groups of each estimate with a ``<name>_err`` column among ``names``: value, error, interval."""
+    index = {n: i for i, n in enumerate(names)}
+    groups = []
+    for name, i in index.items():
+        if f"{name}_err" in index:
+            members = [i] + [index[f"{name}{s}"] for s in ("_err", "_ci_low", "_ci_high") if f"{name}{s}" in index]
+            groups.append(([index[f"{name}_err"]], members))
+    return groups
 
 
 def _table_sheet(wb: object, title: str, ds: xr.Dataset, columns: Sequence[Column], dim: str) -> None:
     """Add a sheet with one row per element of ``dim`` and the ``columns`` present in ``ds``."""
     cols = [c for c in columns if c.var in ds.variables]
     ws = wb.create_sheet(title)
-    _header(ws, [c.name for c in cols], [c.unit for c in cols])
+    names, units = [c.name for c in cols], [c.unit for c in cols]
+    _header(ws, names, units)
+    groups = _error_groups(names)
     for i in range(ds.sizes[dim]):
-        ws.append([_cell(ds[c.var].values[i] if ds[c.var].dims else ds[c.var].values, c.unit) for c in cols])
+        row = [_cell(ds[c.var].values[i] if ds[c.var].dims else ds[c.var].values, c.unit) for c in cols]
+        _format_row(ws, row, units, groups)
 
 
 def _provenance_sheet(wb: object, sources: dict[str, xr.Dataset]) -> None:
@@ -181,12 +270,39 @@ def _provenance_sheet(wb: object, sources: dict[str, xr.Dataset]) -> None:
                 ws.append([name, record, key, json.dumps(values[key], sort_keys=True)])
 
 
-def _fixed_bytes(wb: object) -> bytes:
-    """Return the workbook as bytes with fixed timestamps (properties and zip entries)."""
-    wb.properties.created = FIXED_TIME
-    wb.properties.modified = FIXED_TIME
+def custom_properties(inputs: Mapping[str, str | os.PathLike[str]]) -> dict[str, str]:
+    """Return the workbook's provenance as custom document properties (name -> text, each under 255 characters).
+
+    ``inputs`` maps a name to each file the workbook is made from; each is recorded with its
+    sha256, beside the ballbat version, the sha256 of the package's and the workflow's source,
+    and the git commit (with whether the tree had uncommitted changes).
+    """
+    from .pipeline.provenance import git_state, sha256_file, software_versions
+
+    versions = software_versions()
+    git = git_state()
+    props = {
+        "ballbat version": str(versions["ballbat"]),
+        "ballbat source sha256": str(versions["ballbat_source_sha256"]),
+        "workflow source sha256": str(versions["workflow_source_sha256"]),
+        "git commit": str(git["commit"]),
+        "git dirty": str(git["dirty"]),
+    }
+    for name, path in inputs.items():
+        props[f"input {name}"] = f"{path} sha256:{sha256_file(path)}"[-255:]
+    return props
+
+
+def _fixed_bytes(wb: object, when: _dt.datetime, properties: Mapping[str, str] | None = None) -> bytes:
+    """Return the workbook as bytes with the time ``when`` (properties and zip entries) and custom properties."""
+    from openpyxl.packaging.custom import StringProperty
+
+    wb.properties.created = when
+    wb.properties.modified = when
     wb.properties.creator = "ballbat"
     wb.properties.lastModifiedBy = "ballbat"
+    for name, value in (properties or {}).items():
+        wb.custom_doc_props.append(StringProperty(name=name, value=value))
     raw = io.BytesIO()
     wb.save(raw)
     out = io.BytesIO()
@@ -194,24 +310,24 @@ def _fixed_bytes(wb: object) -> bytes:
         for info in sorted(zin.infolist(), key=lambda i: i.filename):
             data = zin.read(info.filename)
             if info.filename == "docProps/core.xml":  # openpyxl stamps "modified" with the clock on save
-                data = _fix_core_times(data)
-            fixed = zipfile.ZipInfo(info.filename, date_time=FIXED_TIME.timetuple()[:6])
+                data = _fix_core_times(data, when)
+            fixed = zipfile.ZipInfo(info.filename, date_time=max(when, _dt.datetime(1980, 1, 1)).timetuple()[:6])
             fixed.compress_type = zipfile.ZIP_DEFLATED
             fixed.external_attr = 0o644 << 16
             zout.writestr(fixed, data)
     return out.getvalue()
 
 
-def _fix_core_times(xml: bytes) -> bytes:
-    """Return docProps/core.xml with its created/modified times set to :data:`FIXED_TIME`."""
+def _fix_core_times(xml: bytes, when: _dt.datetime) -> bytes:
+    """Return docProps/core.xml with its created/modified times set to ``when``."""
     import re
 
-    stamp = FIXED_TIME.strftime("%Y-%m-%dT%H:%M:%SZ").encode()
+    stamp = when.strftime("%Y-%m-%dT%H:%M:%SZ").encode()
     return re.sub(rb"(<dcterms:(?:created|modified)[^>]*>)[^<]*(</dcterms:)", rb"\g<1>" + stamp + rb"\g<2>", xml)
 
 
-def _write(wb: object, path: str | os.PathLike[str]) -> None:
-    data = _fixed_bytes(wb)
+def _write(wb: object, path: str | os.PathLike[str], when: _dt.datetime, properties: Mapping[str, str] | None) -> None:
+    data = _fixed_bytes(wb, when, properties)
     with atomic_target(path) as tmp:
         tmp.write_bytes(data)
 
@@ -222,6 +338,7 @@ def dataset_workbook(
     fit: xr.Dataset,
     stronge: xr.Dataset,
     comparison: list[dict],
+    properties: Mapping[str, str] | None = None,
 ) -> None:
     """Write one dataset's results workbook.
 
@@ -233,6 +350,8 @@ def dataset_workbook(
         ``reconstruct.nc``, ``fit_ex.nc`` and ``stronge.nc`` of the dataset.
     comparison : list of dict
         The rows of ``paper_comparison.csv`` (:func:`ballbat.compare.read_csv`).
+    properties : mapping, optional
+        Custom document properties (its provenance: :func:`custom_properties`).
 
     Notes
     -----
@@ -248,22 +367,24 @@ def dataset_workbook(
     _table_sheet(wb, "impacts", impacts, IMPACT_COLUMNS, "impact")
 
     ws = wb.create_sheet("e_x")
-    _header(ws, ["ball", "bat", *(c.name for c in FIT_FIELDS), "e_x_status"], ["", "", *("1" for _ in FIT_FIELDS), "1"])
+    names = ["ball", "bat", *(c.name for c in FIT_FIELDS[:2]), "e_x_err_scale", "e_x_err_total"]
+    names += [*(c.name for c in FIT_FIELDS[2:]), "e_x_status"]
+    units = ["", "", *("1" for _ in names[2:])]
+    _header(ws, names, units)
+    # decimals from the statistical and systematic errors; value, errors and interval shown with them
+    groups = [([3, 4], [2, 3, 4, 5, 6, 7])]
     for ball in fit["ball"].values.astype(str):
-        for bat in fit["bat"].values.astype(str):
-            f = fit.sel(ball=ball, bat=bat)
-            if int(f["e_x_n"]) == 0:
+        for bat in [*fit["bat"].values.astype(str), "pooled"]:
+            f = fit.sel(ball=ball) if bat == "pooled" else fit.sel(ball=ball, bat=bat)
+            pre = "e_x_pooled" if bat == "pooled" else "e_x"
+            if int(f[f"{pre}_n"]) == 0:
                 continue
-            ws.append([ball, bat, *(_cell(f[f"e_x{c.var}"].values, "1") for c in FIT_FIELDS), int(f["e_x_status"])])
-        p = fit.sel(ball=ball)
-        ws.append(
-            [
-                ball,
-                "pooled",
-                *(_cell(p[f"e_x_pooled{c.var}"].values, "1") for c in FIT_FIELDS),
-                int(p["e_x_pooled_status"]),
-            ]
-        )
+            stat = _cell(f[f"{pre}_err"].values, "1")
+            syst = _cell(f[f"{pre}_err_scale"].values, "1") if f"{pre}_err_scale" in f else None
+            total = None if stat is None else total_uncertainty(stat, syst)
+            row = [ball, bat, _cell(f[pre].values, "1"), stat, syst, total]
+            row += [_cell(f[f"{pre}{c.var}"].values, "1") for c in FIT_FIELDS[2:]]
+            _format_row(ws, [*row, int(f[f"{pre}_status"])], units, groups)
 
     ws = wb.create_sheet("sec4")
     names, units = ["ball"], [""]
@@ -271,6 +392,7 @@ def dataset_workbook(
         names += [var] + ([err] if err else [])
         units += [unit] + ([unit] if err else [])
     _header(ws, names, units)
+    groups = _error_groups(names)
     for ball in fit["ball"].values.astype(str):
         f = fit.sel(ball=ball)
         row = [ball]
@@ -278,7 +400,7 @@ def dataset_workbook(
             row.append(_cell(f[var].values, unit))
             if err:
                 row.append(_cell(f[err].values, unit))
-        ws.append(row)
+        _format_row(ws, row, units, groups)
 
     _table_sheet(
         wb,
@@ -301,7 +423,7 @@ def dataset_workbook(
     for text in (w for w in impacts.attrs.get("ingest_warnings", "").split("\n") if w):
         ws.append([text])
     _provenance_sheet(wb, {"reconstruct.nc": impacts, "fit_ex.nc": fit, "stronge.nc": stronge})
-    _write(wb, path)
+    _write(wb, path, document_time(fit.attrs), properties)
 
 
 def _number_or_text(value: object) -> object:
@@ -313,7 +435,9 @@ def _number_or_text(value: object) -> object:
         return value
 
 
-def implications_workbook(path: str | os.PathLike[str], scenarios: dict[str, xr.Dataset]) -> None:
+def implications_workbook(
+    path: str | os.PathLike[str], scenarios: dict[str, xr.Dataset], properties: Mapping[str, str] | None = None
+) -> None:
     """Write the batted-ball scenarios' workbook: one sheet per scenario, then the provenance.
 
     Each case is a row: D and psi (D sweeps), exit speed, launch and spray angles, backspin and
@@ -326,4 +450,5 @@ def implications_workbook(path: str | os.PathLike[str], scenarios: dict[str, xr.
     for name in sorted(scenarios):
         _table_sheet(wb, name[:31], scenarios[name], SCENARIO_COLUMNS, "case")
     _provenance_sheet(wb, {f"{name}.nc": ds for name, ds in sorted(scenarios.items())})
-    _write(wb, path)
+    first = scenarios[sorted(scenarios)[0]].attrs if scenarios else {}
+    _write(wb, path, document_time(first), properties)

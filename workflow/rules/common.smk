@@ -1,6 +1,7 @@
 # Config validation, input functions and code dependencies shared by all rules.
 import math
 import sys
+import time
 from argparse import Namespace
 from pathlib import Path
 
@@ -50,6 +51,18 @@ def remove_stale_temporaries():
     """Remove the temporary files of jobs that were killed (call once Snakemake holds the lock)."""
     for message in remove_temporaries("results"):
         print(f"ballbat: {message}", file=sys.stderr)
+
+
+#: When this run started (the crate's run action; no data file records a time).
+RUN_STARTED = time.time()
+
+
+def write_crate():
+    """Write the run's Provenance Run Crate, results/ro-crate-metadata.json (ballbat.pipeline.crate)."""
+    from ballbat.pipeline.crate import write_crate_of_run
+
+    path = write_crate_of_run(workflow, config, started=RUN_STARTED)
+    print(f"ballbat: the run's provenance crate: {path}", file=sys.stderr)
 
 
 def print_warnings(results, datasets, scenarios):

@@ -8,6 +8,7 @@ rule compare:
     output:
         csv="results/{dataset}/paper_comparison.csv",
         md="results/{dataset}/paper_comparison.md",
+        prov="results/{dataset}/paper_comparison.provenance.json",
     log:
         "results/{dataset}/logs/compare.log",
     conda:

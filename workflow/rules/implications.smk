@@ -32,6 +32,7 @@ rule implications_compare:
     output:
         csv="results/implications/paper_comparison.csv",
         md="results/implications/paper_comparison.md",
+        prov="results/implications/paper_comparison.provenance.json",
     log:
         "results/implications/logs/paper_comparison.log",
     conda:

@@ -1,6 +1,6 @@
 """Rules plot_*: adapter around ballbat.plotting.draw (figures from NetCDF files only)."""
 
-from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.provenance import data_inputs, job_provenance, png_text
 from ballbat.pipeline.runlog import logged
 from ballbat.plotting import draw
 
@@ -9,4 +9,5 @@ with logged(snakemake.log[0], snakemake.rule):
         snakemake.params.figure,
         inputs=data_inputs(snakemake.input),
         outputs=dict(snakemake.output.items()),
+        provenance=png_text(*job_provenance(snakemake)),
     )

@@ -1,6 +1,7 @@
 """Rule tracks_qa: adapter around ballbat.tracks.qa."""
 
 from ballbat.pipeline.ncio import read_dataset
+from ballbat.pipeline.provenance import job_provenance, png_text
 from ballbat.pipeline.runlog import logged
 from ballbat.tracks.io import load_tracks
 from ballbat.tracks.qa import impacts_figure, save_figure, summary_figure
@@ -8,5 +9,6 @@ from ballbat.tracks.qa import impacts_figure, save_figure, summary_figure
 with logged(snakemake.log[0], snakemake.rule):
     red = read_dataset(snakemake.input.reduced)
     tracks = load_tracks(snakemake.input.tracks, snakemake.input.get("impacts"))
-    save_figure(impacts_figure(red, tracks), snakemake.output.impacts)
-    save_figure(summary_figure(red), snakemake.output.summary)
+    provenance = png_text(*job_provenance(snakemake))
+    save_figure(impacts_figure(red, tracks), snakemake.output.impacts, provenance)
+    save_figure(summary_figure(red), snakemake.output.summary, provenance)

@@ -7,6 +7,7 @@ the same inputs, config and code give byte-identical files.
 
 from __future__ import annotations
 
+import datetime
 import hashlib
 import json
 import platform
@@ -26,6 +27,8 @@ if TYPE_CHECKING:
 STACK = ("numpy", "scipy", "xarray", "netCDF4", "lmfit", "matplotlib", "snakemake")
 
 PACKAGE_DIR = Path(__file__).resolve().parent.parent  # src/ballbat
+#: What of a workflow checkout is the workflow's own source (beside the package).
+WORKFLOW_PARTS = ("Snakefile", "workflow")
 
 
 def sha256_file(path: str | os.PathLike[str], chunk: int = 1 << 20) -> str:
@@ -54,6 +57,43 @@ def package_source_hash() -> str:
     return h.hexdigest()
 
 
+def workflow_root() -> Path | None:
+    """Return the directory holding ``Snakefile`` and ``workflow/``.
+
+    That is the working directory of a workflow job, else the checkout the package was installed
+    from; ``None`` if neither has them.
+    """
+    for where in (Path.cwd(), PACKAGE_DIR.parent.parent):
+        if (where / "Snakefile").is_file() and (where / "workflow" / "rules").is_dir():
+            return where.resolve()
+    return None
+
+
+def workflow_sources(root: Path) -> list[Path]:
+    """Return the workflow's own files under ``root`` (Snakefile, rules, scripts, schemas, envs, report), sorted."""
+    files = [root / "Snakefile"]
+    files += [p for p in (root / "workflow").rglob("*") if p.is_file() and "__pycache__" not in p.parts]
+    return sorted(files)
+
+
+@lru_cache(maxsize=4)
+def workflow_source_hash(root: str | None = None) -> str:
+    """sha256 over the workflow's own files (relative path and bytes of each), like the package's.
+
+    ``"unknown"`` when no workflow checkout is found (ballbat used as a library).
+    """
+    top = Path(root) if root else workflow_root()
+    if top is None:
+        return "unknown"
+    h = hashlib.sha256()
+    for p in workflow_sources(top):
+        h.update(p.relative_to(top).as_posix().encode())
+        h.update(b"\0")
+        h.update(p.read_bytes())
+        h.update(b"\0")
+    return h.hexdigest()
+
+
 @lru_cache(maxsize=4)
 def git_state(where: str | None = None) -> dict:
     """Commit and dirtiness of the git checkout holding ``where`` (default: the package)."""
@@ -75,9 +115,35 @@ def git_state(where: str | None = None) -> dict:
     return {"commit": commit, "dirty": bool(status.strip())}
 
 
+@lru_cache(maxsize=8)
+def commit_time(commit: str, where: str | None = None) -> datetime.datetime | None:
+    """Return the committer date of ``commit`` (naive UTC), or ``None`` when git does not know it."""
+    if not commit or commit == "unknown":
+        return None
+    try:
+        out = subprocess.run(
+            ["git", "show", "-s", "--format=%ct", commit],
+            cwd=str(where or PACKAGE_DIR),
+            capture_output=True,
+            text=True,
+            timeout=10,
+            check=True,
+        ).stdout.strip()
+    except (OSError, subprocess.SubprocessError):
+        return None
+    if not out.isdigit():
+        return None
+    return datetime.datetime.fromtimestamp(int(out), tz=datetime.UTC).replace(tzinfo=None)
+
+
 def software_versions() -> dict:
     """Versions of ballbat, Python and the scientific stack (read from metadata, no imports)."""
-    out = {"ballbat": __version__, "ballbat_source_sha256": package_source_hash(), "python": platform.python_version()}
+    out = {
+        "ballbat": __version__,
+        "ballbat_source_sha256": package_source_hash(),
+        "workflow_source_sha256": workflow_source_hash(),
+        "python": platform.python_version(),
+    }
     for dist in STACK:
         try:
             out[dist] = metadata.version(dist)
@@ -137,3 +203,42 @@ def provenance_attrs(
 def data_inputs(named_input: Mapping[str, object]) -> dict:
     """Return a Snakemake job's named inputs without the code files (recorded by the source hash)."""
     return {k: v for k, v in named_input.items() if k != "code"}
+
+
+def provenance_record(rule: str, inputs: dict | list, config: dict) -> dict:
+    """Return the provenance of :func:`provenance_attrs` as one JSON-ready dict (keys without the prefix)."""
+    attrs = provenance_attrs(rule, inputs, config)
+    return {
+        "rule": rule,
+        **{k.removeprefix("provenance_"): json.loads(v) for k, v in attrs.items() if k != "provenance_rule"},
+    }
+
+
+def job_provenance(job: object) -> tuple[str, dict, dict]:
+    """Return a Snakemake job's (rule, data inputs, params): what the provenance of its products records."""
+    return job.rule, data_inputs(job.input), dict(job.params)
+
+
+def png_text(rule: str, inputs: dict | list, config: dict) -> dict[str, str]:
+    """Return a figure's provenance as PNG text chunks (``provenance_*`` keys, JSON values; no time)."""
+    return provenance_attrs(rule, inputs, config)
+
+
+def write_sidecar(
+    path: str | os.PathLike[str], products: list[str | os.PathLike[str]], rule: str, inputs: dict | list, config: dict
+) -> Path:
+    """Write the provenance of text tables (CSV, Markdown) to the JSON file ``path``, atomically.
+
+    The tables stay plain for every reader (a comment line is not CSV); the sidecar names each
+    table with its sha256, so that a reader can check the pair belongs together.
+    """
+    from .atomic import atomic_target
+
+    record = {
+        "describes": [{"path": str(p), "sha256": sha256_file(p)} for p in products],
+        **provenance_record(rule, inputs, config),
+    }
+    path = Path(path)
+    with atomic_target(path) as tmp:
+        tmp.write_text(dumps(record) + "\n")
+    return path

@@ -1,0 +1,562 @@
+"""Provenance Run Crate of a workflow run: ``results/ro-crate-metadata.json``.
+
+A successful ``snakemake`` run describes itself in the standard that WorkflowHub, Galaxy and
+the CWL tools exchange: an RO-Crate (1.1) following the Workflow Run Crate and Provenance Run
+Crate profiles (0.5, https://w3id.org/ro/wfrun/provenance/0.5). ``results/`` is the crate:
+
+* the workflow's own files (Snakefile, rules, scripts, schemas), the package source and the
+  config files of the run are copied into ``results/workflow.snapshot/`` (the main
+  ``ComputationalWorkflow`` is its ``Snakefile``, with the git commit as its version), so the
+  crate says what ran even where there is no git;
+* one ``CreateAction`` for the run (instrument: the workflow; object: the config files and the
+  merged config's values; result: every output) and one per job, i.e. per rule execution
+  (instrument: the rule as a ``SoftwareApplication`` with its script and rule file; object: its
+  input files and the config values it used, as ``PropertyValue``; result: its output files),
+  each tied to its workflow step by a ``ControlAction`` and to Snakemake by an ``OrganizeAction``;
+* every file with its sha256, size (bytes) and media type; the versions of ballbat (with the
+  sha256 of its source and of the workflow's), Python, Snakemake and the scientific stack.
+
+The job records come from Snakemake's DAG and its own metadata (start and end times, the rule,
+the inputs), and the config values each job used from the ``provenance_config`` attribute the
+job wrote into its NetCDF output (its params otherwise). Times are in the crate (it is the
+record of one run); no data file gets one. The crate is written atomically: the old metadata
+file goes first, so a run cut short leaves no crate rather than one that lies.
+"""
+
+from __future__ import annotations
+
+import datetime as dt
+import json
+import os
+import shutil
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+from .. import __version__
+from .atomic import atomic_target
+from .provenance import (
+    PACKAGE_DIR,
+    git_state,
+    package_source_hash,
+    package_sources,
+    sha256_file,
+    software_versions,
+    workflow_source_hash,
+    workflow_sources,
+)
+
+if TYPE_CHECKING:
+    from collections.abc import Iterable, Mapping
+
+#: The crate's metadata file, in the results folder (the crate's root).
+METADATA_NAME = "ro-crate-metadata.json"
+#: Where, inside the crate, the workflow, the package source and the config files are copied.
+SNAPSHOT = "workflow.snapshot"
+#: The profiles the crate conforms to (the root dataset's conformsTo), with name and version.
+PROFILES = {
+    "https://w3id.org/ro/wfrun/process/0.5": ("Process Run Crate", "0.5"),
+    "https://w3id.org/ro/wfrun/workflow/0.5": ("Workflow Run Crate", "0.5"),
+    "https://w3id.org/ro/wfrun/provenance/0.5": ("Provenance Run Crate", "0.5"),
+    "https://w3id.org/workflowhub/workflow-ro-crate/1.0": ("Workflow RO-Crate", "1.0"),
+}
+#: Terms of the Workflow Run Crate vocabulary used here (https://w3id.org/ro/terms/workflow-run/context),
+#: given in the crate's own context so that a reader needs no second remote document.
+WFRUN_TERMS = {"sha256": "https://w3id.org/ro/terms/workflow-run#sha256"}
+#: Media types by file suffix (IANA where registered).
+MEDIA_TYPES = {
+    ".nc": "application/x-netcdf",
+    ".png": "image/png",
+    ".csv": "text/csv",
+    ".md": "text/markdown",
+    ".html": "text/html",
+    ".xlsx": "application/vnd.openxmlformats-officedocument.spreadsheetml.sheet",
+    ".log": "text/plain",
+    ".txt": "text/plain",
+    ".tsv": "text/tab-separated-values",
+    ".rst": "text/x-rst",
+    ".py": "text/x-python",
+    ".smk": "text/x-snakemake",
+    ".yaml": "application/yaml",
+    ".yml": "application/yaml",
+    ".json": "application/json",
+    ".toml": "application/toml",
+}
+LICENSE = "https://spdx.org/licenses/MIT"
+SNAKEMAKE_LANGUAGE = "https://w3id.org/workflowhub/workflow-ro-crate#snakemake"
+
+
+@dataclass
+class JobRecord:
+    """One rule execution, as the crate needs it (paths relative to the working directory)."""
+
+    rule: str
+    wildcards: dict[str, str]
+    inputs: list[str]
+    outputs: list[str]
+    logs: list[str] = field(default_factory=list)
+    benchmarks: list[str] = field(default_factory=list)
+    params: dict[str, Any] = field(default_factory=dict)
+    script: str | None = None
+    snakefile: str | None = None
+    start: float | None = None
+    end: float | None = None
+
+    @property
+    def name(self) -> str:
+        """The job's readable name: rule and wildcards."""
+        wc = ", ".join(f"{k}={v}" for k, v in sorted(self.wildcards.items()))
+        return f"{self.rule} ({wc})" if wc else self.rule
+
+    @property
+    def key(self) -> str:
+        """The job's identifier inside the crate."""
+        wc = "-".join(f"{k}={v}" for k, v in sorted(self.wildcards.items()))
+        return f"{self.rule}-{wc}" if wc else self.rule
+
+
+def media_type(path: str | os.PathLike[str]) -> str:
+    """Return the media type of a file by its name (``Snakefile`` is a rule file)."""
+    p = Path(path)
+    if p.name == "Snakefile":
+        return MEDIA_TYPES[".smk"]
+    return MEDIA_TYPES.get(p.suffix.lower(), "application/octet-stream")
+
+
+def _iso(t: float | None) -> str | None:
+    if t is None:
+        return None
+    return dt.datetime.fromtimestamp(t, tz=dt.UTC).isoformat(timespec="seconds")
+
+
+def jobs_from_dag(dag: Any, persistence: Any, workdir: str | os.PathLike[str]) -> list[JobRecord]:
+    """Return a record of every job of Snakemake's DAG (run now or earlier), with times from Snakemake's metadata."""
+    here = Path(workdir).resolve()
+
+    def rel(p: object) -> str:
+        path = Path(str(p))
+        if path.is_absolute() and path.is_relative_to(here):
+            return path.relative_to(here).as_posix()
+        return path.as_posix()
+
+    records = []
+    for job in sorted(dag.jobs, key=lambda j: (j.rule.name, sorted(j.wildcards_dict.items()))):
+        if not job.output:  # a target rule (all): it runs nothing
+            continue
+        named = dict(job.input.items())
+        code = {str(f) for f in named.get("code", [])} if "code" in named else set()
+        inputs = [rel(f) for f in job.input if str(f) not in code]
+        outputs = [rel(f) for f in job.output]
+        starts, ends = [], []
+        for f in job.output:
+            meta = persistence.metadata(f) or {}
+            if meta.get("starttime") is not None:
+                starts.append(meta["starttime"])
+            if meta.get("endtime") is not None:
+                ends.append(meta["endtime"])
+        params = {k: v for k, v in job.params.items()}
+        snakefile = Path(str(job.rule.snakefile)) if job.rule.snakefile else None
+        script = job.rule.script
+        if script and not Path(script).is_absolute() and snakefile is not None:
+            script = str(snakefile.parent / script)
+        records.append(
+            JobRecord(
+                rule=job.rule.name,
+                wildcards={k: str(v) for k, v in job.wildcards_dict.items()},
+                inputs=inputs,
+                outputs=outputs,
+                logs=[rel(f) for f in job.log],
+                benchmarks=[rel(job.benchmark)] if job.benchmark else [],
+                params=params,
+                script=rel(Path(script).resolve()) if script else None,
+                snakefile=rel(snakefile.resolve()) if snakefile else None,
+                start=min(starts) if starts else None,
+                end=max(ends) if ends else None,
+            )
+        )
+    return records
+
+
+def _config_used(job: JobRecord, workdir: Path) -> dict[str, Any]:
+    """Return the config values a job used: its NetCDF output's provenance_config, else its params."""
+    for out in job.outputs:
+        path = workdir / out
+        if path.suffix == ".nc" and path.is_file():
+            import netCDF4
+
+            with netCDF4.Dataset(path) as nc:
+                if "provenance_config" in nc.ncattrs():
+                    return json.loads(nc.getncattr("provenance_config"))
+    return dict(job.params)
+
+
+def _value(v: Any) -> Any:
+    if isinstance(v, bool | int | float | str):
+        return v
+    return json.dumps(v, sort_keys=True, default=str)
+
+
+class _Builder:
+    """Collects the crate's entities (``rocrate`` does the JSON-LD and the root dataset)."""
+
+    def __init__(self, results: Path, workdir: Path) -> None:
+        from rocrate.rocrate import ROCrate
+
+        self.results = results
+        self.workdir = workdir
+        self.crate = ROCrate(version="1.1")
+        self.crate.metadata.extra_terms.update(WFRUN_TERMS)
+        self.files: dict[str, Any] = {}
+
+    def context(self, ident: str, props: dict) -> Any:
+        from rocrate.model.contextentity import ContextEntity
+
+        return self.crate.add(ContextEntity(self.crate, ident, properties=props))
+
+    def file(self, crate_path: str, types: list[str] | None = None, **props: Any) -> Any:
+        """Return the File entity of ``results/crate_path`` with sha256, size and media type (added once)."""
+        if crate_path in self.files:
+            return self.files[crate_path]
+        path = self.results / crate_path
+        base = {
+            "@type": ["File", *(types or [])],
+            "name": Path(crate_path).name,
+            "sha256": sha256_file(path),
+            "contentSize": str(path.stat().st_size),
+            "encodingFormat": media_type(path),
+        }
+        entity = self.crate.add_file(dest_path=crate_path, properties={**base, **props})
+        self.files[crate_path] = entity
+        return entity
+
+    def crate_path(self, path: str) -> str | None:
+        """Where a workdir-relative path is inside the crate (``None`` if not there)."""
+        p = Path(path)
+        full = p if p.is_absolute() else self.workdir / p
+        try:
+            rel = full.resolve().relative_to(self.results.resolve())
+            return rel.as_posix() if full.is_file() else None
+        except ValueError:
+            pass
+        snap = self.snapshot_path(path)
+        return snap if (self.results / snap).is_file() else None
+
+    def snapshot_path(self, path: str) -> str:
+        """Where a file from outside ``results/`` is copied in the snapshot."""
+        p = Path(path)
+        if not p.is_absolute():
+            return f"{SNAPSHOT}/{p.as_posix()}"
+        try:
+            return f"{SNAPSHOT}/{p.resolve().relative_to(self.workdir.resolve()).as_posix()}"
+        except ValueError:
+            return f"{SNAPSHOT}/external/{sha256_file(p)[:16]}/{p.name}"
+
+
+def _copy_snapshot(results: Path, workdir: Path, extra: Iterable[str], builder: _Builder) -> Path:
+    """Copy workflow, package source and ``extra`` files (config, data tables) to a new temporary folder."""
+    tmp = Path(tempfile.mkdtemp(prefix=f".{SNAPSHOT}.", dir=results))
+    wanted: dict[str, Path] = {}
+    root = workdir if (workdir / "Snakefile").is_file() else None
+    if root is not None:
+        for f in workflow_sources(root):
+            wanted[f.relative_to(root).as_posix()] = f
+    for f in package_sources():
+        wanted[f"src/ballbat/{f.relative_to(PACKAGE_DIR).as_posix()}"] = f
+    for path in extra:
+        p = Path(path) if Path(path).is_absolute() else workdir / path
+        if p.is_file() and not p.resolve().is_relative_to(results.resolve()):
+            wanted[builder.snapshot_path(path).removeprefix(f"{SNAPSHOT}/")] = p
+    try:
+        for rel, src in sorted(wanted.items()):
+            dest = tmp / rel
+            dest.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copyfile(src, dest)
+        tmp.chmod(0o777 & ~_umask())
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return tmp
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def _install_snapshot(results: Path, tmp: Path) -> None:
+    """Put the new snapshot in place of the old (renames; the old one is removed after)."""
+    target = results / SNAPSHOT
+    old = None
+    if target.exists():
+        old = Path(tempfile.mkdtemp(prefix=f".{SNAPSHOT}.old.", dir=results))
+        os.replace(target, old / "x")
+    os.replace(tmp, target)
+    if old is not None:
+        shutil.rmtree(old)
+
+
+def build_crate(
+    results: Path,
+    workdir: Path,
+    jobs: list[JobRecord],
+    *,
+    config: Mapping[str, Any],
+    configfiles: list[str],
+    started: float | None,
+    ended: float,
+) -> dict:
+    """Return the crate's JSON-LD (a dict), the snapshot already in ``results/workflow.snapshot``."""
+    b = _Builder(results, workdir)
+    git = git_state(str(workdir))
+    versions = software_versions()
+    smk_version = versions.get("snakemake", "unknown")
+
+    # Software: ballbat (with its source hashes), Python and the stack; Snakemake is the engine.
+    soft_ids = []
+    for name, version in versions.items():
+        if name.endswith("_sha256"):
+            continue
+        ident = f"#software-{name}"
+        props = {"@type": "SoftwareApplication", "name": name, "softwareVersion": str(version)}
+        if name == "ballbat":
+            props["description"] = (
+                f"sha256 of the package source: {versions['ballbat_source_sha256']}; "
+                f"of the workflow's own files: {versions['workflow_source_sha256']}"
+            )
+            props["url"] = "https://pypi.org/project/ballbat/"
+        if name == "snakemake":
+            continue
+        b.context(ident, props)
+        soft_ids.append({"@id": ident})
+    engine = b.context(
+        "#snakemake",
+        {
+            "@type": "SoftwareApplication",
+            "name": "Snakemake",
+            "softwareVersion": smk_version,
+            "url": "https://snakemake.readthedocs.io",
+        },
+    )
+
+    # Profiles the crate conforms to.
+    for ident, (name, version) in PROFILES.items():
+        b.context(ident, {"@type": "CreativeWork", "name": name, "version": version})
+    b.crate.metadata["conformsTo"] = [
+        {"@id": "https://w3id.org/ro/crate/1.1"},
+        {"@id": "https://w3id.org/workflowhub/workflow-ro-crate/1.0"},
+    ]
+
+    # The snapshot's files: the main workflow first, then every other copied file.
+    snap = results / SNAPSHOT
+    language = b.context(
+        SNAKEMAKE_LANGUAGE,
+        {
+            "@type": "ComputerLanguage",
+            "name": "Snakemake",
+            "identifier": {"@id": "https://doi.org/10.1093/bioinformatics/bts480"},
+            "url": {"@id": "https://snakemake.readthedocs.io"},
+            "version": smk_version,
+        },
+    )
+    main_id = f"{SNAPSHOT}/Snakefile"
+    rule_ids = sorted({j.rule for j in jobs})
+    main = b.file(
+        main_id,
+        ["SoftwareSourceCode", "ComputationalWorkflow", "HowTo"],
+        name="ballbat workflow",
+        description=(
+            "Oblique ball-bat collisions, end to end (Kensrud, Nathan & Smith, Am. J. Phys. 85, 503 (2017)): "
+            "the Snakefile with its rules, scripts and config schema (workflow.snapshot/workflow/)"
+        ),
+        programmingLanguage=language,
+        version=str(git["commit"]),
+        softwareVersion=__version__,
+        softwareRequirements=soft_ids,
+        license={"@id": LICENSE},
+    )
+    if git["dirty"] is True:
+        main["description"] += "; the git tree had uncommitted changes at the run"
+    for f in sorted(p for p in snap.rglob("*") if p.is_file()):
+        rel = f.relative_to(results).as_posix()
+        b.file(rel, ["SoftwareSourceCode"] if f.suffix in (".py", ".smk") or f.name == "Snakefile" else None)
+
+    # One tool and one step per rule.
+    tools, steps = {}, {}
+    for pos, rule in enumerate(rule_ids):
+        some = next(j for j in jobs if j.rule == rule)
+        parts = [p for p in (some.script, some.snakefile) if p]
+        has_part = [{"@id": cp} for p in parts if (cp := b.crate_path(p))]
+        tools[rule] = b.context(
+            f"#rule-{rule}",
+            {
+                "@type": "SoftwareApplication",
+                "name": f"rule {rule}",
+                "description": f"the workflow's rule {rule} (its script and rule file), ballbat {__version__}",
+                "softwareVersion": __version__,
+                "hasPart": has_part,
+                "softwareRequirements": soft_ids,
+            },
+        )
+        steps[rule] = b.context(
+            f"#step-{rule}",
+            {"@type": "HowToStep", "name": f"rule {rule}", "position": str(pos), "workExample": tools[rule]},
+        )
+    main["hasPart"] = list(tools.values())
+    main["step"] = list(steps.values())
+
+    # One CreateAction (and ControlAction) per job.
+    job_actions, controls, all_results = [], [], []
+    for job in jobs:
+        ident = f"#job-{job.key}"
+        objects = [{"@id": cp} for p in job.inputs if (cp := b.crate_path(p))]
+        for p in objects:
+            b.file(p["@id"])
+        for key, value in sorted(_config_used(job, workdir).items()):
+            pv = b.context(
+                f"#job-{job.key}-config-{key}",
+                {"@type": "PropertyValue", "name": key, "value": _value(value)},
+            )
+            objects.append(pv)
+        result = []
+        for p in [*job.outputs, *job.logs, *job.benchmarks]:
+            cp = b.crate_path(p)
+            if cp:
+                b.file(cp)
+                result.append({"@id": cp})
+        all_results += [r for r in result if r["@id"] in {b.crate_path(p) for p in job.outputs}]
+        props = {
+            "@type": "CreateAction",
+            "name": f"job {job.name}",
+            "description": f"one execution of rule {job.rule}: its inputs and config values in, its outputs out",
+            "instrument": tools[job.rule],
+            "object": objects,
+            "result": result,
+            "actionStatus": {"@id": "http://schema.org/CompletedActionStatus"},
+        }
+        if job.start is not None:
+            props["startTime"] = _iso(job.start)
+        if job.end is not None:
+            props["endTime"] = _iso(job.end)
+        job_actions.append(b.context(ident, props))
+        controls.append(
+            b.context(
+                f"#control-{job.key}",
+                {
+                    "@type": "ControlAction",
+                    "name": f"orchestrate {job.name}",
+                    "instrument": steps[job.rule],
+                    "object": {"@id": ident},
+                },
+            )
+        )
+
+    # The run: config files and the merged config in, every output out.
+    run_objects = []
+    for cf in configfiles:
+        cp = b.crate_path(cf)
+        if cp:
+            b.file(cp, description=f"config file of the run ({cf}), merged in this order")
+            run_objects.append({"@id": cp})
+    for key, value in sorted(config.items()):
+        run_objects.append(
+            b.context(f"#run-config-{key}", {"@type": "PropertyValue", "name": key, "value": _value(value)})
+        )
+    run = b.context(
+        "#run",
+        {
+            "@type": "CreateAction",
+            "name": f"snakemake run of the ballbat workflow {__version__}",
+            "description": "the run: the config files and the merged config in, every job's outputs out",
+            "instrument": main,
+            "object": run_objects,
+            "result": all_results,
+            "endTime": _iso(ended),
+            "actionStatus": {"@id": "http://schema.org/CompletedActionStatus"},
+            **({"startTime": _iso(started)} if started is not None else {}),
+        },
+    )
+    b.context(
+        "#orchestration",
+        {
+            "@type": "OrganizeAction",
+            "name": "Snakemake orchestrating the run",
+            "instrument": engine,
+            "object": controls,
+            "result": run,
+            "endTime": _iso(ended),
+            **({"startTime": _iso(started)} if started is not None else {}),
+        },
+    )
+
+    root = b.crate.root_dataset
+    root["name"] = "ballbat results"
+    root["description"] = (
+        "The products of one run of the ballbat workflow (results/), described as a Provenance Run Crate: "
+        "the workflow, every job with its inputs, config values and outputs, every file's sha256."
+    )
+    b.context(LICENSE, {"@type": "CreativeWork", "name": "MIT License", "identifier": "MIT"})
+    root["license"] = {"@id": LICENSE}
+    root["datePublished"] = _iso(ended)
+    root["conformsTo"] = [{"@id": ident} for ident in PROFILES]
+    root["mainEntity"] = main
+    root["mentions"] = [run, *job_actions]
+    _ = package_source_hash, workflow_source_hash  # recorded through software_versions()
+    return _single_values(b.crate.metadata.generate())
+
+
+def _single_values(doc: dict) -> dict:
+    """Return the JSON-LD with one-element lists as single values (RO-Crate 1.1's recommendation)."""
+    for entity in doc["@graph"]:
+        for key, value in list(entity.items()):
+            if key != "@type" and isinstance(value, list) and len(value) == 1:
+                entity[key] = value[0]
+    return doc
+
+
+def write_run_crate(
+    results: str | os.PathLike[str],
+    jobs: list[JobRecord],
+    *,
+    config: Mapping[str, Any],
+    configfiles: list[str],
+    started: float | None = None,
+    workdir: str | os.PathLike[str] | None = None,
+) -> Path:
+    """Copy the snapshot and write ``results/ro-crate-metadata.json`` (atomically); return its path.
+
+    The old metadata file is removed first, so if anything fails the folder holds no crate rather
+    than a crate describing files that have changed.
+    """
+    import time
+
+    results = Path(results)
+    work = Path(workdir or Path.cwd()).resolve()
+    target = results / METADATA_NAME
+    target.unlink(missing_ok=True)
+    for stale in results.glob(f".{SNAPSHOT}.*"):  # left by a crate cut short (we hold Snakemake's lock)
+        if stale.is_dir():
+            shutil.rmtree(stale, ignore_errors=True)
+    builder = _Builder(results, work)
+    extra = [*configfiles, *(p for j in jobs for p in j.inputs)]
+    tmp = _copy_snapshot(results, work, extra, builder)
+    try:
+        _install_snapshot(results, tmp)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    doc = build_crate(results, work, jobs, config=config, configfiles=configfiles, started=started, ended=time.time())
+    with atomic_target(target) as out:
+        out.write_text(json.dumps(doc, indent=1, sort_keys=True, ensure_ascii=False) + "\n", encoding="utf-8")
+    return target
+
+
+def write_crate_of_run(workflow: Any, config: Mapping[str, Any], started: float | None = None) -> Path:
+    """Write the crate of the Snakemake run ``workflow`` (call from ``onsuccess``)."""
+    workdir = Path.cwd()
+    jobs = jobs_from_dag(workflow.dag, workflow.persistence, workdir)
+    configfiles = [str(f) for f in workflow.configfiles]
+    return write_run_crate(
+        workdir / "results", jobs, config=config, configfiles=configfiles, started=started, workdir=workdir
+    )
