@@ -426,3 +426,26 @@ def test_tool_files_run_end_to_end_with_the_long_csvs_e_x(tmp_path):
         assert found["cameras"]["spin"]["m_per_px"] == pytest.approx(0.00125, rel=1e-6)
         want = "config" if name == "kcsv" else "12 file(s)"  # a table holds no frame rate; the tools' files do
         assert found["cameras"]["swing"]["fps_from"].startswith(want)
+
+
+def test_check_tracks_reads_a_folder_of_tool_files_as_the_workflow_does(tmp_path):
+    """``ballbat check --kind tracks --config`` on a dataset naming a folder (``dir``) imports the files
+    as the import_tracks rule does and then reduces them: the same verdict per impact as the long CSV.
+    """
+    lab = write_lab_folder(tmp_path / "lab", EXAMPLE / "tracked_tracks.csv", "trk", CAMS)
+    rig = {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0}
+    impacts = str(EXAMPLE / "tracked_impacts.csv")
+    mirrors = {"swing": {"mirror": False, "m_per_px_err": 0.005}, "spin": {"mirror": True}}
+    full = {c: {**mirrors[c], **CAMS[c]} for c in CAMS}
+    outs = {}
+    for name, block in {
+        "csv": {"file": str(EXAMPLE / "tracked_tracks.csv"), "impacts": impacts, "cameras": full, "rig": rig},
+        "dir": {"dir": str(lab), "points": POINTS, "impacts": impacts, "cameras": mirrors, "rig": rig},
+    }.items():
+        cfg = tmp_path / f"{name}.yaml"
+        cfg.write_text(yaml.safe_dump({"datasets": {"lab": {"tracks": block}}}))
+        res = subprocess.run([BALLBAT, "check", "--kind", "tracks", "--config", cfg], capture_output=True, text=True)
+        assert res.returncode == 0, res.stdout + res.stderr
+        outs[name] = [line for line in res.stdout.splitlines() if line.startswith("impact ")]
+    assert len(outs["csv"]) == 12 and outs["dir"] == outs["csv"]
+    assert sum(line.endswith(": used") for line in outs["dir"]) >= 9

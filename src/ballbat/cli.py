@@ -194,13 +194,25 @@ def _tracks_dataset(args: argparse.Namespace, defaults: dict) -> tuple[str, dict
     if args.dataset not in datasets:
         raise UsageError(f"argument --dataset: {cfg_path} has no dataset {args.dataset!r} with a tracks block")
     ds = datasets[args.dataset]
-    if "file" not in ds["tracks"]:
-        raise UsageError(
-            f"argument --config: datasets.{args.dataset}.tracks names no file (a folder of a tool's files: "
-            "convert it with ballbat import-tracks and give that CSV as the file)"
-        )
     tables = {**defaults, **(cfg.get("tables") or {})}
     return args.dataset, ds["tracks"], {k: ds.get(k, tables[k]) for k in ("balls", "bats")}
+
+
+def _reduce_tool_files(block: dict, where: str, balls_path: str, bats_path: str) -> tuple:
+    """Import a ``tracks`` block's folder of tool files, then reduce and cross-check them.
+
+    The same steps as the workflow's import_tracks and reduce rules: the camera settings found
+    in the files complete the block's (:func:`ballbat.tracks.data.with_found_settings`).
+    """
+    from .properties import load_balls, load_bats
+    from .tracks.data import camera_block, with_found_settings
+    from .tracks.formats.layout import import_block
+    from .tracks.stage import reduce_in_memory
+
+    balls, bats = load_balls(balls_path), load_bats(bats_path)
+    tracks, imported = import_block(block, where, balls, bats)
+    settings = with_found_settings(camera_block(block), imported.settings_yaml())
+    return reduce_in_memory(tracks, settings, balls, bats, where)
 
 
 def _check_tracks(path: Path | None, args: argparse.Namespace, defaults: dict) -> int:
@@ -219,13 +231,19 @@ def _check_tracks(path: Path | None, args: argparse.Namespace, defaults: dict) -
 
     if args.config:
         name, block, tables = _tracks_dataset(args, defaults)
-        path = path or Path(block["file"])
-        impacts = args.impacts or block.get("impacts")
         where = f"datasets.{name}.tracks"
         try:
-            red, verdict = reduce_checked(
-                path, impacts, block, args.balls or tables["balls"], args.bats or tables["bats"], where
-            )
+            if "dir" in block and path is None:  # a folder of tool files: imported as the workflow does
+                path = Path(block["dir"])
+                red, verdict = _reduce_tool_files(
+                    block, where, args.balls or tables["balls"], args.bats or tables["bats"]
+                )
+            else:
+                path = path or Path(block["file"])
+                impacts = args.impacts or block.get("impacts")
+                red, verdict = reduce_checked(
+                    path, impacts, block, args.balls or tables["balls"], args.bats or tables["bats"], where
+                )
         except InputError as exc:
             for problem in exc.problems:
                 print(problem)
