@@ -34,7 +34,13 @@ import numpy as np
 from ..units import INCH
 
 if TYPE_CHECKING:
+    import os
+    from collections.abc import Sequence
+
     from numpy.typing import ArrayLike
+
+    from .data import CameraTracks
+    from .reduce import Reduction
 
 G = 9.80665
 #: False-alarm probability of the glitch test per tracked point (2-D Gaussian noise:
@@ -61,7 +67,13 @@ SCALE_ERR_MAX = 0.1
 # frame runs
 
 
-def check_frame_runs(path, impact_id, camera, frame, labels) -> list[str]:
+def check_frame_runs(
+    path: str | os.PathLike[str],
+    impact_id: np.ndarray,
+    camera: np.ndarray,
+    frame: np.ndarray,
+    labels: Sequence[str],
+) -> list[str]:
     """Rows whose frame lies far outside the run of its impact and camera.
 
     The frames of one impact in one camera are one clip. Sorted, they are split where a gap
@@ -221,7 +233,15 @@ def lift_bound(v: ArrayLike, r: ArrayLike, m: ArrayLike, omega: ArrayLike) -> np
         return LIFT_MARGIN * RHO_AIR_MAX * np.pi * r**2 * np.nan_to_num(cl) * v**2 / (2 * m)
 
 
-def free_fall(X, Y, t, flight, r, m, omega) -> FreeFall:
+def free_fall(
+    X: np.ndarray,
+    Y: np.ndarray,
+    t: np.ndarray,
+    flight: np.ndarray,
+    r: np.ndarray,
+    m: np.ndarray,
+    omega: np.ndarray,
+) -> FreeFall:
     """Fit ``X = a + b u + c u^2`` and the same in Y over the flight frames; g across the velocity.
 
     Drag acts along the velocity, so the acceleration's component across it, divided by
@@ -266,7 +286,14 @@ def free_fall(X, Y, t, flight, r, m, omega) -> FreeFall:
 
 
 def tip_arc(
-    swing, X, Y, t, t_contact, L_cfg: float, fps: float, tau_prior_frames: float
+    swing: CameraTracks,
+    X: np.ndarray,
+    Y: np.ndarray,
+    t: np.ndarray,
+    t_contact: np.ndarray,
+    L_cfg: float,
+    fps: float,
+    tau_prior_frames: float,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Per impact: ``kappa = (L_cfg / L_arc)^2`` and its error, from the tip's pre-impact frames.
 
@@ -494,7 +521,7 @@ def _fmt_ratio(val: float, rel: float) -> str:
     return f"{val:.3g} +- {abs(val) * rel:.2g}"
 
 
-def cross_check(red, balls: dict, bats: dict, where: str = "tracks") -> Verdict:
+def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") -> Verdict:
     """Check a reduction against physics; exclude implausible impacts; stop a dataset a setting spoils.
 
     Changes ``red.flag`` and ``red.reason`` in place: impacts whose reduced values no collision
