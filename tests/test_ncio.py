@@ -68,7 +68,17 @@ def test_config_validation_lists_all_problems(root):
     schema = yaml.safe_load((root / "workflow" / "schemas" / "config.schema.yaml").read_text())
     good = yaml.safe_load((root / "config" / "config.yaml").read_text())
     assert validate_config(good, schema)["normalize"]["v_ref_mph"] == 77.0
-    minimal = {"datasets": {"d": {"synthetic": {"impacts": {"baseball": {"wood": 3}}, "e_x": {}, "e_y": {}}}}}
+    minimal = {
+        "datasets": {
+            "d": {
+                "synthetic": {
+                    "impacts": {"baseball": {"wood": 3}},
+                    "e_x": {"baseball": {"wood": 0.46}},
+                    "e_y": {"baseball": 0.45},
+                }
+            }
+        }
+    }
     filled = validate_config(minimal, schema)
     assert filled["tables"]["balls"] == "config/balls.csv"  # defaults filled
     assert filled["datasets"]["d"]["synthetic"]["noise"]["omega_rpm"] == 75.0

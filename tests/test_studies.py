@@ -263,6 +263,10 @@ def test_study_rules_through_snakemake(tmp_path):
 def _small_dataset(config):
     ds = copy.deepcopy(config["datasets"]["synthetic"])
     ds["synthetic"]["impacts"] = {"baseball": {"wood": 6, "metal_rough": 6}, "softball": {"wood": 6}}
+    e_x = ds["synthetic"]["e_x"]
+    ds["synthetic"]["e_x"] = {
+        ball: {bat: e_x[ball][bat] for bat in bats} for ball, bats in ds["synthetic"]["impacts"].items()
+    }
     return ds
 
 
