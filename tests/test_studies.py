@@ -201,6 +201,7 @@ def test_replicates_cover_the_truth(config, balls, bats):
     assert "centred within bats" in str(cov.error_kind.values[list(cov.quantity_name.values).index("eta2")])
 
 
+@pytest.mark.slow
 def test_study_rules_through_snakemake(tmp_path):
     """`snakemake studies`: batches, coverage and design files with units and provenance; `all` runs none."""
     import csv
