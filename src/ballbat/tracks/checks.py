@@ -293,7 +293,7 @@ def tip_arc(
     t_contact: np.ndarray,
     L_cfg: float,
     fps: float,
-    tau_prior_frames: float,
+    tau_prior_frames: float | np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Per impact: ``kappa = (L_cfg / L_arc)^2`` and its error, from the tip's pre-impact frames.
 
@@ -539,7 +539,7 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
     from ..ingest import implausible_rows
     from ..linefit import MIN_FIT_IMPACTS
     from ..properties import InputError, recoil_factors
-    from .reduce import STAGE, TAU_PRIOR_FRAMES, ReduceFlag, contact_start
+    from .reduce import STAGE, TAU_PRIOR_FRAMES, ReduceFlag, fit_contact
 
     tr, cams = red.tracks, red.cameras
     ball_ids, bat_ids = tr.ball.astype(str), tr.bat.astype(str)
@@ -595,15 +595,17 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
             )
 
     # the tip's arc
-    t_contact = contact_start(*red.phys[("swing", "ball")], red.times["swing"], red.onset["swing"], red.flight["swing"])
+    contact = red.contact or fit_contact(
+        *red.phys[("swing", "ball")], red.times["swing"], red.onset["swing"], red.flight["swing"], red.tracks.ball
+    )
     kap, kap_err = tip_arc(
         red.swing,
         *red.phys[("swing", "bat_tip")],
         red.times["swing"],
-        t_contact,
+        contact.t_start,
         red.rig.pivot_to_tip,
         cams["swing"].fps,
-        TAU_PRIOR_FRAMES,
+        np.hypot(TAU_PRIOR_FRAMES, np.nan_to_num(contact.t_start_err) * cams["swing"].fps),
     )
     sel = pool & np.isfinite(kap)
     kh, se, k = weighted_mean(kap[sel], kap_err[sel])

@@ -59,9 +59,14 @@ THRESHOLD_FLOOR_PX = 3.0
 THRESHOLD_SIGMA = 8.0
 #: Longest contact (s): "under a millisecond" (Sec. II).
 CONTACT_MAX = 1.0e-3
-#: Typical ball-bat contact time (s), 0.6-0.9 ms: places the contact's start before the
-#: time the free flight extrapolates back to the rest position (its midpoint).
-CONTACT_TYPICAL = 0.75e-3
+#: Prior range of a ball-on-bat contact time (s), uniform: generous bounds around the
+#: literature's 0.6-0.7 ms of a baseball on a bat and about 1 ms or more of a softball
+#: (docs/tracks.md, "The contact time"). Each impact's contact time is fitted within it.
+CONTACT_PRIOR = (0.2e-3, 2.0e-3)
+#: Grid points of the contact-time posterior (10 us steps over CONTACT_PRIOR).
+CONTACT_GRID = 181
+#: EM iterations of the contact times' distribution among the impacts of a ball type.
+CONTACT_EM_ITERATIONS = 200
 #: A frame within this many sigma of the flight fit is already in free flight.
 SEPARATION_SIGMA = 4.0
 #: Sd of the prior on the bat's alignment time tau, in frames (the rest frame is its centre).
@@ -333,14 +338,59 @@ def radius_scatter_limit(noise: ArrayLike, noise_dof: ArrayLike, n: ArrayLike) -
     return np.where(ok, lim, np.nan)
 
 
-def contact_start(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, flight: Flight) -> np.ndarray:
-    """Time the contact began (s), from the ball's rest position and its free flight.
+@dataclass
+class Contact:
+    """Each impact's contact, fitted from the ball's departure from rest (swing camera; s)."""
+
+    t_mid: np.ndarray
+    t_start: np.ndarray
+    t_start_err: np.ndarray
+    duration: np.ndarray
+    duration_err: np.ndarray
+    n: np.ndarray
+
+
+def _contact_population(lik: np.ndarray, groups: np.ndarray) -> np.ndarray:
+    """Per impact, the distribution of contact times among its group's impacts (grid weights).
+
+    The nonparametric maximum-likelihood mixing distribution of each group's likelihoods
+    (EM from the uniform prior, :data:`CONTACT_EM_ITERATIONS` steps); rows whose likelihood
+    is flat (no frame inside the contact) or not finite inform nothing and get it too.
+    """
+    prior = np.full(lik.shape, 1.0 / lik.shape[1])
+    for g in np.unique(groups):
+        rows = (groups == g) & np.all(np.isfinite(lik), axis=1)
+        if not rows.any():
+            continue
+        L = lik[rows]
+        pi = np.full(lik.shape[1], 1.0 / lik.shape[1])
+        for _ in range(CONTACT_EM_ITERATIONS):
+            post = L * pi
+            post /= post.sum(axis=1, keepdims=True)
+            pi = post.mean(axis=0)
+        prior[groups == g] = pi
+    return prior
+
+
+def fit_contact(
+    X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, flight: Flight, groups: ArrayLike | None = None
+) -> Contact:
+    """Each impact's contact interval from the ball's track, with its uncertainty.
 
     The free flight extrapolated back passes the rest position at the impulse-weighted mean
-    time of the contact, its midpoint for a symmetric force pulse; the contact began half a
-    typical contact time (:data:`CONTACT_TYPICAL`) earlier. This is steadier than the last
-    frame at rest, which lags behind the impact by up to a frame or two when the tracking
-    is noisy (the ball must first move clear of the noise).
+    time of the contact ``t_mid`` (its midpoint for a symmetric force pulse). The contact
+    lasts ``t_c``: the ball leaves rest at ``t_mid - t_c / 2`` and, under a constant force,
+    is ``v (t - t_mid + t_c / 2)^2 / (2 t_c)`` along its flight direction until
+    ``t_mid + t_c / 2``, then on its free flight. ``t_c`` is a nuisance parameter: its
+    likelihood on a grid over :data:`CONTACT_PRIOR` from the ball's frames within the widest
+    contact about ``t_mid`` (Gaussian, the flight fit's noise per coordinate). The prior is
+    the distribution of contact times among the impacts of the same group (ball type),
+    estimated from all their likelihoods (:func:`_contact_population`), so that the
+    posterior means are unbiased on average over the group even where the frames say
+    little (a uniform prior would pull every one towards the middle of its range).
+    The posterior's mean and standard deviation give the contact's duration and start;
+    the start's error adds the extrapolated ``t_mid``'s. With no frame inside the contact
+    the posterior is the group's distribution.
 
     Parameters
     ----------
@@ -352,26 +402,79 @@ def contact_start(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, flight
         The impact found in this camera.
     flight : Flight
         Its free-flight fit.
+    groups : ndarray, optional
+        Group of each impact (its ball type); one group if None.
 
     Returns
     -------
-    ndarray
+    Contact
         NaN where no impact was found.
     """
     X = np.asarray(X, dtype=float)
     Y = np.asarray(Y, dtype=float)
+    t = np.asarray(t, dtype=float)
+    valid = np.isfinite(X) & np.isfinite(Y)
     cols = np.arange(X.shape[1])[None, :]
-    at_rest = np.isfinite(X) & np.isfinite(Y) & (cols <= onset.rest[:, None]) & onset.found[:, None]
+    at_rest = valid & (cols <= onset.rest[:, None]) & onset.found[:, None]
     w = at_rest.astype(float)
+    lo, hi = CONTACT_PRIOR
     with np.errstate(all="ignore"):
-        n = w.sum(axis=1)
-        xr, yr = _msum(X, w) / n, _msum(Y, w) / n
-        u = ((xr - flight.x0) * flight.vx + (yr - flight.y0) * flight.vy) / (flight.vx**2 + flight.vy**2)
-    return np.where(onset.found & (n > 0), flight.t_ref + u - 0.5 * CONTACT_TYPICAL, np.nan)
+        v2 = flight.vx**2 + flight.vy**2
+        v = np.sqrt(v2)
+        for _ in range(2):  # the rest position from frames before the longest contact can have begun
+            n_rest = w.sum(axis=1)
+            xr, yr = _msum(X, w) / n_rest, _msum(Y, w) / n_rest
+            u = ((xr - flight.x0) * flight.vx + (yr - flight.y0) * flight.vy) / v2
+            t_mid = flight.t_ref + u
+            early = at_rest & (t < t_mid[:, None] - 0.5 * hi)
+            w = np.where(early.sum(axis=1)[:, None] >= 2, early, at_rest).astype(float)
+        # error of t_mid: the extrapolated line's position error at u, over the speed
+        var_pos = flight.sigma**2 * (1 / flight.n + (u - flight.u_mean) ** 2 / flight.sxx)
+        t_mid_err = np.sqrt(var_pos + flight.sigma**2 / n_rest) / v
+        s = ((X - xr[:, None]) * flight.vx[:, None] + (Y - yr[:, None]) * flight.vy[:, None]) / v[:, None]
+        dt = t - t_mid[:, None]
+        win = valid & onset.found[:, None] & (np.abs(dt) < 0.5 * hi)
+        win &= np.isfinite(dt)
+        # the window's columns only (a few frames per impact)
+        first = np.where(win.any(axis=1), np.argmax(win, axis=1), 0)
+        width = int(max(1, np.max(np.where(win.any(axis=1), _last(win) - first + 1, 1))))
+        idx = np.minimum(first[:, None] + np.arange(width)[None, :], X.shape[1] - 1)
+        dtw, sw = np.take_along_axis(dt, idx, axis=1), np.take_along_axis(s, idx, axis=1)
+        ww = np.take_along_axis(win, idx, axis=1) & (first[:, None] + np.arange(width)[None, :] < X.shape[1])
+        grid = np.linspace(lo, hi, CONTACT_GRID)
+        logl = np.empty((X.shape[0], grid.size))
+        for j, tc in enumerate(grid):
+            x = np.clip(dtw + 0.5 * tc, 0.0, tc)  # time since the start, within the contact
+            model = v[:, None] * (x**2 / (2 * tc) + np.maximum(dtw - 0.5 * tc, 0.0))
+            logl[:, j] = -0.5 * _msum((sw - model) ** 2, ww.astype(float)) / flight.sigma**2
+        logl -= np.max(logl, axis=1, keepdims=True)
+        lik = np.exp(logl)
+        grp = np.zeros(X.shape[0], dtype=int) if groups is None else np.unique(groups, return_inverse=True)[1]
+        post = lik * _contact_population(lik, np.where(onset.found, grp, -1))
+        post /= post.sum(axis=1, keepdims=True)
+        tc_mean = post @ grid
+        tc_err = np.sqrt(np.maximum(post @ grid**2 - tc_mean**2, 0.0))
+    ok = onset.found & (n_rest > 0) & np.isfinite(t_mid) & np.isfinite(tc_mean)
+    nan = np.full(X.shape[0], np.nan)
+    return Contact(
+        t_mid=np.where(ok, t_mid, nan),
+        t_start=np.where(ok, t_mid - 0.5 * tc_mean, nan),
+        t_start_err=np.where(ok, np.hypot(t_mid_err, 0.5 * tc_err), nan),
+        duration=np.where(ok, tc_mean, nan),
+        duration_err=np.where(ok, tc_err, nan),
+        n=np.where(ok, win.sum(axis=1), 0).astype(int),
+    )
 
 
 def fit_swing(
-    X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: float, L: float, t_contact: ArrayLike
+    X: ArrayLike,
+    Y: ArrayLike,
+    t: ArrayLike,
+    onset: Onset,
+    fps: float,
+    L: float,
+    t_contact: ArrayLike,
+    t_contact_err: ArrayLike | float = 0.0,
 ) -> Swing:
     """Fit the tip dot's pre-impact motion (a circle of radius L about the pivot, seen edge-on).
 
@@ -388,9 +491,11 @@ def fit_swing(
     L : float
         Pivot-to-tip distance (m).
     t_contact : ndarray
-        Start of the contact (:func:`contact_start`): only earlier frames are fitted (the
+        Start of the contact (:func:`fit_contact`): only earlier frames are fitted (the
         bat slows in the collision), and the tip is aligned with the impact then (the prior
         of the alignment time tau).
+    t_contact_err : ndarray or float
+        Its uncertainty (s): the prior's sd is this and :data:`TAU_PRIOR_FRAMES` in quadrature.
 
     Returns
     -------
@@ -426,7 +531,7 @@ def fit_swing(
         a = -L * np.sin(om * st)  # start: u = a + L sin(om (t - tau0)) through the centroid
         tau = tau0.copy()
         prior = np.full_like(om, 1e12)  # first iterations: tau held at its prior
-        sigma_tau = TAU_PRIOR_FRAMES / fps
+        sigma_tau = np.hypot(TAU_PRIOR_FRAMES / fps, np.nan_to_num(np.asarray(t_contact_err, dtype=float)))
         for it in range(GN_ITERATIONS):
             arg = om[:, None] * (t - tau[:, None])
             c = np.cos(arg)
@@ -601,6 +706,7 @@ class Reduction:
     reason: np.ndarray
     n_outliers: dict
     agreement: object = None
+    contact: Contact | None = None
 
 
 def remove_glitches(tracks: Tracks, cameras: dict[str, Camera]) -> tuple[Tracks, dict[str, np.ndarray]]:
@@ -667,8 +773,17 @@ def reduce_tracks(
         flight[name] = fit_flight(X, Y, t, onset[name], cam.fps)
     Xt, Yt = physical(tracks.cameras["swing"], cameras["swing"], "bat_tip")
     phys[("swing", "bat_tip")] = (Xt, Yt)
-    t_contact = contact_start(*phys[("swing", "ball")], times["swing"], onset["swing"], flight["swing"])
-    swing = fit_swing(Xt, Yt, times["swing"], onset["swing"], cameras["swing"].fps, rig.pivot_to_tip, t_contact)
+    contact = fit_contact(*phys[("swing", "ball")], times["swing"], onset["swing"], flight["swing"], tracks.ball)
+    swing = fit_swing(
+        Xt,
+        Yt,
+        times["swing"],
+        onset["swing"],
+        cameras["swing"].fps,
+        rig.pivot_to_tip,
+        contact.t_start,
+        contact.t_start_err,
+    )
     dots = {p: physical(tracks.cameras["spin"], cameras["spin"], p) for p in ("dot_a", "dot_b")}
     for p, v in dots.items():
         phys[("spin", p)] = v
@@ -707,6 +822,8 @@ def reduce_tracks(
         "swing_plane_angle_err": swing.beta_err,
         "launch_angle": launch,
         "launch_angle_err": launch_err,
+        "contact_time": contact.duration,
+        "contact_time_err": contact.duration_err,
     }
 
     flag = np.zeros(n, dtype=np.int8)
@@ -810,6 +927,7 @@ def reduce_tracks(
         reason.astype(str),
         n_outliers,
         agree,
+        contact,
     )
 
 
@@ -850,6 +968,12 @@ def reduction_table(truth_names: Sequence[str] = ()) -> dict[str, Var]:
     table["swing_plane_angle_err"] = _v("rad", "standard uncertainty of the swing-plane angle")
     table["launch_angle"] = _v("rad", "angle of the batted ball above the horizontal (in the swing direction)")
     table["launch_angle_err"] = _v("rad", "standard uncertainty of the launch angle")
+    table["contact_time"] = _v("s", "duration of the ball-bat contact, fitted from the ball's departure from rest")
+    table["contact_time_err"] = _v("s", "standard uncertainty of the fitted contact time")
+    table["contact_start_time"] = _v(
+        "s", "fitted time the contact began (end of the bat-tip fit), from the swing camera's frame origin"
+    )
+    table["contact_start_time_err"] = _v("s", "standard uncertainty of the fitted contact start")
     for cam in ("swing", "spin"):
         table[f"impact_frame_{cam}"] = _v("1", f"first {cam}-camera frame with the ball moving (-1: none)")
         table[f"separation_frame_{cam}"] = _v("1", f"first {cam}-camera frame of the ball's free flight (-1: none)")
@@ -945,6 +1069,9 @@ def reduction_dataset(red: Reduction) -> xr.Dataset:
     values["n_frames_tip"] = red.swing.n
     values["tip_rms"] = red.swing.rms
     values["bat_alignment_time"] = red.swing.tau
+    if red.contact is not None:
+        values["contact_start_time"] = red.contact.t_start
+        values["contact_start_time_err"] = red.contact.t_start_err
     values["n_frames_spin"] = red.spin.n
     values["dot_angle_rms"] = red.spin.rms
     for p in ("dot_a", "dot_b"):
