@@ -65,8 +65,8 @@ CONTACT_MAX = 1.0e-3
 CONTACT_PRIOR = (0.2e-3, 2.0e-3)
 #: Grid points of the contact-time posterior (10 us steps over CONTACT_PRIOR).
 CONTACT_GRID = 181
-#: EM iterations of the contact times' distribution among the impacts of a ball type.
-CONTACT_EM_ITERATIONS = 200
+#: EM iterations of the contact times' (normal) distribution among the impacts of a ball type.
+CONTACT_EM_ITERATIONS = 50
 #: A frame within this many sigma of the flight fit is already in free flight.
 SEPARATION_SIGMA = 4.0
 #: Sd of the prior on the bat's alignment time tau, in frames (the rest frame is its centre).
@@ -350,25 +350,35 @@ class Contact:
     n: np.ndarray
 
 
-def _contact_population(lik: np.ndarray, groups: np.ndarray) -> np.ndarray:
+def _contact_population(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -> np.ndarray:
     """Per impact, the distribution of contact times among its group's impacts (grid weights).
 
-    The nonparametric maximum-likelihood mixing distribution of each group's likelihoods
-    (EM from the uniform prior, :data:`CONTACT_EM_ITERATIONS` steps); rows whose likelihood
-    is flat (no frame inside the contact) or not finite inform nothing and get it too.
+    A normal distribution (cut to the grid) whose mean and standard deviation maximise the
+    group's marginal likelihood (EM, :data:`CONTACT_EM_ITERATIONS` steps from the grid's
+    middle and half-width). Smooth on purpose: the nonparametric maximum-likelihood
+    distribution is a few spikes, and posteriors under it understate their spread (by 1.2-1.7x
+    in tests). Rows with a flat likelihood (no frame inside the contact) inform little and
+    get it too; a group with no finite likelihood gets the uniform prior.
     """
     prior = np.full(lik.shape, 1.0 / lik.shape[1])
+    step = grid[1] - grid[0]
     for g in np.unique(groups):
         rows = (groups == g) & np.all(np.isfinite(lik), axis=1)
         if not rows.any():
             continue
         L = lik[rows]
-        pi = np.full(lik.shape[1], 1.0 / lik.shape[1])
+        mu, sd = 0.5 * (grid[0] + grid[-1]), 0.5 * (grid[-1] - grid[0])
         for _ in range(CONTACT_EM_ITERATIONS):
+            pi = np.exp(-0.5 * ((grid - mu) / sd) ** 2)
             post = L * pi
             post /= post.sum(axis=1, keepdims=True)
-            pi = post.mean(axis=0)
-        prior[groups == g] = pi
+            m = post @ grid
+            var = np.maximum(post @ grid**2 - m**2, 0.0)
+            mu = float(m.mean())
+            sd = float(np.sqrt(np.mean(var + (m - mu) ** 2)))
+            sd = max(sd, 2 * step)
+        pi = np.exp(-0.5 * ((grid - mu) / sd) ** 2)
+        prior[groups == g] = pi / pi.sum()
     return prior
 
 
@@ -450,7 +460,7 @@ def fit_contact(
         logl -= np.max(logl, axis=1, keepdims=True)
         lik = np.exp(logl)
         grp = np.zeros(X.shape[0], dtype=int) if groups is None else np.unique(groups, return_inverse=True)[1]
-        post = lik * _contact_population(lik, np.where(onset.found, grp, -1))
+        post = lik * _contact_population(lik, np.where(onset.found, grp, -1), grid)
         post /= post.sum(axis=1, keepdims=True)
         tc_mean = post @ grid
         tc_err = np.sqrt(np.maximum(post @ grid**2 - tc_mean**2, 0.0))

@@ -74,7 +74,7 @@ class RenderSettings:
     rig: Rig
     seed: int = 0
     swing_plane: tuple[float, float] = (-5 * DEGREE, 10 * DEGREE)
-    contact_time: tuple[float, float] = (0.6e-3, 0.9e-3)
+    contact_time: tuple[float, float] = (0.5e-3, 1.2e-3)
     bat_slowdown: tuple[float, float] = (0.10, 0.25)
     bat_axis_to_ball: float = 0.07
     axis_offset: float = 5e-3
@@ -119,7 +119,7 @@ def settings_from_config(cfg: dict) -> RenderSettings:
         rig=rig,
         seed=int(cfg.get("seed", 0)),
         swing_plane=deg("swing_plane_deg", (-5.0, 10.0)),
-        contact_time=tuple(v * 1e-3 for v in cfg.get("contact_ms", (0.6, 0.9))),
+        contact_time=tuple(v * 1e-3 for v in cfg.get("contact_ms", (0.5, 1.2))),
         bat_slowdown=tuple(cfg.get("bat_slowdown", (0.10, 0.25))),
         bat_axis_to_ball=float(cfg.get("bat_axis_to_ball_mm", 70.0)) * 1e-3,
         axis_offset=float(cfg.get("axis_offset_mm", 5.0)) * 1e-3,
