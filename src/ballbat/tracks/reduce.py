@@ -45,6 +45,7 @@ import xarray as xr
 from ..pipeline.products import Var, build_dataset, flag_attrs
 from .checks import IMPACT_Z, camera_agreement, glitch_mask
 from .data import POINTS, Camera, CameraTracks, Rig, Tracks
+from .render import contact_distance
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -389,8 +390,9 @@ def fit_contact(
 
     The free flight extrapolated back passes the rest position at the impulse-weighted mean
     time of the contact ``t_mid`` (its midpoint for a symmetric force pulse). The contact
-    lasts ``t_c``: the ball leaves rest at ``t_mid - t_c / 2`` and, under a constant force,
-    is ``v (t - t_mid + t_c / 2)^2 / (2 t_c)`` along its flight direction until
+    lasts ``t_c``: the ball leaves rest at ``t_mid - t_c / 2`` and, under a force that follows
+    sin^2 (the shape of a ball-bat force pulse: :func:`.render.contact_distance`), is
+    ``v contact_distance(t - t_mid + t_c / 2, t_c)`` along its flight direction until
     ``t_mid + t_c / 2``, then on its free flight. ``t_c`` is a nuisance parameter: its
     likelihood on a grid over :data:`CONTACT_PRIOR` from the ball's frames within the widest
     contact about ``t_mid`` (Gaussian, the flight fit's noise per coordinate). The prior is
@@ -455,7 +457,7 @@ def fit_contact(
         logl = np.empty((X.shape[0], grid.size))
         for j, tc in enumerate(grid):
             x = np.clip(dtw + 0.5 * tc, 0.0, tc)  # time since the start, within the contact
-            model = v[:, None] * (x**2 / (2 * tc) + np.maximum(dtw - 0.5 * tc, 0.0))
+            model = v[:, None] * (contact_distance(x, tc) + np.maximum(dtw - 0.5 * tc, 0.0))
             logl[:, j] = -0.5 * _msum((sw - model) ** 2, ww.astype(float)) / flight.sigma**2
         logl -= np.max(logl, axis=1, keepdims=True)
         lik = np.exp(logl)

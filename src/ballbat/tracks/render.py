@@ -9,9 +9,9 @@ image plane is the scattering plane. In a physical frame with X along the swing 
   the ball's centre along -n (n at psi above the bat's path) and moves along the swing
   direction by ``pivot_to_tip * sin(Omega t)`` (a circle about the pivot seen edge-on),
   Omega = v_bat / pivot_to_impact before impact and Omega (1 - slowdown) after;
-* the ball rests on the tee, is accelerated uniformly for the contact time t_c (under a
-  millisecond), and then flies freely under gravity with the true exit velocity at the
-  launch angle beta + theta;
+* the ball rests on the tee, is accelerated for the contact time t_c (drawn from
+  ``contact_ms``) by a force that follows sin^2 (:func:`contact_distance`), and then flies
+  freely under gravity with the true exit velocity at the launch angle beta + theta;
 * two adjacent corner dots of a 1.5-inch square spin about the spin axis, which passes
   through the ball's centre within the square (offset from its centre); the axis points
   at the camera except for a few impacts where it is tilted (their dots trace ellipses
@@ -128,13 +128,24 @@ def settings_from_config(cfg: dict) -> RenderSettings:
     )
 
 
+def contact_distance(x, t_c):
+    """Distance / exit speed travelled a time ``x`` into a contact of duration ``t_c`` (0 <= x <= t_c).
+
+    The force follows sin^2(pi x / t_c) (zero at both ends, peak at the middle: the shape of a
+    ball-bat force pulse, Russell, "Forces between bat and ball"); the ball's speed is then
+    v (x / t_c - sin(2 pi x / t_c) / (2 pi)) and at the end it is v t_c / 2 from its start.
+    """
+    return x**2 / (2 * t_c) + t_c * (np.cos(2 * np.pi * x / t_c) - 1) / (4 * np.pi**2)
+
+
 def _ball_motion(t, v, launch, t_c):
-    """Ball centre (X, Y) and rotation fraction clock: uniform acceleration, then free flight."""
+    """Ball centre (X, Y) and rotation fraction clock: a sin^2 force pulse, then free flight."""
     vx, vy = v * np.cos(launch), v * np.sin(launch)
     tc = t_c[:, None]
     during = (t > 0) & (t < tc)
     after = t >= tc
-    s = np.where(during, t**2 / (2 * tc), np.where(after, t - tc / 2, 0.0))  # distance / speed
+    x = np.clip(t, 0.0, tc)
+    s = np.where(during, contact_distance(x, tc), np.where(after, t - tc / 2, 0.0))  # distance / speed
     tf = np.where(after, t - tc, 0.0)
     X = vx[:, None] * s
     Y = vy[:, None] * s - 0.5 * G * tf**2
