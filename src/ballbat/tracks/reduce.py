@@ -12,11 +12,15 @@ Per impact, all impacts at once (dense arrays, masked sums; no Python loop over 
    :data:`SEPARATION_SIGMA` sigma) are added; the first one is the separation frame; u is
    the time from separation (half a frame before it). Swing camera: v_ball and the launch
    angle (to the horizontal, in the swing direction).
-3. **Bat** (swing camera, frames up to one before ``rest_frame`` only: the bat slows in the
+3. **Contact** (swing camera): the contact's middle from the free flight extrapolated back to
+   the rest position, its duration a nuisance parameter fitted to the ball's departure from
+   rest (:func:`fit_contact`); its start, with its uncertainty.
+   **Bat** (swing camera, frames before the contact's start only: the bat slows in the
    collision): the tip dot's positions give the swing direction (principal axis: the
    swing-plane angle beta) and, along it, u(t) = a + L sin(Omega (t - tau)) (a circle about
-   the pivot seen edge-on, L = pivot_to_tip), fitted by Gauss-Newton with a loose prior
-   tau ~ rest frame +- 1 frame; v_bat = Omega pivot_to_impact. theta = launch - beta.
+   the pivot seen edge-on, L = pivot_to_tip), fitted by Gauss-Newton with a prior
+   tau ~ contact start +- (its error and TAU_PRIOR_FRAMES in quadrature);
+   v_bat = Omega pivot_to_impact. theta = launch - beta.
 4. **Spin** (spin camera, frames after separation): each dot's angle about the fitted
    ball centre, unwrapped frame to frame, fitted by one straight line per dot with a
    common slope omega (counter-clockwise on the image for a +x swing is backspin, > 0).
@@ -70,7 +74,7 @@ CONTACT_GRID = 181
 CONTACT_EM_ITERATIONS = 50
 #: A frame within this many sigma of the flight fit is already in free flight.
 SEPARATION_SIGMA = 4.0
-#: Sd of the prior on the bat's alignment time tau, in frames (the rest frame is its centre).
+#: Sd of the prior on the bat's alignment time tau, in frames, beside the contact start's own error (its centre).
 TAU_PRIOR_FRAMES = 0.6
 #: Gauss-Newton iterations of the tip fit.
 GN_ITERATIONS = 6
