@@ -128,7 +128,7 @@ def settings_from_config(cfg: dict) -> RenderSettings:
     )
 
 
-def contact_distance(x, t_c):
+def contact_distance(x: np.ndarray, t_c: np.ndarray | float) -> np.ndarray:
     """Distance / exit speed travelled a time ``x`` into a contact of duration ``t_c`` (0 <= x <= t_c).
 
     The force follows sin^2(pi x / t_c) (zero at both ends, peak at the middle: the shape of a
