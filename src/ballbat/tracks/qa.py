@@ -102,7 +102,11 @@ def impacts_figure(red: xr.Dataset, tracks: Tracks, impacts: list[int] | None = 
             x, y = _to_px(X, Y, cam)
             ax.plot(x[used], y[used], color="tab:brown", lw=1.2, label="tip fit (pre-impact)")
         _flight_line(ax, red, i, "swing", t, cam, ct.x["ball"][i])
-        ax.set_title(f"impact {iid}: swing camera ({cam.fps:g} fps) — {status}", fontsize=9)
+        contact = ""
+        if "contact_time" in red and np.isfinite(red["contact_time"].values[i]):
+            tc, tc_err = red["contact_time"].values[i], red["contact_time_err"].values[i]
+            contact = f"\ncontact {1e3 * tc:.2f} ± {1e3 * tc_err:.2f} ms (fitted)"
+        ax.set_title(f"impact {iid}: swing camera ({cam.fps:g} fps) — {status}{contact}", fontsize=9)
         ax.set_xlabel("x (px)")
         ax.set_ylabel("y (px, down)")
         ax.invert_yaxis()
