@@ -369,3 +369,22 @@ def test_contact_time_tracks_the_true_one():
     assert abs(d.mean()) < 30e-6, d.mean()
     assert abs(z.mean()) < 0.2 and 0.7 < z.std() < 1.3, (z.mean(), z.std())
     assert np.mean(np.abs(z) < 2) > 0.9
+
+
+def test_contact_prior_of_uninformative_frames_stays_uniform():
+    """Flat likelihoods (no frame inside any contact) keep the uniform prior: EM on a normal cut to the
+    grid would shrink it towards the middle step by step and make every start overconfident.
+    """
+    from ballbat.tracks.reduce import CONTACT_GRID, CONTACT_PRIOR, _contact_population
+
+    grid = np.linspace(*CONTACT_PRIOR, CONTACT_GRID)
+    prior = _contact_population(np.ones((50, grid.size)), np.zeros(50, int), grid)
+    np.testing.assert_allclose(prior, 1.0 / grid.size)
+    # informative likelihoods about 0.9 +- 0.05 ms: the prior narrows around them
+    rng = np.random.default_rng(0)
+    centres = rng.normal(0.9e-3, 0.05e-3, 200)
+    lik = np.exp(-0.5 * ((grid[None, :] - centres[:, None]) / 0.1e-3) ** 2)
+    p = _contact_population(lik, np.zeros(200, int), grid)[0]
+    mean = p @ grid
+    sd = np.sqrt(p @ grid**2 - mean**2)
+    assert abs(mean - 0.9e-3) < 0.03e-3 and sd < 0.1e-3, (mean, sd)

@@ -72,6 +72,9 @@ CONTACT_PRIOR = (0.2e-3, 2.0e-3)
 CONTACT_GRID = 181
 #: EM iterations of the contact times' (normal) distribution among the impacts of a ball type.
 CONTACT_EM_ITERATIONS = 50
+#: A group's likelihoods are flat (uniform prior kept) when their median spread exceeds this
+#: fraction of the prior range's (its sd).
+CONTACT_FLAT = 0.95
 #: A frame within this many sigma of the flight fit is already in free flight.
 SEPARATION_SIGMA = 4.0
 #: Sd of the prior on the bat's alignment time tau, in frames, beside the contact start's own error (its centre).
@@ -363,7 +366,8 @@ def _contact_population(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -
     middle and half-width). Smooth on purpose: the nonparametric maximum-likelihood
     distribution is a few spikes, and posteriors under it understate their spread (by 1.2-1.7x
     in tests). Rows with a flat likelihood (no frame inside the contact) inform little and
-    get it too; a group with no finite likelihood gets the uniform prior.
+    get it too; a group with no finite likelihood, or whose likelihoods are mostly flat
+    (:data:`CONTACT_FLAT`), gets the uniform prior.
     """
     prior = np.full(lik.shape, 1.0 / lik.shape[1])
     step = grid[1] - grid[0]
@@ -372,6 +376,12 @@ def _contact_population(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -
         if not rows.any():
             continue
         L = lik[rows]
+        # frames that barely inform (a flat likelihood): EM would shrink a normal cut to the grid
+        # step by step towards its middle; keep the uniform prior
+        u = L / L.sum(axis=1, keepdims=True)
+        sd_u = np.sqrt(np.maximum(u @ grid**2 - (u @ grid) ** 2, 0.0))
+        if np.median(sd_u) > CONTACT_FLAT * (grid[-1] - grid[0]) / np.sqrt(12):
+            continue
         mu, sd = 0.5 * (grid[0] + grid[-1]), 0.5 * (grid[-1] - grid[0])
         for _ in range(CONTACT_EM_ITERATIONS):
             pi = np.exp(-0.5 * ((grid - mu) / sd) ** 2)
