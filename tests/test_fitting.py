@@ -321,7 +321,7 @@ def test_eiv_is_the_weighted_fit_when_the_abscissa_is_exact():
 
 
 def test_eiv_correlated_noise_of_x_and_y():
-    """The abscissa and the ordinate share a measured quantity (as psi shares omega with the spin): the covariance is removed too.
+    """Abscissa and ordinate share a measured quantity (as psi shares omega with the spin): both moments go.
 
     x = m0 + m1 and y = 2 m0 + m1 with m0 known exactly in y but measured in x, m1 measured in
     both: the noise of m1 pulls least squares up, that of m0 down; the corrected slope is the

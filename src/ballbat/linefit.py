@@ -8,7 +8,9 @@ weights depend on the slope, so the fit is iterated (three passes converge to fa
 standard error). Standard errors are lmfit's, scaled by the reduced chi-square (as the
 paper's standard errors come from the scatter of the data); the reduced chi-square itself
 tells whether the stated measurement uncertainties explain that scatter. 95 % intervals use
-Student's t with n - p degrees of freedom. Without uncertainties the fit is unweighted and
+Student's t with n - p degrees of freedom. Where the abscissa is measured,
+:func:`eiv_line` (``fit_line(errors_in_variables=True)``) removes the attenuation its noise
+causes (Fuller's method-of-moments correction). Without uncertainties the fit is unweighted and
 the reduced chi-square is undefined (NaN). lmfit and scipy are imported inside
 :func:`fit_line` only, so that modules which merely read these names start fast.
 
@@ -16,6 +18,8 @@ References
 ----------
 .. [1] J. Orear, "Least squares when both variables have uncertainties",
    Am. J. Phys. 50, 912 (1982) (effective variance).
+.. [2] W. A. Fuller, *Measurement Error Models* (Wiley, 1987), Secs. 1.2 and 2.2
+   (the method-of-moments correction for a measured abscissa).
 """
 
 from __future__ import annotations
