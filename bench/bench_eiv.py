@@ -11,7 +11,7 @@ experiment and tracks are simulated once and reused by the second pass. The desi
 of a replicate's standard error, docs/studies.md).
 
 Run: ``nice -n 10 .venv/bin/python bench/bench_eiv.py [replicates] [setup ...]`` (one process;
-about 15 minutes for the three set-ups at 300 / 300 / 200 replicates). Prints, per set-up,
+about 15 minutes for the three set-ups at 300 / 300 / 200 replicates on a shared machine). Prints, per set-up,
 quantity and estimator, the 95 % coverage with its binomial error and the bias / SE, and
 the mean bias / SE of e_x per bat.
 """
