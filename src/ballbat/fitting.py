@@ -21,7 +21,7 @@ the slope with each impact's recoil factors and its bat's e_x, weighted as the f
 impacts (:func:`implied_e_y`), with a sandwich standard error. Every abscissa is measured,
 so every fit is corrected for its noise (errors in variables: the moment-corrected fit
 :func:`ballbat.linefit.eiv_line`, which the replicate studies find unbiased where plain least
-squares was attenuated by up to 0.3 standard errors). 95 % intervals use Student's t with
+squares was attenuated by up to 0.8 standard errors: docs/studies.md). 95 % intervals use Student's t with
 n - p degrees of freedom. Without uncertainties the fit is unweighted and the
 reduced chi-square is undefined (NaN).
 
