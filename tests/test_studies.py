@@ -199,6 +199,12 @@ def test_replicates_cover_the_truth(config, balls, bats):
     eta = batch.dof.isel(quantity=np.flatnonzero(batch.quantity_name.values == "eta2")).values
     assert eta.size == 80 and np.all((eta > 5) & (eta < 60)) and not np.all(eta == np.round(eta))
     assert "centred within bats" in str(cov.error_kind.values[list(cov.quantity_name.values).index("eta2")])
+    # implied e_y's interval has n - k degrees of freedom, k = the ball's bats + 1 (its variance's n / (n - k)):
+    # the Eq. ratio slope's n - 1 less the ball's bats (3 baseball, 4 softball)
+    for ball, n_bats in (("baseball", 3), ("softball", 4)):
+        dof_ey = batch.dof.sel(quantity=f"e_y_implied:{ball}:").values
+        dof_ratio = batch.dof.sel(quantity=f"tan_ratio_slope:{ball}:").values
+        np.testing.assert_array_equal(dof_ratio - dof_ey, n_bats)
 
 
 @pytest.mark.slow

@@ -260,6 +260,8 @@ def run_replicate(
         if n is not None and "bat" in n.dims:
             n = n.sel(bat=row["bat"])
         dof = math.inf if n is None else int(n) - dof_of.get(var, 1)
+        if q == "e_y_implied":  # its sandwich has n / (n - k) for the k = bats + 1 slopes it rests on
+            dof = int(n) - (int((fit["e_x_n"].sel(ball=row["ball"]) > 0).sum()) + 1)
         rows.append({**{k: row[k] for k in ("quantity", "ball", "bat", "value", "uncertainty", "truth")}, "dof": dof})
     if "eta2" in STUDY_QUANTITIES:
         rec_truth = reconstruct(normalize(_truth_source(src), v_ref_mph=settings.v_ref_mph), balls, bats)
