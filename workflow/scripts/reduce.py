@@ -7,12 +7,14 @@ from ballbat.tracks.stage import excluded_listing, reduce_stage
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     inp = snakemake.input
+    files = snakemake.params.files  # as the config names them: a missing one is reported by the reader
+    lab = "tracks" in files  # a lab's tracks; else the rendered tracks.nc, which holds its impact table
     ds = reduce_stage(
-        inp.tracks,
-        inp.get("impacts"),
+        files["tracks"] if lab else inp.tracks,
+        files["tracks_impacts"] if lab else None,
         snakemake.params.settings,
-        inp.balls,
-        inp.bats,
+        files["balls"],
+        files["bats"],
         where=snakemake.params.where,
     )
     excluded = excluded_listing(ds)
@@ -25,5 +27,5 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         title=f"Impacts of dataset {snakemake.wildcards.dataset} reduced from raw camera tracks (Sec. II)",
         rule=snakemake.rule,
         inputs=data_inputs(inp),
-        config=dict(snakemake.params),
+        config={k: v for k, v in snakemake.params.items() if k != "files"},
     )
