@@ -1,5 +1,6 @@
 """Rule reduce: adapter around ballbat.tracks.stage.reduce_stage."""
 
+from ballbat.pipeline.checked import verify_netcdf
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import logged
@@ -9,6 +10,8 @@ with logged(snakemake.log[0], snakemake.rule) as log:
     inp = snakemake.input
     files = snakemake.params.files  # as the config names them: a missing one is reported by the reader
     lab = "tracks" in files  # a lab's tracks; else the rendered tracks.nc, which holds its impact table
+    if not lab:
+        verify_netcdf(inp.tracks)  # the workflow's own product: checked whole before use
     ds = reduce_stage(
         files["tracks"] if lab else inp.tracks,
         files["tracks_impacts"] if lab else None,

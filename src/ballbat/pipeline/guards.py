@@ -190,7 +190,8 @@ def unwritable(folder: str | os.PathLike[str]) -> str | None:
     while not p.exists() and p != p.parent:
         p = p.parent
     if p.is_dir() and not os.access(p, os.W_OK | os.X_OK):
-        return f"{Path.cwd() if p == Path('.') else p}: folder is read-only; the workflow writes its results and Snakemake its records here"
+        where = Path.cwd() if p == Path(".") else p
+        return f"{where}: folder is read-only; the workflow writes its results and Snakemake its records here"
     return None
 
 
