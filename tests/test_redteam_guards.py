@@ -76,7 +76,10 @@ RED_TEAM = {
     ),
     "`--keep-going` with a dataset whose tracks file is missing": (
         "only that dataset's reduce job fails, naming the file; the others complete",
-        ["test_missing_tracks_file_stops_only_its_dataset"],
+        [
+            "test_missing_tracks_file_stops_only_its_dataset",
+            "test_check_inputs_names_a_missing_file_and_refuses_a_damaged_product",
+        ],
     ),
 }
 
@@ -237,6 +240,24 @@ def test_a_job_removes_only_what_the_workflow_wrote(tmp_path, monkeypatch):
         with logged("log/user.log", "r"):
             read_dataset(user)
     assert user.exists()
+
+
+def test_check_inputs_names_a_missing_file_and_refuses_a_damaged_product(tmp_path, monkeypatch):
+    from snakemake.iocontainers import Namedlist
+
+    from ballbat.properties import InputError
+
+    monkeypatch.chdir(tmp_path)
+    files = {"tracks": "lab/tracks.csv", "tracks_impacts": "lab", "balls": "b.csv", "bats": "t.csv"}
+    Path("lab").mkdir()
+    with pytest.raises(InputError) as err:
+        guards.check_inputs(Namedlist(fromdict={"tracks": [], "impacts": [], "balls": "b.csv"}), files)
+    assert err.value.problems == ["lab/tracks.csv: file not found", "lab: is a directory, not a file"]
+    product = write_product(Path("results") / "d" / "tracks.nc")
+    with open(product, "r+b") as fh:
+        fh.truncate(product.stat().st_size - 10)
+    with pytest.raises(DamagedFileError, match=r"results/d/tracks\.nc: truncated"):
+        guards.check_inputs(Namedlist(fromdict={"tracks": str(product)}), files)
 
 
 # --- the workflow ----------------------------------------------------------------------------

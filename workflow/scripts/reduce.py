@@ -1,23 +1,21 @@
 """Rule reduce: adapter around ballbat.tracks.stage.reduce_stage."""
 
-from ballbat.pipeline.checked import verify_netcdf
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import logged
 from ballbat.tracks.stage import excluded_listing, reduce_stage
 
 with logged(snakemake.log[0], snakemake.rule) as log:
+    from ballbat.pipeline.guards import check_inputs
+
+    check_inputs(snakemake.input, snakemake.params.files)  # a missing file fails this job, naming it
     inp = snakemake.input
-    files = snakemake.params.files  # as the config names them: a missing one is reported by the reader
-    lab = "tracks" in files  # a lab's tracks; else the rendered tracks.nc, which holds its impact table
-    if not lab:
-        verify_netcdf(inp.tracks)  # the workflow's own product: checked whole before use
     ds = reduce_stage(
-        files["tracks"] if lab else inp.tracks,
-        files["tracks_impacts"] if lab else None,
+        inp.tracks,
+        inp.get("impacts"),
         snakemake.params.settings,
-        files["balls"],
-        files["bats"],
+        inp.balls,
+        inp.bats,
         where=snakemake.params.where,
     )
     excluded = excluded_listing(ds)
