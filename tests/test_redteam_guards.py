@@ -128,6 +128,12 @@ def test_verify_netcdf_reads_every_byte(tmp_path):
         verify_netcdf(path)
 
 
+def test_sealed_files_are_byte_identical_on_rewrite(tmp_path):
+    a = write_product(tmp_path / "a" / "x.nc").read_bytes()
+    b = write_product(tmp_path / "b" / "x.nc").read_bytes()
+    assert a == b
+
+
 def test_sealed_csv_refuses_a_truncated_table(tmp_path):
     table = compare.to_csv([{c: "1" for c in compare.COLUMNS} | {"quantity": f"q{i}"} for i in range(41)])
     path = tmp_path / "paper_comparison.csv"
