@@ -316,7 +316,7 @@ def test_parsing_removes_nothing(run):
     with open(own, "r+b") as fh:
         fh.truncate(own.stat().st_size // 2)
     before = {p: p.read_bytes() for p in (user, own)}
-    for args in (["-n"], ["--summary"]):
+    for args in (["-n"], ["--summary"], ["--lint"]):
         out = snakemake(run, *args)
         assert {p: p.read_bytes() for p in (user, own)} == before, args
         assert "results/small/reconstruct.nc: truncated" in out.stderr, args
