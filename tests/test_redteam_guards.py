@@ -74,13 +74,6 @@ RED_TEAM = {
         "refused, never removed",
         ["test_a_job_removes_only_what_the_workflow_wrote"],
     ),
-    "`--keep-going` with a dataset whose tracks file is missing": (
-        "only that dataset's reduce job fails, naming the file; the others complete",
-        [
-            "test_missing_tracks_file_stops_only_its_dataset",
-            "test_check_inputs_names_a_missing_file_and_refuses_a_damaged_product",
-        ],
-    ),
 }
 
 
@@ -246,24 +239,6 @@ def test_a_job_removes_only_what_the_workflow_wrote(tmp_path, monkeypatch):
         with logged("log/user.log", "r"):
             read_dataset(user)
     assert user.exists()
-
-
-def test_check_inputs_names_a_missing_file_and_refuses_a_damaged_product(tmp_path, monkeypatch):
-    from snakemake.iocontainers import Namedlist
-
-    from ballbat.properties import InputError
-
-    monkeypatch.chdir(tmp_path)
-    files = {"tracks": "lab/tracks.csv", "tracks_impacts": "lab", "balls": "b.csv", "bats": "t.csv"}
-    Path("lab").mkdir()
-    with pytest.raises(InputError) as err:
-        guards.check_inputs(Namedlist(fromdict={"tracks": [], "impacts": [], "balls": "b.csv"}), files)
-    assert err.value.problems == ["lab/tracks.csv: file not found", "lab: is a directory, not a file"]
-    product = write_product(Path("results") / "d" / "tracks.nc")
-    with open(product, "r+b") as fh:
-        fh.truncate(product.stat().st_size - 10)
-    with pytest.raises(DamagedFileError, match=r"results/d/tracks\.nc: truncated"):
-        guards.check_inputs(Namedlist(fromdict={"tracks": str(product)}), files)
 
 
 # --- the workflow ----------------------------------------------------------------------------
@@ -438,16 +413,3 @@ def test_truncated_table_is_never_used(run):
         assert not csv.exists()  # the workflow wrote it: removed, so that the next run rebuilds it
     snakemake(run, "-c2")
     assert csv.read_text() == text
-
-
-@pytest.mark.slow
-def test_missing_tracks_file_stops_only_its_dataset(run):
-    """A lab dataset whose tracks file is missing fails its own job under --keep-going; the others go on."""
-    gone = yaml.safe_load((run / "config" / "examples" / "tracked.yaml").read_text())["datasets"]["tracked"]
-    gone["tracks"]["file"] = "nothere_tracks.csv"
-    (run / "gone.yaml").write_text(yaml.safe_dump({"datasets": {"gone": gone}}))
-    (run / "results" / "small" / "fit_ex.nc").unlink()
-    out = snakemake(run, "-c2", "--keep-going", "--configfile", "gone.yaml", check=False)
-    assert out.returncode != 0 and "MissingInputException" not in out.stderr
-    assert (run / "results" / "small" / "fit_ex.nc").exists()  # the good dataset went on
-    assert "nothere_tracks.csv: file not found" in (run / "results" / "gone" / "logs" / "reduce.log").read_text()

@@ -274,10 +274,10 @@ def write_table(
     ``warnings`` (those of the measured file, carried from ingest.nc) are listed under the
     Markdown table; the CSV has their count as the row ``n_warnings``.
     """
-    from .pipeline.ncio import atomic_write_text, write_table_csv
+    from .pipeline.ncio import atomic_write_text
 
     table = comparison_table(rows, published)
-    write_table_csv(csv_path, to_csv(table))
+    atomic_write_text(csv_path, to_csv(table))
     md = to_markdown(table, title)
     if warnings:
         md += "\n## Warnings\n\n" + "".join(f"- {w}\n" for w in warnings)

@@ -172,7 +172,7 @@ def get_tracks_inputs(wildcards):
     """A lab's tracks and impacts files, or the rendered tracks.nc (which holds its impact table)."""
     d = dataset_config(wildcards)
     if "tracks" in d:
-        return {"tracks": existing(d["tracks"]["file"]), "impacts": existing(d["tracks"]["impacts"])}
+        return {"tracks": d["tracks"]["file"], "impacts": d["tracks"]["impacts"]}
     return {"tracks": f"results/{wildcards.dataset}/tracks.nc"}
 
 

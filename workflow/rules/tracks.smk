@@ -55,7 +55,6 @@ rule reduce:
         settings=get_reduce_settings,
         where=get_reduce_where,
         sha256=data_hashes,
-        files=data_files,
     script:
         "../scripts/reduce.py"
 

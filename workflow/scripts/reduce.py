@@ -6,9 +6,6 @@ from ballbat.pipeline.runlog import logged
 from ballbat.tracks.stage import excluded_listing, reduce_stage
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    from ballbat.pipeline.guards import check_inputs
-
-    check_inputs(snakemake.input, snakemake.params.files)  # a missing file fails this job, naming it
     inp = snakemake.input
     ds = reduce_stage(
         inp.tracks,
@@ -28,5 +25,5 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         title=f"Impacts of dataset {snakemake.wildcards.dataset} reduced from raw camera tracks (Sec. II)",
         rule=snakemake.rule,
         inputs=data_inputs(inp),
-        config={k: v for k, v in snakemake.params.items() if k != "files"},
+        config=dict(snakemake.params),
     )

@@ -1,6 +1,6 @@
 """Rule study_aggregate: adapter around ballbat.studies (combine, coverage)."""
 
-from ballbat.pipeline.ncio import read_dataset, write_job_output, write_table_csv
+from ballbat.pipeline.ncio import atomic_write_text, read_dataset, write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.plotting import coverage_figure, save_figure
 from ballbat.studies import combine, coverage, coverage_csv, truths_from_dataset
@@ -12,5 +12,5 @@ with logged(snakemake.log[0], snakemake.rule) as log:
     for line in coverage_csv(cov).splitlines()[1:]:
         log.info("%s", line)
     write_job_output(cov, snakemake, "coverage", f"Study {study}: coverage of every reported uncertainty")
-    write_table_csv(snakemake.output.csv, coverage_csv(cov))
+    atomic_write_text(snakemake.output.csv, coverage_csv(cov))
     save_figure(coverage_figure(cov, point=0), snakemake.output.png)

@@ -223,32 +223,3 @@ def warnings_summary(
                 if " WARNING " in line or line.startswith("WARNING"):
                     lines.append(f"{log}: {line.split('WARNING', 1)[1].strip(' :')}")
     return lines
-
-
-#: A rule's named input -> the key of :func:`data_files` (common.smk) that names its file in the config.
-_INPUT_FILES = {"tracks": "tracks", "impacts": "tracks_impacts", "balls": "balls", "bats": "bats"}
-
-
-def check_inputs(named_input: object, files: dict) -> None:
-    """Check a job's inputs before use: each file the config names is there, each product is whole.
-
-    The workflow leaves a missing or misnamed data file out of a job's inputs (``existing`` in
-    common.smk), so that only that dataset's job fails (``--keep-going`` goes on with the
-    others); here it fails, with an input error naming the file and what it is. A NetCDF input
-    under ``results/`` (a product of the workflow, such as rendered tracks) is verified whole
-    (:func:`ballbat.pipeline.checked.verify_netcdf`).
-    """
-    from ..properties import InputError
-    from .checked import verify_netcdf
-
-    problems = []
-    for name, key in _INPUT_FILES.items():
-        if name in named_input.keys() and not named_input[name] and key in files:
-            path = Path(files[key])
-            what = "is a directory, not a file" if path.is_dir() else "file not found"
-            problems.append(f"{path}: {what}")
-    if problems:
-        raise InputError(problems)
-    for path in named_input:
-        if str(path).endswith(".nc") and Path(path).parts[:1] == ("results",):
-            verify_netcdf(path)

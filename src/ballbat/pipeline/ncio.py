@@ -123,19 +123,20 @@ def read_dataset(path: str | os.PathLike[str], require: tuple[str, ...] = ()) ->
     return ds
 
 
-def write_table_csv(path: str | os.PathLike[str], text: str) -> Path:
-    """Write a CSV table atomically, ending in its checked last line (:func:`~ballbat.pipeline.checked.sealed_csv`)."""
-    return atomic_write_text(path, sealed_csv(text))
-
-
 def read_table_csv(path: str | os.PathLike[str]) -> str:
     """Return the text of a CSV table the workflow wrote, verified whole (without its check line)."""
     return read_sealed_csv(path)
 
 
 def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
-    """Write a text file atomically (temporary file renamed into place)."""
+    """Write a text file atomically (temporary file renamed into place).
+
+    A CSV table (``.csv``) ends in its check line (:func:`~ballbat.pipeline.checked.sealed_csv`),
+    so that a table cut short is never used (:func:`read_table_csv`).
+    """
     path = Path(path)
+    if path.suffix == ".csv":
+        text = sealed_csv(text)
     with atomic_target(path) as tmp:
         tmp.write_text(text, newline="")
     return path
