@@ -18,7 +18,7 @@ import xarray as xr
 
 from .. import __version__
 from .atomic import atomic_target
-from .checked import CHECKSUM_ATTR, read_sealed_csv, seal_netcdf, sealed_csv, verify_netcdf
+from .checked import CHECKSUM_ATTR, read_sealed_csv, seal_netcdf, verify_netcdf
 from .provenance import data_inputs, provenance_attrs
 
 if TYPE_CHECKING:
@@ -129,14 +129,8 @@ def read_table_csv(path: str | os.PathLike[str]) -> str:
 
 
 def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:
-    """Write a text file atomically (temporary file renamed into place).
-
-    A CSV table (``.csv``) ends in its check line (:func:`~ballbat.pipeline.checked.sealed_csv`),
-    so that a table cut short is never used (:func:`read_table_csv`).
-    """
+    """Write a text file atomically (temporary file renamed into place)."""
     path = Path(path)
-    if path.suffix == ".csv":
-        text = sealed_csv(text)
     with atomic_target(path) as tmp:
         tmp.write_text(text, newline="")
     return path
