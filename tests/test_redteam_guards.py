@@ -230,12 +230,15 @@ def test_a_job_removes_only_what_the_workflow_wrote(tmp_path, monkeypatch):
     with open(own, "r+b") as fh:
         fh.truncate(own.stat().st_size // 2)
     user = Path("results") / "user.nc"
-    xr.Dataset({"x": ("n", np.arange(3.0))}).to_netcdf(user, format="NETCDF4")
+    xr.Dataset({"x": ("n", np.arange(3000.0))}).to_netcdf(user, format="NETCDF4")
+    assert netcdf_problem(user) is None  # a whole file of the user's is read as it is
+    with open(user, "r+b") as fh:
+        fh.truncate(user.stat().st_size // 2)
     with pytest.raises(DamagedFileError, match=r"own\.nc: truncated.*removed \(this workflow wrote it\)"):
         with logged("log/own.log", "r"):
             read_dataset(own)
     assert not own.exists()
-    with pytest.raises(DamagedFileError, match=r"user\.nc: not written by this workflow.*left alone"):
+    with pytest.raises(DamagedFileError, match=r"user\.nc: truncated.*not written by this workflow, so left alone"):
         with logged("log/user.log", "r"):
             read_dataset(user)
     assert user.exists()

@@ -135,9 +135,9 @@ def seal_netcdf(path: str | os.PathLike[str]) -> str:
 def netcdf_problem(path: str | os.PathLike[str]) -> str | None:
     """Return why the NetCDF file ``path`` is not whole, reading every byte of it; None when it is.
 
-    A file without the checksum is not refused here when it carries the workflow's provenance
-    (written before files were sealed); :func:`ballbat.pipeline.guards.written_by_workflow`
-    says whether it does.
+    A file without the checksum (written before files were sealed, or not by the workflow) is
+    judged by its header alone; :func:`ballbat.pipeline.guards.written_by_workflow` says whether
+    the workflow wrote it (a run never replaces, and a job never removes, a file it did not write).
     """
     from .guards import hdf5_problem
 
@@ -149,10 +149,8 @@ def netcdf_problem(path: str | os.PathLike[str]) -> str | None:
     try:
         with netCDF4.Dataset(path, "r") as nc:
             recorded = nc.getncattr(CHECKSUM_ATTR) if CHECKSUM_ATTR in nc.ncattrs() else None
-            if recorded is None:
-                if "provenance_rule" in nc.ncattrs():
-                    return None
-                return "not written by this workflow (no provenance record)"
+            if recorded is None:  # not sealed: an older result, or a file the workflow did not write
+                return None
             found = _content_sha256(nc)
     except (OSError, RuntimeError, ValueError, KeyError, IndexError, TypeError) as err:
         return f"damaged: netCDF cannot read it ({type(err).__name__}: {str(err).splitlines()[0] if str(err) else ''})"
