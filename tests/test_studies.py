@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import copy
+import csv
+import io
 import math
 
 import numpy as np
@@ -13,6 +15,7 @@ from scipy import stats
 
 from ballbat import studies
 from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.pipeline.ncio import read_table_csv
 
 
 def settings(config, name="calibration", **over):
@@ -210,8 +213,6 @@ def test_replicates_cover_the_truth(config, balls, bats):
 @pytest.mark.slow
 def test_study_rules_through_snakemake(tmp_path):
     """`snakemake studies`: batches, coverage and design files with units and provenance; `all` runs none."""
-    import csv
-
     from workflow_helpers import assert_cf, assert_not_blank, make_workdir, planned_jobs, snakemake
 
     wd = make_workdir(tmp_path)
@@ -238,11 +239,9 @@ def test_study_rules_through_snakemake(tmp_path):
         truth.truth.sel(quantity=judged).values, cov.mean_truth.sel(quantity=judged).values, rtol=1e-12, equal_nan=True
     )
     assert int(cov.n_replicates.max()) == 4
-    with open(res / "calibration" / "coverage.csv") as fh:
-        rows = list(csv.DictReader(fh))
+    rows = list(csv.DictReader(io.StringIO(read_table_csv(res / "calibration" / "coverage.csv"))))
     assert len(rows) == 21 and set(rows[0]) == set(studies.COVERAGE_COLUMNS)
-    with open(res / "design" / "design.csv") as fh:
-        design = list(csv.DictReader(fh))
+    design = list(csv.DictReader(io.StringIO(read_table_csv(res / "design" / "design.csv"))))
     assert [r["setting"] for r in design] == ["5"] * 7 + ["8"] * 7
     assert all(float(r["impacts_required"]) >= 3 for r in design)
     for png in ("calibration/coverage.png", "design/coverage.png", "design/design.png"):

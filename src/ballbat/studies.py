@@ -608,18 +608,22 @@ COVERAGE_COLUMNS = (
 
 
 def _csv_text(header: Sequence[str], rows: Iterable[Sequence]) -> str:
-    """Return CSV text: strings as they are, numbers as in paper_comparison.csv (empty when not finite)."""
+    """Return CSV text: strings as they are, numbers as in paper_comparison.csv (empty when not finite).
+
+    The table ends in its check line (:func:`ballbat.pipeline.checked.sealed_csv`).
+    """
     import csv
     import io
 
     from .compare import format_number
+    from .pipeline.checked import sealed_csv
 
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(header)
     for row in rows:
         w.writerow([x if isinstance(x, str) else format_number(x) for x in row])
-    return buf.getvalue()
+    return sealed_csv(buf.getvalue())  # its check line: a table cut short is never used
 
 
 def coverage_csv(cov: xr.Dataset) -> str:
