@@ -3,13 +3,54 @@ with the lock file. `make lint` runs ruff, snakefmt and `snakemake --lint`; thes
 ones no linter does.
 """
 
+import ast
 import importlib
 import inspect
 import pkgutil
+from pathlib import Path
 
 import yaml
 
 import ballbat
+
+#: The plotting layer: the only modules of the package that may import matplotlib (issue 20).
+PLOTTING_LAYER = {"ballbat.plotting", "ballbat.plotting_tracks"}
+
+
+def _imported_top_packages(source: str) -> set[str]:
+    """The top-level packages a module's source imports (anywhere in it, also inside functions)."""
+    found = set()
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            found.update(alias.name.split(".")[0] for alias in node.names)
+        elif isinstance(node, ast.ImportFrom) and node.level == 0 and node.module:
+            found.add(node.module.split(".")[0])
+    return found
+
+
+def test_import_scan_sees_every_form_of_import():
+    """The scan below finds matplotlib however it is imported, and not where it is only named."""
+    for source in (
+        "import matplotlib",
+        "import matplotlib.pyplot as plt",
+        "from matplotlib.figure import Figure",
+        "def f():\n    from matplotlib import cm\n",
+    ):
+        assert "matplotlib" in _imported_top_packages(source), source
+    assert "matplotlib" not in _imported_top_packages('"""Nothing here imports matplotlib."""\nimport numpy')
+
+
+def test_only_the_plotting_layer_imports_matplotlib():
+    """No module under src/ballbat except the plotting layer imports matplotlib: figures sit on top."""
+    root = Path(ballbat.__file__).parent
+    importers = set()
+    for path in sorted(root.rglob("*.py")):
+        parts = path.relative_to(root.parent).with_suffix("").parts
+        name = ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+        if "matplotlib" in _imported_top_packages(path.read_text(encoding="utf-8")):
+            importers.add(name)
+    assert importers - PLOTTING_LAYER == set(), f"modules below the plotting layer import matplotlib: {importers}"
+    assert importers == PLOTTING_LAYER  # the scan does see the layer's own imports
 
 
 def _public_functions():
