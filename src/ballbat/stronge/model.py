@@ -37,6 +37,7 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -334,47 +335,83 @@ def _stick_event(th0, end, u0, s0, rho, Lam, e, thf):
     # local maxima of g strictly before the first sampled crossing
     jj = np.arange(K)[None, :]
     cand = (gp[:, :-1] > 0) & (gp[:, 1:] < 0) & (jj + 1 < first[:, None]) & np.isfinite(L_)
-    ci, cj = np.nonzero(cand)
-    if ci.size:
-        a0, au, as_, ar, aL, ae, af = th0[ci], u0[ci], s0[ci], rho[ci], Lam[ci], e[ci], thf[ci]
-        Sa, Sb = S[ci, cj], S[ci, cj + 1]
-        sgc = np.sign(np.where(np.abs(Sa) > np.abs(Sb), Sa, Sb))
-
-        def dg(x):
-            U1, S1 = _stick_state(a0, au, as_, ar, x)
-            N1, dN1, _ = _normal(x, ae, af)
-            d2N = np.where(x > HALF_PI, -N1 / ae**2, -N1)
-            # minus g' so that the bracket convention f(lo) <= 0 < f(hi) holds
-            return -(sgc * U1 - aL * dN1), -(-sgc * ar * ar * S1 - aL * d2N)
-
-        xm = _newton_bracketed(dg, 0.5 * (grid[ci, cj] + grid[ci, cj + 1]), grid[ci, cj], grid[ci, cj + 1])
-        _, S1 = _stick_state(a0, au, as_, ar, xm)
-        N1, _, _ = _normal(xm, ae, af)
-        # a maximum that only touches zero (the edge of stick, e.g. at a re-stick) is not a
-        # crossing: require it to stand clear of rounding
-        up = (sgc * S1 - aL * N1 > 1e-12 * np.abs(S1)) & (xm > a0 + 1e-9)
-        if np.any(up):
-            ui, first_idx = np.unique(ci[up], return_index=True)
-            pick = np.flatnonzero(up)[first_idx]
-            has[ui] = True
-            lo[ui] = grid[ci[pick], cj[pick]]
-            hi[ui] = xm[pick]
-            sg[ui] = sgc[pick]
+    piece = _StickPiece(th0, u0, s0, rho, Lam, e, thf)
+    _crossings_at_maxima(piece, np.nonzero(cand), grid, S, has, lo, hi, sg)
     out = np.full(th0.shape, np.nan)
     sig = np.zeros(th0.shape)
     i = np.flatnonzero(has)
     if i.size == 0:
         return out, sig
-    a0, au, as_, ar, aL, ae, af, sgi = th0[i], u0[i], s0[i], rho[i], Lam[i], e[i], thf[i], sg[i]
+    crossing, sign_s = piece.take(i), sg[i]
 
     def F(x):
-        U1, S1 = _stick_state(a0, au, as_, ar, x)
-        N1, dN1, _ = _normal(x, ae, af)
-        return sgi * S1 - aL * N1, sgi * U1 - aL * dN1
+        U1, S1 = crossing.state(x)
+        N1, dN1, _ = crossing.normal(x)
+        return sign_s * S1 - crossing.Lam * N1, sign_s * U1 - crossing.Lam * dN1
 
     out[i] = _newton_bracketed(F, hi[i].copy(), lo[i], hi[i])
-    sig[i] = sgi
+    sig[i] = sign_s
     return out, sig
+
+
+class _StickPiece(NamedTuple):
+    """One stick piece per impact: where it starts (theta, U, S) and the impact's parameters."""
+
+    th0: NDArray  # theta at the start of the piece
+    u0: NDArray  # U at the start
+    s0: NDArray  # S at the start
+    rho: NDArray  # Omega_t/Omega_n
+    Lam: NDArray  # the friction bound of S over N/N_max
+    e: NDArray  # e_y
+    thf: NDArray  # theta at separation
+
+    def take(self, i) -> _StickPiece:
+        """Return the pieces of the impacts ``i``."""
+        return _StickPiece(*(a[i] for a in self))
+
+    def state(self, th):
+        """Return (U, S) at ``th`` in this stick piece."""
+        return _stick_state(self.th0, self.u0, self.s0, self.rho, th)
+
+    def normal(self, th):
+        """Return N/N_max, its derivative and its integral at ``th`` (:func:`_normal`)."""
+        return _normal(th, self.e, self.thf)
+
+
+def _crossings_at_maxima(piece: _StickPiece, cand, grid, S, has, lo, hi, sg) -> None:
+    """Check the local maxima of g = |S| - Lam N between two grid points; mark the crossings.
+
+    ``cand`` (rows, columns) are the grid intervals where g' changes from + to -. Each maximum
+    is located by Newton on g'; one that stands clear of zero is a crossing, and the first
+    per impact replaces that impact's bracket (``has``, ``lo``, ``hi``, ``sg``, in place).
+    """
+    ci, cj = cand
+    if ci.size == 0:
+        return
+    at_max = piece.take(ci)
+    Sa, Sb = S[ci, cj], S[ci, cj + 1]
+    sgc = np.sign(np.where(np.abs(Sa) > np.abs(Sb), Sa, Sb))
+
+    def dg(x):
+        U1, S1 = at_max.state(x)
+        N1, dN1, _ = at_max.normal(x)
+        d2N = np.where(x > HALF_PI, -N1 / at_max.e**2, -N1)
+        # minus g' so that the bracket convention f(lo) <= 0 < f(hi) holds
+        return -(sgc * U1 - at_max.Lam * dN1), -(-sgc * at_max.rho * at_max.rho * S1 - at_max.Lam * d2N)
+
+    xm = _newton_bracketed(dg, 0.5 * (grid[ci, cj] + grid[ci, cj + 1]), grid[ci, cj], grid[ci, cj + 1])
+    _, S1 = at_max.state(xm)
+    N1, _, _ = at_max.normal(xm)
+    # a maximum that only touches zero (the edge of stick, e.g. at a re-stick) is not a
+    # crossing: require it to stand clear of rounding
+    up = (sgc * S1 - at_max.Lam * N1 > 1e-12 * np.abs(S1)) & (xm > at_max.th0 + 1e-9)
+    if np.any(up):
+        ui, first_idx = np.unique(ci[up], return_index=True)
+        pick = np.flatnonzero(up)[first_idx]
+        has[ui] = True
+        lo[ui] = grid[ci[pick], cj[pick]]
+        hi[ui] = xm[pick]
+        sg[ui] = sgc[pick]
 
 
 def _slip_step(th0, u0, sig, rho, Lam, e, thf):
