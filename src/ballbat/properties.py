@@ -176,6 +176,48 @@ def read_csv_table(path: str | os.PathLike[str], required: Sequence[str]) -> tup
     return header, rows
 
 
+def cell_number(raw: str, at: str, problems: list[str], empty: str = "empty", integer: bool = False) -> float:
+    """Return a table cell's text as a finite number, or NaN with the problem added to ``problems``.
+
+    ``at`` names the file, the row and the column; ``empty`` is the message for an empty
+    cell; ``integer`` also requires a whole number (a frame number).
+    """
+    if raw == "":
+        problems.append(f"{at}: {empty}")
+        return math.nan
+    try:
+        val = float(raw)
+    except ValueError:
+        problems.append(f"{at}: {raw!r} is not a number")
+        return math.nan
+    if not math.isfinite(val):
+        problems.append(f"{at}: {raw!r} is not finite")
+        return math.nan
+    if integer and val != int(val):
+        problems.append(f"{at}: {raw!r} is not a whole frame number")
+        return math.nan
+    return val
+
+
+def table_keys(row: dict, at: str, balls: dict | None, bats: dict | None, problems: list[str]) -> dict[str, str]:
+    """Return a row's ``bat`` and ``ball`` cells, each checked against its property table.
+
+    An empty cell, or a name not in its table, is added to ``problems`` (``at`` names the
+    file and row); a table that is None (itself bad) is not checked against.
+    """
+    names = {}
+    for key, table in (("bat", bats), ("ball", balls)):
+        name = row.get(key, "")
+        if not name:
+            problems.append(f"{at}, column {key}: empty")
+        elif table is not None and name not in table:
+            problems.append(
+                f"{at}, column {key}: {key} {name!r} is not in the {key} table (known: {', '.join(sorted(table))})"
+            )
+        names[key] = name
+    return names
+
+
 def cell_text(v: object) -> str:
     """Return a NetCDF cell as the text a CSV cell would hold (NaN and None as empty)."""
     if isinstance(v, bytes):

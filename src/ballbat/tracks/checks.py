@@ -536,7 +536,7 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
         with enough usable impacts. The messages give the numbers, the setting most likely
         wrong, and the count of every exclusion reason.
     """
-    from ..ingest import implausible_rows
+    from ..ingest import Measured, implausible_rows
     from ..linefit import MIN_FIT_IMPACTS
     from ..properties import InputError, recoil_factors
     from .reduce import STAGE, TAU_PRIOR_FRAMES, ReduceFlag, contact_start
@@ -670,15 +670,9 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
     v = red.values
     live = (flag == 0) & np.all([np.isfinite(v[k]) for k in ("v_bat", "v_ball", "theta", "omega")], axis=0)
     if live.any():
+        measured = Measured(v["v_bat"], v["v_ball"], v["theta"], v["omega"], r, alpha, r_x, r_y)
         why = implausible_rows(
-            v["v_bat"][live],
-            v["v_ball"][live],
-            v["theta"][live],
-            v["omega"][live],
-            r[live],
-            alpha[live],
-            r_x[live],
-            r_y[live],
+            measured.take(live),
             # one group per impact: the group-outlier test (a unit mistake in some rows of a file)
             # does not apply to a reduction, whose rows share their settings; the ranges do
             np.arange(int(live.sum())),
