@@ -56,6 +56,8 @@ from .properties import (
     InputError,
     cell_number,
     cell_text,
+    check_impact_id,
+    header_problems,
     load_balls,
     load_bats,
     read_csv_table,
@@ -162,25 +164,6 @@ def read_impacts_table(path: str | os.PathLike[str]) -> tuple[list[str], list[tu
 EMPTY_CELL = "empty (every impact needs a value; delete the row or fill it in)"
 
 
-def _header_problems(path, header: list[str]) -> list[str]:
-    """Missing, unknown and repeated columns of an impacts file's header."""
-    problems = []
-    allowed = (*REQUIRED, *OPTIONAL)
-    missing = [c for c in REQUIRED if c not in header]
-    if missing:
-        problems.append(
-            f"{path}: missing column(s) {', '.join(missing)} (required: {', '.join(REQUIRED)}; "
-            f"optional: {', '.join(OPTIONAL)})"
-        )
-    unknown = [c for c in header if c not in allowed]
-    if unknown:
-        problems.append(f"{path}: unknown column(s) {', '.join(map(repr, unknown))} (allowed: {', '.join(allowed)})")
-    repeated = sorted({c for c in header if header.count(c) > 1})
-    if repeated:
-        problems.append(f"{path}: column(s) {', '.join(repeated)} appear more than once")
-    return problems
-
-
 def _measured_cells(row: dict, at: str, problems: list[str]) -> dict[str, float]:
     """Return the four measured cells of a row as numbers (file units): speeds > 0, |theta| < 90 deg."""
     vals = {c: cell_number(row.get(c, ""), f"{at}, column {c}", problems, EMPTY_CELL) for c in MEASURED_COLUMNS}
@@ -217,7 +200,7 @@ def check_rows(
 
     ``balls`` / ``bats`` None (their table was bad) skip the membership checks.
     """
-    problems = _header_problems(path, header)
+    problems = header_problems(path, header, REQUIRED, OPTIONAL)
     if any(c not in header for c in REQUIRED):
         return {}, problems
     if not rows:
@@ -245,12 +228,7 @@ def check_rows(
             out[c].append(e)
         iid = row.get("impact_id", "") if "impact_id" in header else label
         if "impact_id" in header:
-            if not iid:
-                problems.append(f"{at}, column impact_id: empty")
-            elif iid in seen_ids:
-                problems.append(f"{at}, column impact_id: {iid!r} duplicates {seen_ids[iid]}")
-            else:
-                seen_ids[iid] = label
+            check_impact_id(iid, at, label, seen_ids, problems)
         out["impact_id"].append(iid)
         out["label"].append(label)
         # The same measurement twice (rows pasted twice) would shrink every standard error by

@@ -176,6 +176,25 @@ def read_csv_table(path: str | os.PathLike[str], required: Sequence[str]) -> tup
     return header, rows
 
 
+def header_problems(
+    path: str | os.PathLike[str], header: list[str], required: Sequence[str], optional: Sequence[str] = ()
+) -> list[str]:
+    """Return the problems of a table's header: missing, unknown and repeated columns."""
+    problems = []
+    allowed = (*required, *optional)
+    missing = [c for c in required if c not in header]
+    if missing:
+        also = f"; optional: {', '.join(optional)}" if optional else ""
+        problems.append(f"{path}: missing column(s) {', '.join(missing)} (required: {', '.join(required)}{also})")
+    unknown = [c for c in header if c not in allowed]
+    if unknown:
+        problems.append(f"{path}: unknown column(s) {', '.join(map(repr, unknown))} (allowed: {', '.join(allowed)})")
+    repeated = sorted({c for c in header if header.count(c) > 1})
+    if repeated:
+        problems.append(f"{path}: column(s) {', '.join(repeated)} appear more than once")
+    return problems
+
+
 def cell_number(raw: str, at: str, problems: list[str], empty: str = "empty", integer: bool = False) -> float:
     """Return a table cell's text as a finite number, or NaN with the problem added to ``problems``.
 
@@ -197,6 +216,16 @@ def cell_number(raw: str, at: str, problems: list[str], empty: str = "empty", in
         problems.append(f"{at}: {raw!r} is not a whole frame number")
         return math.nan
     return val
+
+
+def check_impact_id(iid: str, at: str, label: str, seen: dict[str, str], problems: list[str]) -> None:
+    """Record an impact id in ``seen`` (id -> row label), or add why it cannot be: empty or repeated."""
+    if not iid:
+        problems.append(f"{at}, column impact_id: empty")
+    elif iid in seen:
+        problems.append(f"{at}, column impact_id: {iid!r} duplicates {seen[iid]}")
+    else:
+        seen[iid] = label
 
 
 def table_keys(row: dict, at: str, balls: dict | None, bats: dict | None, problems: list[str]) -> dict[str, str]:

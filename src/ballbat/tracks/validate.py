@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from ..properties import EXTRA, cell_number, table_keys
+from ..properties import EXTRA, cell_number, check_impact_id, header_problems, table_keys
 from .checks import SCALE_ERR_MAX
 from .data import CAMERAS, POINTS
 
@@ -29,18 +29,8 @@ RIG_KEYS = ("pivot_to_tip_in", "pivot_to_impact_in")
 
 
 def check_header(path: str | os.PathLike[str], header: list[str], required: tuple[str, ...]) -> list[str]:
-    """Missing, unknown and repeated columns."""
-    problems = []
-    missing = [c for c in required if c not in header]
-    if missing:
-        problems.append(f"{path}: missing column(s) {', '.join(missing)} (required: {', '.join(required)})")
-    unknown = [c for c in header if c not in required]
-    if unknown:
-        problems.append(f"{path}: unknown column(s) {', '.join(map(repr, unknown))} (allowed: {', '.join(required)})")
-    repeated = sorted({c for c in header if header.count(c) > 1})
-    if repeated:
-        problems.append(f"{path}: column(s) {', '.join(repeated)} appear more than once")
-    return problems
+    """Missing, unknown and repeated columns (:func:`ballbat.properties.header_problems`)."""
+    return header_problems(path, header, required)
 
 
 def check_impact_rows(
@@ -58,13 +48,7 @@ def check_impact_rows(
         at = f"{path}: {label}"
         if EXTRA in row:
             problems.append(f"{at}: {row[EXTRA]} more cell(s) than the header has columns")
-        iid = row.get("impact_id", "")
-        if not iid:
-            problems.append(f"{at}, column impact_id: empty")
-        elif iid in seen:
-            problems.append(f"{at}, column impact_id: {iid!r} duplicates {seen[iid]}")
-        else:
-            seen[iid] = label
+        check_impact_id(row.get("impact_id", ""), at, label, seen, problems)
         table_keys(row, at, balls, bats, problems)
     return seen, problems
 

@@ -25,7 +25,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from . import FileTracks, FormatError, length_to_m, whole_frames
+from . import FileTracks, FormatError, finite_number, length_to_m, whole_frames
 
 if TYPE_CHECKING:
     import os
@@ -44,15 +44,7 @@ KINOVEA_UNITS = {
 
 
 def _float(text: str | None, what: str, problems: list[str]) -> float | None:
-    try:
-        v = float((text or "").strip())
-    except ValueError:
-        problems.append(f"{what}: {text!r} is not a number")
-        return None
-    if not math.isfinite(v):
-        problems.append(f"{what}: {text!r} is not finite")
-        return None
-    return v
+    return finite_number(text, f"{what}:", problems)
 
 
 def _point(text: str | None, what: str, problems: list[str]) -> tuple[float, float] | None:

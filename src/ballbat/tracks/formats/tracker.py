@@ -29,7 +29,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from . import FileTracks, FormatError, length_to_m
+from . import FileTracks, FormatError, finite_number, length_to_m
 
 if TYPE_CHECKING:
     import os
@@ -49,16 +49,7 @@ def _number(props: dict, name: str, where: str, problems: list[str], integer: bo
     p = props.get(name)
     if p is None:
         return None
-    text = (p.text or "").strip()
-    try:
-        v = int(text) if integer else float(text)
-    except ValueError:
-        problems.append(f"{where}: {name} {text!r} is not a number")
-        return None
-    if not math.isfinite(v):
-        problems.append(f"{where}: {name} {text!r} is not finite")
-        return None
-    return v
+    return finite_number((p.text or "").strip(), f"{where}: {name}", problems, integer)
 
 
 def _array(prop: ET.Element) -> dict[int, ET.Element]:
