@@ -70,6 +70,7 @@ def function_lengths(path: Path) -> list[tuple[int, int, str]]:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """List the functions of ROOT (default src) over --min lines of code, longest first."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("roots", nargs="*", default=["src"], help="folders or files to read")
     parser.add_argument("--min", type=int, default=60, help="list functions with more lines of code")
