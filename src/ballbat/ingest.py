@@ -293,8 +293,9 @@ class Measured:
     r_y: ArrayLike
 
     def take(self, sel: ArrayLike) -> Measured:
-        """Return the impacts ``sel`` (an index or boolean mask along the impacts)."""
-        return Measured(*(np.asarray(getattr(self, f.name))[sel] for f in fields(self)))
+        """Return the impacts ``sel`` (an index or boolean mask along the impacts); scalars stay as they are."""
+        values = (np.asarray(getattr(self, f.name)) for f in fields(self))
+        return Measured(*(a[sel] if a.ndim else a for a in values))
 
 
 def implausible(m: Measured) -> dict[str, tuple[int, int]]:
