@@ -50,6 +50,12 @@ GLITCH_FALSE_ALARM = 1e-9
 IMPACT_Z = 4.89
 #: z beyond which a dataset's pooled check fails (two-sided normal, 6e-7).
 DATASET_Z = 5.0
+#: z of the one-sided test of g's sign: a camera whose y points up sees g negative. A y-down
+#: camera shows at least g less the largest Magnus lift, so a g that is negative and more than
+#: FLIP_Z standard errors below that is a y axis pointing up (false alarm 1.3e-3 per camera for
+#: Gaussian errors); the two-sided test at DATASET_Z must also allow for the lift, and misses
+#: a flip whenever the lift allowance is large against g.
+FLIP_Z = 3.0
 #: A setting is wrong for the whole dataset when more than this fraction of impacts fails.
 DATASET_FRACTION = 0.5
 #: Air density (kg m-3) bounding the aerodynamic allowance (sea level, cold: 1.3).
@@ -589,6 +595,11 @@ def _check_free_fall(red: Reduction, pool, r, m, where: str, found: _Findings) -
         if abs(g - G) > allowed:
             failed.append(
                 f"{where}.cameras.{c}: {line}: g scales as m_per_px x fps^2 and changes sign when y points up"
+            )
+        elif g < 0 and g < G - lift - FLIP_Z * se:
+            failed.append(
+                f"{where}.cameras.{c}: {line}: g is negative, {(G - lift - g) / se:.1f} standard errors below "
+                "the least a camera with y pointing down shows (g less the largest lift): y points up"
             )
 
 
