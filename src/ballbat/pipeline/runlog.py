@@ -67,3 +67,10 @@ def logged(log_path: str | os.PathLike[str], rule: str) -> Iterator[logging.Logg
     finally:
         root.removeHandler(handler)
         handler.close()
+
+
+def log_exclusions(log: logging.Logger, excluded: list[str], n_impacts: int) -> None:
+    """Log how many impacts a stage excluded (kept in its file, flagged) and one line per impact."""
+    log.info("%d of %d impacts excluded (kept in the file, flagged)", len(excluded), n_impacts)
+    for line in excluded:
+        log.info("excluded: %s", line)
