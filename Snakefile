@@ -49,9 +49,9 @@ localrules:
     report_front_studies,
 
 
-# Once Snakemake holds the folder's lock, no running job of ours owns a temporary file any more.
+# When a real run starts: no file the workflow did not write is replaced; dead jobs' temporaries go.
 onstart:
-    remove_stale_temporaries()
+    start_run(workflow.dag)
 
 
 # Every warning of the run's jobs, printed at its end, success or not; after a success, the run's

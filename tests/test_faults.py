@@ -17,6 +17,7 @@ import time
 import pytest
 import yaml
 
+from ballbat.pipeline.atomic import hostname
 from ballbat.pipeline.provenance import sha256_file
 from workflow_helpers import make_workdir, snakemake
 
@@ -53,15 +54,17 @@ def test_deleted_intermediate_is_rebuilt(clean):
 
 
 def test_truncated_intermediate_is_named_and_rebuilt(clean):
+    """Named by any invocation with the command that rebuilds it; nothing removed while parsing (issue 19)."""
     wd, reference = clean
     path = wd / "results" / "maple" / "reconstruct.nc"
     with open(path, "r+b") as fh:
         fh.truncate(path.stat().st_size // 2)
-    out = snakemake(wd, "-c2", "--configfile", MAPLE)
-    assert (
-        "results/maple/reconstruct.nc: truncated" in out.stderr
-        and "removed, so that this run rebuilds it" in out.stderr
-    )
+    size = path.stat().st_size
+    out = snakemake(wd, "-n", "--configfile", MAPLE)
+    assert "results/maple/reconstruct.nc: truncated" in out.stderr
+    assert "rebuild it with: snakemake --forcerun results/maple/reconstruct.nc" in out.stderr
+    assert path.stat().st_size == size  # a dry run removes nothing
+    snakemake(wd, "-c2", "--configfile", MAPLE, "--forcerun", "results/maple/reconstruct.nc")
     assert data_files(wd) == reference
 
 
@@ -109,7 +112,9 @@ def test_job_killed_while_writing(clean):
     os.killpg(proc.pid, signal.SIGKILL)
     proc.wait(timeout=30)
     # as a job killed mid-write leaves it: a temporary file beside its output
-    stale = wd / "results" / "maple" / ".fit_ex.nc.abc123.tmp"
+    dead = subprocess.Popen([sys.executable, "-c", "pass"])
+    dead.wait()
+    stale = wd / "results" / "maple" / f".fit_ex.nc.{dead.pid}@{hostname()}.abc12345.tmp"  # its owner is dead
     stale.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 4096)
     shutil.rmtree(wd / ".snakemake" / "locks", ignore_errors=True)  # the killed run's lock
     out = snakemake(wd, "-c2", "--configfile", MAPLE, "--rerun-incomplete")

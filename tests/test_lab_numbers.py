@@ -78,12 +78,14 @@ def test_workbook_e_x_sheet(default_run, fit):
     row = rows[("baseball", "wood")]
     f = fit.sel(ball="baseball", bat="wood")
     stat, syst = float(f.e_x_err), float(f.e_x_err_scale)
-    assert [c.value for c in row[2:6]] == [float(f.e_x), stat, syst, math.hypot(stat, syst)]  # full precision
+    # full precision: openpyxl writes numbers with 16 significant digits ("%.16g"; Excel keeps 15)
+    full = [float(f.e_x), stat, syst, math.hypot(stat, syst)]
+    assert [c.value for c in row[2:6]] == pytest.approx(full, rel=1e-15, abs=0)
     fmt = _number_format(uncertainty_decimals(stat, syst))
     assert [c.number_format for c in row[2:8]] == [fmt] * 6
     assert row[names.index("e_x_n")].number_format == "0"
     pooled = rows[("softball", "pooled")]
-    assert pooled[4].value == float(fit.e_x_pooled_err_scale.sel(ball="softball"))
+    assert pooled[4].value == pytest.approx(float(fit.e_x_pooled_err_scale.sel(ball="softball")), rel=1e-15, abs=0)
     for sheet in book.worksheets:
         assert "1" not in [c.value for c in sheet[2]], sheet.title
     impacts = book["impacts"]

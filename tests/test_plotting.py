@@ -9,6 +9,7 @@ from matplotlib.figure import Figure
 from PIL import Image
 
 from ballbat import plotting, reporting
+from ballbat.pipeline.checked import sealed_csv
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.pipeline.products import build_dataset
 from ballbat.stronge.analysis import PUBLISHED_ETA2, STRONGE_COORDS, stronge_variables
@@ -156,8 +157,10 @@ def test_unknown_figure_names_the_known_ones(tmp_path):
 def test_comparison_html(tmp_path):
     csv = tmp_path / "t.csv"
     csv.write_text(
-        "quantity,ball,bat,paper,paper_uncertainty,value,uncertainty,truth,unit\n"
-        "e_x,baseball,wood,0.464,0.014,0.47,0.02,,1\n"
+        sealed_csv(  # as the workflow writes its tables: with their check line
+            "quantity,ball,bat,paper,paper_uncertainty,value,uncertainty,truth,unit\n"
+            "e_x,baseball,wood,0.464,0.014,0.47,0.02,,1\n"
+        )
     )
     text = reporting.comparison_html(csv, tmp_path / "t.html", title="A & B")
     assert "<td>0.464</td>" in text and "A &amp; B" in text

@@ -158,9 +158,9 @@ def test_a_caption_shows_its_fitted_number(page, report_root):
     page.wait_for("document.body.innerText.includes('Fig. 5 of the paper')")
     text = page.evaluate("document.body.innerText")
     fit = xr.open_dataset(report_root / "results" / name / "fit_ex.nc")
-    shown = re.search(rf"baseball: 1 \+ e_x = {NUM}.*?e_x = {NUM}", text, re.DOTALL)
+    shown = re.search(rf"baseball: e_x = {NUM} ± {NUM} \(stat\).*?slope 1 \+ e_x = {NUM}", text, re.DOTALL)
     assert shown, text[:2000]
     e_x = float(fit["e_x_pooled"].sel(ball="baseball"))
-    assert _close(shown[2], e_x) and _close(shown[1], 1 + e_x), (shown[0], e_x)
+    assert _close(shown[1], e_x) and _close(shown[3], 1 + e_x), (shown[0], e_x)
     prov = json.loads(fit.attrs["provenance_git"])
     assert prov["commit"][:12] in _front_text(page) or prov["commit"] == "unknown"

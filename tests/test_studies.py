@@ -3,6 +3,8 @@
 from __future__ import annotations
 
 import copy
+import csv
+import io
 import math
 
 import numpy as np
@@ -13,6 +15,7 @@ from scipy import stats
 
 from ballbat import studies
 from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.pipeline.ncio import read_table_csv
 
 
 def settings(config, name="calibration", **over):
@@ -199,13 +202,17 @@ def test_replicates_cover_the_truth(config, balls, bats):
     eta = batch.dof.isel(quantity=np.flatnonzero(batch.quantity_name.values == "eta2")).values
     assert eta.size == 80 and np.all((eta > 5) & (eta < 60)) and not np.all(eta == np.round(eta))
     assert "centred within bats" in str(cov.error_kind.values[list(cov.quantity_name.values).index("eta2")])
+    # implied e_y's interval has n - k degrees of freedom, k = the ball's bats + 1 (its variance's n / (n - k)):
+    # the Eq. ratio slope's n - 1 less the ball's bats (3 baseball, 4 softball)
+    for ball, n_bats in (("baseball", 3), ("softball", 4)):
+        dof_ey = batch.dof.sel(quantity=f"e_y_implied:{ball}:").values
+        dof_ratio = batch.dof.sel(quantity=f"tan_ratio_slope:{ball}:").values
+        np.testing.assert_array_equal(dof_ratio - dof_ey, n_bats)
 
 
 @pytest.mark.slow
 def test_study_rules_through_snakemake(tmp_path):
     """`snakemake studies`: batches, coverage and design files with units and provenance; `all` runs none."""
-    import csv
-
     from workflow_helpers import assert_cf, assert_not_blank, make_workdir, planned_jobs, snakemake
 
     wd = make_workdir(tmp_path)
@@ -232,11 +239,9 @@ def test_study_rules_through_snakemake(tmp_path):
         truth.truth.sel(quantity=judged).values, cov.mean_truth.sel(quantity=judged).values, rtol=1e-12, equal_nan=True
     )
     assert int(cov.n_replicates.max()) == 4
-    with open(res / "calibration" / "coverage.csv") as fh:
-        rows = list(csv.DictReader(fh))
+    rows = list(csv.DictReader(io.StringIO(read_table_csv(res / "calibration" / "coverage.csv"))))
     assert len(rows) == 21 and set(rows[0]) == set(studies.COVERAGE_COLUMNS)
-    with open(res / "design" / "design.csv") as fh:
-        design = list(csv.DictReader(fh))
+    design = list(csv.DictReader(io.StringIO(read_table_csv(res / "design" / "design.csv"))))
     assert [r["setting"] for r in design] == ["5"] * 7 + ["8"] * 7
     assert all(float(r["impacts_required"]) >= 3 for r in design)
     for png in ("calibration/coverage.png", "design/coverage.png", "design/design.png"):

@@ -204,6 +204,28 @@ def test_table_at_the_wrong_frame_rate_names_rows(tmp_path, rows):
     assert "times are not whole frames at 1500 fps (units.time 'ms'): is the frame rate or the time unit wrong?" in msg
 
 
+def test_exported_tables_name_cells_that_are_not_finite_numbers(tmp_path, rows):
+    """Both exported tables name the line and track of a cell that is not a finite number."""
+    k = tmp_path / "W05_swing.csv"
+    lines = kinovea_csv_text(rows[("W05", "swing")], 3000.0, 0.00074).splitlines()
+    cells = lines[2].split(",")
+    cells[1], cells[2] = "inf", "abc"
+    lines[2] = ",".join(cells)
+    lines[3] = ",".join([lines[3].split(",")[0], "nan", "1.0", *lines[3].split(",")[3:]])
+    k.write_text("\n".join(lines) + "\n")
+    with pytest.raises(FormatError) as exc:
+        read_kinovea_table(k, TABLE_UNITS, 3000.0, 0.00074)
+    msg = "\n".join(exc.value.problems)
+    assert f"{k}: line 3, track " in msg and "X 'inf', Y 'abc' are not numbers" in msg
+    assert f"{k}: line 4, track " in msg and "X 'nan', Y '1.0' are not finite" in msg
+    t = tmp_path / "W05_swing.txt"
+    text = tracker_table_text(rows[("W05", "swing")], 3000.0, 0.00074).splitlines()
+    first = next(i for i, ln in enumerate(text) if ln[:1].isdigit() or ln[:1] == "-")
+    t.write_text("\n".join([*text[:first], "abc" + text[first][text[first].index("\t") :], *text[first + 1 :]]))
+    with pytest.raises(FormatError, match=rf"line {first + 1}, column t: 'abc' is not a number"):
+        read_tracker_table(t, {"time": "s", "length": "m", "y": "up"}, 3000.0, 0.00074)
+
+
 def test_tables_need_units_and_settings(tmp_path, rows):
     write_lab_folder(tmp_path, EXAMPLE / "tracked_tracks.csv", "kinovea_csv", CAMS)
     with pytest.raises(FormatError) as exc:

@@ -253,7 +253,7 @@ def test_bat_slows_only_pre_impact_frames_used(swing_fps):
 
 def test_qa_figures_draw_the_fits(tmp_path):
     """The QA figure shows usable and excluded impacts with fitted lines through the tracked points."""
-    from ballbat.tracks.qa import impacts_figure, pick_impacts, save_figure, summary_figure
+    from ballbat.plotting_tracks import impacts_figure, pick_impacts, save_figure, summary_figure
 
     tr, s = render(experiment(11, per_bat=3), render_cfg(tilted_fraction=0.3))
     red = reduction_dataset(reduce(tr, s))

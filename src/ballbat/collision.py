@@ -142,22 +142,9 @@ def pitched_ball_collision(
     ``theta = psi - atan(v_t / v_n)``; the derivation is in ``docs/collision.md``
     (docs/model.md, "Collision of a pitched, spinning ball").
     """
-    D, v_pitch, descent, spin_i, v_bat, attack, e_x, e_y = (
-        np.asarray(a, dtype=float)
-        for a in np.broadcast_arrays(D, v_pitch, pitch_descent, pitch_spin, v_bat, attack_angle, e_x, e_y)
+    D, v_pitch, descent, spin_i, v_bat, attack, e_x, e_y = _checked_inputs(
+        D, v_pitch, pitch_descent, pitch_spin, v_bat, attack_angle, e_x, e_y
     )
-    for name, arr in (
-        ("D", D),
-        ("v_pitch", v_pitch),
-        ("pitch_descent", descent),
-        ("pitch_spin", spin_i),
-        ("v_bat", v_bat),
-        ("attack_angle", attack),
-        ("e_x", e_x),
-        ("e_y", e_y),
-    ):
-        if not np.all(np.isfinite(arr)):
-            raise ValueError(f"pitched_ball_collision: {name} has non-finite values")
     m, r, alpha = ball.m, ball.r, ball.alpha
     r_x, r_y = recoil_factors(ball, bat)
     reach = r + bat.R
@@ -169,21 +156,11 @@ def pitched_ball_collision(
         )
 
     # Lab velocities in the (X, Z) plane: pitch towards -X and falling, bat towards +X.
-    vb_x, vb_z = -v_pitch * np.cos(descent), -v_pitch * np.sin(descent)
-    W_x = v_bat * np.cos(attack) - vb_x
-    W_z = v_bat * np.sin(attack) - vb_z
-    W = np.hypot(W_x, W_z)
-    if np.any(W == 0.0):
-        raise ValueError("pitched_ball_collision: the bat does not move relative to the ball (W = 0)")
-    phi_W = np.arctan2(W_z, W_x)
-
+    pitch_x, pitch_z = -v_pitch * np.cos(descent), -v_pitch * np.sin(descent)
+    W, phi_W = _relative_velocity(v_bat, attack, pitch_x, pitch_z)
     sin_psi = D / reach
-    psi = np.arcsin(sin_psi)
     cos_psi = np.sqrt(1.0 - sin_psi**2)
-    # n at angle phi_W + psi above +X; t = n rotated by -90 deg.
-    a_n = phi_W + psi
-    n_x, n_z = np.cos(a_n), np.sin(a_n)
-    t_x, t_z = n_z, -n_x
+    psi, (n_x, n_z), (t_x, t_z) = _contact_frame(sin_psi, phi_W)
 
     # Impulses from the definitions of e_y and e_x (per unit ball mass).
     W_n = W * cos_psi
@@ -192,11 +169,11 @@ def pitched_ball_collision(
     u_i = r * spin_i - W_t
     jt = -(1.0 + e_x) * u_i * alpha / ((1.0 + alpha) * (1.0 + r_x))
 
-    out_x = vb_x + jn * n_x + jt * t_x
-    out_z = vb_z + jn * n_z + jt * t_z
+    out_x = pitch_x + jn * n_x + jt * t_x
+    out_z = pitch_z + jn * n_z + jt * t_z
     spin_f = spin_i + jt / (alpha * r)
-    v_n = vb_x * n_x + vb_z * n_z + jn
-    v_t = vb_x * t_x + vb_z * t_z + jt
+    v_n = pitch_x * n_x + pitch_z * n_z + jn
+    v_t = pitch_x * t_x + pitch_z * t_z + jt
 
     friction_ratio = np.abs(jt) / jn  # jn > 0: |psi| < 90 deg and W > 0
     if mu is None:
@@ -217,3 +194,34 @@ def pitched_ball_collision(
         friction_ratio=friction_ratio,
         exceeds_mu=np.broadcast_to(exceeds, friction_ratio.shape).copy(),
     )
+
+
+def _checked_inputs(*args: ArrayLike) -> tuple[NDArray[np.float64], ...]:
+    """Broadcast the array arguments of :func:`pitched_ball_collision` to float arrays; all finite."""
+    names = ("D", "v_pitch", "pitch_descent", "pitch_spin", "v_bat", "attack_angle", "e_x", "e_y")
+    arrays = tuple(np.asarray(a, dtype=float) for a in np.broadcast_arrays(*args))
+    for name, arr in zip(names, arrays, strict=True):
+        if not np.all(np.isfinite(arr)):
+            raise ValueError(f"pitched_ball_collision: {name} has non-finite values")
+    return arrays
+
+
+def _relative_velocity(v_bat, attack, pitch_x, pitch_z) -> tuple[NDArray[np.float64], NDArray[np.float64]]:
+    """Return the speed ``|W|`` of the bat relative to the ball and the elevation of ``W``, rad."""
+    W_x = v_bat * np.cos(attack) - pitch_x
+    W_z = v_bat * np.sin(attack) - pitch_z
+    W = np.hypot(W_x, W_z)
+    if np.any(W == 0.0):
+        raise ValueError("pitched_ball_collision: the bat does not move relative to the ball (W = 0)")
+    return W, np.arctan2(W_z, W_x)
+
+
+def _contact_frame(sin_psi, phi_W):
+    """Return psi and the lab components of ``n`` and ``t`` (Eq. D: ``sin psi = D / (r + R)``).
+
+    ``n`` stands at ``phi_W + psi`` above +X; ``t`` is ``n`` rotated by -90 deg.
+    """
+    psi = np.arcsin(sin_psi)
+    normal_angle = phi_W + psi
+    n_x, n_z = np.cos(normal_angle), np.sin(normal_angle)
+    return psi, (n_x, n_z), (n_z, -n_x)

@@ -288,9 +288,10 @@ def to_markdown(table: list[dict], title: str) -> str:
 
 
 def read_csv(path: str | os.PathLike[str]) -> list[dict]:
-    """Read a comparison CSV back (strings)."""
-    with open(path, newline="") as fh:
-        return list(csv.DictReader(fh))
+    """Read a comparison CSV back (strings), verified whole (its checked last line: :mod:`ballbat.pipeline.checked`)."""
+    from .pipeline.ncio import read_table_csv
+
+    return list(csv.DictReader(io.StringIO(read_table_csv(path), newline="")))
 
 
 def write_comparison(
@@ -328,10 +329,11 @@ def write_table(
     ``warnings`` (those of the measured file, carried from ingest.nc) are listed under the
     Markdown table; the CSV has their count as the row ``n_warnings``.
     """
+    from .pipeline.checked import sealed_csv
     from .pipeline.ncio import atomic_write_text
 
     table = comparison_table(rows, published)
-    atomic_write_text(csv_path, to_csv(table))
+    atomic_write_text(csv_path, sealed_csv(to_csv(table)))  # its check line: a table cut short is never used
     md = to_markdown(table, title)
     if warnings:
         md += "\n## Warnings\n\n" + "".join(f"- {w}\n" for w in warnings)

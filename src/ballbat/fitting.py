@@ -18,8 +18,11 @@ linear in theta): their scatter is not the same everywhere, and their standard e
 the sandwich (HC3) ones, which the replicate studies (:mod:`ballbat.studies`) find
 calibrated where the scaled covariance was 10-20 % small. e_y implied by Eq. ratio inverts
 the slope with each impact's recoil factors and its bat's e_x, weighted as the fit weighs the
-impacts (:func:`implied_e_y`), with a sandwich standard error. 95 % intervals use Student's
-t with n - p degrees of freedom. Without uncertainties the fit is unweighted and the
+impacts (:func:`implied_e_y`), with a sandwich standard error. Every abscissa is measured,
+so every fit is corrected for its noise (errors in variables: the moment-corrected fit
+:func:`ballbat.linefit.eiv_line`, which the replicate studies find unbiased where plain least
+squares was attenuated by up to 0.8 standard errors: docs/studies.md). 95 % intervals use Student's t with
+n - p degrees of freedom. Without uncertainties the fit is unweighted and the
 reduced chi-square is undefined (NaN).
 
 References
@@ -133,6 +136,13 @@ def _weights(jx, jy, sigma, slope):
     return 1.0 / np.sqrt(var) if np.all(var > 0) else None
 
 
+def _noise_moments(jx, jy, sigma) -> tuple[np.ndarray, np.ndarray]:
+    """Each impact's noise variance of x and covariance of the x and y noise (zeros without uncertainties)."""
+    if sigma is None:
+        return np.zeros(len(jx)), np.zeros(len(jx))
+    return np.sum(jx**2 * sigma**2, axis=1), np.sum(jx * jy * sigma**2, axis=1)
+
+
 def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool) -> tuple[FitGrid, FitGrid]:
     """Fit Eq. omega per bat and ball and pooled per ball (usable impacts, ``flag == 0``).
 
@@ -162,7 +172,7 @@ def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool)
         r, r_x, alpha = (ds[k].values[sel] for k in ("r", "r_x", "alpha"))
         x, y, jx, jy = spin_design(*_measured(ds, sel), r, r_x, alpha)
         sig = _sigma(ds, sel)
-        fit = fit_line(x, y, jx, jy, sig)
+        fit = fit_line(x, y, jx, jy, sig, errors_in_variables=True)
         t = np.nan
         if with_truth and fit.success:
             xt, yt, _, _ = spin_design(*_measured(ds, sel, "truth_"), r, r_x, alpha)
@@ -235,7 +245,10 @@ def implied_e_y(
     The standard error comes from the impacts' influences on ln(1 + e_y): through the e_x fit
     of the impact's bat and through sum(W x y), each impact about its own slope (the bats'
     differences are structure, not scatter; the same spin measurement enters both), a
-    sandwich estimate with n / (n - k) for the k fitted slopes.
+    sandwich estimate with n / (n - k) for the k fitted slopes (its interval: Student's t with
+    n - k degrees of freedom). Both sums are moment-corrected for the noise of the abscissa
+    as the fits are (:func:`ballbat.linefit.eiv_line`): sum(W (x^2 - var x_i) c_i (1 + e_x))
+    / sum(W (x y - cov(x_i, y_i))).
 
     Parameters
     ----------
@@ -264,6 +277,10 @@ def implied_e_y(
     W = np.ones(n) if w_r is None else w_r**2
     # each impact's e_x (its bat's; the pooled one where the bat has no fit) and its influence
     xs, ys, jxs, jys = spin_design(*_measured(ds, sel), r, r_x, alpha)
+    # the noise of each abscissa (and its covariance with the ordinate), removed from the sums
+    # as the moment-corrected fits remove it (linefit.eiv_line); zero without uncertainties
+    var_x, cov_xy = _noise_moments(jx, jy, sig)
+    var_xs, cov_s = _noise_moments(jxs, jys, sig)
     one_plus = np.empty(n)
     influence_ex = np.empty(n)
     groups = []
@@ -274,22 +291,26 @@ def implied_e_y(
             fit, m_fit = res.e_x_pooled.fits[i], np.ones(n, dtype=bool)
         w = _weights(jxs[m_fit], jys[m_fit], None if sig is None else sig[m_fit], fit.slope)
         ws = np.ones(int(m_fit.sum())) if w is None else w**2
+        # the e_x fit's estimating function (moment-corrected for the bracket's noise, as the fit)
+        score = xs[m_fit] * (ys[m_fit] - fit.slope * xs[m_fit]) + fit.slope * var_xs[m_fit] - cov_s[m_fit]
         infl = np.zeros(n)
-        infl[m_fit] = ws * xs[m_fit] * (ys[m_fit] - fit.slope * xs[m_fit]) / np.sum(ws * xs[m_fit] ** 2)
+        infl[m_fit] = ws * score / np.sum(ws * (xs[m_fit] ** 2 - var_xs[m_fit]))
         one_plus[m], influence_ex[m] = fit.slope, infl[m]
         groups.append(m)
     # each impact's Eq. ratio slope times (1 + e_y): its recoil factors and its bat's e_x
     k_i = tan_ratio_slope_model(one_plus - 1.0, 0.0, r_x, r_y, alpha)
-    # 1 + e_y = D / T with D = sum(W x^2 k_i) and T = sum(W x y) (= slope sum(W x^2))
-    d = float(np.sum(W * x * x * k_i))
-    t = float(np.sum(W * x * y))
+    # 1 + e_y = D / T with D = sum(W (x^2 - var x) k_i) and T = sum(W (x y - cov(x, y)))
+    # (= slope sum(W (x^2 - var x)))
+    x2 = x * x - var_x
+    d = float(np.sum(W * x2 * k_i))
+    t = float(np.sum(W * (x * y - cov_xy)))
     e_y = d / t - 1.0
     # influences on ln D (through each bat's e_x) and on ln T (each impact about its own
     # slope k_i / (1 + e_y): the bats' differences are structure, not scatter)
     share = np.zeros(n)
     for m in groups:
-        share[m] = np.sum((W * x * x * k_i / one_plus)[m])
-    infl_t = W * x * (y - k_i / (1.0 + e_y) * x)
+        share[m] = np.sum((W * x2 * k_i / one_plus)[m])
+    infl_t = W * (x * y - cov_xy - k_i / (1.0 + e_y) * x2)
     infl = share * influence_ex / d - infl_t / t
     k = len(groups) + 1
     var = np.sum(infl**2) * n / max(n - k, 1)
@@ -342,7 +363,7 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
         r, r_x, alpha = (ds[k].values[in_ball] for k in ("r", "r_x", "alpha"))
         x, y, jx, jy = tan_ratio_design(*_measured(ds, in_ball), r, alpha)
         sig = _sigma(ds, in_ball)
-        rfit = fit_line(x, y, jx, jy, sig)
+        rfit = fit_line(x, y, jx, jy, sig, errors_in_variables=True)
         res.tan_ratio_slope.fits[i] = rfit
         exf = res.e_x_pooled.fits[i]
         a = float(np.mean(alpha))
@@ -368,7 +389,7 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
         for grid, which in ((res.spin_theta_slope, "omega"), (res.speed_theta_slope, "v_ball")):
             y_norm = ds[f"{which}_norm"].values[in_ball].astype(float)
             x, y, jx, jy = normalized_theta_design(v_bat, y_norm, theta, which, v_ref)
-            fit = fit_line(x, y, jx, jy, sig, through_origin=False, robust=True)
+            fit = fit_line(x, y, jx, jy, sig, through_origin=False, robust=True, errors_in_variables=True)
             grid.fits[i] = fit
             if has_truth:
                 yt_norm = normalize_to_bat_speed(tv[MEASURED.index(which)], tv[0], v_ref)

@@ -38,7 +38,7 @@ References
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -524,6 +524,43 @@ def fly(
     the exact mph conversion; with exact factors the same scheme gives 421.8 ft, 5.52 s and
     92.0 ft (docs/flight.md).
     """
+    ball_radius = _check_settings(method, ball_mass, ball_circumference, ball_radius, rho, tau, dt, n_points)
+    shape, launch = _launch_arrays(v0, launch_angle, spray_angle, backspin, sidespin, start, wind)
+    V0, spin, omega_hat = _launch_velocity_and_spin(launch)
+    N = launch.speed.size
+    k = np.full(N, rho * np.pi * ball_radius**2 / (2.0 * ball_mass))
+    if method == "calculator" and calculator_rounding:
+        # The spreadsheet's c0 (1/ft) = 0.07182 rho_lb (5.125 oz / m)(C / 9.125 in)^2.
+        circ = 2.0 * np.pi * ball_radius
+        k_ft = SHEET_C0 * SHEET_LB_FT3 * rho * (5.125 * OUNCE / ball_mass) * (circ / (9.125 * INCH)) ** 2
+        k = np.full(N, k_ft / FOOT)
+        V0 = V0 * (SHEET_FPS_PER_MPH * FOOT / MPH)
+        model = _Model(k, ball_radius, spin, omega_hat, launch.wind, tau, SHEET_V100_FPS * FOOT, SHEET_G_FPS2 * FOOT)
+    else:
+        model = _Model(k, ball_radius, spin, omega_hat, launch.wind, tau)
+    X0 = launch.start
+
+    keep = n_points is not None
+    if method == "accurate":
+        hang, apex, landing, hist = _fly_accurate(model, X0, V0, rtol, atol, t_max, keep)
+        T, P = _resample_accurate(hist, hang, n_points) if keep else (None, None)
+    else:
+        hang, apex, landing, hist = _fly_calculator(model, X0, V0, dt, t_max, keep)
+        T, P = _resample_calculator(hist, hang, landing, dt, n_points) if keep else (None, None)
+
+    carry = np.hypot(landing[:, 0], landing[:, 1])
+    return FlightResult(
+        carry=carry.reshape(shape),
+        hang_time=hang.reshape(shape),
+        apex=apex.reshape(shape),
+        landing=landing.reshape(*shape, 3),
+        t=None if T is None else T.reshape(*shape, n_points),
+        points=None if P is None else P.reshape(*shape, n_points, 3),
+    )
+
+
+def _check_settings(method, ball_mass, ball_circumference, ball_radius, rho, tau, dt, n_points) -> float:
+    """Check the scalar settings of :func:`fly`; return the ball's radius, m."""
     if method not in ("accurate", "calculator"):
         raise ValueError(f"fly: method must be 'accurate' or 'calculator', got {method!r}")
     if ball_radius is None:
@@ -540,7 +577,27 @@ def fly(
         raise ValueError(f"fly: dt must be positive, got {dt}")
     if n_points is not None and n_points < 2:
         raise ValueError(f"fly: n_points must be at least 2, got {n_points}")
+    return ball_radius
 
+
+@dataclass(frozen=True)
+class _Launch:
+    """Launch conditions of N balls, flattened from the broadcast shape (SI)."""
+
+    speed: NDArray  # (N,) launch speed
+    launch_angle: NDArray  # (N,) above the horizontal
+    spray_angle: NDArray  # (N,) from the y axis towards +x
+    backspin: NDArray  # (N,)
+    sidespin: NDArray  # (N,)
+    start: NDArray  # (N, 3) starting point
+    wind: NDArray  # (N, 3) wind velocity (w_x, w_y, 0)
+
+
+def _launch_arrays(v0, launch_angle, spray_angle, backspin, sidespin, start, wind) -> tuple[tuple[int, ...], _Launch]:
+    """Broadcast and flatten the launch conditions of :func:`fly`, checked whole.
+
+    Returns the broadcast shape and the conditions as (N,) and (N, 3) arrays.
+    """
     start = np.asarray(start, dtype=float)
     if start.shape[-1:] != (3,):
         raise ValueError(f"fly: start must have a last dimension of 3, got shape {start.shape}")
@@ -561,57 +618,35 @@ def fly(
     def flat(a):
         return np.broadcast_to(np.asarray(a, dtype=float), shape).reshape(N)
 
-    v0_, th, ph, wb, ws = (flat(a) for a in (v0, launch_angle, spray_angle, backspin, sidespin))
     X0 = np.broadcast_to(start, (*shape, 3)).reshape(N, 3).astype(float)
     W = np.zeros((N, 3))
     W[:, :2] = np.broadcast_to(wind_arr, (*shape, 2)).reshape(N, 2)
-    for name, arr in (
-        ("v0", v0_),
-        ("launch_angle", th),
-        ("spray_angle", ph),
-        ("backspin", wb),
-        ("sidespin", ws),
-        ("start", X0),
-        ("wind", W),
-    ):
+    launch = _Launch(*(flat(a) for a in (v0, launch_angle, spray_angle, backspin, sidespin)), X0, W)
+    names = ("v0", "launch_angle", "spray_angle", "backspin", "sidespin", "start", "wind")
+    for name, field in zip(names, fields(launch), strict=True):
+        arr = getattr(launch, field.name)
         if not np.all(np.isfinite(arr)):
             raise ValueError(f"fly: {name} has non-finite values")
-    bad = (X0[:, 2] < 0) | ((X0[:, 2] == 0) & (np.sin(th) <= 0))
+    bad = (X0[:, 2] < 0) | ((X0[:, 2] == 0) & (np.sin(launch.launch_angle) <= 0))
     if bad.any():
         raise ValueError("fly: every ball must start above the ground (or at z = 0 moving up)")
+    return shape, launch
 
-    ct, st, cp, sp = np.cos(th), np.sin(th), np.cos(ph), np.sin(ph)
-    V0 = v0_[:, None] * np.stack([ct * sp, ct * cp, st], axis=1)
-    omega = wb[:, None] * np.stack([cp, -sp, np.zeros(N)], axis=1) + ws[:, None] * np.stack(
-        [-st * sp, -st * cp, ct], axis=1
-    )
+
+def _launch_velocity_and_spin(launch: _Launch) -> tuple[NDArray, NDArray, NDArray]:
+    """Return the launch velocity (N, 3), the spin's magnitude (N,) and its unit axis (N, 3).
+
+    The spin vector as in Nathan's calculator (:func:`fly`, Notes): ``backspin (cos phi,
+    -sin phi, 0) + sidespin (-sin theta sin phi, -sin theta cos phi, cos theta)``, with
+    ``theta`` the launch and ``phi`` the spray angle; the axis is zero where there is no spin.
+    """
+    N = launch.speed.size
+    cos_launch, sin_launch = np.cos(launch.launch_angle), np.sin(launch.launch_angle)
+    cos_spray, sin_spray = np.cos(launch.spray_angle), np.sin(launch.spray_angle)
+    V0 = launch.speed[:, None] * np.stack([cos_launch * sin_spray, cos_launch * cos_spray, sin_launch], axis=1)
+    backspin_axis = np.stack([cos_spray, -sin_spray, np.zeros(N)], axis=1)
+    sidespin_axis = np.stack([-sin_launch * sin_spray, -sin_launch * cos_spray, cos_launch], axis=1)
+    omega = launch.backspin[:, None] * backspin_axis + launch.sidespin[:, None] * sidespin_axis
     spin = np.sqrt(np.einsum("ij,ij->i", omega, omega))
     omega_hat = np.divide(omega, spin[:, None], out=np.zeros_like(omega), where=spin[:, None] > 0)
-    k = np.full(N, rho * np.pi * ball_radius**2 / (2.0 * ball_mass))
-    if method == "calculator" and calculator_rounding:
-        # The spreadsheet's c0 (1/ft) = 0.07182 rho_lb (5.125 oz / m)(C / 9.125 in)^2.
-        circ = 2.0 * np.pi * ball_radius
-        k_ft = SHEET_C0 * SHEET_LB_FT3 * rho * (5.125 * OUNCE / ball_mass) * (circ / (9.125 * INCH)) ** 2
-        k = np.full(N, k_ft / FOOT)
-        V0 = V0 * (SHEET_FPS_PER_MPH * FOOT / MPH)
-        model = _Model(k, ball_radius, spin, omega_hat, W, tau, SHEET_V100_FPS * FOOT, SHEET_G_FPS2 * FOOT)
-    else:
-        model = _Model(k, ball_radius, spin, omega_hat, W, tau)
-
-    keep = n_points is not None
-    if method == "accurate":
-        hang, apex, landing, hist = _fly_accurate(model, X0, V0, rtol, atol, t_max, keep)
-        T, P = _resample_accurate(hist, hang, n_points) if keep else (None, None)
-    else:
-        hang, apex, landing, hist = _fly_calculator(model, X0, V0, dt, t_max, keep)
-        T, P = _resample_calculator(hist, hang, landing, dt, n_points) if keep else (None, None)
-
-    carry = np.hypot(landing[:, 0], landing[:, 1])
-    return FlightResult(
-        carry=carry.reshape(shape),
-        hang_time=hang.reshape(shape),
-        apex=apex.reshape(shape),
-        landing=landing.reshape(*shape, 3),
-        t=None if T is None else T.reshape(*shape, n_points),
-        points=None if P is None else P.reshape(*shape, n_points, 3),
-    )
+    return V0, spin, omega_hat

@@ -295,7 +295,8 @@ def provenance_line(git: Mapping[str, object], date: str | None) -> str:
     return (
         f"**Provenance:** commit ``{commit[:12]}`` ({state}). The full record (every input with its sha256,"
         " the config values each job used, the software versions) is in the ``provenance_*`` attributes of"
-        " every NetCDF file and in each workbook's provenance sheet."
+        " every NetCDF file and in each workbook's provenance sheet; the run as a whole, every job with its"
+        " inputs, config values and outputs, is the Provenance Run Crate ``results/ro-crate-metadata.json``."
     )
 
 

@@ -90,47 +90,11 @@ def run_scenario(
     ball = balls[scenario["ball"]]
     rho = density_from_conditions(air)
     flight = scenario["flight"]
-    data = {}
-    coords = {}
     e_x_used = float(scenario["e_x"] if e_x is None else e_x)
     if "sweep" in scenario:
-        sw = scenario["sweep"]
-        bat = bats[scenario["bat"]]
-        D = np.linspace(sw["D_in"]["start"], sw["D_in"]["stop"], int(sw["D_in"]["num"])) * INCH
-        col = pitched_ball_collision(
-            D,
-            v_pitch=sw["pitch_mph"] * MPH,
-            pitch_descent=sw["pitch_descent_deg"] * DEGREE,
-            pitch_spin=-sw["pitch_backspin_rpm"] * RPM,  # a pitch's backspin is topspin for the batted ball
-            v_bat=sw["bat_mph"] * MPH,
-            attack_angle=sw["attack_deg"] * DEGREE,
-            e_x=e_x_used,
-            e_y=scenario["e_y"],
-            ball=ball,
-            bat=bat,
-            mu=scenario["mu"],
-        )
-        n = D.size
-        launch = {
-            "exit_speed": col.exit_speed,
-            "launch_angle": col.launch_angle,
-            "spray_angle": np.full(n, flight["spray_deg"] * DEGREE),
-            "backspin": col.backspin,
-            "sidespin": np.zeros(n),
-        }
-        data["D"] = variable("case", D, "m", "ball-bat offset D (along the relative velocity)")
-        data["psi"] = variable("case", col.psi, "rad", "impact angle psi")
-        data["friction_ratio"] = variable("case", col.friction_ratio, "1", "required friction |J_t / J_n|")
-        data["exceeds_mu"] = variable(
-            "case",
-            col.exceeds_mu.astype(np.int8),
-            "1",
-            f"1 where the impact needs more friction than mu = {scenario['mu']} (e_x model kept as is)",
-            flag_values=np.array([0, 1], dtype=np.int8),
-            flag_meanings="within_friction needs_more_friction_than_mu",
-        )
+        launch, data = _sweep(scenario, ball, bats[scenario["bat"]], e_x_used)
     else:
-        launch = launch_conditions(scenario["launch"])
+        launch, data = launch_conditions(scenario["launch"]), {}
     res = fly(
         launch["exit_speed"],
         launch["launch_angle"],
@@ -146,12 +110,78 @@ def run_scenario(
         n_points=int(flight["n_points"]),
     )
     n = np.size(launch["exit_speed"])
-    coords["case"] = ("case", np.arange(n, dtype=np.int64), {"units": "1", "long_name": "case number"})
-    coords["point"] = (
-        "point",
-        np.arange(res.points.shape[-2], dtype=np.int64),
-        {"units": "1", "long_name": "trajectory sample"},
+    coords = {
+        "case": ("case", np.arange(n, dtype=np.int64), {"units": "1", "long_name": "case number"}),
+        "point": (
+            "point",
+            np.arange(res.points.shape[-2], dtype=np.int64),
+            {"units": "1", "long_name": "trajectory sample"},
+        ),
+    }
+    data.update(_flight_variables(launch, res))
+    ds = xr.Dataset(data, coords=coords)
+    ds.attrs.update(
+        {
+            "ball": scenario["ball"],
+            "bat": scenario.get("bat", ""),
+            "kind": "D sweep" if "sweep" in scenario else "launch conditions",
+            "e_x": e_x_used,
+            "air_density": rho,
+            "air_density_units": "kg m-3",
+            "flight_method": flight["method"],
+        }
     )
+    return ds
+
+
+def _sweep(scenario: dict, ball: Ball, bat: Bat, e_x: float) -> tuple[dict, dict]:
+    """Collide the pitched ball with the bat over the scenario's sweep of D (Sec. V.B).
+
+    Returns the launch conditions (SI, one per D) and the sweep's own variables (D, psi, the
+    friction the impacts need).
+    """
+    sw = scenario["sweep"]
+    D = np.linspace(sw["D_in"]["start"], sw["D_in"]["stop"], int(sw["D_in"]["num"])) * INCH
+    col = pitched_ball_collision(
+        D,
+        v_pitch=sw["pitch_mph"] * MPH,
+        pitch_descent=sw["pitch_descent_deg"] * DEGREE,
+        pitch_spin=-sw["pitch_backspin_rpm"] * RPM,  # a pitch's backspin is topspin for the batted ball
+        v_bat=sw["bat_mph"] * MPH,
+        attack_angle=sw["attack_deg"] * DEGREE,
+        e_x=e_x,
+        e_y=scenario["e_y"],
+        ball=ball,
+        bat=bat,
+        mu=scenario["mu"],
+    )
+    n = D.size
+    launch = {
+        "exit_speed": col.exit_speed,
+        "launch_angle": col.launch_angle,
+        "spray_angle": np.full(n, scenario["flight"]["spray_deg"] * DEGREE),
+        "backspin": col.backspin,
+        "sidespin": np.zeros(n),
+    }
+    data = {
+        "D": variable("case", D, "m", "ball-bat offset D (along the relative velocity)"),
+        "psi": variable("case", col.psi, "rad", "impact angle psi"),
+        "friction_ratio": variable("case", col.friction_ratio, "1", "required friction |J_t / J_n|"),
+        "exceeds_mu": variable(
+            "case",
+            col.exceeds_mu.astype(np.int8),
+            "1",
+            f"1 where the impact needs more friction than mu = {scenario['mu']} (e_x model kept as is)",
+            flag_values=np.array([0, 1], dtype=np.int8),
+            flag_meanings="within_friction needs_more_friction_than_mu",
+        ),
+    }
+    return launch, data
+
+
+def _flight_variables(launch: dict, res) -> dict:
+    """Return the variables of the launch conditions and of the flights (:func:`ballbat.flight.fly`)."""
+    data = {}
     data["exit_speed"] = variable("case", launch["exit_speed"], "m s-1", "exit speed of the batted ball")
     data["launch_angle"] = variable("case", launch["launch_angle"], "rad", "launch angle above the horizontal")
     data["spray_angle"] = variable(
@@ -167,19 +197,7 @@ def run_scenario(
     data["trajectory_t"] = variable(("case", "point"), res.t, "s", "time since contact")
     for i, axis in enumerate("xyz"):
         data[f"trajectory_{axis}"] = variable(("case", "point"), res.points[..., i], "m", f"trajectory {axis}")
-    ds = xr.Dataset(data, coords=coords)
-    ds.attrs.update(
-        {
-            "ball": scenario["ball"],
-            "bat": scenario.get("bat", ""),
-            "kind": "D sweep" if "sweep" in scenario else "launch conditions",
-            "e_x": e_x_used,
-            "air_density": rho,
-            "air_density_units": "kg m-3",
-            "flight_method": flight["method"],
-        }
-    )
-    return ds
+    return data
 
 
 def comparison_rows(ds: xr.Dataset) -> list[dict]:

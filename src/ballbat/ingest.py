@@ -33,8 +33,7 @@ References
 
 from __future__ import annotations
 
-import math
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
@@ -55,11 +54,15 @@ from .properties import (
     Ball,
     Bat,
     InputError,
+    cell_number,
     cell_text,
+    check_impact_id,
+    header_problems,
     load_balls,
     load_bats,
     read_csv_table,
     recoil_factors,
+    table_keys,
 )
 from .units import DEGREE, MPH, RPM
 
@@ -157,19 +160,37 @@ def read_impacts_table(path: str | os.PathLike[str]) -> tuple[list[str], list[tu
 # Checks
 
 
-def _number(raw: str, where: str, problems: list[str]) -> float:
-    if raw == "":
-        problems.append(f"{where}: empty (every impact needs a value; delete the row or fill it in)")
-        return math.nan
-    try:
-        val = float(raw)
-    except ValueError:
-        problems.append(f"{where}: {raw!r} is not a number")
-        return math.nan
-    if not math.isfinite(val):
-        problems.append(f"{where}: {raw!r} is not finite")
-        return math.nan
-    return val
+#: What an empty measured cell says: every impact needs every value.
+EMPTY_CELL = "empty (every impact needs a value; delete the row or fill it in)"
+
+
+def _measured_cells(row: dict, at: str, problems: list[str]) -> dict[str, float]:
+    """Return the four measured cells of a row as numbers (file units): speeds > 0, |theta| < 90 deg."""
+    vals = {c: cell_number(row.get(c, ""), f"{at}, column {c}", problems, EMPTY_CELL) for c in MEASURED_COLUMNS}
+    for c in ("v_bat_mph", "v_ball_mph"):
+        if vals[c] <= 0:
+            problems.append(f"{at}, column {c}: {row[c]} mph; a speed must be positive")
+    if abs(vals["theta_deg"]) >= 90:
+        problems.append(
+            f"{at}, column theta_deg: {row['theta_deg']} deg is outside the physical range (-90, 90) "
+            "(the ball leaves the bat forwards)"
+        )
+    return vals
+
+
+def _zero_uncertainty_problems(path, zeros: dict[str, list[str]], n_rows: int) -> list[str]:
+    """One problem per uncertainty column with zeros (``zeros``: column -> row labels)."""
+    problems = []
+    for c, labels in zeros.items():
+        if not labels:
+            continue
+        where = "every row" if len(labels) == n_rows else ", ".join(labels[:5]) + (" ..." if len(labels) > 5 else "")
+        problems.append(
+            f"{path}: column {c}: zero uncertainty in {where}: a zero standard uncertainty says the measurement is "
+            "exact, which none is (the weighted fits would divide by it); give the real uncertainties, or leave "
+            "the column out (the fits are then unweighted)"
+        )
+    return problems
 
 
 def check_rows(
@@ -179,21 +200,8 @@ def check_rows(
 
     ``balls`` / ``bats`` None (their table was bad) skip the membership checks.
     """
-    problems: list[str] = []
-    allowed = (*REQUIRED, *OPTIONAL)
-    missing = [c for c in REQUIRED if c not in header]
-    if missing:
-        problems.append(
-            f"{path}: missing column(s) {', '.join(missing)} (required: {', '.join(REQUIRED)}; "
-            f"optional: {', '.join(OPTIONAL)})"
-        )
-    unknown = [c for c in header if c not in allowed]
-    if unknown:
-        problems.append(f"{path}: unknown column(s) {', '.join(map(repr, unknown))} (allowed: {', '.join(allowed)})")
-    repeated = sorted({c for c in header if header.count(c) > 1})
-    if repeated:
-        problems.append(f"{path}: column(s) {', '.join(repeated)} appear more than once")
-    if missing:
+    problems = header_problems(path, header, REQUIRED, OPTIONAL)
+    if any(c not in header for c in REQUIRED):
         return {}, problems
     if not rows:
         problems.append(f"{path}: no impacts (only a header)")
@@ -207,29 +215,12 @@ def check_rows(
         at = f"{path}: {label}"
         if EXTRA in row:
             problems.append(f"{at}: {row[EXTRA]} more cell(s) than the header has columns")
-        for key, table, what in (("bat", bats, "bat"), ("ball", balls, "ball")):
-            name = row.get(key, "")
-            if not name:
-                problems.append(f"{at}, column {key}: empty")
-            elif table is not None and name not in table:
-                problems.append(
-                    f"{at}, column {key}: {what} {name!r} is not in the {what} table "
-                    f"(known: {', '.join(sorted(table))})"
-                )
+        for key, name in table_keys(row, at, balls, bats, problems).items():
             out[key].append(name)
-        vals = {c: _number(row.get(c, ""), f"{at}, column {c}", problems) for c in MEASURED_COLUMNS}
-        for c in ("v_bat_mph", "v_ball_mph"):
-            if vals[c] <= 0:
-                problems.append(f"{at}, column {c}: {row[c]} mph; a speed must be positive")
-        if abs(vals["theta_deg"]) >= 90:
-            problems.append(
-                f"{at}, column theta_deg: {row['theta_deg']} deg is outside the physical range (-90, 90) "
-                "(the ball leaves the bat forwards)"
-            )
-        for c in MEASURED_COLUMNS:
-            out[c].append(vals[c])
+        for c, val in _measured_cells(row, at, problems).items():
+            out[c].append(val)
         for c in errs:
-            e = _number(row.get(c, ""), f"{at}, column {c}", problems)
+            e = cell_number(row.get(c, ""), f"{at}, column {c}", problems, EMPTY_CELL)
             if e < 0:
                 problems.append(f"{at}, column {c}: {row[c]} is negative; an uncertainty must be >= 0")
             elif e == 0:
@@ -237,12 +228,7 @@ def check_rows(
             out[c].append(e)
         iid = row.get("impact_id", "") if "impact_id" in header else label
         if "impact_id" in header:
-            if not iid:
-                problems.append(f"{at}, column impact_id: empty")
-            elif iid in seen_ids:
-                problems.append(f"{at}, column impact_id: {iid!r} duplicates {seen_ids[iid]}")
-            else:
-                seen_ids[iid] = label
+            check_impact_id(iid, at, label, seen_ids, problems)
         out["impact_id"].append(iid)
         out["label"].append(label)
         # The same measurement twice (rows pasted twice) would shrink every standard error by
@@ -257,15 +243,7 @@ def check_rows(
             )
         else:
             seen_rows[key] = label
-    for c, labels in zeros.items():
-        if not labels:
-            continue
-        where = "every row" if len(labels) == len(rows) else ", ".join(labels[:5]) + (" ..." if len(labels) > 5 else "")
-        problems.append(
-            f"{path}: column {c}: zero uncertainty in {where}: a zero standard uncertainty says the measurement is "
-            "exact, which none is (the weighted fits would divide by it); give the real uncertainties, or leave "
-            "the column out (the fits are then unweighted)"
-        )
+    problems += _zero_uncertainty_problems(path, zeros, len(rows))
     return {k: np.asarray(v) for k, v in out.items()}, problems
 
 
@@ -297,16 +275,30 @@ def exclusions(
     return flag, reason
 
 
-def implausible(
-    v_bat: ArrayLike,
-    v_ball: ArrayLike,
-    theta: ArrayLike,
-    omega: ArrayLike,
-    r: ArrayLike,
-    alpha: ArrayLike,
-    r_x: ArrayLike,
-    r_y: ArrayLike,
-) -> dict[str, tuple[int, int]]:
+@dataclass(frozen=True)
+class Measured:
+    """Impacts in SI: the four measured quantities and the ball's and bat's properties of each.
+
+    ``r`` and ``alpha`` are the ball's (Table I, Eq. iball); ``r_x`` and ``r_y`` the recoil
+    factors of its bat (Eqs. rx and ry). The properties may be scalars or per-impact arrays.
+    """
+
+    v_bat: ArrayLike
+    v_ball: ArrayLike
+    theta: ArrayLike
+    omega: ArrayLike
+    r: ArrayLike
+    alpha: ArrayLike
+    r_x: ArrayLike
+    r_y: ArrayLike
+
+    def take(self, sel: ArrayLike) -> Measured:
+        """Return the impacts ``sel`` (an index or boolean mask along the impacts); scalars stay as they are."""
+        values = (np.asarray(getattr(self, f.name)) for f in fields(self))
+        return Measured(*(a[sel] if a.ndim else a for a in values))
+
+
+def implausible(m: Measured) -> dict[str, tuple[int, int]]:
     """Physics checks that betray unit mistakes: name -> (failing, checked) impact counts (SI).
 
     Notes
@@ -319,7 +311,7 @@ def implausible(
     * ``e_x``: the e_x each impact implies through Eq. omega lies in :data:`E_X_PLAUSIBLE`
       (impacts with |psi| >= :data:`PSI_MIN_FOR_E_X` only).
     """
-    c = _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y)
+    c = _collision_checks(m)
     n = c.psi.size
     return {
         "psi": (int((~c.ok).sum()), n),
@@ -344,9 +336,10 @@ class _Checks:
     e_y: np.ndarray  # implied through Eq. vballn
 
 
-def _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y) -> _Checks:
+def _collision_checks(m: Measured) -> _Checks:
     """Return the bounds a collision of a ball at rest sets (:func:`implausible`), impact by impact."""
-    v_bat, v_ball, theta, omega = (np.asarray(a, dtype=float) for a in (v_bat, v_ball, theta, omega))
+    v_bat, v_ball, theta, omega = (np.asarray(a, dtype=float) for a in (m.v_bat, m.v_ball, m.theta, m.omega))
+    r, alpha, r_x, r_y = m.r, m.alpha, m.r_x, m.r_y
     psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
     ok = flag == ImpactFlag.OK
     with np.errstate(invalid="ignore", divide="ignore"):
@@ -368,17 +361,7 @@ def _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y) -> _Check
 
 
 def implausible_rows(
-    v_bat: ArrayLike,
-    v_ball: ArrayLike,
-    theta: ArrayLike,
-    omega: ArrayLike,
-    r: ArrayLike,
-    alpha: ArrayLike,
-    r_x: ArrayLike,
-    r_y: ArrayLike,
-    groups: ArrayLike,
-    sigma: dict | None = None,
-    coarse: ArrayLike | None = None,
+    m: Measured, groups: ArrayLike, sigma: dict | None = None, coarse: ArrayLike | None = None
 ) -> np.ndarray:
     """Return, per impact, why its measurement is implausible ("" when it is not); SI inputs.
 
@@ -404,18 +387,48 @@ def implausible_rows(
 
     Impacts psi cannot reconstruct are left to :func:`exclusions` ("" here).
     """
-    v_bat, v_ball, theta, omega = (np.asarray(a, dtype=float) for a in (v_bat, v_ball, theta, omega))
-    groups = np.asarray(groups)
-    coarse = None if coarse is None else np.asarray(coarse)
-    c = _collision_checks(v_bat, v_ball, theta, omega, r, alpha, r_x, r_y)
-    psi, ok, ratio, e_x, use_ex = c.psi, c.ok, c.ratio, c.e_x, c.use_ex
+    v_bat, v_ball, omega = (np.asarray(a, dtype=float) for a in (m.v_bat, m.v_ball, m.omega))
+    c = _collision_checks(m)
+    off = _group_outliers(m, c, np.asarray(groups), sigma, None if coarse is None else np.asarray(coarse))
+    robust = np.any(list(off.values()), axis=0) if off else np.zeros(v_bat.shape, dtype=bool)
     out = np.full(v_bat.shape, "", dtype=object)
+    for i in np.flatnonzero(c.ok):
+        words = []
+        for k, top in SPEED_MAX_MPH.items():
+            speed = (v_bat if k == "v_bat" else v_ball)[i] / MPH
+            if speed > top:
+                words.append(f"{k} = {speed:.1f} mph is faster than any {k[2:]} reaches (above {top:g}; km/h?)")
+        if c.ratio_high[i]:
+            words.append(f"v_ball/v_bat = {c.ratio[i]:.2f} exceeds 2/(1 + r_y), the most any collision gives")
+        elif c.ratio_low[i]:
+            words.append(f"v_ball/v_bat = {c.ratio[i]:.2f} is below cos(psi)/(1 + r_y), the least any collision gives")
+
+        if c.e_x_out[i]:
+            lo, hi = E_X_PLAUSIBLE
+            words.append(f"implied e_x = {c.e_x[i]:.2f} (Eq. omega) is outside [{lo:g}, {hi:g}], where impacts lie")
+        elif robust[i]:
+            planes_off = " and ".join(k for k, v in off.items() if v[i])
+            words.append(
+                f"{planes_off} far from its bat x ball group's line (spin {omega[i] / RPM:.0f} rpm, implied"
+                f" e_x = {c.e_x[i]:.2f}; robust z > {OUTLIER_Z:g})"
+            )
+        out[i] = "; ".join(words)
+    return out.astype(str)
+
+
+def _group_outliers(m: Measured, c: _Checks, groups, sigma: dict | None, coarse) -> dict[str, np.ndarray]:
+    """Per plane, the impacts far from their group's line (:func:`implausible_rows`, last bullet).
+
+    Returns plane name -> boolean per impact, for the planes where any group could be judged.
+    """
+    v_bat, theta, omega = (np.asarray(a, dtype=float) for a in (m.v_bat, m.theta, m.omega))
+    ok, use_ex = c.ok, c.use_ex
     # Group outliers on the spin residual of Eq. omega, omega - (1 + e_x) x with x its bracket:
     # spin noise is the same for every impact, so the residuals share one spread (the implied
     # e_x does not: its noise grows as sin psi -> 0), and a robust spread (MAD) of the group
     # is not pulled by the outliers themselves.
     with np.errstate(invalid="ignore", divide="ignore"):
-        x = spin_bracket(v_bat, psi, r, r_x, alpha)
+        x = spin_bracket(v_bat, c.psi, m.r, m.r_x, m.alpha)
     # Two planes where a group's impacts lie close to a line through the origin: Eq. omega
     # (spin against its bracket) and Fig. 3 (spin per bat speed against theta, the paper's
     # "remarkably linear" relation). Rows in the wrong unit fall off at least one of them; the
@@ -453,29 +466,7 @@ def implausible_rows(
         else:  # one spread for the file: a MAD of a dozen impacts is too uncertain
             spread = 1.4826 * np.median(dev[np.isfinite(dev)])
             off[name] = np.isfinite(dev) & (dev > OUTLIER_Z * max(spread, 1e-12))
-    robust = np.any(list(off.values()), axis=0) if off else np.zeros(v_bat.shape, dtype=bool)
-    for i in np.flatnonzero(ok):
-        words = []
-        for k, top in SPEED_MAX_MPH.items():
-            speed = (v_bat if k == "v_bat" else v_ball)[i] / MPH
-            if speed > top:
-                words.append(f"{k} = {speed:.1f} mph is faster than any {k[2:]} reaches (above {top:g}; km/h?)")
-        if c.ratio_high[i]:
-            words.append(f"v_ball/v_bat = {ratio[i]:.2f} exceeds 2/(1 + r_y), the most any collision gives")
-        elif c.ratio_low[i]:
-            words.append(f"v_ball/v_bat = {ratio[i]:.2f} is below cos(psi)/(1 + r_y), the least any collision gives")
-
-        if c.e_x_out[i]:
-            lo, hi = E_X_PLAUSIBLE
-            words.append(f"implied e_x = {e_x[i]:.2f} (Eq. omega) is outside [{lo:g}, {hi:g}], where impacts lie")
-        elif robust[i]:
-            planes_off = " and ".join(k for k, v in off.items() if v[i])
-            words.append(
-                f"{planes_off} far from its bat x ball group's line (spin {omega[i] / RPM:.0f} rpm, implied"
-                f" e_x = {e_x[i]:.2f}; robust z > {OUTLIER_Z:g})"
-            )
-        out[i] = "; ".join(words)
-    return out.astype(str)
+    return off
 
 
 _CHECK_WORDS = {
@@ -485,45 +476,36 @@ _CHECK_WORDS = {
     "e_x": f"implied e_x (Eq. omega) outside [{E_X_PLAUSIBLE[0]:g}, {E_X_PLAUSIBLE[1]:g}]",
 }
 
-#: Suspected unit mistakes: (columns, what went wrong, correction of the SI arrays).
+#: Suspected unit mistakes: (columns, what went wrong, correction of the SI measurements).
 _MISTAKES = (
-    ("omega_rpm", "spin in rad/s, not rpm", lambda d: {**d, "omega": d["omega"] / RPM}),
-    ("v_bat_mph", "bat speed in m/s, not mph", lambda d: {**d, "v_bat": d["v_bat"] / MPH}),
-    ("v_ball_mph", "exit speed in m/s, not mph", lambda d: {**d, "v_ball": d["v_ball"] / MPH}),
+    ("omega_rpm", "spin in rad/s, not rpm", lambda m: replace(m, omega=m.omega / RPM)),
+    ("v_bat_mph", "bat speed in m/s, not mph", lambda m: replace(m, v_bat=m.v_bat / MPH)),
+    ("v_ball_mph", "exit speed in m/s, not mph", lambda m: replace(m, v_ball=m.v_ball / MPH)),
     (
         "v_bat_mph, v_ball_mph",
         "speeds in m/s, not mph",
-        lambda d: {**d, "v_bat": d["v_bat"] / MPH, "v_ball": d["v_ball"] / MPH},
+        lambda m: replace(m, v_bat=m.v_bat / MPH, v_ball=m.v_ball / MPH),
     ),
-    ("theta_deg", "angle in radians, not degrees", lambda d: {**d, "theta": d["theta"] / DEGREE}),
+    ("theta_deg", "angle in radians, not degrees", lambda m: replace(m, theta=m.theta / DEGREE)),
     (
         "v_bat_mph, v_ball_mph",
         "the two speed columns swapped (v_bat_mph holds the exit speeds)",
-        lambda d: {**d, "v_bat": d["v_ball"], "v_ball": d["v_bat"]},
+        lambda m: replace(m, v_bat=m.v_ball, v_ball=m.v_bat),
     ),
     # last: on a tie the mistakes above are the likelier
-    ("omega_rpm", "spin with the opposite sign (omega > 0 is backspin, Fig. 2)", lambda d: {**d, "omega": -d["omega"]}),
+    ("omega_rpm", "spin with the opposite sign (omega > 0 is backspin, Fig. 2)", lambda m: replace(m, omega=-m.omega)),
 )
 
 
-def swapped_speeds(
-    path: str | os.PathLike[str],
-    data: dict,
-    usable: np.ndarray,
-    groups: np.ndarray,
-    r: ArrayLike,
-    alpha: ArrayLike,
-    r_x: ArrayLike,
-    r_y: ArrayLike,
-) -> list[str]:
-    """Problems naming bat x ball pairs whose impacts imply a median e_y below :data:`E_Y_MIN` (SI ``data``).
+def swapped_speeds(path: str | os.PathLike[str], m: Measured, usable: np.ndarray, groups: np.ndarray) -> list[str]:
+    """Problems naming bat x ball pairs whose impacts imply a median e_y below :data:`E_Y_MIN` (SI).
 
     Such impacts came out slower, against the bat's speed, than any ball-bat collision sends
     a ball: most often the columns v_bat_mph and v_ball_mph are swapped; the message says
     what the median would be with them swapped back.
     """
-    c = _collision_checks(data["v_bat"], data["v_ball"], data["theta"], data["omega"], r, alpha, r_x, r_y)
-    back = _collision_checks(data["v_ball"], data["v_bat"], data["theta"], data["omega"], r, alpha, r_x, r_y)
+    c = _collision_checks(m)
+    back = _collision_checks(replace(m, v_bat=m.v_ball, v_ball=m.v_bat))
     problems = []
     for g in np.unique(groups):
         sel = usable & (groups == g) & c.ok & np.isfinite(c.e_y)
@@ -546,30 +528,26 @@ def _score(checks: dict) -> float:
     return max((bad / n for bad, n in checks.values() if n >= 3), default=0.0)
 
 
-def unit_warnings(
-    path: str | os.PathLike[str], data: dict, r: ArrayLike, alpha: ArrayLike, r_x: ArrayLike, r_y: ArrayLike
-) -> list[str]:
-    """Warnings naming a column whose values look like a unit mistake (SI ``data``).
+def unit_warnings(path: str | os.PathLike[str], m: Measured) -> list[str]:
+    """Warnings naming a column whose values look like a unit mistake (SI measurements).
 
     When a physics check of :func:`implausible` fails for most impacts, each suspected
     mistake of :data:`_MISTAKES` is undone in turn; one that makes the data plausible is
     named with its column. Only warnings: such values are possible, just unlikely.
     """
-    args = (r, alpha, r_x, r_y)
-    theta_deg = np.abs(data["theta"]) / DEGREE
+    theta_deg = np.abs(m.theta) / DEGREE
     if theta_deg.size >= 5 and np.all(theta_deg < 90 * DEGREE) and np.ptp(theta_deg) > 0:
         return [
             f"{path}: column theta_deg: every |theta| is below {90 * DEGREE:.2f} deg, a range no oblique "
             "impacts span: the values look like radians, not degrees"
         ]
-    raw = implausible(data["v_bat"], data["v_ball"], data["theta"], data["omega"], *args)
+    raw = implausible(m)
     if _score(raw) <= UNIT_WARN_FRACTION:
         return []
     failing = "; ".join(f"{_CHECK_WORDS[k]} for {bad} of {n}" for k, (bad, n) in raw.items() if bad)
     best = None
     for cols, what, fix in _MISTAKES:
-        d = fix(data)
-        s = _score(implausible(d["v_bat"], d["v_ball"], d["theta"], d["omega"], *args))
+        s = _score(implausible(fix(m)))
         if s <= UNIT_FIX_FRACTION and (best is None or s < best[0]):
             best = (s, cols, what)
     if best is None:
@@ -597,6 +575,26 @@ def ingest(
     dataset (bad property tables included). Impacts psi cannot use stay in the output with
     ``ingest_flag`` > 0 and the reason in ``ingest_flag_reason``.
     """
+    cols, balls, bats = _read_checked(impacts_path, balls_path, bats_path)
+    ball_ids, bat_ids = cols["ball"].astype(str), cols["bat"].astype(str)
+    m = _measured(cols, ball_ids, bat_ids, balls, bats)
+    flag, reason = _flags(impacts_path, cols, m, ball_ids, bat_ids)
+    warnings = _dataset_checks(impacts_path, cols, m, flag, ball_ids, bat_ids)
+    ds = _impacts_dataset(cols, m, flag, reason, ball_ids, bat_ids)
+    ds.attrs["source_file"] = str(impacts_path)
+    ds.attrs["n_impacts"] = len(ball_ids)
+    ds.attrs["n_excluded"] = int((flag != 0).sum())
+    ds.attrs["n_warnings"] = len(warnings)
+    ds.attrs["ingest_warnings"] = "\n".join(warnings)
+    return ds, warnings
+
+
+def _read_checked(impacts_path, balls_path, bats_path) -> tuple[dict, dict[str, Ball], dict[str, Bat]]:
+    """Read the property tables and the impacts file, checked whole (:func:`check_rows`).
+
+    Returns the impacts' columns in the file's units and the two tables; raises one
+    :class:`~ballbat.properties.InputError` with the problems of all three files.
+    """
     problems: list[str] = []
     balls: dict[str, Ball] | None = None
     bats: dict[str, Bat] | None = None
@@ -616,29 +614,29 @@ def ingest(
     problems += row_problems
     if problems:
         raise InputError(problems)
+    return cols, balls, bats
 
-    data = {si: cols[c] * factor for c, (si, factor, _) in MEASURED_COLUMNS.items()}
-    ball_ids, bat_ids = cols["ball"].astype(str), cols["bat"].astype(str)
+
+def _measured(cols: dict, ball_ids, bat_ids, balls: dict[str, Ball], bats: dict[str, Bat]) -> Measured:
+    """Return the impacts in SI with each one's ball radius, alpha and recoil factors (Eqs. rx, ry)."""
+    si = {name: cols[c] * factor for c, (name, factor, _) in MEASURED_COLUMNS.items()}
     r = np.array([balls[b].r for b in ball_ids])
     alpha = np.array([balls[b].alpha for b in ball_ids])
     rxy = {(b, t): recoil_factors(balls[b], bats[t]) for b, t in set(zip(ball_ids, bat_ids, strict=True))}
     r_x = np.array([rxy[(b, t)][0] for b, t in zip(ball_ids, bat_ids, strict=True)])
     r_y = np.array([rxy[(b, t)][1] for b, t in zip(ball_ids, bat_ids, strict=True)])
-    flag, reason = exclusions(data["v_ball"], data["theta"], data["omega"], r, alpha)
+    return Measured(si["v_bat"], si["v_ball"], si["theta"], si["omega"], r, alpha, r_x, r_y)
+
+
+def _flags(impacts_path, cols: dict, m: Measured, ball_ids, bat_ids) -> tuple[np.ndarray, np.ndarray]:
+    """Per impact: ``(ingest_flag, reason)`` from :func:`exclusions` and :func:`implausible_rows`.
+
+    A file with more than :data:`IMPLAUSIBLE_MAX_FRACTION` implausible impacts is an
+    :class:`~ballbat.properties.InputError` (its units are likely wrong).
+    """
+    flag, reason = exclusions(m.v_ball, m.theta, m.omega, m.r, m.alpha)
     sigma = {si: cols[f"{c}_err"] * factor for c, (si, factor, _) in MEASURED_COLUMNS.items() if f"{c}_err" in cols}
-    why = implausible_rows(
-        data["v_bat"],
-        data["v_ball"],
-        data["theta"],
-        data["omega"],
-        r,
-        alpha,
-        r_x,
-        r_y,
-        np.char.add(ball_ids, bat_ids),
-        sigma=sigma,
-        coarse=ball_ids,
-    )
+    why = implausible_rows(m, np.char.add(ball_ids, bat_ids), sigma=sigma, coarse=ball_ids)
     bad = why != ""
     flag = np.where(bad, ImpactFlag.IMPLAUSIBLE, flag).astype(np.int8)
     reason = np.where(bad, np.char.add("implausible: ", why.astype(str)), reason)
@@ -648,15 +646,23 @@ def ingest(
             [
                 f"{impacts_path}: {int(bad.sum())} of {bad.size} impacts are measurements no ball-bat collision "
                 "can produce, more than half: the file's units are likely wrong (mph, deg, rpm expected)",
-                *unit_warnings(impacts_path, data, r, alpha, r_x, r_y),
+                *unit_warnings(impacts_path, m),
                 *listing,
             ]
         )
+    return flag, reason
 
+
+def _dataset_checks(impacts_path, cols: dict, m: Measured, flag: np.ndarray, ball_ids, bat_ids) -> list[str]:
+    """Check the file as a whole: swapped speeds and no pair to fit stop it; the rest warns.
+
+    Returns the warnings: pairs with fewer than :data:`MIN_FIT_IMPACTS` usable impacts, some
+    but not all uncertainty columns, suspected unit mistakes (:func:`unit_warnings`).
+    """
     warnings: list[str] = []
     usable = flag == 0
     pairs = np.array([f"ball {str(b)!r} on bat {str(t)!r}" for b, t in zip(ball_ids, bat_ids, strict=True)], dtype=str)
-    swapped = swapped_speeds(impacts_path, data, usable, pairs, r, alpha, r_x, r_y)
+    swapped = swapped_speeds(impacts_path, m, usable, pairs)
     if swapped:
         raise InputError(swapped)
     groups = sorted({(str(b), str(t)) for b, t in zip(ball_ids, bat_ids, strict=True)})
@@ -681,12 +687,15 @@ def ingest(
             f"{impacts_path}: only {given} of the four uncertainty columns given: the fits are unweighted "
             "and their reduced chi-square undefined"
         )
-    warnings += unit_warnings(impacts_path, data, r, alpha, r_x, r_y)
+    warnings += unit_warnings(impacts_path, m)
+    return warnings
 
-    n = len(ball_ids)
+
+def _impacts_dataset(cols: dict, m: Measured, flag, reason, ball_ids, bat_ids) -> xr.Dataset:
+    """Return the impacts as a Dataset along ``impact``: measurements and uncertainties in SI, ids, flags."""
     out = {}
     for c, (si, factor, long_name) in MEASURED_COLUMNS.items():
-        out[si] = variable("impact", data[si], SI_UNITS[si], f"measured {long_name}", ballbat_role="measurement")
+        out[si] = variable("impact", getattr(m, si), SI_UNITS[si], f"measured {long_name}", ballbat_role="measurement")
         if f"{c}_err" in cols:
             out[f"{si}_err"] = variable(
                 "impact",
@@ -709,20 +718,18 @@ def ingest(
         **flag_attrs(ImpactFlag),
     )
     out["ingest_flag_reason"] = ("impact", reason, {"long_name": "why the impact is excluded (ok if it is not)"})
-    ds = xr.Dataset(
+    return xr.Dataset(
         out,
         coords={
-            "impact": ("impact", np.arange(n, dtype=np.int64), {"long_name": "impact number", "units": "1"}),
+            "impact": (
+                "impact",
+                np.arange(len(ball_ids), dtype=np.int64),
+                {"long_name": "impact number", "units": "1"},
+            ),
             "ball": ("impact", ball_ids, {"long_name": "ball type (key of the ball table)"}),
             "bat": ("impact", bat_ids, {"long_name": "bat (key of the bat table)"}),
         },
     )
-    ds.attrs["source_file"] = str(impacts_path)
-    ds.attrs["n_impacts"] = int(n)
-    ds.attrs["n_excluded"] = int((flag != 0).sum())
-    ds.attrs["n_warnings"] = len(warnings)
-    ds.attrs["ingest_warnings"] = "\n".join(warnings)
-    return ds, warnings
 
 
 def excluded_listing(ds: xr.Dataset) -> list[str]:

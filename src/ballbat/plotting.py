@@ -12,7 +12,9 @@ published lines dotted.
 metadata, so the same data give the same bytes) and writes the caption numbers
 (:mod:`ballbat.reporting`).
 
-This is the only module that imports matplotlib (with the non-interactive Agg backend).
+Together with :mod:`ballbat.plotting_tracks` (the QA figures of the camera tracks, drawn with
+this module's :func:`save_figure`) this is the plotting layer: the only modules that import
+matplotlib (with the non-interactive Agg backend, set here). ``tests/test_lint.py`` checks it.
 """
 
 from __future__ import annotations

@@ -176,6 +176,77 @@ def read_csv_table(path: str | os.PathLike[str], required: Sequence[str]) -> tup
     return header, rows
 
 
+def header_problems(
+    path: str | os.PathLike[str], header: list[str], required: Sequence[str], optional: Sequence[str] = ()
+) -> list[str]:
+    """Return the problems of a table's header: missing, unknown and repeated columns."""
+    problems = []
+    allowed = (*required, *optional)
+    missing = [c for c in required if c not in header]
+    if missing:
+        also = f"; optional: {', '.join(optional)}" if optional else ""
+        problems.append(f"{path}: missing column(s) {', '.join(missing)} (required: {', '.join(required)}{also})")
+    unknown = [c for c in header if c not in allowed]
+    if unknown:
+        problems.append(f"{path}: unknown column(s) {', '.join(map(repr, unknown))} (allowed: {', '.join(allowed)})")
+    repeated = sorted({c for c in header if header.count(c) > 1})
+    if repeated:
+        problems.append(f"{path}: column(s) {', '.join(repeated)} appear more than once")
+    return problems
+
+
+def cell_number(raw: str, at: str, problems: list[str], empty: str = "empty", integer: bool = False) -> float:
+    """Return a table cell's text as a finite number, or NaN with the problem added to ``problems``.
+
+    ``at`` names the file, the row and the column; ``empty`` is the message for an empty
+    cell; ``integer`` also requires a whole number (a frame number).
+    """
+    if raw == "":
+        problems.append(f"{at}: {empty}")
+        return math.nan
+    try:
+        val = float(raw)
+    except ValueError:
+        problems.append(f"{at}: {raw!r} is not a number")
+        return math.nan
+    if not math.isfinite(val):
+        problems.append(f"{at}: {raw!r} is not finite")
+        return math.nan
+    if integer and val != int(val):
+        problems.append(f"{at}: {raw!r} is not a whole frame number")
+        return math.nan
+    return val
+
+
+def check_impact_id(iid: str, at: str, label: str, seen: dict[str, str], problems: list[str]) -> None:
+    """Record an impact id in ``seen`` (id -> row label), or add why it cannot be: empty or repeated."""
+    if not iid:
+        problems.append(f"{at}, column impact_id: empty")
+    elif iid in seen:
+        problems.append(f"{at}, column impact_id: {iid!r} duplicates {seen[iid]}")
+    else:
+        seen[iid] = label
+
+
+def table_keys(row: dict, at: str, balls: dict | None, bats: dict | None, problems: list[str]) -> dict[str, str]:
+    """Return a row's ``bat`` and ``ball`` cells, each checked against its property table.
+
+    An empty cell, or a name not in its table, is added to ``problems`` (``at`` names the
+    file and row); a table that is None (itself bad) is not checked against.
+    """
+    names = {}
+    for key, table in (("bat", bats), ("ball", balls)):
+        name = row.get(key, "")
+        if not name:
+            problems.append(f"{at}, column {key}: empty")
+        elif table is not None and name not in table:
+            problems.append(
+                f"{at}, column {key}: {key} {name!r} is not in the {key} table (known: {', '.join(sorted(table))})"
+            )
+        names[key] = name
+    return names
+
+
 def cell_text(v: object) -> str:
     """Return a NetCDF cell as the text a CSV cell would hold (NaN and None as empty)."""
     if isinstance(v, bytes):

@@ -260,6 +260,8 @@ def run_replicate(
         if n is not None and "bat" in n.dims:
             n = n.sel(bat=row["bat"])
         dof = math.inf if n is None else int(n) - dof_of.get(var, 1)
+        if q == "e_y_implied":  # its sandwich has n / (n - k) for the k = bats + 1 slopes it rests on
+            dof = int(n) - (int((fit["e_x_n"].sel(ball=row["ball"]) > 0).sum()) + 1)
         rows.append({**{k: row[k] for k in ("quantity", "ball", "bat", "value", "uncertainty", "truth")}, "dof": dof})
     if "eta2" in STUDY_QUANTITIES:
         rec_truth = reconstruct(normalize(_truth_source(src), v_ref_mph=settings.v_ref_mph), balls, bats)
@@ -606,18 +608,22 @@ COVERAGE_COLUMNS = (
 
 
 def _csv_text(header: Sequence[str], rows: Iterable[Sequence]) -> str:
-    """Return CSV text: strings as they are, numbers as in paper_comparison.csv (empty when not finite)."""
+    """Return CSV text: strings as they are, numbers as in paper_comparison.csv (empty when not finite).
+
+    The table ends in its check line (:func:`ballbat.pipeline.checked.sealed_csv`).
+    """
     import csv
     import io
 
     from .compare import format_number
+    from .pipeline.checked import sealed_csv
 
     buf = io.StringIO()
     w = csv.writer(buf, lineterminator="\n")
     w.writerow(header)
     for row in rows:
         w.writerow([x if isinstance(x, str) else format_number(x) for x in row])
-    return buf.getvalue()
+    return sealed_csv(buf.getvalue())  # its check line: a table cut short is never used
 
 
 def coverage_csv(cov: xr.Dataset) -> str:

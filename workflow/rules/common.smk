@@ -6,6 +6,7 @@ from argparse import Namespace
 from pathlib import Path
 
 import yaml
+from snakemake.exceptions import WorkflowError
 
 from ballbat.pipeline.codedeps import module_files
 from ballbat.pipeline.config import (
@@ -16,10 +17,20 @@ from ballbat.pipeline.config import (
     study_impacts,
     validate_config,
 )
-from ballbat.pipeline.guards import remove_broken, remove_temporaries, warnings_summary
+from ballbat.pipeline.guards import (
+    damaged_products,
+    foreign_outputs,
+    remove_temporaries,
+    unwritable_folders,
+    warnings_summary,
+)
 from ballbat.pipeline.provenance import sha256_file
 from ballbat.tracks.data import camera_block
 from ballbat.tracks.formats.layout import tool_file_extensions
+
+# A folder the run cannot write: one line naming it, for every invocation (a dry run, --unlock too).
+for _line in unwritable_folders(["results", ".snakemake"]):
+    sys.exit(f"ballbat: {_line}")
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 # A dataset or scenario set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.
@@ -41,14 +52,21 @@ wildcard_constraints:
     dataset="|".join(DATASETS),
 
 
-def report_broken_results():
-    """Remove broken results (so that this run rebuilds them) and say which."""
-    for message in remove_broken("results"):
-        print(f"ballbat: {message}", file=sys.stderr)
+def report_damaged_products(paths):
+    """Name every damaged product among ``paths``, and how to rebuild it. Reads only: this runs while
+    Snakemake parses the workflow (dry runs, --lint, --summary and cluster jobs too), so nothing is removed."""
+    if workflow.remote_exec or workflow.subprocess_exec:
+        return
+    for line in damaged_products(paths):
+        print(f"ballbat: {line}", file=sys.stderr)
 
 
-def remove_stale_temporaries():
-    """Remove the temporary files of jobs that were killed (call once Snakemake holds the lock)."""
+def start_run(dag):
+    """When a real run starts (Snakemake holds the folder's lock): stop before any file the workflow did
+    not write would be replaced, and remove the temporary files of dead jobs on this host."""
+    lines = foreign_outputs(f for job in dag.needrun_jobs() for f in job.output)
+    if lines:
+        raise WorkflowError("\n".join(f"ballbat: {line}" for line in lines))
     for message in remove_temporaries("results"):
         print(f"ballbat: {message}", file=sys.stderr)
 
@@ -70,11 +88,6 @@ def print_warnings(results, datasets, scenarios):
     lines = warnings_summary(results, datasets, ["implications"] if scenarios else [])
     if lines:
         print("\nballbat: warnings of this run (details in the logs named):", *lines, sep="\n  ", file=sys.stderr)
-
-
-# A broken result (cut short by a full disk or a copy) would be kept by its timestamp and fail
-# every later job: remove it so that this run rebuilds it, and say so.
-report_broken_results()
 
 
 def code(script):
@@ -119,9 +132,20 @@ def get_bats_table(wildcards):
     return existing(data_files(wildcards)["bats"])
 
 
+def file_hashes(files):
+    """Return the sha256 of each of ``files`` (name -> path): a param of the rules that read them, so that
+    their jobs rerun when the content changes, even to a copy with an older timestamp (cp -p, tar, rsync -a)."""
+    return {k: sha256_file(v) if Path(v).is_file() else "not a file" for k, v in files.items()}
+
+
 def data_hashes(wildcards):
-    """Return the sha256 of each data file, a param of the rules that read them (reruns follow content)."""
-    return {k: sha256_file(v) if Path(v).is_file() else "not a file" for k, v in data_files(wildcards).items()}
+    """Return the sha256 of each data file of a dataset (:func:`file_hashes`)."""
+    return file_hashes(data_files(wildcards))
+
+
+def tables_hashes(wildcards):
+    """Return the sha256 of the property tables of config `tables` (the implications' balls and bats)."""
+    return file_hashes(config["tables"])
 
 
 def is_measured(name):
@@ -291,6 +315,11 @@ def _study_dataset(wildcards):
     return Namespace(dataset=config["studies"][wildcards.study]["dataset"])
 
 
+def study_hashes(wildcards):
+    """The sha256 of a study's property tables (:func:`file_hashes`: a changed table reruns the study)."""
+    return data_hashes(_study_dataset(wildcards))
+
+
 def get_study_balls(wildcards):
     return get_balls_table(_study_dataset(wildcards))
 
@@ -335,9 +364,17 @@ def study_batch_runtime(wildcards):
 
 
 def study_targets():
+    """Every product of every study, its truth and batches included (so that one deleted by hand is rebuilt:
+    Snakemake does not rebuild a missing intermediate whose consumers are up to date)."""
     targets = []
     for name in STUDIES:
         targets += [f"results/studies/{name}/coverage.{ext}" for ext in ("nc", "csv", "png")]
         if config["studies"][name].get("sweep"):
             targets += [f"results/studies/{name}/design.{ext}" for ext in ("nc", "csv", "png")]
+        targets += [f"results/studies/{name}/truth.nc"]
+        targets += get_study_batches(Namespace(study=name))
     return targets
+
+
+# A damaged product is named, with the command that rebuilds it (nothing is removed here).
+report_damaged_products(final_targets() + study_targets())

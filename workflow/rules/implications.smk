@@ -20,6 +20,7 @@ rule implications:
     params:
         scenario=get_scenario,
         air=config["implications"]["air"],
+        sha256=tables_hashes,
     script:
         "../scripts/implications.py"
 

@@ -23,6 +23,7 @@ rule study_batch:
         runtime=study_batch_runtime,
     params:
         study=get_study_config,
+        sha256=study_hashes,
     script:
         "../scripts/study_batch.py"
 
@@ -50,6 +51,7 @@ rule study_truth:
         runtime=30,
     params:
         study=get_study_config,
+        sha256=study_hashes,
     script:
         "../scripts/study_truth.py"
 

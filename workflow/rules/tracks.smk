@@ -25,6 +25,7 @@ rule render_tracks:
         runtime=10,
     params:
         settings=get_render_settings,
+        sha256=data_hashes,
     script:
         "../scripts/render_tracks.py"
 

@@ -4,7 +4,7 @@ import yaml
 
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.pipeline.provenance import data_inputs
-from ballbat.pipeline.runlog import logged
+from ballbat.pipeline.runlog import log_exclusions, logged
 from ballbat.tracks.data import with_found_settings
 from ballbat.tracks.stage import excluded_listing, reduce_stage
 
@@ -29,10 +29,7 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         log.info("cross-check: %s", line)
     for text in ds.attrs["reduce_warnings"].splitlines():
         log.warning(text)
-    excluded = excluded_listing(ds)
-    log.info("%d of %d impacts excluded (kept in the file, flagged)", len(excluded), ds.sizes["impact"])
-    for line in excluded:
-        log.info("excluded: %s", line)
+    log_exclusions(log, excluded_listing(ds), ds.sizes["impact"])
     write_dataset(
         ds,
         snakemake.output.impacts,

@@ -1,10 +1,10 @@
-"""Rule tracks_qa: adapter around ballbat.tracks.qa."""
+"""Rule tracks_qa: adapter around ballbat.plotting_tracks."""
 
 from ballbat.pipeline.ncio import read_dataset
 from ballbat.pipeline.provenance import job_provenance, png_text
 from ballbat.pipeline.runlog import logged
+from ballbat.plotting_tracks import impacts_figure, save_figure, summary_figure
 from ballbat.tracks.io import load_tracks
-from ballbat.tracks.qa import impacts_figure, save_figure, summary_figure
 
 with logged(snakemake.log[0], snakemake.rule):
     red = read_dataset(snakemake.input.reduced)

@@ -4,15 +4,38 @@ The content is written to a temporary file in the target's directory, given the 
 permissions (0666 less the umask: ``mkstemp`` alone would make it private), and renamed
 into place only when complete. On any error the temporary file is removed and whatever
 was at the target before is left untouched.
+
+The temporary file's name says who owns it: ``.<name>.<pid>@<host>.<random><suffix>``.
+A job killed outright (SIGKILL, a lost node) cannot remove it; :func:`temporary_owner` reads
+the owner back, so that only the temporaries of dead processes on this host are ever removed
+(:func:`ballbat.pipeline.guards.remove_temporaries`), never those of another run's live job.
 """
 
 from __future__ import annotations
 
 import os
+import re
+import socket
 import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
+
+#: ``.<target>.<pid>@<host>.<8 random characters of mkstemp><suffix>``
+_OWNED = re.compile(
+    r"^\.(?P<target>.+)\.(?P<pid>\d+)@(?P<host>[A-Za-z0-9_.-]+)\.[a-z0-9_]{8}(?P<suffix>\.[A-Za-z0-9]+)$"
+)
+
+
+def hostname() -> str:
+    """Return this machine's name as temporaries carry it (only letters, digits, ``_``, ``.`` and ``-``)."""
+    return re.sub(r"[^A-Za-z0-9_.-]", "_", socket.gethostname()) or "localhost"
+
+
+def temporary_owner(name: str) -> tuple[int, str] | None:
+    """Return ``(pid, host)`` of the job that made the temporary file ``name``; None if not one of ours."""
+    m = _OWNED.match(name)
+    return (int(m["pid"]), m["host"]) if m else None
 
 
 @contextmanager
@@ -20,7 +43,7 @@ def atomic_target(path: str | os.PathLike[str], suffix: str = ".tmp") -> Iterato
     """Yield a temporary path to write; on success it replaces ``path``."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=suffix, dir=path.parent)
+    fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.{os.getpid()}@{hostname()}.", suffix=suffix, dir=path.parent)
     os.close(fd)
     try:
         yield Path(tmp)

@@ -312,8 +312,22 @@ def build_crate(
     git = git_state(str(workdir))
     versions = software_versions()
     smk_version = versions.get("snakemake", "unknown")
+    soft_ids, engine = _software(b, versions, smk_version)
+    _profiles(b)
+    main = _workflow_files(b, results, git, soft_ids, smk_version)
+    tools, steps = _rules(b, jobs, soft_ids, main)
+    job_actions, controls, all_results = _job_actions(b, jobs, workdir, tools, steps)
+    run = _run(b, config, configfiles, main, all_results, engine, controls, started, ended)
+    _root(b, main, run, job_actions, ended)
+    _ = package_source_hash, workflow_source_hash  # recorded through software_versions()
+    return _single_values(b.crate.metadata.generate())
 
-    # Software: ballbat (with its source hashes), Python and the stack; Snakemake is the engine.
+
+def _software(b: _Builder, versions: dict, smk_version: str) -> tuple[list[dict], dict]:
+    """Add ballbat (with its source hashes), Python and the stack, and Snakemake (the engine).
+
+    Returns the references to the software (without Snakemake) and the engine's entity.
+    """
     soft_ids = []
     for name, version in versions.items():
         if name.endswith("_sha256"):
@@ -339,8 +353,11 @@ def build_crate(
             "url": "https://snakemake.readthedocs.io",
         },
     )
+    return soft_ids, engine
 
-    # Profiles the crate conforms to.
+
+def _profiles(b: _Builder) -> None:
+    """Add the profiles the crate conforms to."""
     for ident, (name, version) in PROFILES.items():
         b.context(ident, {"@type": "CreativeWork", "name": name, "version": version})
     b.crate.metadata["conformsTo"] = [
@@ -348,7 +365,9 @@ def build_crate(
         {"@id": "https://w3id.org/workflowhub/workflow-ro-crate/1.0"},
     ]
 
-    # The snapshot's files: the main workflow first, then every other copied file.
+
+def _workflow_files(b: _Builder, results: Path, git: dict, soft_ids: list[dict], smk_version: str):
+    """Add the snapshot's files: the main workflow (returned) first, then every other copied file."""
     snap = results / SNAPSHOT
     language = b.context(
         SNAKEMAKE_LANGUAGE,
@@ -361,7 +380,6 @@ def build_crate(
         },
     )
     main_id = f"{SNAPSHOT}/Snakefile"
-    rule_ids = sorted({j.rule for j in jobs})
     main = b.file(
         main_id,
         ["SoftwareSourceCode", "ComputationalWorkflow", "HowTo"],
@@ -381,8 +399,12 @@ def build_crate(
     for f in sorted(p for p in snap.rglob("*") if p.is_file()):
         rel = f.relative_to(results).as_posix()
         b.file(rel, ["SoftwareSourceCode"] if f.suffix in (".py", ".smk") or f.name == "Snakefile" else None)
+    return main
 
-    # One tool and one step per rule.
+
+def _rules(b: _Builder, jobs: list[JobRecord], soft_ids: list[dict], main) -> tuple[dict, dict]:
+    """Add one tool and one step per rule (parts and steps of ``main``); return both by rule."""
+    rule_ids = sorted({j.rule for j in jobs})
     tools, steps = {}, {}
     for pos, rule in enumerate(rule_ids):
         some = next(j for j in jobs if j.rule == rule)
@@ -405,8 +427,11 @@ def build_crate(
         )
     main["hasPart"] = list(tools.values())
     main["step"] = list(steps.values())
+    return tools, steps
 
-    # One CreateAction (and ControlAction) per job.
+
+def _job_actions(b: _Builder, jobs: list[JobRecord], workdir: Path, tools: dict, steps: dict):
+    """Add one CreateAction (and ControlAction) per job; return them and every job's outputs."""
     job_actions, controls, all_results = [], [], []
     for job in jobs:
         ident = f"#job-{job.key}"
@@ -451,8 +476,11 @@ def build_crate(
                 },
             )
         )
+    return job_actions, controls, all_results
 
-    # The run: config files and the merged config in, every output out.
+
+def _run(b: _Builder, config, configfiles, main, all_results, engine, controls, started, ended):
+    """Add the run (config files and the merged config in, every output out) and its orchestration."""
     run_objects = []
     for cf in configfiles:
         cp = b.crate_path(cf)
@@ -489,7 +517,11 @@ def build_crate(
             **({"startTime": _iso(started)} if started is not None else {}),
         },
     )
+    return run
 
+
+def _root(b: _Builder, main, run, job_actions: list, ended: float) -> None:
+    """Describe the crate's root dataset: the results of one run, its workflow and actions."""
     root = b.crate.root_dataset
     root["name"] = "ballbat results"
     root["description"] = (
@@ -502,8 +534,6 @@ def build_crate(
     root["conformsTo"] = [{"@id": ident} for ident in PROFILES]
     root["mainEntity"] = main
     root["mentions"] = [run, *job_actions]
-    _ = package_source_hash, workflow_source_hash  # recorded through software_versions()
-    return _single_values(b.crate.metadata.generate())
 
 
 def _single_values(doc: dict) -> dict:

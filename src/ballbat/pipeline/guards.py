@@ -1,31 +1,56 @@
-"""Guards of the results folder: broken results are rebuilt, left-over temporary files removed.
+"""Guards of the results folder: nothing deleted behind the user's back, nothing damaged used.
 
-Results are written atomically (:mod:`.atomic`): a finished file is complete. A file can still
-be broken afterwards (a full disk, a copy cut short, a hand edit); Snakemake, which judges by
-timestamps, would then keep it and every later job would fail on it. :func:`remove_broken`
-finds NetCDF files that are not whole, by the HDF5 superblock's end-of-file address against the
-file's size (no library, a few bytes read per file), and removes them so that the run rebuilds
-them. A job killed while writing leaves its temporary file (``.name.XXXX.tmp``) behind:
-:func:`remove_temporaries` removes those.
+Results are written atomically (:mod:`.atomic`): a finished file is complete, and carries
+a record of what wrote it (the ``provenance_rule`` attribute of every NetCDF file, the
+checked last line of every CSV table: :mod:`.checked`). A file can still be damaged
+afterwards (a full disk, a copy cut short, a hand edit), or a user's own file can sit
+where the workflow writes. The guards:
+
+* never delete or write while Snakemake parses the workflow (a dry run, ``--lint``,
+  ``--summary`` and every cluster job parse it too). :func:`damaged_products` only reads:
+  a damaged product is named, with the command that rebuilds it;
+* remove a file only when the workflow wrote it: a job that finds its input damaged
+  (:func:`ballbat.pipeline.checked.DamagedFileError`) removes it if, and only if, it
+  carries the workflow's provenance record, so that the next run rebuilds it;
+* never let a run overwrite a file the workflow did not write: :func:`foreign_outputs`,
+  called when a real run starts (``onstart``), names each such file and the run stops;
+* remove only the temporaries of dead jobs on this host (:func:`remove_temporaries`): a
+  second run in the same folder never removes a live job's temporary file;
+* name a folder the run cannot write (:func:`unwritable`), in one line.
 """
 
 from __future__ import annotations
 
+import os
 import struct
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from .atomic import hostname, temporary_owner
+from .checked import csv_problem
+
 if TYPE_CHECKING:
-    import os
+    from collections.abc import Iterable
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+#: The attribute name every NetCDF file of the workflow carries (:mod:`.provenance`); netCDF
+#: writes the global attributes near the start of the file (byte ~10000 in ours).
+PROVENANCE_MARK = b"provenance_rule"
+MARK_WINDOW = 1 << 16
+#: How the workflow's CSV tables begin (paper_comparison.csv, a study's coverage.csv and design.csv;
+#: tests/test_redteam_guards.py holds them to the writers' columns): a table written before tables
+#: carried their check line is still recognised as the workflow's.
+TABLE_HEADERS = ("quantity,ball,bat,paper,", "setting,quantity,ball,bat,", "parameter,setting,ball,bat,")
 
 
 def hdf5_problem(path: str | os.PathLike[str]) -> str | None:
     """Return why ``path`` is not a whole HDF5 (NetCDF-4) file, or None when it is.
 
     Reads the superblock (versions 0-3 of the HDF5 format): the file must start with the HDF5
-    signature and be at least as long as the end-of-file address it records.
+    signature and be at least as long as the end-of-file address it records. A file whose
+    header is whole can still be damaged inside: :func:`ballbat.pipeline.checked.verify_netcdf`
+    checks every byte of its contents.
     """
     path = Path(path)
     size = path.stat().st_size
@@ -54,28 +79,137 @@ def hdf5_problem(path: str | os.PathLike[str]) -> str | None:
     return None
 
 
-def remove_broken(results: str | os.PathLike[str]) -> list[str]:
-    """Remove the NetCDF files under ``results`` that are not whole; return a message for each."""
-    messages = []
-    for path in sorted(Path(results).rglob("*.nc")):
-        if path.name.startswith("."):
+def written_by_workflow(path: str | os.PathLike[str]) -> bool:
+    """Whether ``path`` carries the workflow's record of having written it.
+
+    NetCDF: the ``provenance_rule`` attribute (looked for in the file's first 64 KiB, so that a
+    truncated file is still recognised); CSV: the check line at its end (:mod:`.checked`) or the
+    header of one of the workflow's tables (:data:`TABLE_HEADERS`).
+    """
+    path = Path(path)
+    with open(path, "rb") as fh:
+        if path.suffix == ".csv":
+            head = fh.read(256).decode("utf-8", errors="replace")
+            fh.seek(max(0, path.stat().st_size - 4096))
+            return head.startswith(TABLE_HEADERS) or b"\n# ballbat table: " in b"\n" + fh.read()
+        return PROVENANCE_MARK in fh.read(MARK_WINDOW)
+
+
+def product_problem(path: str | os.PathLike[str]) -> str | None:
+    """Why the product ``path`` (NetCDF or CSV) cannot be used, from a quick look; None when none is seen."""
+    path = Path(path)
+    if path.suffix == ".nc":
+        return hdf5_problem(path)
+    if path.suffix == ".csv":
+        return csv_problem(path)
+    return None
+
+
+def damaged_products(paths: Iterable[str | os.PathLike[str]]) -> list[str]:
+    """Return a line for each existing product among ``paths`` that is damaged or not the workflow's.
+
+    Reads only (a few bytes of each NetCDF file, each CSV table whole): safe while Snakemake
+    parses the workflow, in a dry run or a cluster job. Nothing is removed.
+    """
+    lines = []
+    for path in sorted({str(p) for p in paths}):
+        p = Path(path)
+        if p.suffix not in (".nc", ".csv") or not p.is_file():
             continue
-        problem = hdf5_problem(path)
-        if problem:
-            path.unlink()
-            messages.append(f"{path}: {problem}; removed, so that this run rebuilds it")
-    return messages
+        problem = product_problem(p)
+        if problem is None:
+            continue
+        if written_by_workflow(p):
+            lines.append(f"{path}: {problem}; rebuild it with: snakemake --forcerun {path}")
+        else:
+            lines.append(
+                f"{path}: {problem}, and not written by this workflow (no provenance record); "
+                "it is left alone: move it out of results/"
+            )
+    return lines
 
 
-def remove_temporaries(results: str | os.PathLike[str]) -> list[str]:
-    """Remove temporary files that killed jobs left under ``results``; return a message for each."""
-    messages = []
-    for path in sorted(Path(results).rglob(".*.tmp")):
-        if path.is_file():
-            size = path.stat().st_size
+def foreign_outputs(paths: Iterable[str | os.PathLike[str]]) -> list[str]:
+    """Return a line for each existing NetCDF or CSV file among ``paths`` that the workflow did not write.
+
+    ``paths`` are the outputs of the jobs a run is about to start: Snakemake would remove each
+    before its job runs. A run that finds any stops before that (``onstart``).
+    """
+    lines = []
+    for path in sorted({str(p) for p in paths}):
+        p = Path(path)
+        if p.suffix in (".nc", ".csv") and p.is_file() and not written_by_workflow(p):
+            lines.append(
+                f"{path}: not written by this workflow (no provenance record), and this run would replace it; "
+                "nothing was changed: move it out of results/ and run again"
+            )
+    return lines
+
+
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # another user's live process
+        return True
+    return True
+
+
+def remove_temporaries(results: str | os.PathLike[str], host: str | None = None) -> list[str]:
+    """Remove the temporary files of dead jobs on this host under ``results``; return a line for each.
+
+    A temporary file names its owner (:func:`ballbat.pipeline.atomic.temporary_owner`). One
+    whose process still lives, or that was made on another host (a cluster's shared folder),
+    is left alone: it may belong to a job of another run in the same folder.
+    """
+    host = host or hostname()
+    lines = []
+    root = Path(results)
+    if not root.is_dir():
+        return lines
+    for path in sorted(root.rglob(".*")):
+        owner = temporary_owner(path.name)
+        if owner is None or not path.is_file():
+            continue
+        pid, where = owner
+        if where != host or _alive(pid):
+            continue
+        size = path.stat().st_size
+        try:
             path.unlink()
-            messages.append(f"{path}: temporary file of a job that did not finish ({size} bytes); removed")
-    return messages
+        except FileNotFoundError:  # its job finished meanwhile
+            continue
+        lines.append(f"{path}: temporary file of a job that died (pid {pid}, {size} bytes); removed")
+    return lines
+
+
+def unwritable(folder: str | os.PathLike[str]) -> str | None:
+    """Return a line naming ``folder`` (or the first existing folder above it) when it cannot be written."""
+    p = Path(folder)
+    while not p.exists() and p != p.parent:
+        p = p.parent
+    if p.is_dir() and not os.access(p, os.W_OK | os.X_OK):
+        where = Path.cwd() if p == Path(".") else p
+        return f"{where}: folder is read-only; the workflow writes its results and Snakemake its records here"
+    return None
+
+
+def unwritable_folders(folders: Iterable[str | os.PathLike[str]]) -> list[str]:
+    """:func:`unwritable` of each folder, and of each folder under them (the results of a dataset)."""
+    lines = []
+    for folder in folders:
+        line = unwritable(folder)
+        if line:
+            lines.append(line)
+            continue
+        root = Path(folder)
+        if root.is_dir():
+            for sub in sorted(p for p in root.rglob("*") if p.is_dir()):
+                line = unwritable(sub)
+                if line:
+                    lines.append(line)
+    return lines
 
 
 def warnings_summary(

@@ -4,7 +4,8 @@
 variable has ``units`` and ``long_name``, sets the CF-style global attributes
 (Conventions, title, source, history, references) and the provenance records, and writes
 atomically (a temporary file in the same directory, renamed into place), so a failed job
-never leaves a half-written file. :func:`read_dataset` loads a file fully and checks it.
+never leaves a half-written file, and seals it with the checksum of its contents
+(:mod:`.checked`). :func:`read_dataset` verifies every byte of a file, loads it fully and checks it.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import xarray as xr
 
 from .. import __version__
 from .atomic import atomic_target
+from .checked import CHECKSUM_ATTR, read_sealed_csv, seal_netcdf, verify_netcdf
 from .provenance import data_inputs, provenance_attrs
 
 if TYPE_CHECKING:
@@ -84,6 +86,7 @@ def write_dataset(
             encoding[name] = {"dtype": str}
     with atomic_target(path) as tmp:
         ds.to_netcdf(tmp, engine="netcdf4", format="NETCDF4", encoding=encoding)
+        seal_netcdf(tmp)
     return path
 
 
@@ -105,13 +108,24 @@ def write_job_output(ds: xr.Dataset, job: object, output: str, title: str, confi
 
 
 def read_dataset(path: str | os.PathLike[str], require: tuple[str, ...] = ()) -> xr.Dataset:
-    """Load a results file fully into memory and check the variables ``require`` names."""
+    """Load a results file fully into memory and check the variables ``require`` names.
+
+    The file is verified whole first (:func:`~ballbat.pipeline.checked.verify_netcdf`): a damaged
+    file raises :class:`~ballbat.pipeline.checked.DamagedFileError` naming it.
+    """
+    verify_netcdf(path)
     with xr.open_dataset(path, engine="netcdf4") as ds:
         ds = ds.load()
+    ds.attrs.pop(CHECKSUM_ATTR, None)  # of the file, not of the data: a file written from ds gets its own
     missing = [v for v in require if v not in ds.variables]
     if missing:
         raise MetadataError(f"{path}: missing variable(s) {', '.join(missing)}")
     return ds
+
+
+def read_table_csv(path: str | os.PathLike[str]) -> str:
+    """Return the text of a CSV table the workflow wrote, verified whole (without its check line)."""
+    return read_sealed_csv(path)
 
 
 def atomic_write_text(path: str | os.PathLike[str], text: str) -> Path:

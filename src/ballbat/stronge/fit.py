@@ -154,14 +154,92 @@ def fit_eta2(
     least-squares fit (lmfit, Levenberg-Marquardt) starts there.
     """
     import lmfit
-    from scipy.optimize import brentq
-    from scipy.stats import chi2
-    from scipy.stats import t as t_dist
-
-    from ..linefit import sandwich_cov, sandwich_dof
 
     psi = np.asarray(psi, dtype=float).ravel()
     what = _describe(psi, e_y, mu, vary_e_y, vary_mu)
+    x, y, r_x, r_y, alpha, sig = _checked_inputs(psi, x, y, r_x, r_y, alpha, sigma, vary_e_y, vary_mu, what)
+
+    def residual(eta2_, e_, mu_):
+        ex = stronge_ex(psi, eta2_, e_, mu_, r_x, r_y, alpha)
+        return (y - (1.0 + ex) * x) / sig
+
+    bounds = (float(eta2_bounds[0]), float(eta2_bounds[1]))
+    start = _scan_start(psi, x, y, r_x, r_y, alpha, sig, e_y, mu, bounds)
+    params = lmfit.Parameters()
+    params.add("eta2", value=start, min=bounds[0], max=bounds[1])
+    params.add("e_y", value=e_y, min=0.05, max=1.0, vary=vary_e_y)
+    params.add("mu", value=mu, min=1e-3, max=10.0, vary=vary_mu)
+
+    def fcn(p):
+        return residual(p["eta2"].value, p["e_y"].value, p["mu"].value)
+
+    try:
+        res = lmfit.minimize(fcn, params, method="leastsq", scale_covar=scale_covar)
+    except (ValueError, RuntimeError) as exc:  # pragma: no cover - lmfit internals
+        raise Eta2FitError(f"fit_eta2: lmfit raised {exc!r} ({what})") from exc
+    best = res.params["eta2"].value
+    if not res.success or not np.isfinite(best):
+        raise Eta2FitError(f"fit_eta2: fit failed ({res.message}) ({what})")
+
+    chi_min = float(res.chisqr)
+    nfree = int(res.nfree)
+    redchi = chi_min / nfree
+    e_best, mu_best = res.params["e_y"].value, res.params["mu"].value
+    if robust:
+        if strata is not None and np.shape(strata) != psi.shape:
+            raise ValueError(f"fit_eta2: strata must have one label per impact ({what})")
+        errs, dof, delta = _robust_errors(res.params, residual, strata, level)
+    else:
+        errs, dof = _lmfit_errors(res.params), float(nfree)
+        delta = _chi2_rise(level, redchi if scale_covar else 1.0)
+
+    if vary_e_y or vary_mu:
+
+        def profile(h):
+            q = res.params.copy()
+            q["eta2"].set(value=h, vary=False)
+            r = lmfit.minimize(fcn, q, method="leastsq")
+            return float(r.chisqr)
+    else:
+
+        def profile(h):
+            r = residual(h, e_best, mu_best)
+            return float(r @ r)
+
+    if interval:
+        ci_low, ci_high = (
+            _profile_crossing(profile, best, errs["eta2"], chi_min, delta, bounds, d) for d in (-1.0, 1.0)
+        )
+    else:
+        ci_low, ci_high = np.nan, np.nan
+    return Eta2Fit(
+        eta2=float(best),
+        eta2_err=errs["eta2"],
+        eta2_ci_low=float(ci_low),
+        eta2_ci_high=float(ci_high),
+        e_y=float(e_best),
+        e_y_err=errs["e_y"],
+        mu=float(mu_best),
+        mu_err=errs["mu"],
+        chisqr=chi_min,
+        redchi=redchi,
+        n=psi.size,
+        nfree=nfree,
+        dof=dof,
+        robust=bool(robust),
+        level=float(level),
+        delta_chi2=delta,
+        scale_covar=bool(scale_covar),
+        success=bool(res.success),
+        message=str(res.message),
+    )
+
+
+def _checked_inputs(psi, x, y, r_x, r_y, alpha, sigma, vary_e_y, vary_mu, what):
+    """Check the inputs of :func:`fit_eta2` whole and return them as float arrays of psi's shape.
+
+    Returns ``(x, y, r_x, r_y, alpha, sigma)``; sigma is ones when None (unweighted).
+    """
     n = psi.size
     try:
         x, y = (np.asarray(a, dtype=float).ravel() for a in (x, y))
@@ -179,107 +257,76 @@ def fit_eta2(
     nvary = 1 + int(vary_e_y) + int(vary_mu)
     if n <= nvary:
         raise ValueError(f"fit_eta2: need more than {nvary} impacts ({what})")
+    return x, y, r_x, r_y, alpha, sig
 
-    def residual(eta2_, e_, mu_):
-        ex = stronge_ex(psi, eta2_, e_, mu_, r_x, r_y, alpha)
-        return (y - (1.0 + ex) * x) / sig
 
-    def chisq(eta2_, e_, mu_):
-        r = residual(eta2_, e_, mu_)
-        return float(r @ r)
-
-    lo_b, hi_b = (float(b) for b in eta2_bounds)
-    scan = np.geomspace(lo_b, hi_b, 48)
+def _scan_start(psi, x, y, r_x, r_y, alpha, sig, e_y, mu, bounds: tuple[float, float]) -> float:
+    """Return the starting eta^2: the lowest chi^2 of a logarithmic scan of ``bounds`` (48 values)."""
+    scan = np.geomspace(bounds[0], bounds[1], 48)
     # one call of the closed-form model for the whole scan (elementwise: the same numbers as one call per value)
     ex_scan = stronge_ex(psi, scan[:, None], e_y, mu, r_x, r_y, alpha)
     res_scan = (y - (1.0 + ex_scan) * x) / sig
-    start = scan[int(np.argmin([float(r @ r) for r in res_scan]))]
+    return scan[int(np.argmin([float(r @ r) for r in res_scan]))]
 
-    params = lmfit.Parameters()
-    params.add("eta2", value=start, min=lo_b, max=hi_b)
-    params.add("e_y", value=e_y, min=0.05, max=1.0, vary=vary_e_y)
-    params.add("mu", value=mu, min=1e-3, max=10.0, vary=vary_mu)
 
-    def fcn(p):
-        return residual(p["eta2"].value, p["e_y"].value, p["mu"].value)
-
-    try:
-        res = lmfit.minimize(fcn, params, method="leastsq", scale_covar=scale_covar)
-    except (ValueError, RuntimeError) as exc:  # pragma: no cover - lmfit internals
-        raise Eta2FitError(f"fit_eta2: lmfit raised {exc!r} ({what})") from exc
-    best = res.params["eta2"].value
-    if not res.success or not np.isfinite(best):
-        raise Eta2FitError(f"fit_eta2: fit failed ({res.message}) ({what})")
+def _lmfit_errors(params) -> dict[str, float]:
+    """Return lmfit's standard error of each parameter (NaN where fixed or not estimated)."""
 
     def err(name):
-        p = res.params[name]
+        p = params[name]
         return float(p.stderr) if (p.vary and p.stderr is not None) else np.nan
 
-    chi_min = float(res.chisqr)
-    nfree = int(res.nfree)
-    redchi = chi_min / nfree
-    e_best, mu_best = res.params["e_y"].value, res.params["mu"].value
-    errs = {k: err(k) for k in ("eta2", "e_y", "mu")}
-    dof = float(nfree)
-    if robust:
-        if strata is not None and np.shape(strata) != psi.shape:
-            raise ValueError(f"fit_eta2: strata must have one label per impact ({what})")
-        names = [k for k in ("eta2", "e_y", "mu") if res.params[k].vary]
-        J = _jacobian(residual, {k: res.params[k].value for k in ("eta2", "e_y", "mu")}, names)
-        cov = sandwich_cov(J, residual(best, e_best, mu_best), strata)
-        errs.update({k: float(np.sqrt(cov[i, i])) for i, k in enumerate(names)})
-        dof = sandwich_dof(J, strata, 0)
-        var_unscaled = float(np.linalg.inv(J.T @ J)[0, 0])
-        delta = float(t_dist.ppf(0.5 + level / 2.0, dof)) ** 2 * errs["eta2"] ** 2 / var_unscaled
-    else:
-        delta = float(chi2.ppf(level, 1)) * (redchi if scale_covar else 1.0)
+    return {k: err(k) for k in ("eta2", "e_y", "mu")}
 
-    if vary_e_y or vary_mu:
 
-        def profile(h):
-            q = res.params.copy()
-            q["eta2"].set(value=h, vary=False)
-            r = lmfit.minimize(fcn, q, method="leastsq")
-            return float(r.chisqr)
-    else:
+def _chi2_rise(level: float, scale: float) -> float:
+    """Delta of the profile interval, not robust: ``chi2.ppf(level, 1)`` times ``scale``."""
+    from scipy.stats import chi2
 
-        def profile(h):
-            return chisq(h, e_best, mu_best)
+    return float(chi2.ppf(level, 1)) * scale
 
-    def crossing(direction):
-        step = errs["eta2"]
-        step = step if np.isfinite(step) and step > 0 else 0.05 * best
-        inner = best
-        for _ in range(40):
-            outer = best + direction * 2.0 * step
-            outer = min(max(outer, lo_b), hi_b)
-            if profile(outer) - chi_min > delta:
-                g = lambda h: profile(h) - chi_min - delta  # noqa: E731
-                return brentq(g, min(inner, outer), max(inner, outer), xtol=1e-8 * best)
-            if outer in (lo_b, hi_b):
-                return np.nan
-            inner, step = outer, 2.0 * step
-        return np.nan
 
-    ci_low, ci_high = (crossing(-1.0), crossing(+1.0)) if interval else (np.nan, np.nan)
-    return Eta2Fit(
-        eta2=float(best),
-        eta2_err=errs["eta2"],
-        eta2_ci_low=float(ci_low),
-        eta2_ci_high=float(ci_high),
-        e_y=float(e_best),
-        e_y_err=errs["e_y"],
-        mu=float(mu_best),
-        mu_err=errs["mu"],
-        chisqr=chi_min,
-        redchi=redchi,
-        n=n,
-        nfree=nfree,
-        dof=dof,
-        robust=bool(robust),
-        level=float(level),
-        delta_chi2=delta,
-        scale_covar=bool(scale_covar),
-        success=bool(res.success),
-        message=str(res.message),
-    )
+def _robust_errors(params, residual, strata, level: float) -> tuple[dict[str, float], float, float]:
+    """Sandwich standard errors, their Bell-McCaffrey dof and the chi^2 rise of the interval.
+
+    The errors of the free parameters are the HC3 sandwich's centred within ``strata``; the
+    rise is t_nu^2 times the ratio of the robust to the unscaled variance of eta^2.
+    """
+    from scipy.stats import t as t_dist
+
+    from ..linefit import sandwich_cov, sandwich_dof
+
+    errs = _lmfit_errors(params)
+    names = [k for k in ("eta2", "e_y", "mu") if params[k].vary]
+    J = _jacobian(residual, {k: params[k].value for k in ("eta2", "e_y", "mu")}, names)
+    cov = sandwich_cov(J, residual(params["eta2"].value, params["e_y"].value, params["mu"].value), strata)
+    errs.update({k: float(np.sqrt(cov[i, i])) for i, k in enumerate(names)})
+    dof = sandwich_dof(J, strata, 0)
+    var_unscaled = float(np.linalg.inv(J.T @ J)[0, 0])
+    delta = float(t_dist.ppf(0.5 + level / 2.0, dof)) ** 2 * errs["eta2"] ** 2 / var_unscaled
+    return errs, dof, delta
+
+
+def _profile_crossing(profile, best, eta2_err, chi_min, delta, bounds: tuple[float, float], direction: float) -> float:
+    """Where ``profile(eta2)`` rises ``delta`` above ``chi_min`` on one side of ``best``.
+
+    Steps out from ``best`` by doubling steps (from the standard error, or 5 % of ``best``)
+    until the rise is passed, then brackets the crossing (brentq). NaN if it stays below
+    within ``bounds`` or 40 steps.
+    """
+    from scipy.optimize import brentq
+
+    lo_b, hi_b = bounds
+    step = eta2_err if np.isfinite(eta2_err) and eta2_err > 0 else 0.05 * best
+    inner = best
+    for _ in range(40):
+        outer = best + direction * 2.0 * step
+        outer = min(max(outer, lo_b), hi_b)
+        if profile(outer) - chi_min > delta:
+            return brentq(
+                lambda h: profile(h) - chi_min - delta, min(inner, outer), max(inner, outer), xtol=1e-8 * best
+            )
+        if outer in (lo_b, hi_b):
+            return np.nan
+        inner, step = outer, 2.0 * step
+    return np.nan

@@ -37,6 +37,7 @@ References
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
@@ -301,8 +302,8 @@ def _newton_bracketed(fun, x, lo, hi, iters=100, tol=None):
     return x
 
 
-def _stick_event(th0, end, u0, s0, rho, Lam, e, thf):
-    """First theta in (th0, end] where |S| = Lam N/N_max is crossed upwards (NaN: none).
+def _stick_event(piece: _StickPiece, end):
+    """First theta in (th0, end] where |S| = Lam N/N_max is crossed upwards in a stick piece (NaN: none).
 
     g = |S| - Lam N is sampled on a grid (at least STICK_GRID points, and fine enough that
     Omega_t changes phase by at most STICK_DPHASE between points). A sign change brackets
@@ -310,6 +311,7 @@ def _stick_event(th0, end, u0, s0, rho, Lam, e, thf):
     located (Newton on g') and checked, so that a near-tangential excursion of g above zero
     between grid points is not missed. The bracketed root is refined by safeguarded Newton.
     """
+    th0, u0, s0, rho, Lam, e, thf = piece
     K = max(STICK_GRID, int(np.ceil(np.max(rho * (end - th0), initial=0.0) / STICK_DPHASE)))
     k = np.arange(0, K + 1) / K
     grid = th0[:, None] + (end - th0)[:, None] * k
@@ -334,47 +336,82 @@ def _stick_event(th0, end, u0, s0, rho, Lam, e, thf):
     # local maxima of g strictly before the first sampled crossing
     jj = np.arange(K)[None, :]
     cand = (gp[:, :-1] > 0) & (gp[:, 1:] < 0) & (jj + 1 < first[:, None]) & np.isfinite(L_)
-    ci, cj = np.nonzero(cand)
-    if ci.size:
-        a0, au, as_, ar, aL, ae, af = th0[ci], u0[ci], s0[ci], rho[ci], Lam[ci], e[ci], thf[ci]
-        Sa, Sb = S[ci, cj], S[ci, cj + 1]
-        sgc = np.sign(np.where(np.abs(Sa) > np.abs(Sb), Sa, Sb))
-
-        def dg(x):
-            U1, S1 = _stick_state(a0, au, as_, ar, x)
-            N1, dN1, _ = _normal(x, ae, af)
-            d2N = np.where(x > HALF_PI, -N1 / ae**2, -N1)
-            # minus g' so that the bracket convention f(lo) <= 0 < f(hi) holds
-            return -(sgc * U1 - aL * dN1), -(-sgc * ar * ar * S1 - aL * d2N)
-
-        xm = _newton_bracketed(dg, 0.5 * (grid[ci, cj] + grid[ci, cj + 1]), grid[ci, cj], grid[ci, cj + 1])
-        _, S1 = _stick_state(a0, au, as_, ar, xm)
-        N1, _, _ = _normal(xm, ae, af)
-        # a maximum that only touches zero (the edge of stick, e.g. at a re-stick) is not a
-        # crossing: require it to stand clear of rounding
-        up = (sgc * S1 - aL * N1 > 1e-12 * np.abs(S1)) & (xm > a0 + 1e-9)
-        if np.any(up):
-            ui, first_idx = np.unique(ci[up], return_index=True)
-            pick = np.flatnonzero(up)[first_idx]
-            has[ui] = True
-            lo[ui] = grid[ci[pick], cj[pick]]
-            hi[ui] = xm[pick]
-            sg[ui] = sgc[pick]
+    _crossings_at_maxima(piece, np.nonzero(cand), grid, S, has, lo, hi, sg)
     out = np.full(th0.shape, np.nan)
     sig = np.zeros(th0.shape)
     i = np.flatnonzero(has)
     if i.size == 0:
         return out, sig
-    a0, au, as_, ar, aL, ae, af, sgi = th0[i], u0[i], s0[i], rho[i], Lam[i], e[i], thf[i], sg[i]
+    crossing, sign_s = piece.take(i), sg[i]
 
     def F(x):
-        U1, S1 = _stick_state(a0, au, as_, ar, x)
-        N1, dN1, _ = _normal(x, ae, af)
-        return sgi * S1 - aL * N1, sgi * U1 - aL * dN1
+        U1, S1 = crossing.state(x)
+        N1, dN1, _ = crossing.normal(x)
+        return sign_s * S1 - crossing.Lam * N1, sign_s * U1 - crossing.Lam * dN1
 
     out[i] = _newton_bracketed(F, hi[i].copy(), lo[i], hi[i])
-    sig[i] = sgi
+    sig[i] = sign_s
     return out, sig
+
+
+class _StickPiece(NamedTuple):
+    """One stick or slip piece per impact: where it starts (theta, U, S) and the impact's parameters."""
+
+    th0: NDArray  # theta at the start of the piece
+    u0: NDArray  # U at the start
+    s0: NDArray  # S at the start
+    rho: NDArray  # Omega_t/Omega_n
+    Lam: NDArray  # the friction bound of S over N/N_max
+    e: NDArray  # e_y
+    thf: NDArray  # theta at separation
+
+    def take(self, i) -> _StickPiece:
+        """Return the pieces of the impacts ``i``."""
+        return _StickPiece(*(a[i] for a in self))
+
+    def state(self, th):
+        """Return (U, S) at ``th`` in this stick piece."""
+        return _stick_state(self.th0, self.u0, self.s0, self.rho, th)
+
+    def normal(self, th):
+        """Return N/N_max, its derivative and its integral at ``th`` (:func:`_normal`)."""
+        return _normal(th, self.e, self.thf)
+
+
+def _crossings_at_maxima(piece: _StickPiece, cand, grid, S, has, lo, hi, sg) -> None:
+    """Check the local maxima of g = |S| - Lam N between two grid points; mark the crossings.
+
+    ``cand`` (rows, columns) are the grid intervals where g' changes from + to -. Each maximum
+    is located by Newton on g'; one that stands clear of zero is a crossing, and the first
+    per impact replaces that impact's bracket (``has``, ``lo``, ``hi``, ``sg``, in place).
+    """
+    ci, cj = cand
+    if ci.size == 0:
+        return
+    at_max = piece.take(ci)
+    Sa, Sb = S[ci, cj], S[ci, cj + 1]
+    sgc = np.sign(np.where(np.abs(Sa) > np.abs(Sb), Sa, Sb))
+
+    def dg(x):
+        U1, S1 = at_max.state(x)
+        N1, dN1, _ = at_max.normal(x)
+        d2N = np.where(x > HALF_PI, -N1 / at_max.e**2, -N1)
+        # minus g' so that the bracket convention f(lo) <= 0 < f(hi) holds
+        return -(sgc * U1 - at_max.Lam * dN1), -(-sgc * at_max.rho * at_max.rho * S1 - at_max.Lam * d2N)
+
+    xm = _newton_bracketed(dg, 0.5 * (grid[ci, cj] + grid[ci, cj + 1]), grid[ci, cj], grid[ci, cj + 1])
+    _, S1 = at_max.state(xm)
+    N1, _, _ = at_max.normal(xm)
+    # a maximum that only touches zero (the edge of stick, e.g. at a re-stick) is not a
+    # crossing: require it to stand clear of rounding
+    up = (sgc * S1 - at_max.Lam * N1 > 1e-12 * np.abs(S1)) & (xm > at_max.th0 + 1e-9)
+    if np.any(up):
+        ui, first_idx = np.unique(ci[up], return_index=True)
+        pick = np.flatnonzero(up)[first_idx]
+        has[ui] = True
+        lo[ui] = grid[ci[pick], cj[pick]]
+        hi[ui] = xm[pick]
+        sg[ui] = sgc[pick]
 
 
 def _slip_step(th0, u0, sig, rho, Lam, e, thf):
@@ -445,6 +482,33 @@ def _engine(p: _Params, idx) -> _Pieces:
     )
 
 
+def _end_of_stick(piece: _StickPiece, end):
+    """Advance stick pieces to where they slip (:func:`_stick_event`) or to ``end``.
+
+    Returns theta, U, S and the mode (+-1 slipping, 0 still sticking) there.
+    """
+    tev, sg = _stick_event(piece, end)
+    ev = np.isfinite(tev) & (tev < piece.thf - SEPARATION_TOL)
+    tnew = np.where(ev, tev, end)
+    U1, S1 = piece.state(tnew)
+    N1, _, _ = piece.normal(tnew)
+    N1 = np.where(tnew >= piece.thf, 0.0, N1)
+    with np.errstate(invalid="ignore"):
+        s_new = np.where(ev, sg * piece.Lam * N1, S1)
+    return tnew, U1, s_new, np.where(ev, sg, 0).astype(np.int8)
+
+
+def _end_of_slip(piece: _StickPiece, slip_mode):
+    """Advance slip pieces (direction ``slip_mode``) to re-stick or the end of their normal segment.
+
+    Returns theta, U, S and the mode (0 stuck again, else ``slip_mode``) there (:func:`_slip_step`).
+    """
+    tnew, U1, S1, ev = _slip_step(
+        piece.th0, piece.u0, slip_mode.astype(float), piece.rho, piece.Lam, piece.e, piece.thf
+    )
+    return tnew, U1, S1, np.where(ev, 0, slip_mode).astype(np.int8)
+
+
 def _engine_block(p: _Params, idx) -> _Pieces:
     """Run the phase machine for one block of impacts."""
     rho, Lam, e, thf = p.rho[idx], p.Lam[idx], p.e[idx], p.thf[idx]
@@ -469,34 +533,20 @@ def _engine_block(p: _Params, idx) -> _Pieces:
         u_rec[act, k] = u[act]
         s_rec[act, k] = s[act]
         npieces[act] = k + 1
-        a_th, a_u, a_s, a_m = th[act], u[act], s[act], mode[act]
-        a_rho, a_L, a_e, a_f = rho[act], Lam[act], e[act], thf[act]
-        end = np.where(a_th < HALF_PI, HALF_PI, a_f)
-        n_th, n_u, n_s, n_m = a_th.copy(), a_u.copy(), a_s.copy(), a_m.copy()
-        st = a_m == 0
-        i = np.flatnonzero(st)
+        piece = _StickPiece(th[act], u[act], s[act], rho[act], Lam[act], e[act], thf[act])
+        piece_mode = mode[act]
+        # the end of the piece's normal segment: maximum compression, or separation
+        end = np.where(piece.th0 < HALF_PI, HALF_PI, piece.thf)
+        n_th, n_u, n_s, n_m = piece.th0.copy(), piece.u0.copy(), piece.s0.copy(), piece_mode.copy()
+        sticking = piece_mode == 0
+        i = np.flatnonzero(sticking)
         if i.size:
-            tev, sg = _stick_event(a_th[i], end[i], a_u[i], a_s[i], a_rho[i], a_L[i], a_e[i], a_f[i])
-            ev = np.isfinite(tev) & (tev < a_f[i] - SEPARATION_TOL)
-            tnew = np.where(ev, tev, end[i])
-            U1, S1 = _stick_state(a_th[i], a_u[i], a_s[i], a_rho[i], tnew)
-            N1, _, _ = _normal(tnew, a_e[i], a_f[i])
-            N1 = np.where(tnew >= a_f[i], 0.0, N1)
-            n_th[i] = tnew
-            n_u[i] = U1
-            with np.errstate(invalid="ignore"):
-                n_s[i] = np.where(ev, sg * a_L[i] * N1, S1)
-            n_m[i] = np.where(ev, sg, 0).astype(np.int8)
-        j = np.flatnonzero(~st)
+            n_th[i], n_u[i], n_s[i], n_m[i] = _end_of_stick(piece.take(i), end[i])
+        j = np.flatnonzero(~sticking)
         if j.size:
-            sig = a_m[j].astype(float)
-            tnew, U1, S1, ev = _slip_step(a_th[j], a_u[j], sig, a_rho[j], a_L[j], a_e[j], a_f[j])
-            n_th[j] = tnew
-            n_u[j] = U1
-            n_s[j] = S1
-            n_m[j] = np.where(ev, 0, a_m[j]).astype(np.int8)
+            n_th[j], n_u[j], n_s[j], n_m[j] = _end_of_slip(piece.take(j), piece_mode[j])
         th[act], u[act], s[act], mode[act] = n_th, n_u, n_s, n_m
-        fin = n_th >= a_f
+        fin = n_th >= piece.thf
         uf[act[fin]] = n_u[fin]
         act = act[~fin]
     if act.size:

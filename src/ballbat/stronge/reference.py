@@ -74,79 +74,92 @@ def stronge_reference(
     }
 
 
+class _Contact:
+    """Equations of motion of one impact in physical form (unit ball mass, k_n and incident speed).
+
+    State ``y = (d, v, u, s)``: normal compression and its rate, the contact point's
+    tangential velocity and the tangential spring's stretch. ``m_n`` and ``m_t`` are the
+    effective masses (Eqs. ry and rx); the normal spring stiffens by 1/e_y^2 on unloading
+    from the compression ``d_m`` reached at t_c.
+    """
+
+    def __init__(self, eta2, e, fric, r_x, r_y, alpha):
+        self.m_n = 1.0 / (1.0 + r_y)
+        self.m_t = alpha / ((1.0 + alpha) * (1.0 + r_x))
+        self.k_n = 1.0
+        self.k_t = self.k_n / eta2
+        self.e, self.fric = e, fric
+        self.unloading, self.d_m = False, np.nan
+
+    def normal_force(self, d):
+        if self.unloading:
+            return (self.k_n / self.e**2) * (d - self.d_m * (1.0 - self.e**2))
+        return self.k_n * d
+
+    def dN_dt(self, d, v):
+        return (self.k_n / self.e**2 if self.unloading else self.k_n) * v
+
+    def rhs(self, t, y, mode):
+        """Return the derivatives of the state; ``mode`` 0 sticks, +-1 slips in that direction."""
+        d, v, u, s = y
+        N = self.normal_force(d)
+        if mode == 0:
+            return [v, -N / self.m_n, -self.k_t * s / self.m_t, u]
+        return [v, -N / self.m_n, -mode * self.fric * N / self.m_t, mode * self.fric * self.dN_dt(d, v) / self.k_t]
+
+    def events(self, mode):
+        """Return the terminal events of a phase: the end of compression (or separation), of stick or of slip."""
+
+        def compression(t, y):
+            return y[1]
+
+        def separation(t, y):
+            return self.normal_force(y[0])
+
+        def stick_pos(t, y):
+            return self.k_t * y[3] - self.fric * self.normal_force(y[0])
+
+        def stick_neg(t, y):
+            return -self.k_t * y[3] - self.fric * self.normal_force(y[0])
+
+        def slip(t, y):
+            return y[2] - mode * self.fric * self.dN_dt(y[0], y[1]) / self.k_t
+
+        for f, d in ((compression, -1), (separation, -1), (stick_pos, 1), (stick_neg, 1), (slip, -mode)):
+            f.terminal, f.direction = True, d
+        evl = [separation if self.unloading else compression]
+        if mode == 0 and np.isfinite(self.fric):
+            evl += [stick_pos, stick_neg]
+        elif mode != 0:
+            evl.append(slip)
+        return evl
+
+
 def _reference_one(psi, eta2, e, mu, r_x, r_y, alpha, rtol, atol):
     """One impact of :func:`stronge_reference`: (e_x, regime, t_c, events)."""
     from scipy.integrate import solve_ivp
 
-    m_n = 1.0 / (1.0 + r_y)
-    m_t = alpha / ((1.0 + alpha) * (1.0 + r_x))
-    k_n = 1.0
-    k_t = k_n / eta2
     v_n = np.cos(psi)
     u0 = abs(np.sin(psi))
     fric = mu
     if u0 == 0.0:
         u0, fric = 1.0, np.inf
-    st = {"unloading": False, "d_m": np.nan}
-
-    def normal_force(d):
-        if st["unloading"]:
-            return (k_n / e**2) * (d - st["d_m"] * (1.0 - e**2))
-        return k_n * d
-
-    def dN_dt(d, v):
-        return (k_n / e**2 if st["unloading"] else k_n) * v
-
-    def rhs(t, y, mode):
-        d, v, u, s = y
-        N = normal_force(d)
-        if mode == 0:
-            return [v, -N / m_n, -k_t * s / m_t, u]
-        return [v, -N / m_n, -mode * fric * N / m_t, mode * fric * dN_dt(d, v) / k_t]
-
-    def ev_compression(t, y):
-        return y[1]
-
-    def ev_separation(t, y):
-        return normal_force(y[0])
-
-    def ev_stick_pos(t, y):
-        return k_t * y[3] - fric * normal_force(y[0])
-
-    def ev_stick_neg(t, y):
-        return -k_t * y[3] - fric * normal_force(y[0])
-
-    def ev_slip(t, y, mode):
-        return y[2] - mode * fric * dN_dt(y[0], y[1]) / k_t
-
-    for f, d in ((ev_compression, -1), (ev_separation, -1), (ev_stick_pos, 1), (ev_stick_neg, 1)):
-        f.terminal, f.direction = True, d
-
+    c = _Contact(eta2, e, fric, r_x, r_y, alpha)
     y = np.array([0.0, v_n, u0, 0.0])
     t = 0.0
-    mode = 0 if (np.isinf(fric) or k_t * u0 < fric * k_n * v_n) else 1
+    mode = 0 if (np.isinf(fric) or c.k_t * u0 < fric * c.k_n * v_n) else 1
     seq = ["stick" if mode == 0 else "slip"]
     evs = []
     t_c = np.nan
     for _ in range(200):
-        evl = [ev_separation if st["unloading"] else ev_compression]
-        if mode == 0 and np.isfinite(fric):
-            evl += [ev_stick_pos, ev_stick_neg]
-        elif mode != 0:
-
-            def ev(t, y, mode=mode):
-                return ev_slip(t, y, mode)
-
-            ev.terminal, ev.direction = True, -mode
-            evl.append(ev)
         sol = solve_ivp(
-            lambda t, y, mode=mode: rhs(t, y, mode),
+            lambda t, y, mode=mode: c.rhs(t, y, mode),
             (t, t + 10.0),
             y,
             method="DOP853",
             rtol=rtol,
             atol=atol,
-            events=evl,
+            events=c.events(mode),
         )
         if sol.status != 1:
             raise RuntimeError(
@@ -156,14 +169,14 @@ def _reference_one(psi, eta2, e, mu, r_x, r_y, alpha, rtol, atol):
         t, k_hit = min((te[0], k) for k, te in enumerate(sol.t_events) if te.size)
         y = sol.y_events[k_hit][0].copy()
         if k_hit == 0:
-            if st["unloading"]:
+            if c.unloading:
                 break  # separation
-            st["unloading"], st["d_m"] = True, y[0]
+            c.unloading, c.d_m = True, y[0]
             t_c = t
             continue
         if mode == 0:
             mode = 1 if k_hit == 1 else -1
-            y[3] = mode * fric * normal_force(y[0]) / k_t
+            y[3] = mode * fric * c.normal_force(y[0]) / c.k_t
             seq.append("slip")
         else:
             mode = 0

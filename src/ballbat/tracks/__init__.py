@@ -5,7 +5,9 @@
 * :mod:`.io` and :mod:`.validate` — a lab's ``tracks.csv``/``.nc`` and ``impacts.csv``, checked whole.
 * :mod:`.formats` — the tracking tools' own files (Tracker ``.trk``/``.trz``, Kinovea ``.kva``, exported tables).
 * :mod:`.reduce` — per-impact fits giving v_bat, v_ball, theta, omega with fitted uncertainties.
-* :mod:`.qa` — figures a lab uses to eyeball its tracks and fits.
+
+The figures a lab uses to eyeball its tracks and fits are in the plotting layer,
+:mod:`ballbat.plotting_tracks`: nothing here imports matplotlib.
 
 See docs/tracks.md.
 """

@@ -50,6 +50,12 @@ GLITCH_FALSE_ALARM = 1e-9
 IMPACT_Z = 4.89
 #: z beyond which a dataset's pooled check fails (two-sided normal, 6e-7).
 DATASET_Z = 5.0
+#: z of the one-sided test of g's sign: a camera whose y points up sees g negative. A y-down
+#: camera shows at least g less the largest Magnus lift, so a g that is negative and more than
+#: FLIP_Z standard errors below that is a y axis pointing up (false alarm 1.3e-3 per camera for
+#: Gaussian errors); the two-sided test at DATASET_Z must also allow for the lift, and misses
+#: a flip whenever the lift allowance is large against g.
+FLIP_Z = 3.0
 #: A setting is wrong for the whole dataset when more than this fraction of impacts fails.
 DATASET_FRACTION = 0.5
 #: Air density (kg m-3) bounding the aerodynamic allowance (sea level, cold: 1.3).
@@ -536,13 +542,10 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
         with enough usable impacts. The messages give the numbers, the setting most likely
         wrong, and the count of every exclusion reason.
     """
-    from ..ingest import implausible_rows
-    from ..linefit import MIN_FIT_IMPACTS
-    from ..properties import InputError, recoil_factors
-    from .reduce import STAGE, TAU_PRIOR_FRAMES, ReduceFlag, fit_contact
+    from .reduce import ReduceFlag
 
-    tr, cams = red.tracks, red.cameras
-    ball_ids, bat_ids = tr.ball.astype(str), tr.bat.astype(str)
+    tr = red.tracks
+    ball_ids = tr.ball.astype(str)
     r = np.array([balls[b].r for b in ball_ids])
     m = np.array([balls[b].m for b in ball_ids])
     flag = red.flag
@@ -551,11 +554,29 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
     n_test = int(fitted.sum())
     setting_wrong = n_test > 0 and disagree.sum() > DATASET_FRACTION * n_test
     pool = fitted & (~disagree | setting_wrong)
-    observed: dict = {}
-    failed: list[str] = []
-    lines: list[str] = []
+    found = _Findings({}, [], [])
+    _check_free_fall(red, pool, r, m, where, found)
+    _check_two_cameras(red, pool, fitted & disagree, n_test, setting_wrong, where, found)
+    _check_tip_arc(red, pool, where, found)
+    _check_spin_dots(red, pool, ball_ids, balls, where, found)
+    if found.failed:
+        _raise_setting(found, red.cameras, where)
+    pairs = _exclude_implausible(red, r, balls, bats, where)
+    return Verdict(found.observed, found.lines, _usable_pairs(red, pairs, where))
 
-    # g with g free, each camera
+
+@dataclass
+class _Findings:
+    """What the dataset checks of :func:`cross_check` found so far (filled in place)."""
+
+    observed: dict  # pooled observable -> (value, relative error), for :func:`diagnose`
+    lines: list  # one line per check, for the log
+    failed: list  # the checks that stop the dataset, each naming the setting
+
+
+def _check_free_fall(red: Reduction, pool, r, m, where: str, found: _Findings) -> None:
+    """Check g, fitted free in each camera's ball flight, against G (allowing for Magnus lift)."""
+    observed, lines, failed = found.observed, found.lines, found.failed
     for c in ("swing", "spin"):
         ff = free_fall(*red.phys[(c, "ball")], red.times[c], red.flight[c], r, m, red.values["omega"])
         sel = pool & np.isfinite(ff.g)
@@ -575,14 +596,22 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
             failed.append(
                 f"{where}.cameras.{c}: {line}: g scales as m_per_px x fps^2 and changes sign when y points up"
             )
+        elif g < 0 and g < G - lift - FLIP_Z * se:
+            failed.append(
+                f"{where}.cameras.{c}: {line}: g is negative, {(G - lift - g) / se:.1f} standard errors below "
+                "the least a camera with y pointing down shows (g less the largest lift): y points up"
+            )
 
-    # the two cameras
+
+def _check_two_cameras(red: Reduction, pool, disagreeing, n_test: int, setting_wrong, where: str, found) -> None:
+    """Check the ball's speed in the swing camera over that in the spin camera against 1."""
+    observed, lines, failed = found.observed, found.lines, found.failed
     ag = red.agreement
     sel = pool & np.isfinite(ag.ratio)
     ratio, se, k = weighted_mean(ag.ratio[sel], ag.ratio_err[sel])
     if k:
         observed["speed"] = (ratio, se / ratio)
-        n_bad = int((fitted & disagree).sum())
+        n_bad = int(disagreeing.sum())
         line = (
             f"the ball's speed in swing / in spin: {ratio:.4f} +- {se:.4f} over {k} impacts (expected 1); "
             f"{n_bad} of {n_test} impacts disagree beyond z = {IMPACT_Z}"
@@ -594,7 +623,13 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
                 "direction with mirror and the direction of y"
             )
 
-    # the tip's arc
+
+def _check_tip_arc(red: Reduction, pool, where: str, found: _Findings) -> None:
+    """Check the radius of the bat tip's arc in the swing camera against the rig's pivot_to_tip."""
+    from .reduce import TAU_PRIOR_FRAMES, fit_contact
+
+    observed, lines, failed = found.observed, found.lines, found.failed
+    cams = red.cameras
     contact = red.contact or fit_contact(
         *red.phys[("swing", "ball")], red.times["swing"], red.onset["swing"], red.flight["swing"], red.tracks.ball
     )
@@ -630,7 +665,10 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
                 "not with fps"
             )
 
-    # spin dots against the ball's radius (Table I)
+
+def _check_spin_dots(red: Reduction, pool, ball_ids, balls: dict, where: str, found: _Findings) -> None:
+    """Check the spin dots' mean distance from the ball's centre against its radius (Table I)."""
+    lines, failed = found.lines, found.failed
     for b in sorted(set(ball_ids)):
         sel = pool & (ball_ids == b)
         rho = np.concatenate([red.spin.radius[p][sel] for p in ("dot_a", "dot_b")])
@@ -650,21 +688,38 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
                 "(the distance scales with the spin camera's m_per_px)"
             )
 
-    if failed:
-        found = diagnose(observed, cams)
-        tail = []
-        if found is not None:
-            name, chi2, none = found
-            ok = chi2 < DATASET_Z**2 * max(len(observed), 1) and chi2 < none
-            tail = [
-                f"{where}: most likely {name}"
-                if ok
-                else f"{where}: no single setting explains these; check fps, m_per_px, mirror and the direction of y "
-                "of both cameras, and the rig's units (inches)"
-            ]
-        raise InputError([*failed, *tail])
 
-    # ranges, as for a measured file
+def _raise_setting(found: _Findings, cams, where: str) -> None:
+    """Stop the dataset: the failed checks, and the setting that most likely explains them."""
+    from ..properties import InputError
+
+    failed, observed = found.failed, found.observed
+    likely = diagnose(observed, cams)
+    tail = []
+    if likely is not None:
+        name, chi2, none = likely
+        ok = chi2 < DATASET_Z**2 * max(len(observed), 1) and chi2 < none
+        tail = [
+            f"{where}: most likely {name}"
+            if ok
+            else f"{where}: no single setting explains these; check fps, m_per_px, mirror and the direction of y "
+            "of both cameras, and the rig's units (inches)"
+        ]
+    raise InputError([*failed, *tail])
+
+
+def _exclude_implausible(red: Reduction, r, balls: dict, bats: dict, where: str) -> dict:
+    """Flag the impacts whose reduced values no collision gives, as for a measured file.
+
+    Returns the recoil factors of each (ball, bat) pair; more than half the live impacts
+    implausible stops the dataset.
+    """
+    from ..ingest import Measured, implausible_rows
+    from ..properties import InputError, recoil_factors
+    from .reduce import STAGE, ReduceFlag
+
+    tr, flag = red.tracks, red.flag
+    ball_ids, bat_ids = tr.ball.astype(str), tr.bat.astype(str)
     pairs = {(b, t): recoil_factors(balls[b], bats[t]) for b, t in set(zip(ball_ids, bat_ids, strict=True))}
     r_x = np.array([pairs[(b, t)][0] for b, t in zip(ball_ids, bat_ids, strict=True)])
     r_y = np.array([pairs[(b, t)][1] for b, t in zip(ball_ids, bat_ids, strict=True)])
@@ -672,15 +727,9 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
     v = red.values
     live = (flag == 0) & np.all([np.isfinite(v[k]) for k in ("v_bat", "v_ball", "theta", "omega")], axis=0)
     if live.any():
+        measured = Measured(v["v_bat"], v["v_ball"], v["theta"], v["omega"], r, alpha, r_x, r_y)
         why = implausible_rows(
-            v["v_bat"][live],
-            v["v_ball"][live],
-            v["theta"][live],
-            v["omega"][live],
-            r[live],
-            alpha[live],
-            r_x[live],
-            r_y[live],
+            measured.take(live),
             # one group per impact: the group-outlier test (a unit mistake in some rows of a file)
             # does not apply to a reduction, whose rows share their settings; the ranges do
             np.arange(int(live.sum())),
@@ -698,6 +747,17 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
                 ]
             )
 
+    return pairs
+
+
+def _usable_pairs(red: Reduction, pairs: dict, where: str) -> list[str]:
+    """Stop a dataset with no ball x bat pair to fit; return a warning per pair with too few impacts."""
+    from ..linefit import MIN_FIT_IMPACTS
+    from ..properties import InputError
+    from .reduce import ReduceFlag
+
+    tr, flag = red.tracks, red.flag
+    ball_ids, bat_ids = tr.ball.astype(str), tr.bat.astype(str)
     usable = flag == 0
     counts = {(b, t): int((usable & (ball_ids == b) & (bat_ids == t)).sum()) for b, t in sorted(pairs)}
     if not usable.any() or not any(k >= MIN_FIT_IMPACTS for k in counts.values()):
@@ -721,4 +781,4 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
         for (b, t), k in counts.items()
         if k < MIN_FIT_IMPACTS
     ]
-    return Verdict(observed, lines, warnings)
+    return warnings

@@ -103,6 +103,32 @@ def cameras_from_config(cfg: dict, where: str = "tracks") -> tuple[dict[str, Cam
     return cams, rig
 
 
+def read_impacts(
+    ipath: Path, balls: dict | None, bats: dict | None, more_columns: bool = False
+) -> tuple[dict[str, str] | None, list, list[str]]:
+    """Read and check a tracks dataset's impacts table: return (impact id -> row label, rows, problems).
+
+    The impacts are None when the table cannot be read or its header is wrong; ``more_columns``
+    allows columns beyond :data:`~ballbat.tracks.validate.IMPACT_COLUMNS` (a NetCDF's own
+    impact table holds the truth too).
+    """
+    problems: list[str] = []
+    impacts: dict[str, str] | None = None
+    irows: list = []
+    try:
+        iheader, irows = read_table(ipath, IMPACT_COLUMNS, "impact")
+        hp = check_header(ipath, iheader, IMPACT_COLUMNS)
+        if more_columns:
+            hp = [p for p in hp if "unknown column" not in p]
+        problems += hp
+        if not hp:
+            impacts, rp = check_impact_rows(ipath, irows, balls, bats)
+            problems += rp
+    except InputError as exc:
+        problems += exc.problems
+    return impacts, irows, problems
+
+
 def load_tracks(
     tracks_path: str | os.PathLike[str],
     impacts_path: str | os.PathLike[str] | None = None,
@@ -133,19 +159,8 @@ def load_tracks(
     tracks_path = Path(tracks_path)
     problems: list[str] = []
     ipath = Path(impacts_path) if impacts_path is not None else tracks_path
-    impacts: dict | None = None
-    irows: list = []
-    try:
-        iheader, irows = read_table(ipath, IMPACT_COLUMNS, "impact")
-        hp = check_header(ipath, iheader, IMPACT_COLUMNS)
-        if impacts_path is None:  # the NetCDF's own impact table may hold more (truth_*)
-            hp = [p for p in hp if "unknown column" not in p]
-        problems += hp
-        if not hp:
-            impacts, rp = check_impact_rows(ipath, irows, balls, bats)
-            problems += rp
-    except InputError as exc:
-        problems += exc.problems
+    # the NetCDF's own impact table may hold more (truth_*)
+    impacts, irows, problems = read_impacts(ipath, balls, bats, more_columns=impacts_path is None)
     if not problems and impacts is not None and tracks_path.suffix.lower() in _NC:
         fast = _fast_nc(tracks_path, impacts)
         if fast is not None:  # well-formed: skip the row-by-row checks (they would find nothing)

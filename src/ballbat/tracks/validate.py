@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from ..properties import EXTRA
+from ..properties import EXTRA, cell_number, check_impact_id, header_problems, table_keys
 from .checks import SCALE_ERR_MAX
 from .data import CAMERAS, POINTS
 
@@ -29,18 +29,8 @@ RIG_KEYS = ("pivot_to_tip_in", "pivot_to_impact_in")
 
 
 def check_header(path: str | os.PathLike[str], header: list[str], required: tuple[str, ...]) -> list[str]:
-    """Missing, unknown and repeated columns."""
-    problems = []
-    missing = [c for c in required if c not in header]
-    if missing:
-        problems.append(f"{path}: missing column(s) {', '.join(missing)} (required: {', '.join(required)})")
-    unknown = [c for c in header if c not in required]
-    if unknown:
-        problems.append(f"{path}: unknown column(s) {', '.join(map(repr, unknown))} (allowed: {', '.join(required)})")
-    repeated = sorted({c for c in header if header.count(c) > 1})
-    if repeated:
-        problems.append(f"{path}: column(s) {', '.join(repeated)} appear more than once")
-    return problems
+    """Missing, unknown and repeated columns (:func:`ballbat.properties.header_problems`)."""
+    return header_problems(path, header, required)
 
 
 def check_impact_rows(
@@ -58,40 +48,9 @@ def check_impact_rows(
         at = f"{path}: {label}"
         if EXTRA in row:
             problems.append(f"{at}: {row[EXTRA]} more cell(s) than the header has columns")
-        iid = row.get("impact_id", "")
-        if not iid:
-            problems.append(f"{at}, column impact_id: empty")
-        elif iid in seen:
-            problems.append(f"{at}, column impact_id: {iid!r} duplicates {seen[iid]}")
-        else:
-            seen[iid] = label
-        for key, table in (("bat", bats), ("ball", balls)):
-            name = row.get(key, "")
-            if not name:
-                problems.append(f"{at}, column {key}: empty")
-            elif table is not None and name not in table:
-                problems.append(
-                    f"{at}, column {key}: {key} {name!r} is not in the {key} table (known: {', '.join(sorted(table))})"
-                )
+        check_impact_id(row.get("impact_id", ""), at, label, seen, problems)
+        table_keys(row, at, balls, bats, problems)
     return seen, problems
-
-
-def _number(raw: str, at: str, problems: list[str], integer: bool = False) -> float:
-    if raw == "":
-        problems.append(f"{at}: empty")
-        return math.nan
-    try:
-        val = float(raw)
-    except ValueError:
-        problems.append(f"{at}: {raw!r} is not a number")
-        return math.nan
-    if not math.isfinite(val):
-        problems.append(f"{at}: {raw!r} is not finite")
-        return math.nan
-    if integer and val != int(val):
-        problems.append(f"{at}: {raw!r} is not a whole frame number")
-        return math.nan
-    return val
 
 
 def check_track_rows(
@@ -153,9 +112,9 @@ def check_track_rows(
             )
             bad = True
         n0 = len(problems)
-        frame = _number(row.get("frame", ""), f"{at}, column frame", problems, integer=True)
-        x = _number(row.get("x_px", ""), f"{at}, column x_px", problems)
-        y = _number(row.get("y_px", ""), f"{at}, column y_px", problems)
+        frame = cell_number(row.get("frame", ""), f"{at}, column frame", problems, integer=True)
+        x = cell_number(row.get("x_px", ""), f"{at}, column x_px", problems)
+        y = cell_number(row.get("y_px", ""), f"{at}, column y_px", problems)
         bad = bad or len(problems) > n0
         if bad:
             continue

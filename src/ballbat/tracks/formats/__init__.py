@@ -78,6 +78,23 @@ def whole_frames(values: np.ndarray, what: str, labels: list[str], tol: float = 
     return out, problems
 
 
+def finite_number(text: str | None, what: str, problems: list[str], integer: bool = False) -> float | int | None:
+    """Return a tracking file's number (``integer``: a whole number), or None with the problem added.
+
+    ``what`` names the file and the field; the message is ``"{what} {text!r} is not a number"``
+    (or ``is not finite``).
+    """
+    try:
+        v = int((text or "").strip()) if integer else float((text or "").strip())
+    except ValueError:
+        problems.append(f"{what} {text!r} is not a number")
+        return None
+    if not math.isfinite(v):
+        problems.append(f"{what} {text!r} is not finite")
+        return None
+    return v
+
+
 def length_to_m(unit: str, where: str) -> float:
     """Metres per ``unit``; a ValueError naming ``where`` when the unit is unknown."""
     key = str(unit).strip().lower()

@@ -25,7 +25,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from . import FileTracks, FormatError, length_to_m, whole_frames
+from . import FileTracks, FormatError, finite_number, length_to_m, whole_frames
 
 if TYPE_CHECKING:
     import os
@@ -44,15 +44,7 @@ KINOVEA_UNITS = {
 
 
 def _float(text: str | None, what: str, problems: list[str]) -> float | None:
-    try:
-        v = float((text or "").strip())
-    except ValueError:
-        problems.append(f"{what}: {text!r} is not a number")
-        return None
-    if not math.isfinite(v):
-        problems.append(f"{what}: {text!r} is not finite")
-        return None
-    return v
+    return finite_number(text, f"{what}:", problems)
 
 
 def _point(text: str | None, what: str, problems: list[str]) -> tuple[float, float] | None:
@@ -84,6 +76,16 @@ def read_kva(path: str | os.PathLike[str]) -> FileTracks:
     if rotation not in ("Rotate0", "None", ""):
         problems.append(f"{path}: Rotation is {rotation}: ballbat reads unrotated images only")
 
+    fps, per_frame, first = _timing(root, path, problems, source)
+    m_per_px = _calibration(root, path, problems, source)
+    tracks = _tracks(root, path, per_frame, first, problems)
+    if problems:
+        raise FormatError(problems)
+    return FileTracks(path=str(path), tracks=tracks, fps=fps, m_per_px=m_per_px, source=source)
+
+
+def _timing(root, path: Path, problems: list[str], source: dict) -> tuple[float | None, float | None, float]:
+    """Return the capture frame rate (None: not given), the timestamps per frame and the first timestamp."""
     fps = None
     if root.find("CaptureFramerate") is not None:
         fps = _float(root.findtext("CaptureFramerate"), f"{path}: CaptureFramerate", problems)
@@ -103,7 +105,11 @@ def read_kva(path: str | os.PathLike[str]) -> FileTracks:
     first = 0.0
     if root.find("FirstTimeStamp") is not None:
         first = _float(root.findtext("FirstTimeStamp"), f"{path}: FirstTimeStamp", problems) or 0.0
+    return fps, per_frame, first
 
+
+def _calibration(root, path: Path, problems: list[str], source: dict) -> float | None:
+    """Return m_per_px from a calibration line (None: no calibration, a plane or pixels)."""
     m_per_px = None
     cal = root.find("Calibration")
     if cal is not None:
@@ -127,7 +133,11 @@ def read_kva(path: str | os.PathLike[str]) -> FileTracks:
                 else:
                     m_per_px = length * length_to_m(KINOVEA_UNITS[kunit], str(path)) / px
                     source["m_per_px"] = f"CalibrationLine {length:g} {KINOVEA_UNITS[kunit]} over {px:.2f} px"
+    return m_per_px
 
+
+def _tracks(root, path: Path, per_frame: float | None, first: float, problems: list[str]) -> dict:
+    """Return each track's points: (frames, x, y) in pixels, the frames from the timestamps."""
     tracks: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
     for track in root.findall("Tracks/Track"):
         name = track.get("name")
@@ -165,6 +175,4 @@ def read_kva(path: str | os.PathLike[str]) -> FileTracks:
                 problems.append(f"{lab}: frame {int(f)} twice (also {seen[int(f)]})")
             seen.setdefault(int(f), lab)
         tracks[name] = (frames, np.array(x, dtype=float), np.array(y, dtype=float))
-    if problems:
-        raise FormatError(problems)
-    return FileTracks(path=str(path), tracks=tracks, fps=fps, m_per_px=m_per_px, source=source)
+    return tracks

@@ -310,22 +310,11 @@ def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | 
     :class:`~ballbat.properties.InputError`.
     """
     from ...properties import InputError
-    from ..io import _assemble, read_table
-    from ..validate import IMPACT_COLUMNS, check_header, check_impact_rows
+    from ..io import _assemble, read_impacts
 
-    problems: list[str] = []
     ipath = Path(cfg["impacts"])
-    irows: list = []
-    impacts: dict[str, str] = {}
-    try:
-        header, irows = read_table(ipath, IMPACT_COLUMNS, "impact")
-        hp = check_header(ipath, header, IMPACT_COLUMNS)
-        problems += hp
-        if not hp:
-            impacts, rp = check_impact_rows(ipath, irows, balls, bats)
-            problems += rp
-    except InputError as exc:
-        problems += exc.problems
+    impacts, irows, problems = read_impacts(ipath, balls, bats)
+    impacts = impacts or {}
     try:
         imp = import_files(
             [cfg["dir"]],

@@ -75,6 +75,36 @@ def _num(cell: str, decimal_comma: bool) -> float:
     return float(cell)
 
 
+def _add_row(path, ln: int, cells: list[str], blocks: dict, decimal_comma: bool, names, data, problems) -> None:
+    """Add one data row of an exported table to ``data`` (track -> lists of t, x, y and row labels).
+
+    ``blocks`` maps each track to its (x, y) column indices; ``names`` are the table's names of
+    the time, x and y columns, for messages. A cell that is not a finite number is a problem
+    naming the file, the line and the track; a track with both cells empty is not in this row.
+    """
+    time_name, x_name, y_name = names
+    try:
+        t = _num(cells[0], decimal_comma)
+    except ValueError:
+        problems.append(f"{path}: line {ln}, column {time_name}: {cells[0]!r} is not a number")
+        return
+    for name, (cx, cy) in blocks.items():
+        sx = cells[cx].strip() if cx < len(cells) else ""
+        sy = cells[cy].strip() if cy < len(cells) else ""
+        if not sx and not sy:
+            continue
+        try:
+            x, y = _num(sx, decimal_comma), _num(sy, decimal_comma)
+        except ValueError:
+            problems.append(f"{path}: line {ln}, track {name!r}: {x_name} {sx!r}, {y_name} {sy!r} are not numbers")
+            continue
+        if not (np.isfinite(x) and np.isfinite(y)):
+            problems.append(f"{path}: line {ln}, track {name!r}: {x_name} {sx!r}, {y_name} {sy!r} are not finite")
+            continue
+        for lst, v in zip(data[name], (t, x, y, f"{path}: line {ln}, track {name!r}"), strict=True):
+            lst.append(v)
+
+
 def _to_file_tracks(path, cols, units, fps, m_per_px, what) -> FileTracks:
     """(name -> (t, x, y, row labels)) in the table's units -> FileTracks in pixels and frames."""
     problems: list[str] = []
@@ -141,27 +171,7 @@ def read_tracker_table(path: str | os.PathLike[str], units: dict, fps: float, m_
     for ln, line in enumerate(lines[i + 2 :], start=i + 3):
         if not line.strip() or line.startswith("#"):
             continue
-        cells = line.split(delim)
-        try:
-            t = _num(cells[0], decimal_comma)
-        except ValueError:
-            problems.append(f"{path}: line {ln}, column t: {cells[0]!r} is not a number")
-            continue
-        for name, (cx, cy) in blocks.items():
-            sx = cells[cx].strip() if cx < len(cells) else ""
-            sy = cells[cy].strip() if cy < len(cells) else ""
-            if not sx and not sy:
-                continue
-            try:
-                x, y = _num(sx, decimal_comma), _num(sy, decimal_comma)
-            except ValueError:
-                problems.append(f"{path}: line {ln}, track {name!r}: x {sx!r}, y {sy!r} are not numbers")
-                continue
-            if not (np.isfinite(x) and np.isfinite(y)):
-                problems.append(f"{path}: line {ln}, track {name!r}: x {sx!r}, y {sy!r} are not finite")
-                continue
-            for lst, v in zip(data[name], (t, x, y, f"{path}: line {ln}, track {name!r}"), strict=True):
-                lst.append(v)
+        _add_row(path, ln, line.split(delim), blocks, decimal_comma, ("t", "x", "y"), data, problems)
     if problems:
         raise FormatError(problems)
     cols = {n: (np.array(t), np.array(x), np.array(y), lab) for n, (t, x, y, lab) in data.items()}
@@ -197,23 +207,7 @@ def read_kinovea_table(path: str | os.PathLike[str], units: dict, fps: float, m_
     for ln, cells in enumerate(rows[1:], start=2):
         if not any(c.strip() for c in cells):
             continue
-        try:
-            t = _num(cells[0], decimal_comma)
-        except ValueError:
-            problems.append(f"{path}: line {ln}, column Time: {cells[0]!r} is not a number")
-            continue
-        for name, (cx, cy) in blocks.items():
-            sx = cells[cx].strip() if cx < len(cells) else ""
-            sy = cells[cy].strip() if cy < len(cells) else ""
-            if not sx and not sy:
-                continue
-            try:
-                x, y = _num(sx, decimal_comma), _num(sy, decimal_comma)
-            except ValueError:
-                problems.append(f"{path}: line {ln}, track {name!r}: X {sx!r}, Y {sy!r} are not numbers")
-                continue
-            for lst, v in zip(data[name], (t, x, y, f"{path}: line {ln}, track {name!r}"), strict=True):
-                lst.append(v)
+        _add_row(path, ln, cells, blocks, decimal_comma, ("Time", "X", "Y"), data, problems)
     if problems:
         raise FormatError(problems)
     cols = {n: (np.array(t), np.array(x), np.array(y), lab) for n, (t, x, y, lab) in data.items()}

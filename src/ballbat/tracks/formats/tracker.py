@@ -29,7 +29,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from . import FileTracks, FormatError, length_to_m
+from . import FileTracks, FormatError, finite_number, length_to_m
 
 if TYPE_CHECKING:
     import os
@@ -49,16 +49,7 @@ def _number(props: dict, name: str, where: str, problems: list[str], integer: bo
     p = props.get(name)
     if p is None:
         return None
-    text = (p.text or "").strip()
-    try:
-        v = int(text) if integer else float(text)
-    except ValueError:
-        problems.append(f"{where}: {name} {text!r} is not a number")
-        return None
-    if not math.isfinite(v):
-        problems.append(f"{where}: {name} {text!r} is not finite")
-        return None
-    return v
+    return finite_number((p.text or "").strip(), f"{where}: {name}", problems, integer)
 
 
 def _array(prop: ET.Element) -> dict[int, ET.Element]:
@@ -83,7 +74,22 @@ def read_trk_text(text: bytes | str, path: str) -> FileTracks:
     problems: list[str] = []
     top = _props(root)
     source: dict[str, str] = {}
+    clip = _clip_steps(top, path, problems)
+    fps = _frame_rate(top, path, problems, source)
+    m_per_px, axes = _coordinate_system(top, path, problems, source)
+    tracks = _point_masses(root, path, clip, axes, problems)
+    if problems:
+        raise FormatError(problems)
+    _xo, _yo, angle, ratio = axes
+    if angle or ratio != 1.0:
+        source["axes"] = (
+            f"pixels turned into the coordinate system's axes (angle {angle:g} deg, xscale/yscale {ratio:g})"
+        )
+    return FileTracks(path=path, tracks=tracks, fps=fps, m_per_px=m_per_px, source=source)
 
+
+def _clip_steps(top: dict, path: str, problems: list[str]) -> tuple[int, int, int | None]:
+    """Return the video clip's first frame, step and number of steps (None: not given)."""
     clip = _child_object(top.get("videoclip"))
     cp = _props(clip) if clip is not None else {}
     start = _number(cp, "startframe", f"{path}: videoclip", problems, integer=True)
@@ -94,7 +100,11 @@ def read_trk_text(text: bytes | str, path: str) -> FileTracks:
     if step < 1:
         problems.append(f"{path}: videoclip: stepsize {step} must be at least 1")
         step = 1
+    return start, step, count
 
+
+def _frame_rate(top: dict, path: str, problems: list[str], source: dict) -> float | None:
+    """Return the frame rate the clip control's delta_t gives (None: not in the file)."""
     fps = None
     cc = _child_object(top.get("clipcontrol"))
     dt = _number(_props(cc), "delta_t", f"{path}: clipcontrol", problems) if cc is not None else None
@@ -104,7 +114,14 @@ def read_trk_text(text: bytes | str, path: str) -> FileTracks:
         else:
             fps = 1000.0 / dt
             source["fps"] = f"clipcontrol delta_t {dt:g} ms"
+    return fps
 
+
+def _coordinate_system(top: dict, path: str, problems: list[str], source: dict):
+    """Return m_per_px (None: no scale or no unit) and the axes (x and y origin, angle in deg, xscale/yscale).
+
+    The coordinate system must be the same in every frame.
+    """
     unit_prop = top.get("length_unit")
     unit = (unit_prop.text or "").strip() if unit_prop is not None else None
     m_per_px = None
@@ -142,7 +159,16 @@ def read_trk_text(text: bytes | str, path: str) -> FileTracks:
                 except ValueError as exc:
                     problems.append(str(exc))
                 ratio = xs / ys
+    return m_per_px, (xo, yo, angle, ratio)
 
+
+def _point_masses(root, path: str, clip: tuple, axes: tuple, problems: list[str]) -> dict:
+    """Return each point mass's marks: (frames, x, y) in pixels along the coordinate system's axes.
+
+    A mark must sit on a step of the clip; axes, tapes and other tools are not tracked points.
+    """
+    start, step, count = clip
+    xo, yo, angle, ratio = axes
     tracks: dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]] = {}
     items = _props(root).get("tracks")
     for item in items.findall("property") if items is not None else []:
@@ -177,13 +203,7 @@ def read_trk_text(text: bytes | str, path: str) -> FileTracks:
             xs_.append(x)
             ys_.append(y)
         tracks[name] = (np.array(frames, dtype=np.int64), *_to_axes(np.array(xs_), np.array(ys_), xo, yo, angle, ratio))
-    if problems:
-        raise FormatError(problems)
-    if angle or ratio != 1.0:
-        source["axes"] = (
-            f"pixels turned into the coordinate system's axes (angle {angle:g} deg, xscale/yscale {ratio:g})"
-        )
-    return FileTracks(path=path, tracks=tracks, fps=fps, m_per_px=m_per_px, source=source)
+    return tracks
 
 
 def _to_axes(px, py, xo, yo, angle_deg, ratio):

@@ -1,0 +1,230 @@
+"""QA figures of the raw-track reduction (rule ``tracks_qa``): labs must be able to eyeball their tracks.
+
+* :func:`impacts_figure` — for a few impacts (usable ones and, if any, excluded ones): the
+  swing camera's view (tracked tip dot and ball, the fitted tip motion and ball flight,
+  frames used marked), the spin camera's view (ball and dots, fitted centre path), and
+  each dot's unwrapped angle about the fitted centre against time with the fitted spin.
+* :func:`summary_figure` — residuals of every fit across impacts, and the flags.
+
+Drawn from ``reduce.nc`` (the fitted parameters) and the tracks (the points); nothing is
+refitted. Part of the plotting layer (with :mod:`ballbat.plotting`, which sets matplotlib's
+Agg backend): the measurement chain (:mod:`ballbat.tracks`) never imports matplotlib. Figures
+are saved deterministically by :func:`ballbat.plotting.save_figure`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import xarray as xr
+from matplotlib.figure import Figure
+
+from .plotting import save_figure
+from .tracks.data import Camera, Tracks
+from .tracks.reduce import FLAG_VAR, G, ReduceFlag, physical
+
+__all__ = ["impacts_figure", "pick_impacts", "save_figure", "summary_figure"]
+
+
+def _cameras(red: xr.Dataset) -> dict[str, Camera]:
+    return {
+        c: Camera(
+            float(red.attrs[f"{c}_fps"]),
+            float(red.attrs[f"{c}_m_per_px"]),
+            bool(red.attrs[f"{c}_mirror"]),
+            float(red.attrs[f"{c}_m_per_px_rel_err"]),
+        )
+        for c in ("swing", "spin")
+    }
+
+
+def pick_impacts(red: xr.Dataset, n_ok: int = 2, n_excluded: int = 1) -> list[int]:
+    """Return the indices of the impacts to show: the first usable ones and the first excluded ones."""
+    flag = red[FLAG_VAR].values
+    ok = list(np.flatnonzero(flag == 0)[:n_ok])
+    bad = list(np.flatnonzero(flag != 0)[:n_excluded])
+    return ok + bad
+
+
+def _to_px(X, Y, cam: Camera):
+    return cam.sign * X / cam.m_per_px, -Y / cam.m_per_px
+
+
+def impacts_figure(red: xr.Dataset, tracks: Tracks, impacts: list[int] | None = None) -> Figure:
+    """Both camera views and the dot angles of a few impacts, with the fitted motions.
+
+    Parameters
+    ----------
+    red : xarray.Dataset
+        ``reduce.nc``.
+    tracks : Tracks
+        The tracks it was reduced from (same impact order).
+    impacts : list of int, optional
+        Impact indices to show (default :func:`pick_impacts`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    idx = pick_impacts(red) if impacts is None else impacts
+    cams = _cameras(red)
+    fig = Figure(figsize=(13, 3.4 * max(len(idx), 1)), layout="constrained")
+    axes = fig.subplots(max(len(idx), 1), 3, squeeze=False)
+    for row, i in enumerate(idx):
+        _swing_panel(axes[row, 0], red, tracks, cams["swing"], i)
+        _spin_panel(axes[row, 1], red, tracks, cams["spin"], i)
+        _dot_angle_panel(axes[row, 2], red, tracks, cams["spin"], i)
+    return fig
+
+
+def _camera_axes(ax, title: str) -> None:
+    """Title, pixel labels (y down, as in the image) and the legend of a camera view."""
+    ax.set_title(title, fontsize=9)
+    ax.set_xlabel("x (px)")
+    ax.set_ylabel("y (px, down)")
+    ax.invert_yaxis()
+    ax.set_aspect("equal", adjustable="datalim")
+    ax.legend(fontsize=7, loc="best")
+
+
+def _swing_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int) -> None:
+    """Swing camera: tracked tip dot and ball, the fitted pre-impact tip motion and the ball flight."""
+    flag = int(red[FLAG_VAR].values[i])
+    status = "usable" if flag == 0 else f"EXCLUDED ({ReduceFlag(flag).name.lower()})"
+    ct = tracks.cameras["swing"]
+    t = np.arange(ct.n_columns) / cam.fps
+    for p, style in (
+        ("bat_tip", dict(color="tab:brown", marker="s")),
+        ("ball", dict(color="tab:blue", marker="o")),
+    ):
+        ax.scatter(
+            ct.x[p][i],
+            ct.y[p][i],
+            s=9,
+            facecolors="none",
+            edgecolors=style["color"],
+            marker=style["marker"],
+            linewidths=0.7,
+            label=f"{p} (tracked)",
+        )
+    pivot_to_tip = float(red.attrs["pivot_to_tip_m"])
+    plane_angle = red["swing_plane_angle"].values[i]
+    alignment_time = red["bat_alignment_time"].values[i]
+    angular_speed = red["bat_angular_speed"].values[i]
+    if np.isfinite(angular_speed):
+        used = (t - alignment_time) <= 0
+        along = red["tip_offset"].values[i] + pivot_to_tip * np.sin(angular_speed * (t - alignment_time))
+        X = red["tip_centroid_x"].values[i] + along * np.cos(plane_angle)
+        Y = red["tip_centroid_y"].values[i] + along * np.sin(plane_angle)
+        x, y = _to_px(X, Y, cam)
+        ax.plot(x[used], y[used], color="tab:brown", lw=1.2, label="tip fit (pre-impact)")
+    _flight_line(ax, red, i, "swing", t, cam, ct.x["ball"][i])
+    iid = red["impact_id"].values[i]
+    contact = ""
+    if "contact_time" in red and np.isfinite(red["contact_time"].values[i]):
+        tc, tc_err = red["contact_time"].values[i], red["contact_time_err"].values[i]
+        contact = f"\ncontact {1e3 * tc:.2f} ± {1e3 * tc_err:.2f} ms (fitted)"
+    _camera_axes(ax, f"impact {iid}: swing camera ({cam.fps:g} fps) — {status}{contact}")
+
+
+def _spin_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int) -> None:
+    """Spin camera: tracked ball and dots, and the fitted path of the ball's centre."""
+    ct = tracks.cameras["spin"]
+    t = np.arange(ct.n_columns) / cam.fps
+    for p, c in (("ball", "tab:blue"), ("dot_a", "tab:red"), ("dot_b", "tab:green")):
+        ax.scatter(ct.x[p][i], ct.y[p][i], s=9, color=c, label=p)
+    _flight_line(ax, red, i, "spin", t, cam, ct.x["ball"][i])
+    _camera_axes(ax, f"spin camera ({cam.fps:g} fps)")
+
+
+def _dot_angle_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int) -> None:
+    """Each dot's unwrapped angle about the fitted centre against time, with the fitted spin."""
+    ct = tracks.cameras["spin"]
+    t = np.arange(ct.n_columns) / cam.fps
+    cx, cy = _flight_xy(red, i, "spin", t)
+    sep = red["separation_frame_spin"].values[i] - red["frame0_spin"].values[i]
+    omega = red["omega"].values[i]
+    for p, c in (("dot_a", "tab:red"), ("dot_b", "tab:green")):
+        X, Y = physical(ct, cam, p)
+        phi = np.arctan2(Y[i] - cy, X[i] - cx)
+        ok = np.isfinite(phi) & (np.arange(t.size) >= sep)
+        if ok.sum() < 2:
+            continue
+        phase = red[f"{p}_phase"].values[i]
+        unwrapped = np.unwrap(phi[ok])
+        unwrapped += 2 * np.pi * np.round((phase + omega * t[ok][0] - unwrapped[0]) / (2 * np.pi))
+        ax.plot(1e3 * t[ok], np.degrees(unwrapped), "o", ms=3, color=c, label=f"{p} (tracked)")
+        ax.plot(1e3 * t[ok], np.degrees(phase + omega * t[ok]), "-", color=c, lw=1)
+    rpm = omega * 60 / (2 * np.pi)
+    err = red["omega_err"].values[i] * 60 / (2 * np.pi)
+    ax.set_title(f"dot angle about the centre: spin {rpm:.0f} ± {err:.0f} rpm", fontsize=9)
+    ax.set_xlabel("time from the spin camera's first frame (ms)")
+    ax.set_ylabel("angle (deg, counter-clockwise for a +x swing)")
+    ax.legend(fontsize=7, loc="best")
+    if int(red[FLAG_VAR].values[i]) != 0:
+        ax.text(
+            0.02,
+            0.02,
+            red[f"{FLAG_VAR}_reason"].values[i][:110],
+            transform=ax.transAxes,
+            fontsize=6,
+            color="tab:red",
+            wrap=True,
+        )
+
+
+def _flight_xy(red, i, cam_name, t):
+    u = t - red[f"flight_t_ref_{cam_name}"].values[i]
+    X = red[f"flight_x0_{cam_name}"].values[i] + red[f"flight_vx_{cam_name}"].values[i] * u
+    Y = red[f"flight_y0_{cam_name}"].values[i] + red[f"flight_vy_{cam_name}"].values[i] * u - 0.5 * G * u**2
+    return np.where(u >= 0, X, np.nan), np.where(u >= 0, Y, np.nan)
+
+
+def _flight_line(ax, red, i, cam_name, t, cam, tracked):
+    X, Y = _flight_xy(red, i, cam_name, t)
+    seen = np.flatnonzero(np.isfinite(tracked))
+    if seen.size:  # draw over the tracked frames only
+        X, Y = np.where(np.arange(t.size) <= seen[-1], X, np.nan), np.where(np.arange(t.size) <= seen[-1], Y, np.nan)
+    x, y = _to_px(X, Y, cam)
+    ax.plot(x, y, color="tab:blue", lw=1.0, label="ball flight fit")
+
+
+def summary_figure(red: xr.Dataset) -> Figure:
+    """Residuals of the fits across impacts (in pixels and degrees) and the exclusion flags.
+
+    Parameters
+    ----------
+    red : xarray.Dataset
+        ``reduce.nc``.
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    fig = Figure(figsize=(15, 3.2), layout="constrained")
+    axes = fig.subplots(1, 5)
+    ok = red[FLAG_VAR].values == 0
+    panels = (
+        ("tip_rms", red.attrs["swing_m_per_px"], "bat-tip fit rms (swing px)"),
+        ("flight_rms_swing", red.attrs["swing_m_per_px"], "ball flight rms distance (swing px)"),
+        ("flight_rms_spin", red.attrs["spin_m_per_px"], "ball flight rms distance (spin px)"),
+        ("dot_angle_rms", np.pi / 180, "dot angle rms (deg)"),
+    )
+    for ax, (name, scale, label) in zip(axes[:4], panels, strict=True):
+        v = red[name].values / scale
+        bins = np.linspace(0, np.nanmax(v[np.isfinite(v)], initial=1.0) * 1.05, 25)
+        ax.hist(v[ok & np.isfinite(v)], bins=bins, color="tab:blue", label="usable")
+        ax.hist(v[~ok & np.isfinite(v)], bins=bins, color="tab:red", alpha=0.7, label="excluded")
+        ax.set_xlabel(label)
+        ax.set_ylabel("impacts")
+        ax.legend(fontsize=7)
+    ax = axes[4]
+    flags = red[FLAG_VAR].values
+    names = [f.name.lower().replace("_", " ") for f in ReduceFlag]
+    counts = [int((flags == int(f)).sum()) for f in ReduceFlag]
+    ax.barh(range(len(names)), counts, color=["tab:blue"] + ["tab:red"] * (len(names) - 1))
+    ax.set_yticks(range(len(names)), names, fontsize=7)
+    for k, c in enumerate(counts):
+        ax.text(c, k, f" {c}", va="center", fontsize=7)
+    ax.set_xlabel("impacts")
+    ax.set_title(f"{int(ok.sum())} usable of {ok.size}", fontsize=9)
+    return fig
