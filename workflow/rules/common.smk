@@ -25,8 +25,7 @@ from ballbat.pipeline.guards import (
     warnings_summary,
 )
 from ballbat.pipeline.provenance import sha256_file
-from ballbat.tracks.data import camera_block
-from ballbat.tracks.formats.layout import tool_file_extensions
+from ballbat.tracks.data import camera_block, tool_file_extensions
 
 # A folder the run cannot write: one line naming it, for every invocation (a dry run, --unlock too).
 for _line in unwritable_folders(["results", ".snakemake"]):

@@ -172,3 +172,21 @@ def with_found_settings(block: dict, found: dict) -> dict:
             if key in vals:
                 out["cameras"].setdefault(cam, {})[key] = vals[key]
     return out
+
+
+#: The formats of a ``tracks`` block's folder of tool files (``format``) and their files'
+#: extensions; here, not in :mod:`.formats`, so that the workflow's start-up (common.smk) reads
+#: them without importing the readers.
+FORMATS = {
+    "tracker": (".trk", ".trz"),
+    "kinovea": (".kva",),
+    "tracker_table": (".txt", ".csv", ".tsv"),
+    "kinovea_table": (".csv", ".txt"),
+}
+#: Formats known from the extension alone.
+BY_EXTENSION = {".trk": "tracker", ".trz": "tracker", ".kva": "kinovea"}
+
+
+def tool_file_extensions(fmt: str | None) -> tuple[str, ...]:
+    """Extensions of the files a ``dir`` of format ``fmt`` holds (None: the tools' own files)."""
+    return FORMATS[fmt] if fmt else tuple(BY_EXTENSION)

@@ -19,7 +19,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..data import CAMERAS, POINTS, Tracks
+from ..data import BY_EXTENSION, CAMERAS, FORMATS, POINTS, Tracks, tool_file_extensions
 from . import FileTracks, FormatError, close
 from .kinovea import read_kva
 from .tables import check_units, read_kinovea_table, read_tracker_table
@@ -29,15 +29,6 @@ if TYPE_CHECKING:
     import os
     from collections.abc import Iterable
 
-#: Formats and the file extensions each reads.
-FORMATS = {
-    "tracker": (".trk", ".trz"),
-    "kinovea": (".kva",),
-    "tracker_table": (".txt", ".csv", ".tsv"),
-    "kinovea_table": (".csv", ".txt"),
-}
-#: Formats known from the extension alone.
-BY_EXTENSION = {".trk": "tracker", ".trz": "tracker", ".kva": "kinovea"}
 #: Formats whose files hold no settings (the config states units, fps, m_per_px).
 TABLES = ("tracker_table", "kinovea_table")
 DEFAULT_PATTERN = "{impact_id}_{camera}.{ext}"
@@ -345,8 +336,3 @@ def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | 
     if problems:
         raise InputError(problems)
     return _assemble(imp.columns, irows, None), imp
-
-
-def tool_file_extensions(fmt: str | None) -> tuple[str, ...]:
-    """Extensions of the files a ``dir`` of format ``fmt`` holds (None: the tools' own files)."""
-    return FORMATS[fmt] if fmt else tuple(BY_EXTENSION)
