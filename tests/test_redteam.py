@@ -159,31 +159,12 @@ def test_range_message_says_why(base, schema):
 
 
 def _replicates(n, value=np.nan, parameter=""):
-    import xarray as xr
+    """Replicates (n) of one quantity with honest errors, at a sweep point of ``parameter = value``."""
+    from test_studies import fake_replicates
 
-    rng = np.random.default_rng(0)
-    return xr.Dataset(
-        {
-            "value": (("replicate", "quantity"), 1.0 + 0.01 * rng.standard_normal((n, 1))),
-            "uncertainty": (("replicate", "quantity"), np.full((n, 1), 0.01)),
-            "truth": (("replicate", "quantity"), np.ones((n, 1))),
-            "dof": (("replicate", "quantity"), np.full((n, 1), np.inf)),
-            "point": (("replicate",), np.zeros(n, dtype=int)),
-        },
-        coords={
-            "quantity": ["e_x:baseball:wood"],
-            "quantity_name": ("quantity", ["e_x"]),
-            "ball": ("quantity", ["baseball"]),
-            "bat": ("quantity", ["wood"]),
-            "table_unit": ("quantity", ["1"]),
-        },
-        attrs={
-            "sweep_values": np.array([value]),
-            "study_seed": 0,
-            "replicates_per_point": n,
-            "sweep_parameter": parameter,
-        },
-    )
+    ds = fake_replicates(n, se=0.01, spread=0.01)
+    ds.attrs.update(sweep_values=np.array([value]), sweep_parameter=parameter)
+    return ds
 
 
 def test_study_of_4_replicates_warns_in_its_table():
