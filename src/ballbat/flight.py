@@ -43,7 +43,7 @@ from dataclasses import dataclass, fields
 import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
-from .units import FOOT, INCH, INHG_IN_MMHG, MPH, OUNCE, RPM, fahrenheit_to_celsius
+from .units import FOOT, INCH, INHG_IN_MMHG, MPH, OUNCE, RPM, G, fahrenheit_to_celsius
 
 __all__ = [
     "CD0",
@@ -66,8 +66,6 @@ CD_SPIN = 0.0292
 CL2, CL0, CL1 = 1.120, 0.583, 2.333
 #: Reference speed of the spin-decay law, 100 mph in m/s.
 V100 = 100.0 * MPH
-#: Gravitational acceleration, m/s^2 (standard gravity; the calculator's 32.174 ft/s^2).
-G = 9.80665
 #: Pressure scale of the air-density formula, 1/m (docs/model.md, "Flight").
 BETA = 0.0001217
 

@@ -20,7 +20,8 @@ from matplotlib.figure import Figure
 
 from .plotting import save_figure
 from .tracks.data import Camera, Tracks
-from .tracks.reduce import FLAG_VAR, G, ReduceFlag, physical
+from .tracks.reduce import FLAG_VAR, ReduceFlag, physical
+from .units import G
 
 __all__ = ["impacts_figure", "pick_impacts", "save_figure", "summary_figure"]
 

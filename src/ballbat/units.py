@@ -28,6 +28,9 @@ MPH = 0.44704
 RPM = 2.0 * np.pi / 60.0
 #: 1 degree in radians.
 DEGREE = np.pi / 180.0
+#: Standard acceleration of gravity, m s-2 (exact by definition, NIST SP 811; the trajectory
+#: calculator's 32.174 ft/s^2).
+G = 9.80665
 #: 1 ounce inch^2 in kg m^2.
 OZ_IN2 = OUNCE * INCH**2
 #: 1 mmHg in pascal (conventional, 133.322387415 Pa).

@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..units import INCH
+from ..units import INCH, G
 
 if TYPE_CHECKING:
     import os
@@ -42,7 +42,6 @@ if TYPE_CHECKING:
     from .data import CameraTracks
     from .reduce import Reduction
 
-G = 9.80665
 #: False-alarm probability of the glitch test per tracked point (2-D Gaussian noise:
 #: P(|r| > Z s) = exp(-Z^2 / 2)); 10^4 impacts of 200 points make 2e6 points.
 GLITCH_FALSE_ALARM = 1e-9

@@ -47,6 +47,7 @@ import numpy as np
 import xarray as xr
 
 from ..pipeline.products import Var, build_dataset, flag_attrs
+from ..units import G
 from .checks import IMPACT_Z, camera_agreement, glitch_mask
 from .data import POINTS, Camera, CameraTracks, Rig, Tracks
 from .render import contact_distance
@@ -56,7 +57,6 @@ if TYPE_CHECKING:
 
     from numpy.typing import ArrayLike
 
-G = 9.80665
 #: Frames at rest whose median is the ball's rest position.
 N_REST = 5
 #: Motion threshold in pixels: at least this, and THRESHOLD_SIGMA times the rest scatter.

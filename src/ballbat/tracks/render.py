@@ -28,10 +28,9 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from ..units import DEGREE, INCH
+from ..units import DEGREE, INCH, G
 from .data import POINTS, Camera, CameraTracks, Rig, Tracks
 
-G = 9.80665
 #: Side of the square of dots drawn around the spin axis (Sec. II): 1.5 in.
 DOT_SQUARE = 1.5 * INCH
 
