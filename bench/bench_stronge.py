@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ballbat.properties import load_balls, load_bats, recoil_factors
-from ballbat.stronge.model import stronge_ex, stronge_solve
+from ballbat.stronge.model import ContactParams, stronge_ex, stronge_solve
 from ballbat.stronge.reference import stronge_reference
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -51,23 +51,25 @@ def main() -> None:
     mu = rng.uniform(0.2, 0.8, n)
     r_x, r_y = pairs[k, 0], pairs[k, 1]
 
-    stronge_ex(psi[:1000], eta2[:1000], e_y[:1000], mu[:1000], r_x[:1000], r_y[:1000])  # warm-up
-    t_fast = best_of(lambda: stronge_ex(psi, eta2, e_y, mu, r_x, r_y))
+    stronge_ex(psi[:1000], ContactParams(eta2[:1000], e_y[:1000], mu[:1000], r_x[:1000], r_y[:1000]))  # warm-up
+    t_fast = best_of(lambda: stronge_ex(psi, ContactParams(eta2, e_y, mu, r_x, r_y)))
     print(f"stronge_ex, 1e6 realistic impacts: {t_fast:.3f} s -> {n / t_fast:,.0f} impacts/s")
 
     m = 100_000
     eta2_g = rng.uniform(2, 3.5, m)
-    t_gen = best_of(lambda: stronge_ex(psi[:m], eta2_g, e_y[:m], mu[:m], r_x[:m], r_y[:m]), repeat=2)
+    t_gen = best_of(lambda: stronge_ex(psi[:m], ContactParams(eta2_g, e_y[:m], mu[:m], r_x[:m], r_y[:m])), repeat=2)
     print(f"stronge_ex, 1e5 impacts with eta2 2-3.5 (general phase machine): {m / t_gen:,.0f} impacts/s")
-    t_solve = best_of(lambda: stronge_solve(psi[:m], eta2[:m], e_y[:m], mu[:m], r_x[:m], r_y[:m]), repeat=2)
+    t_solve = best_of(
+        lambda: stronge_solve(psi[:m], ContactParams(eta2[:m], e_y[:m], mu[:m], r_x[:m], r_y[:m])), repeat=2
+    )
     print(f"stronge_solve (regimes, event times), 1e5 realistic impacts: {m / t_solve:,.0f} impacts/s")
 
     nr = 100
     sl = slice(0, nr)
     t0 = time.perf_counter()
-    ref = stronge_reference(psi[sl], eta2[sl], e_y[sl], mu[sl], r_x[sl], r_y[sl])
+    ref = stronge_reference(psi[sl], ContactParams(eta2[sl], e_y[sl], mu[sl], r_x[sl], r_y[sl]))
     t_ref = (time.perf_counter() - t0) / nr
-    err = np.max(np.abs(ref["e_x"] - stronge_ex(psi[sl], eta2[sl], e_y[sl], mu[sl], r_x[sl], r_y[sl])))
+    err = np.max(np.abs(ref["e_x"] - stronge_ex(psi[sl], ContactParams(eta2[sl], e_y[sl], mu[sl], r_x[sl], r_y[sl]))))
     per_fast = t_fast / n
     print(f"stronge_reference (solve_ivp DOP853, rtol 1e-12): {t_ref * 1e3:.2f} ms/impact")
     print(f"speed ratio reference/stronge_ex per impact: {t_ref / per_fast:,.0f}x (max |diff e_x| = {err:.1e})")
@@ -84,7 +86,7 @@ def main() -> None:
     fx, fy = rr[kk, 0], rr[kk, 1]
     fpsi = rng.uniform(0, ball.psi_max, 58)
     x = np.tan(fpsi) / (1 + fx)
-    y = (1 + stronge_ex(fpsi, 4.75, 0.5, 0.5, fx, fy)) * x + rng.normal(0, 0.01, 58)
+    y = (1 + stronge_ex(fpsi, ContactParams(4.75, 0.5, 0.5, fx, fy))) * x + rng.normal(0, 0.01, 58)
     print(f"lmfit import: {t_imp:.2f} s (once per process, not counted below)")
     for label, kw in (("eta2 only", {}), ("eta2 + mu", {"vary_mu": True}), ("eta2 + e_y", {"vary_e_y": True})):
         t = best_of(lambda kw=kw: fit_eta2(fpsi, x, y, fx, fy, **kw))

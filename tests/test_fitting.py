@@ -125,9 +125,9 @@ def test_design_jacobians_match_finite_differences(design):
     meas = [rng.uniform(28, 39, n), rng.uniform(30, 45, n), rng.uniform(0.0, 0.4, n), rng.uniform(50, 350, n)]
     r, r_x, alpha = 0.036, 0.25, 0.4
     fun = {
-        "spin": lambda m: f.spin_design(*m, r, r_x, alpha),
-        "tan_ratio": lambda m: f.tan_ratio_design(*m, r, alpha),
-        "vtf": lambda m: f.vtf_design(*m, r, r_x, alpha),
+        "spin": lambda m: f.spin_design(f.Measured(*m), r, r_x, alpha),
+        "tan_ratio": lambda m: f.tan_ratio_design(f.Measured(*m), r, alpha),
+        "vtf": lambda m: f.vtf_design(f.Measured(*m), r, r_x, alpha),
         "theta_spin": lambda m: f.normalized_theta_design(m[0], m[3] * v_ref / m[0], m[2], "omega", v_ref),
         "theta_speed": lambda m: f.normalized_theta_design(m[0], m[1] * v_ref / m[0], m[2], "v_ball", v_ref),
     }[design]

@@ -17,7 +17,7 @@ import pytest
 
 from ballbat.properties import recoil_factors
 from ballbat.stronge.fit import Eta2FitError, fit_eta2
-from ballbat.stronge.model import omega_ratio, stronge_ex, stronge_solve
+from ballbat.stronge.model import ContactParams, omega_ratio, stronge_ex, stronge_solve
 from ballbat.stronge.reference import stronge_reference
 from ballbat.stronge.regimes import Regime, regime_boundaries
 
@@ -46,14 +46,10 @@ def _sample(rng, n, frame):
     k = edges.shape[1]
     r_edge = (np.zeros(k), np.zeros(k)) if frame == "rigid" else (np.full(k, 0.29), np.full(k, 0.27))
     cat = np.concatenate
-    return (
-        cat([psi, edges[0]]),
-        cat([eta2, edges[1]]),
-        cat([e_y, edges[2]]),
-        cat([mu, edges[3]]),
-        cat([r_x, r_edge[0]]),
-        cat([r_y, r_edge[1]]),
+    contact = ContactParams(
+        cat([eta2, edges[1]]), cat([e_y, edges[2]]), cat([mu, edges[3]]), cat([r_x, r_edge[0]]), cat([r_y, r_edge[1]])
     )
+    return cat([psi, edges[0]]), contact
 
 
 # ------------------------------------------------------------------------------------------
@@ -74,8 +70,8 @@ def test_closed_form_matches_reference(frame):
 def test_reference_event_times_match():
     """Phase-change times of the closed form agree with the integrator's events."""
     psi = np.array([30.0, 60.0, 75.0]) * DEG
-    sol = stronge_solve(psi, 2.5, 0.5, 0.5)
-    ref = stronge_reference(psi, 2.5, 0.5, 0.5)
+    sol = stronge_solve(psi, ContactParams(2.5, 0.5, 0.5))
+    ref = stronge_reference(psi, ContactParams(2.5, 0.5, 0.5))
     assert list(sol.regime) == ["stick-slip", "slip-stick-slip", "gross-slip"]
     assert sol.t_stick_end[0] == pytest.approx(ref["events"][0][0][0], abs=1e-9)
     assert sol.t_restick[1] == pytest.approx(ref["events"][1][0][0], abs=1e-9)
@@ -89,7 +85,7 @@ def test_regime_codes_cover_the_solver():
     labels = set()
     for eta2 in (1.2, 2.0, 2.5, 3.5, 4.75, 10.0):
         for e_y in (0.3, 0.5, 1.0):
-            labels |= set(map(str, stronge_solve(psi, eta2, e_y, 0.5).regime))
+            labels |= set(map(str, stronge_solve(psi, ContactParams(eta2, e_y, 0.5)).regime))
     assert {"stick-slip", "slip-stick-slip", "gross-slip"} <= labels
     for label in labels:
         code = Regime.from_label(label)
@@ -108,32 +104,34 @@ def test_fast_path_matches_general_engine():
     e_y, mu = rng.uniform(0.1, 1, n), rng.uniform(0.02, 2, n)
     r_x, r_y = rng.uniform(0, 0.5, n), rng.uniform(0, 0.5, n)
     np.testing.assert_allclose(
-        stronge_ex(psi, eta2, e_y, mu, r_x, r_y), stronge_solve(psi, eta2, e_y, mu, r_x, r_y).e_x, atol=1e-12
+        stronge_ex(psi, ContactParams(eta2, e_y, mu, r_x, r_y)),
+        stronge_solve(psi, ContactParams(eta2, e_y, mu, r_x, r_y)).e_x,
+        atol=1e-12,
     )
 
 
 def test_broadcasting_symmetry_and_psi_zero_limit():
-    e = stronge_ex(np.array([[0.1], [0.2]]), np.array([4.0, 5.0, 6.0]), 0.5, 0.5)
+    e = stronge_ex(np.array([[0.1], [0.2]]), ContactParams(np.array([4.0, 5.0, 6.0]), 0.5, 0.5))
     assert e.shape == (2, 3)
-    assert isinstance(stronge_ex(0.3, 4.75, 0.5, 0.5), float)
-    assert stronge_ex(-0.3, 4.75, 0.5, 0.5) == stronge_ex(0.3, 4.75, 0.5, 0.5)
+    assert isinstance(stronge_ex(0.3, ContactParams(4.75, 0.5, 0.5)), float)
+    assert stronge_ex(-0.3, ContactParams(4.75, 0.5, 0.5)) == stronge_ex(0.3, ContactParams(4.75, 0.5, 0.5))
     # psi -> 0: stick lasts to separation, e_x = -cos(Omega_t t_f)
     rho = omega_ratio(4.75)
-    assert stronge_ex(0.0, 4.75, 0.5, 0.5) == pytest.approx(-np.cos(rho * np.pi / 2 * 1.5), abs=1e-14)
-    assert stronge_ex(1e-9, 4.75, 0.5, 0.5) == pytest.approx(-np.cos(rho * np.pi / 2 * 1.5), abs=1e-8)
-    assert stronge_solve(0.0, 4.75, 0.5, 0.5).regime == "stick"
+    assert stronge_ex(0.0, ContactParams(4.75, 0.5, 0.5)) == pytest.approx(-np.cos(rho * np.pi / 2 * 1.5), abs=1e-14)
+    assert stronge_ex(1e-9, ContactParams(4.75, 0.5, 0.5)) == pytest.approx(-np.cos(rho * np.pi / 2 * 1.5), abs=1e-8)
+    assert stronge_solve(0.0, ContactParams(4.75, 0.5, 0.5)).regime == "stick"
     # empty input
-    assert stronge_ex(np.zeros((0, 3)), 4.75, 0.5, 0.5).shape == (0, 3)
-    assert stronge_solve(np.array([]), 4.75, 0.5, 0.5, histories=True, n_time=5).u.shape == (0, 5)
+    assert stronge_ex(np.zeros((0, 3)), ContactParams(4.75, 0.5, 0.5)).shape == (0, 3)
+    assert stronge_solve(np.array([]), ContactParams(4.75, 0.5, 0.5), histories=True, n_time=5).u.shape == (0, 5)
 
 
 def test_invalid_inputs_raise_with_names():
     with pytest.raises(ValueError, match="e_y"):
-        stronge_ex(0.3, 4.75, 1.2, 0.5)
+        stronge_ex(0.3, ContactParams(4.75, 1.2, 0.5))
     with pytest.raises(ValueError, match="psi"):
-        stronge_ex(np.pi / 2, 4.75, 0.5, 0.5)
+        stronge_ex(np.pi / 2, ContactParams(4.75, 0.5, 0.5))
     with pytest.raises(ValueError, match="eta2"):
-        stronge_solve(0.3, -1.0, 0.5, 0.5)
+        stronge_solve(0.3, ContactParams(-1.0, 0.5, 0.5))
 
 
 # ------------------------------------------------------------------------------------------
@@ -142,12 +140,12 @@ def test_invalid_inputs_raise_with_names():
 def test_superball_ex_is_one():
     """Paper, Sec. V.A: superball, eta^2 = 3.5 and e_y = 1, initial stick -> e_x = 1."""
     psi = np.array([0.0, 5.0, 20.0, 40.0, 60.0]) * DEG
-    sol = stronge_solve(psi, 3.5, 1.0, 0.5)  # tan 60 deg = 1.73 < mu eta2 = 1.75
+    sol = stronge_solve(psi, ContactParams(3.5, 1.0, 0.5))  # tan 60 deg = 1.73 < mu eta2 = 1.75
     np.testing.assert_allclose(sol.e_x, 1.0, atol=1e-12)
     assert set(sol.regime) == {"stick"}
     assert omega_ratio(3.5) == pytest.approx(1.0, abs=1e-15)
     # the tangential spring is back at equilibrium at separation
-    h = stronge_solve(30 * DEG, 3.5, 1.0, 0.5, histories=True, n_time=401)
+    h = stronge_solve(30 * DEG, ContactParams(3.5, 1.0, 0.5), histories=True, n_time=401)
     assert h.stretch[-1] == pytest.approx(0.0, abs=1e-12)
     assert h.u[-1] == pytest.approx(-np.tan(30 * DEG), abs=1e-12)
     # paper: "the initial kinetic energy is completely conserved"
@@ -162,8 +160,8 @@ def test_initial_stick_iff_tan_psi_below_mu_eta2(r):
     mu = rng.uniform(0.05, 0.3, 50)  # keeps psi_stick below 90 deg
     e_y = rng.uniform(0.3, 1, 50)
     psi_b = np.arctan(mu * eta2)
-    below = stronge_solve(psi_b * (1 - 1e-9), eta2, e_y, mu, *r)
-    above = stronge_solve(psi_b * (1 + 1e-9), eta2, e_y, mu, *r)
+    below = stronge_solve(psi_b * (1 - 1e-9), ContactParams(eta2, e_y, mu, *r))
+    above = stronge_solve(psi_b * (1 + 1e-9), ContactParams(eta2, e_y, mu, *r))
     assert all(str(g).startswith("stick") for g in below.regime)
     assert all(str(g).startswith("slip") or g == "gross-slip" for g in above.regime)
     assert np.all(np.isfinite(below.t_stick_end) | (below.regime == "stick"))
@@ -190,7 +188,7 @@ def test_fig10_timeline_bat_frame(ball, t_smax, wood):
     (softball); the latter two are given to 2 decimals (tolerance 0.005).
     """
     r_x, r_y = wood[ball]
-    sol = stronge_solve(30 * DEG, ETA2[ball], 0.5, 0.5, r_x, r_y, histories=True, n_time=3001)
+    sol = stronge_solve(30 * DEG, ContactParams(ETA2[ball], 0.5, 0.5, r_x, r_y), histories=True, n_time=3001)
     assert sol.regime == "stick-slip"
     assert sol.t_stick_end == pytest.approx(1.4, abs=0.03)  # "about 1.4" (1.415 / 1.422)
     assert sol.t_separation == pytest.approx(1.5, abs=1e-12)
@@ -218,7 +216,7 @@ def test_fig10_timeline_rigid_frame_is_not_the_papers(ball, t_smax):
     The softball's 1.342 misses the published 1.33 by more than the rounding; the bat frame
     (previous test) gives 1.156 / 1.328 and matches both. So Fig. 10 is the bat frame.
     """
-    sol = stronge_solve(30 * DEG, ETA2[ball], 0.5, 0.5)
+    sol = stronge_solve(30 * DEG, ContactParams(ETA2[ball], 0.5, 0.5))
     assert sol.t_stick_end == pytest.approx(1.4, abs=0.03)
     assert sol.t_stretch_max == pytest.approx(1 / np.sqrt(3.5 / ETA2[ball]), rel=1e-9)
     if ball == "softball":
@@ -232,7 +230,7 @@ def test_energy_never_increases():
     psi, eta2 = rng.uniform(0, 85, n) * DEG, rng.uniform(0.5, 10, n)
     e_y, mu = rng.uniform(0.3, 1, n), rng.uniform(0.05, 1.5, n)
     r_x, r_y = rng.uniform(0, 0.5, n), rng.uniform(0, 0.5, n)
-    sol = stronge_solve(psi, eta2, e_y, mu, r_x, r_y, histories=True, n_time=801)
+    sol = stronge_solve(psi, ContactParams(eta2, e_y, mu, r_x, r_y), histories=True, n_time=801)
     E = sol.energy
     assert np.all(np.isfinite(E[:, 0]))
     np.testing.assert_allclose(E[:, 0], 1.0, atol=1e-14)
@@ -255,17 +253,17 @@ def test_regimes_for_fitted_eta2_no_slip_stick_slip():
     Coulomb-friction boundary.
     """
     for ball in ("baseball", "softball"):
-        rb = regime_boundaries(ETA2[ball], 0.5, 0.5)
+        rb = regime_boundaries(ContactParams(ETA2[ball], 0.5, 0.5))
         assert rb.below == ("stick-slip",) and rb.above == ("gross-slip",)
         assert rb.psi[0] == pytest.approx(rb.psi_stick_paper, abs=1e-10)
-    rb = regime_boundaries(4.75, 0.5, 0.5)
+    rb = regime_boundaries(ContactParams(4.75, 0.5, 0.5))
     assert np.rad2deg(rb.psi_stick_paper) == pytest.approx(67.166, abs=1e-3)
     assert np.rad2deg(rb.psi_gross_paper) == pytest.approx(69.146, abs=1e-3)
     band = np.linspace(rb.psi_stick_paper, rb.psi_gross_paper, 7)[1:-1]
-    sol = stronge_solve(band, 4.75, 0.5, 0.5)
+    sol = stronge_solve(band, ContactParams(4.75, 0.5, 0.5))
     assert set(sol.regime) == {"gross-slip"}
     assert np.all(sol.e_x > 0)
-    assert stronge_ex(rb.psi_rigid_reversal, 4.75, 0.5, 0.5) == pytest.approx(0.0, abs=1e-12)
+    assert stronge_ex(rb.psi_rigid_reversal, ContactParams(4.75, 0.5, 0.5)) == pytest.approx(0.0, abs=1e-12)
     assert rb.psi_rigid_reversal == pytest.approx(rb.psi_gross_paper, abs=1e-12)  # rigid frame
 
 
@@ -274,7 +272,7 @@ def test_regimes_slip_stick_slip_needs_omega_t_above_omega_n():
     surface), and for e_y = 0.5 its upper end is tan psi = 3.5 mu, not the paper's
     3.5 mu (1 + e_y) (re-stick can then happen only before maximum compression).
     """
-    rb = regime_boundaries(2.5, 0.5, 0.5)
+    rb = regime_boundaries(ContactParams(2.5, 0.5, 0.5))
     assert rb.below == ("stick-slip", "slip-stick-slip")
     assert rb.above == ("slip-stick-slip", "gross-slip")
     assert rb.psi[0] == pytest.approx(rb.psi_stick_paper, abs=1e-10)
@@ -282,14 +280,14 @@ def test_regimes_slip_stick_slip_needs_omega_t_above_omega_n():
     assert np.rad2deg(rb.psi_gross_paper) == pytest.approx(69.15, abs=0.01)
     # the model's gross-slip onset in closed form, for Omega_t > Omega_n, both frames
     for args in ((2.0, 0.9, 0.3), (2.0, 1.0, 0.5), (3.0, 0.5, 0.5), (1.0, 0.7, 0.4), (2.5, 0.8, 0.5, 0.29, 0.27)):
-        rb = regime_boundaries(*args)
+        rb = regime_boundaries(ContactParams(*args))
         assert rb.above[-1] == "gross-slip"
         # abs 1e-8: within ~3e-9 rad below the boundary the final slip starts less than
         # SEPARATION_TOL before separation and the solver labels the impact "slip-stick"
         assert rb.psi[-1] == pytest.approx(rb.psi_gross_model, abs=1e-8)
         assert rb.psi_gross_model < rb.psi_gross_paper
     # superball: stick right up to tan psi = mu eta2, then gross slip
-    rb = regime_boundaries(3.5, 1.0, 0.5)
+    rb = regime_boundaries(ContactParams(3.5, 1.0, 0.5))
     assert rb.below == ("stick",) and rb.above == ("gross-slip",)
     assert rb.psi[0] == pytest.approx(rb.psi_stick_paper, abs=1e-9)
 
@@ -301,9 +299,9 @@ def test_small_psi_insensitive_to_mu():
     """
     mu = np.linspace(0.3, 1.0, 15)
     for psi in (2.0, 5.0, 10.0):
-        ex = stronge_ex(psi * DEG, 4.75, 0.5, mu)
+        ex = stronge_ex(psi * DEG, ContactParams(4.75, 0.5, mu))
         assert np.ptp(ex) < 0.02
-    assert np.ptp(stronge_ex(30 * DEG, 4.75, 0.5, mu)) == pytest.approx(0.065, abs=0.005)
+    assert np.ptp(stronge_ex(30 * DEG, ContactParams(4.75, 0.5, mu))) == pytest.approx(0.065, abs=0.005)
 
 
 def test_ex_sensitive_to_e_y_at_fixed_eta2(wood):
@@ -312,7 +310,7 @@ def test_ex_sensitive_to_e_y_at_fixed_eta2(wood):
     0.30 to 0.54 (baseball, rigid); only after refitting eta2 (4.15 / 5.39) do the curves
     agree (tested in test_fit_absorbs_e_y).
     """
-    ex = stronge_ex(10 * DEG, 4.75, np.array([0.4, 0.5, 0.6]), 0.5)
+    ex = stronge_ex(10 * DEG, ContactParams(4.75, np.array([0.4, 0.5, 0.6]), 0.5))
     np.testing.assert_allclose(ex, [0.298, 0.421, 0.538], atol=0.002)
 
 
@@ -325,7 +323,7 @@ def test_curves_linear_then_flat_after_gross_slip(wood):
     for ball in ("baseball", "softball"):
         r_x, r_y = wood[ball]
         psi = np.linspace(0, 88, 881) * DEG
-        ex = stronge_ex(psi, ETA2[ball], 0.5, 0.5, r_x, r_y)
+        ex = stronge_ex(psi, ContactParams(ETA2[ball], 0.5, 0.5, r_x, r_y))
         x = np.tan(psi) / (1 + r_x)
         y = (1 + ex) * x
         gross = np.tan(psi) >= 0.5 * ETA2[ball]
@@ -350,34 +348,36 @@ def test_ex_over_experiment_range(ball, published, balls, bats):
     means = []
     for bat in bats.values():
         r_x, r_y = recoil_factors(balls[ball], bat)
-        ex = stronge_ex(psi, ETA2[ball], 0.5, 0.5, r_x, r_y)
+        ex = stronge_ex(psi, ContactParams(ETA2[ball], 0.5, 0.5, r_x, r_y))
         assert np.ptp(ex) < 0.08
         assert np.all(np.diff(ex) <= 1e-12)
-        assert set(stronge_solve(psi[1:], ETA2[ball], 0.5, 0.5, r_x, r_y).regime) == {"stick-slip"}
+        assert set(stronge_solve(psi[1:], ContactParams(ETA2[ball], 0.5, 0.5, r_x, r_y)).regime) == {"stick-slip"}
         means.append(ex.mean())
     assert np.mean(means) == pytest.approx(published, abs=0.05)
 
 
 def test_histories_layout():
-    sol = stronge_solve(np.array([10.0, 30.0]) * DEG, 4.75, np.array([0.5, 0.8]), 0.5, histories=True, n_time=181)
+    sol = stronge_solve(
+        np.array([10.0, 30.0]) * DEG, ContactParams(4.75, np.array([0.5, 0.8]), 0.5), histories=True, n_time=181
+    )
     assert sol.t.shape == (181,) and sol.t[-1] == pytest.approx(1.8)
     for a in (sol.normal_force, sol.tangential_force, sol.stretch, sol.c_velocity, sol.u, sol.energy):
         assert a.shape == (2, 181)
     assert np.all(np.isnan(sol.u[0, sol.t > 1.5 + 1e-9]))
     assert np.all(np.isfinite(sol.u[1]))
     assert sol.u[1, -1] == pytest.approx(-sol.e_x[1] * np.tan(30 * DEG), abs=1e-12)
-    assert stronge_solve(0.3, 4.75, 0.5, 0.5).t is None
+    assert stronge_solve(0.3, ContactParams(4.75, 0.5, 0.5)).t is None
 
 
 def test_histories_common_grid():
     """t_max puts impacts solved apart on one grid; a grid ending before separation is refused."""
-    sol = stronge_solve(30.0 * DEG, 4.75, 0.5, 0.5, histories=True, n_time=181, t_max=1.8)
+    sol = stronge_solve(30.0 * DEG, ContactParams(4.75, 0.5, 0.5), histories=True, n_time=181, t_max=1.8)
     assert sol.t[-1] == 1.8 and np.all(np.isnan(sol.u[sol.t > 1.5 + 1e-9]))
-    same = stronge_solve(30.0 * DEG, 4.75, 0.5, 0.5, histories=True, n_time=181, t_max=1.5)
-    default = stronge_solve(30.0 * DEG, 4.75, 0.5, 0.5, histories=True, n_time=181)
+    same = stronge_solve(30.0 * DEG, ContactParams(4.75, 0.5, 0.5), histories=True, n_time=181, t_max=1.5)
+    default = stronge_solve(30.0 * DEG, ContactParams(4.75, 0.5, 0.5), histories=True, n_time=181)
     assert np.array_equal(same.t, default.t) and np.array_equal(same.u, default.u, equal_nan=True)
     with pytest.raises(ValueError, match="ends before separation"):
-        stronge_solve(30.0 * DEG, 4.75, 0.8, 0.5, histories=True, t_max=1.5)
+        stronge_solve(30.0 * DEG, ContactParams(4.75, 0.8, 0.5), histories=True, t_max=1.5)
 
 
 # ------------------------------------------------------------------------------------------
@@ -390,7 +390,7 @@ def _synthetic(balls, bats, rng, eta2=4.75, n=58, noise=0.01):
     r_x, r_y = rr[k, 0], rr[k, 1]
     psi = rng.uniform(0, ball.psi_max, n)
     x = np.tan(psi) / (1 + r_x)
-    y = (1 + stronge_ex(psi, eta2, 0.5, 0.5, r_x, r_y)) * x + rng.normal(0, noise, n)
+    y = (1 + stronge_ex(psi, ContactParams(eta2, 0.5, 0.5, r_x, r_y))) * x + rng.normal(0, noise, n)
     return psi, x, y, r_x, r_y
 
 
@@ -484,7 +484,7 @@ def test_fit_absorbs_e_y(balls, bats, wood):
     r_x, r_y = wood["baseball"]
     psi = np.linspace(0.01, balls["baseball"].psi_max, 60)
     x = np.tan(psi) / (1 + r_x)
-    y = (1 + stronge_ex(psi, 4.75, 0.5, 0.5, r_x, r_y)) * x
+    y = (1 + stronge_ex(psi, ContactParams(4.75, 0.5, 0.5, r_x, r_y))) * x
     for e_y, eta2 in ((0.4, 4.15), (0.6, 5.39)):
         f = fit_eta2(psi, x, y, r_x, r_y, e_y=e_y)
         assert f.eta2 == pytest.approx(eta2, abs=0.01)

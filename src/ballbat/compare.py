@@ -157,6 +157,16 @@ def fit_rows(fit: xr.Dataset) -> list[dict]:
     return rows
 
 
+def result_row(quantity: str, ball: str, value: object, unit: str, bat: str = "", **cells: object) -> dict:
+    """Return one row of ours: ``quantity`` of ``ball`` (and ``bat``), its value and unit; ``cells``: other columns."""
+    return {"quantity": quantity, "ball": ball, "bat": bat, "value": value, **cells, "unit": unit}
+
+
+def _largest(values: np.ndarray | None, unit: str) -> float | None:
+    """Return the largest of ``values`` in ``unit``; None when there are none."""
+    return None if values is None or values.size == 0 else from_si(values.max(), unit)
+
+
 def impact_rows(rec: xr.Dataset) -> list[dict]:
     """Rows from the reconstructed impacts: psi_max, D_max, n_impacts (usable) and n_excluded per ball."""
     rows = []
@@ -165,42 +175,14 @@ def impact_rows(rec: xr.Dataset) -> list[dict]:
     has_truth = "truth_psi" in rec
     for b in sorted(set(ball)):
         sel = ok & (ball == b)
-        psi = rec["psi"].values[sel]
-        D = rec["D"].values[sel]
         tpsi = rec["truth_psi"].values[ball == b] if has_truth else None
         tD = offset_from_psi(tpsi, rec["r"].values[ball == b], rec["R_bat"].values[ball == b]) if has_truth else None
         rows += [
-            {
-                "quantity": "psi_max",
-                "ball": b,
-                "bat": "",
-                "value": from_si(psi.max(), "deg") if psi.size else None,
-                "truth": from_si(tpsi.max(), "deg") if has_truth else None,
-                "unit": "deg",
-            },
-            {
-                "quantity": "D_max",
-                "ball": b,
-                "bat": "",
-                "value": from_si(D.max(), "in") if D.size else None,
-                "truth": from_si(tD.max(), "in") if has_truth else None,
-                "unit": "in",
-            },
-            {
-                "quantity": "n_impacts",
-                "ball": b,
-                "bat": "",
-                "value": int(sel.sum()),
-                "truth": int((ball == b).sum()) if has_truth else None,
-                "unit": "1",
-            },
-            {  # impacts kept in reconstruct.nc with flag > 0 (the reasons are there)
-                "quantity": "n_excluded",
-                "ball": b,
-                "bat": "",
-                "value": int((~ok & (ball == b)).sum()),
-                "unit": "1",
-            },
+            result_row("psi_max", b, _largest(rec["psi"].values[sel], "deg"), "deg", truth=_largest(tpsi, "deg")),
+            result_row("D_max", b, _largest(rec["D"].values[sel], "in"), "in", truth=_largest(tD, "in")),
+            result_row("n_impacts", b, int(sel.sum()), "1", truth=int((ball == b).sum()) if has_truth else None),
+            # impacts kept in reconstruct.nc with flag > 0 (the reasons are there)
+            result_row("n_excluded", b, int((~ok & (ball == b)).sum()), "1"),
         ]
     return rows
 
@@ -311,7 +293,7 @@ def write_comparison(
         *fit_rows(read_dataset(fit)),
         *impact_rows(rec),
         *extra_rows,
-        {"quantity": "n_warnings", "ball": "", "bat": "", "value": len(warnings), "unit": "1"},
+        result_row("n_warnings", "", len(warnings), "1"),
     ]
     return write_table(rows, csv_path, md_path, title, warnings=warnings)
 
@@ -352,23 +334,10 @@ def stronge_rows(stronge: xr.Dataset) -> list[dict]:
     for b in map(str, stronge["ball"].values):
         s = stronge.sel(ball=b)
         rows += [
-            {
-                "quantity": "eta2",
-                "ball": b,
-                "bat": "",
-                "value": float(s.eta2),
-                "uncertainty": float(s.eta2_err),
-                "unit": "1",
-            },
-            {"quantity": "omega_t_over_omega_n", "ball": b, "bat": "", "value": float(s.omega_ratio), "unit": "1"},
-            {
-                "quantity": "stretch_max_time" + at,
-                "ball": b,
-                "bat": "",
-                "value": float(s.t_stretch_max),
-                "unit": "t_c",
-            },
-            {"quantity": "stick_end_time" + at, "ball": b, "bat": "", "value": float(s.t_stick_end), "unit": "t_c"},
-            {"quantity": "separation_time" + at, "ball": b, "bat": "", "value": float(s.t_separation), "unit": "t_c"},
+            result_row("eta2", b, float(s.eta2), "1", uncertainty=float(s.eta2_err)),
+            result_row("omega_t_over_omega_n", b, float(s.omega_ratio), "1"),
+            result_row("stretch_max_time" + at, b, float(s.t_stretch_max), "t_c"),
+            result_row("stick_end_time" + at, b, float(s.t_stick_end), "t_c"),
+            result_row("separation_time" + at, b, float(s.t_separation), "t_c"),
         ]
     return rows

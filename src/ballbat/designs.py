@@ -8,32 +8,51 @@ variances. psi and its derivatives come from Eq. angmom (:func:`ballbat.kinemati
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, NamedTuple
 
 import numpy as np
 
 from .kinematics import angmom_argument, psi_partials, tan_psi_minus_theta
 
 if TYPE_CHECKING:
+    import xarray as xr
     from numpy.typing import ArrayLike
 
 #: What a design returns: x, y and their Jacobians (n, 4) with respect to :data:`MEASURED`.
 Design = tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]
 
+
+class Measured(NamedTuple):
+    """The measured quantities of a set of impacts (SI), in the order of the Jacobian columns."""
+
+    v_bat: np.ndarray
+    v_ball: np.ndarray
+    theta: np.ndarray
+    omega: np.ndarray
+
+    @classmethod
+    def from_dataset(cls, ds: xr.Dataset, sel: ArrayLike, prefix: str = "") -> Measured:
+        """Read the impacts ``sel`` of ``ds`` (``prefix="truth_"``: their true values) as float arrays."""
+        return cls(*(np.asarray(ds[prefix + k].values[sel], dtype=float) for k in cls._fields))
+
+
 #: The measured quantities, in the order of the Jacobian columns.
-MEASURED = ("v_bat", "v_ball", "theta", "omega")
+MEASURED = Measured._fields
 
 
-def spin_design(
-    v_bat: ArrayLike,
-    v_ball: ArrayLike,
-    theta: ArrayLike,
-    omega: ArrayLike,
-    r: ArrayLike,
-    r_x: ArrayLike,
-    alpha: ArrayLike,
-) -> Design:
+def measured_sigma(ds: xr.Dataset, sel: ArrayLike) -> np.ndarray | None:
+    """Return the standard uncertainties (n, 4) of the impacts ``sel`` (columns :data:`MEASURED`).
+
+    None unless ``ds`` holds ``<name>_err`` of every measured quantity.
+    """
+    if all(f"{k}_err" in ds for k in MEASURED):
+        return np.stack([ds[f"{k}_err"].values[sel] for k in MEASURED], axis=1).astype(float)
+    return None
+
+
+def spin_design(m: Measured, r: ArrayLike, r_x: ArrayLike, alpha: ArrayLike) -> Design:
     """Eq. omega: x = v_bat sin psi / (r (1 + r_x)(1 + alpha)), y = omega."""
+    v_bat, v_ball, theta, omega = m
     psi, dpsi = psi_partials(v_ball, theta, omega, r, alpha)
     c = 1.0 / (r * (1.0 + r_x) * (1.0 + alpha))
     x = v_bat * np.sin(psi) * c
@@ -44,10 +63,9 @@ def spin_design(
     return x, omega, jx, jy
 
 
-def tan_ratio_design(
-    v_bat: ArrayLike, v_ball: ArrayLike, theta: ArrayLike, omega: ArrayLike, r: ArrayLike, alpha: ArrayLike
-) -> Design:
+def tan_ratio_design(m: Measured, r: ArrayLike, alpha: ArrayLike) -> Design:
     """Eq. ratio: x = tan psi, y = tan(psi - theta) = q / sqrt(1 - q^2), q = alpha r omega / v_ball."""
+    _, v_ball, theta, omega = m
     psi, dpsi = psi_partials(v_ball, theta, omega, r, alpha)
     q = angmom_argument(v_ball, omega, r, alpha)
     x = np.tan(psi)
@@ -60,19 +78,12 @@ def tan_ratio_design(
     return x, y, jx, jy
 
 
-def vtf_design(
-    v_bat: ArrayLike,
-    v_ball: ArrayLike,
-    theta: ArrayLike,
-    omega: ArrayLike,
-    r: ArrayLike,
-    r_x: ArrayLike,
-    alpha: ArrayLike,
-) -> Design:
+def vtf_design(m: Measured, r: ArrayLike, r_x: ArrayLike, alpha: ArrayLike) -> Design:
     """Eq. vtf: x = tan psi / (1 + r_x), y = (v_ball,t + r omega) / v_bat,n.
 
     With Eq. angmom, v_ball,t = alpha r omega, so y = (1 + alpha) r omega / (v_bat cos psi).
     """
+    v_bat, v_ball, theta, omega = m
     psi, dpsi = psi_partials(v_ball, theta, omega, r, alpha)
     x = np.tan(psi) / (1.0 + r_x)
     y = (1.0 + alpha) * r * omega / (v_bat * np.cos(psi))

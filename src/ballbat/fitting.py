@@ -40,7 +40,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .designs import MEASURED, normalized_theta_design, spin_design, tan_ratio_design
+from .designs import MEASURED, Measured, measured_sigma, normalized_theta_design, spin_design, tan_ratio_design
 from .kinematics import gross_slip_onset, normalize_to_bat_speed, tan_ratio_slope_model
 from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, wls_slope
 from .pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
@@ -119,16 +119,6 @@ PER_BALL = (
 )
 
 
-def _measured(ds, sel, prefix=""):
-    return [np.asarray(ds[prefix + k].values[sel], dtype=float) for k in MEASURED]
-
-
-def _sigma(ds, sel):
-    if all(f"{k}_err" in ds for k in MEASURED):
-        return np.stack([ds[f"{k}_err"].values[sel] for k in MEASURED], axis=1).astype(float)
-    return None
-
-
 def _weights(jx, jy, sigma, slope):
     if sigma is None or not np.isfinite(slope):
         return None
@@ -170,12 +160,12 @@ def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool)
         if n < MIN_FIT_IMPACTS:  # too few for a slope and its error: report, do not fit
             return LineFit.not_fitted(n), np.nan
         r, r_x, alpha = (ds[k].values[sel] for k in ("r", "r_x", "alpha"))
-        x, y, jx, jy = spin_design(*_measured(ds, sel), r, r_x, alpha)
-        sig = _sigma(ds, sel)
+        x, y, jx, jy = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
+        sig = measured_sigma(ds, sel)
         fit = fit_line(x, y, jx, jy, sig, errors_in_variables=True)
         t = np.nan
         if with_truth and fit.success:
-            xt, yt, _, _ = spin_design(*_measured(ds, sel, "truth_"), r, r_x, alpha)
+            xt, yt, _, _ = spin_design(Measured.from_dataset(ds, sel, "truth_"), r, r_x, alpha)
             t = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope))[0] - 1.0
         return fit, t
 
@@ -276,7 +266,7 @@ def implied_e_y(
     w_r = _weights(jx, jy, sig, rfit.slope)
     W = np.ones(n) if w_r is None else w_r**2
     # each impact's e_x (its bat's; the pooled one where the bat has no fit) and its influence
-    xs, ys, jxs, jys = spin_design(*_measured(ds, sel), r, r_x, alpha)
+    xs, ys, jxs, jys = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
     # the noise of each abscissa (and its covariance with the ordinate), removed from the sums
     # as the moment-corrected fits remove it (linefit.eiv_line); zero without uncertainties
     var_x, cov_xy = _noise_moments(jx, jy, sig)
@@ -361,8 +351,8 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
             continue
 
         r, r_x, alpha = (ds[k].values[in_ball] for k in ("r", "r_x", "alpha"))
-        x, y, jx, jy = tan_ratio_design(*_measured(ds, in_ball), r, alpha)
-        sig = _sigma(ds, in_ball)
+        x, y, jx, jy = tan_ratio_design(Measured.from_dataset(ds, in_ball), r, alpha)
+        sig = measured_sigma(ds, in_ball)
         rfit = fit_line(x, y, jx, jy, sig, errors_in_variables=True)
         res.tan_ratio_slope.fits[i] = rfit
         exf = res.e_x_pooled.fits[i]
@@ -379,13 +369,13 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
         )
         pb["gross_slip_psi"][i], pb["gross_slip_theta"][i], pb["gross_slip_omega"][i] = psi_g, theta_g, omega_g
         if has_truth:
-            xt, yt, _, _ = tan_ratio_design(*_measured(ds, in_ball, "truth_"), r, alpha)
+            xt, yt, _, _ = tan_ratio_design(Measured.from_dataset(ds, in_ball, "truth_"), r, alpha)
             res.tan_ratio_slope.truth[i] = wls_slope(xt, yt, _weights(jx, jy, sig, rfit.slope))[0]
             pb["truth_e_y_implied"][i] = float(np.mean(ds["truth_e_y"].values[in_ball]))
             pb["truth_mu_k_lower_bound"][i] = float(np.max(yt))
 
-        v_bat, _, theta, _ = _measured(ds, in_ball)
-        tv = _measured(ds, in_ball, "truth_") if has_truth else None
+        v_bat, _, theta, _ = Measured.from_dataset(ds, in_ball)
+        tv = Measured.from_dataset(ds, in_ball, "truth_") if has_truth else None
         for grid, which in ((res.spin_theta_slope, "omega"), (res.speed_theta_slope, "v_ball")):
             y_norm = ds[f"{which}_norm"].values[in_ball].astype(float)
             x, y, jx, jy = normalized_theta_design(v_bat, y_norm, theta, which, v_ref)

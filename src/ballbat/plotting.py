@@ -162,8 +162,14 @@ def _legend_outside(fig, ax):
     fig.legend(*ax.get_legend_handles_labels(), loc="outside right center", fontsize=7, frameon=False)
 
 
-def _slope_figure(impacts, fit, yvar, var, unit_y, unit_slope, published, ylabel, what):
-    """Figs. 3 and 4: a normalised quantity against theta with fitted and published lines."""
+def _slope_figure(impacts, fit, yvar, var, unit_y, ylabel, what):
+    """Figs. 3 and 4: a normalised quantity against theta with fitted and published lines.
+
+    ``var`` is the slope's name in ``fit`` and in :data:`reporting.PAPER`; slopes are drawn in
+    ``unit_y`` per degree.
+    """
+    unit_slope = f"{unit_y}/deg"
+    published = reporting.PAPER[var]
     n_excluded = reporting.excluded_count(impacts)
     imp = _usable(impacts)
     x = from_si(imp["theta"].values, "deg")
@@ -218,8 +224,6 @@ def fig3_spin_vs_theta(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
         "omega_norm",
         "spin_theta_slope",
         "rpm",
-        "rpm/deg",
-        reporting.PAPER["spin_theta_slope"],
         "normalised spin ω (rpm)",
         "Fig. 3: normalised spin vs launch angle",
     )
@@ -233,8 +237,6 @@ def fig4_speed_vs_theta(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
         "v_ball_norm",
         "speed_theta_slope",
         "mph",
-        "mph/deg",
-        reporting.PAPER["speed_theta_slope"],
         "normalised exit speed (mph)",
         "Fig. 4: normalised exit speed vs launch angle",
     )

@@ -27,12 +27,12 @@ import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
-from ..designs import MEASURED, vtf_design
+from ..designs import Measured, measured_sigma, vtf_design
 from ..linefit import MIN_FIT_IMPACTS, effective_sigma, wls_slope
 from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 from ..published import STRONGE_E_Y, STRONGE_MU, per_ball
 from .fit import Eta2Fit, fit_eta2
-from .model import omega_ratio, stronge_ex, stronge_solve
+from .model import ContactParams, omega_ratio, stronge_ex, stronge_solve
 from .regimes import Regime, regime_boundaries
 
 __all__ = [
@@ -108,13 +108,10 @@ def vtf_data(rec: xr.Dataset, sel: NDArray[np.bool_]) -> VtfData:
         the effective standard uncertainty of ``y - (1 + e_x) x`` with the local slope of the
         data (the model's slope varies slowly with psi over the experiment's range).
     """
-    meas = [np.asarray(rec[k].values[sel], dtype=float) for k in MEASURED]
     r, r_x, r_y, alpha = (rec[k].values[sel] for k in ("r", "r_x", "r_y", "alpha"))
-    x, y, jx, jy = vtf_design(*meas, r, r_x, alpha)
-    sigma = None
-    if all(f"{k}_err" in rec for k in MEASURED):
-        sig = np.stack([rec[f"{k}_err"].values[sel] for k in MEASURED], axis=1).astype(float)
-        sigma = effective_sigma(jx, jy, sig, wls_slope(x, y)[0])
+    x, y, jx, jy = vtf_design(Measured.from_dataset(rec, sel), r, r_x, alpha)
+    sig = measured_sigma(rec, sel)
+    sigma = None if sig is None else effective_sigma(jx, jy, sig, wls_slope(x, y)[0])
     return VtfData(rec["psi"].values[sel], x, y, sigma, r_x, r_y, alpha, rec["bat"].values[sel].astype(str))
 
 
@@ -127,25 +124,23 @@ class ModelCurves:
     vtf_y: NDArray[np.float64]
 
 
-def model_curves(
-    psi_grid: NDArray[np.float64], eta2: float, e_y: float, mu: float, r_x: float, r_y: float, alpha: float
-) -> ModelCurves:
+def model_curves(psi_grid: NDArray[np.float64], contact: ContactParams) -> ModelCurves:
     """Evaluate the model's Eq. vtf curve (Fig. 9) for one set of parameters.
 
     Parameters
     ----------
     psi_grid : ndarray
         Incidence angles, rad.
-    eta2, e_y, mu, r_x, r_y, alpha : float
-        As in :func:`ballbat.stronge.model.stronge_ex` (here the ball's mean recoil factors).
+    contact : ContactParams
+        The model's parameters, scalars (here the ball's mean recoil factors).
 
     Returns
     -------
     ModelCurves
         ``vtf_x = tan(psi)/(1 + r_x)``, ``e_x`` of the model, ``vtf_y = (1 + e_x) vtf_x``.
     """
-    x = np.tan(psi_grid) / (1.0 + r_x)
-    ex = stronge_ex(psi_grid, eta2, e_y, mu, r_x, r_y, alpha)
+    x = np.tan(psi_grid) / (1.0 + contact.r_x)
+    ex = stronge_ex(psi_grid, contact)
     return ModelCurves(x, ex, (1.0 + ex) * x)
 
 
@@ -164,19 +159,19 @@ class Boundaries:
     psi_gross_slip_paper: float
 
 
-def boundaries(eta2: float, e_y: float, mu: float, r_x: float, r_y: float, alpha: float) -> Boundaries:
+def boundaries(contact: ContactParams) -> Boundaries:
     """Regime boundaries of the model for one ball (Fig. 9b's vertical lines).
 
     Parameters
     ----------
-    eta2, e_y, mu, r_x, r_y, alpha : float
+    contact : ContactParams
         As in :func:`ballbat.stronge.regimes.regime_boundaries`.
 
     Returns
     -------
     Boundaries
     """
-    rb = regime_boundaries(eta2, e_y, mu, r_x, r_y, alpha)
+    rb = regime_boundaries(contact)
     stick = [p for p, b in zip(rb.psi, rb.below, strict=True) if str(b).startswith("stick")]
     gross = [p for p, ab in zip(rb.psi, rb.above, strict=True) if ab == "gross-slip"]
     return Boundaries(
@@ -205,25 +200,15 @@ class History:
     n_phases: int
 
 
-def time_history(
-    psi: float,
-    eta2: float,
-    e_y: float,
-    mu: float,
-    r_x: float,
-    r_y: float,
-    alpha: float,
-    n_time: int,
-    t_max: float | None = None,
-) -> History:
+def time_history(psi: float, contact: ContactParams, n_time: int, t_max: float | None = None) -> History:
     """Compute forces, tangential velocity, stretch and stick of one impact against t/t_c (Fig. 10).
 
     Parameters
     ----------
     psi : float
         Incidence angle, rad.
-    eta2, e_y, mu, r_x, r_y, alpha : float
-        As in :func:`ballbat.stronge.model.stronge_solve`.
+    contact : ContactParams
+        The model's parameters, scalars.
     n_time : int
         Number of samples from t = 0 to ``t_max``.
     t_max : float, optional
@@ -233,7 +218,7 @@ def time_history(
     -------
     History
     """
-    sol = stronge_solve(psi, eta2, e_y, mu, r_x, r_y, alpha, histories=True, n_time=n_time, t_max=t_max)
+    sol = stronge_solve(psi, contact, histories=True, n_time=n_time, t_max=t_max)
     stuck = np.where(np.isfinite(sol.normal_force), (np.abs(sol.c_velocity) < 1e-12).astype(float), np.nan)
     return History(
         t=sol.t,
@@ -254,8 +239,8 @@ def time_history(
 class BallAnalysis:
     """The fit of one ball and the model evaluated at it (all but the time histories).
 
-    ``params`` are the model's parameters at the fit: (eta2, e_y, mu, mean r_x, mean r_y,
-    mean alpha) of the ball's impacts (bat frame).
+    ``params`` are the model's parameters at the fit: eta2, e_y, mu and the mean r_x, r_y
+    and alpha of the ball's impacts (bat frame).
     """
 
     fit: Eta2Fit
@@ -271,9 +256,9 @@ class BallAnalysis:
     boundaries: Boundaries
 
     @property
-    def params(self) -> tuple[float, float, float, float, float, float]:
-        """(eta2, e_y, mu, r_x, r_y, alpha) of the model at the fit."""
-        return (self.fit.eta2, self.fit.e_y, self.fit.mu, self.r_x_mean, self.r_y_mean, self.alpha_mean)
+    def params(self) -> ContactParams:
+        """The model's parameters at the fit."""
+        return ContactParams(self.fit.eta2, self.fit.e_y, self.fit.mu, self.r_x_mean, self.r_y_mean, self.alpha_mean)
 
 
 def fit_ball(
@@ -364,10 +349,10 @@ def analyse_ball(
     fit = fit_ball(d, e_y=e_y, mu=mu, vary_e_y=vary_e_y, vary_mu=vary_mu)
     a = float(np.mean(d.alpha))
     rxm, rym = float(np.mean(d.r_x)), float(np.mean(d.r_y))
-    params = (fit.eta2, fit.e_y, fit.mu, rxm, rym, a)
+    params = ContactParams(fit.eta2, fit.e_y, fit.mu, rxm, rym, a)
     published = None
     if eta2_published is not None:
-        published = model_curves(psi_grid, eta2_published, STRONGE_E_Y, STRONGE_MU, rxm, rym, a)
+        published = model_curves(psi_grid, ContactParams(eta2_published, STRONGE_E_Y, STRONGE_MU, rxm, rym, a))
     return BallAnalysis(
         fit=fit,
         data=d,
@@ -375,11 +360,11 @@ def analyse_ball(
         r_y_mean=rym,
         alpha_mean=a,
         omega_ratio=float(omega_ratio(fit.eta2, 0.0, 0.0, a)),
-        omega_ratio_bat=float(omega_ratio(fit.eta2, rxm, rym, a)),
-        model=model_curves(psi_grid, *params),
+        omega_ratio_bat=float(params.omega_ratio()),
+        model=model_curves(psi_grid, params),
         eta2_published=np.nan if eta2_published is None else float(eta2_published),
         published=published,
-        boundaries=boundaries(*params),
+        boundaries=boundaries(params),
     )
 
 
@@ -537,7 +522,7 @@ def stronge_dataset(
     # Fig. 10: time histories at psi_history for the fitted parameters, on one time grid that
     # reaches the last separation (the balls' e_y differ when e_y is fitted).
     t_max = max(1.0 + r.fit.e_y for r in res)
-    hist = [time_history(np.deg2rad(psi_history_deg), *r.params, n_time=n_time, t_max=t_max) for r in res]
+    hist = [time_history(np.deg2rad(psi_history_deg), r.params, n_time=n_time, t_max=t_max) for r in res]
     nan_curve = ModelCurves(*(np.full(psi_grid.size, np.nan),) * 3)
     curves_pub = [nan_curve if r.published is None else r.published for r in res]
     values = {

@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .model import stronge_ex
+from .model import ContactParams, stronge_ex
 
 __all__ = ["Eta2Fit", "Eta2FitError", "fit_eta2"]
 
@@ -160,7 +160,7 @@ def fit_eta2(
     x, y, r_x, r_y, alpha, sig = _checked_inputs(psi, x, y, r_x, r_y, alpha, sigma, vary_e_y, vary_mu, what)
 
     def residual(eta2_, e_, mu_):
-        ex = stronge_ex(psi, eta2_, e_, mu_, r_x, r_y, alpha)
+        ex = stronge_ex(psi, ContactParams(eta2_, e_, mu_, r_x, r_y, alpha))
         return (y - (1.0 + ex) * x) / sig
 
     bounds = (float(eta2_bounds[0]), float(eta2_bounds[1]))
@@ -264,7 +264,7 @@ def _scan_start(psi, x, y, r_x, r_y, alpha, sig, e_y, mu, bounds: tuple[float, f
     """Return the starting eta^2: the lowest chi^2 of a logarithmic scan of ``bounds`` (48 values)."""
     scan = np.geomspace(bounds[0], bounds[1], 48)
     # one call of the closed-form model for the whole scan (elementwise: the same numbers as one call per value)
-    ex_scan = stronge_ex(psi, scan[:, None], e_y, mu, r_x, r_y, alpha)
+    ex_scan = stronge_ex(psi, ContactParams(scan[:, None], e_y, mu, r_x, r_y, alpha))
     res_scan = (y - (1.0 + ex_scan) * x) / sig
     return scan[int(np.argmin([float(r @ r) for r in res_scan]))]
 

@@ -43,6 +43,7 @@ import numpy as np
 from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
+    "ContactParams",
     "StrongeSolution",
     "omega_ratio",
     "stronge_ex",
@@ -75,6 +76,49 @@ _PHASE_NAMES = {_STICK: "stick", _SLIP: "slip"}
 # --------------------------------------------------------------------------------------
 # parameters
 # --------------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class ContactParams:
+    """The parameters of Stronge's contact model for one impact or a batch of impacts.
+
+    Attributes
+    ----------
+    eta2 : k_n / k_t, the ratio of the normal and tangential spring constants (the paper's
+        eta^2), > 0.
+    e_y : normal coefficient of restitution, 0 < e_y <= 1.
+    mu : coefficient of friction (static = sliding), >= 0.
+    r_x, r_y : tangential and normal recoil factors of the target (Eqs. rx and ry). 0
+        (default) is Stronge's rigid massive surface; the bat's values give the frame of the
+        experiment.
+    alpha : I_ball / (m r^2) of the ball.
+
+    Scalars or arrays; they broadcast against each other and against the incidence angles
+    they are solved at. The solvers check the values (:func:`stronge_ex`).
+    """
+
+    eta2: ArrayLike
+    e_y: ArrayLike
+    mu: ArrayLike
+    r_x: ArrayLike = 0.0
+    r_y: ArrayLike = 0.0
+    alpha: ArrayLike = 0.4
+
+    def values(self) -> tuple[ArrayLike, ...]:
+        """Return (eta2, e_y, mu, r_x, r_y, alpha) as given."""
+        return (self.eta2, self.e_y, self.mu, self.r_x, self.r_y, self.alpha)
+
+    def broadcast(self, psi: ArrayLike) -> list[NDArray[np.float64]]:
+        """Return psi and (eta2, e_y, mu, r_x, r_y, alpha) as float arrays of their common broadcast shape."""
+        return np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (psi, *self.values())))
+
+    def scalars(self) -> ContactParams:
+        """Return the same parameters as Python floats (a TypeError if one is an array of several values)."""
+        return ContactParams(*(float(a) for a in self.values()))
+
+    def omega_ratio(self) -> NDArray[np.float64] | float:
+        """Return Omega_t / Omega_n of these parameters (:func:`omega_ratio`)."""
+        return omega_ratio(self.eta2, self.r_x, self.r_y, self.alpha)
+
+
 def omega_ratio(
     eta2: ArrayLike, r_x: ArrayLike = 0.0, r_y: ArrayLike = 0.0, alpha: ArrayLike = 0.4
 ) -> NDArray[np.float64] | float:
@@ -82,10 +126,8 @@ def omega_ratio(
 
     Parameters
     ----------
-    eta2 : ratio k_n / k_t of the normal and tangential spring constants (eta^2).
-    r_x, r_y : tangential and normal recoil factors of the target (Eqs. rx and ry); 0 for
-        the rigid massive surface of Stronge's geometry.
-    alpha : I_ball / (m r^2) of the ball.
+    eta2, r_x, r_y, alpha : as in :class:`ContactParams`; r_x = r_y = 0 is the rigid
+        massive surface of Stronge's geometry.
 
     Returns
     -------
@@ -129,9 +171,8 @@ class _Params:
     eta2: NDArray
 
 
-def _prepare(psi, eta2, e_y, mu, r_x, r_y, alpha) -> _Params:
-    arrs = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (psi, eta2, e_y, mu, r_x, r_y, alpha)))
-    psi, eta2, e_y, mu, r_x, r_y, alpha = arrs
+def _prepare(psi: ArrayLike, contact: ContactParams) -> _Params:
+    psi, eta2, e_y, mu, r_x, r_y, alpha = contact.broadcast(psi)
     with np.errstate(invalid="ignore"):
         _check("psi", psi, np.abs(psi) < HALF_PI, "|psi| < pi/2 (radians)")
         _check("eta2", eta2, (eta2 > 0) & np.isfinite(eta2), "0 < eta2 < inf")
@@ -144,7 +185,7 @@ def _prepare(psi, eta2, e_y, mu, r_x, r_y, alpha) -> _Params:
     f = [a.ravel() for a in (psi, eta2, e_y, mu, r_x, r_y, alpha)]
     psi, eta2, e_y, mu, r_x, r_y, alpha = f
     T = np.abs(np.tan(psi))
-    rho = np.sqrt((1.0 + alpha) * (1.0 + r_x) / (alpha * (1.0 + r_y) * eta2))
+    rho = omega_ratio(eta2, r_x, r_y, alpha)
     rho = np.where(np.abs(rho - 1.0) < 1e-14, 1.0, rho)  # e.g. the superball, eta2 = 3.5
     lam = mu * eta2
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -563,29 +604,15 @@ def _engine_block(p: _Params, idx) -> _Pieces:
 # --------------------------------------------------------------------------------------
 # public solvers
 # --------------------------------------------------------------------------------------
-def stronge_ex(
-    psi: ArrayLike,
-    eta2: ArrayLike,
-    e_y: ArrayLike,
-    mu: ArrayLike,
-    r_x: ArrayLike = 0.0,
-    r_y: ArrayLike = 0.0,
-    alpha: ArrayLike = 0.4,
-) -> NDArray[np.float64]:
+def stronge_ex(psi: ArrayLike, contact: ContactParams) -> NDArray[np.float64]:
     """Tangential coefficient of restitution e_x of Stronge's contact model.
 
     Parameters
     ----------
     psi : incidence angle between the relative velocity and the normal, rad, |psi| < pi/2.
         e_x is even in psi.
-    eta2 : k_n / k_t (the paper's eta^2).
-    e_y : normal coefficient of restitution, 0 < e_y <= 1.
-    mu : coefficient of friction (static = sliding), >= 0.
-    r_x, r_y : recoil factors of the target (Eqs. rx and ry). 0 (default) is Stronge's
-        rigid massive surface; the bat's values give the frame of the experiment.
-    alpha : I_ball / (m r^2).
-
-    All arguments broadcast against each other.
+    contact : the model's parameters (eta2, e_y, mu, r_x, r_y, alpha); they broadcast
+        against psi and each other.
 
     Returns
     -------
@@ -603,7 +630,7 @@ def stronge_ex(
     I(theta_1))`` with theta_1 the end of the initial stick, found by Newton iteration;
     other cases run the general phase machine of :func:`stronge_solve`.
     """
-    p = _prepare(psi, eta2, e_y, mu, r_x, r_y, alpha)
+    p = _prepare(psi, contact)
     uf = np.empty(p.rho.size)
     soft = p.rho <= 1.0
     for a in range(0, uf.size, CHUNK):
@@ -745,12 +772,7 @@ def _regimes(pc: _Pieces):
 
 def stronge_solve(
     psi: ArrayLike,
-    eta2: ArrayLike,
-    e_y: ArrayLike,
-    mu: ArrayLike,
-    r_x: ArrayLike = 0.0,
-    r_y: ArrayLike = 0.0,
-    alpha: ArrayLike = 0.4,
+    contact: ContactParams,
     histories: bool = False,
     n_time: int = 601,
     t_max: float | None = None,
@@ -759,7 +781,7 @@ def stronge_solve(
 
     Parameters
     ----------
-    psi, eta2, e_y, mu, r_x, r_y, alpha
+    psi, contact
         As in :func:`stronge_ex`; they broadcast against each other.
     histories : bool
         Also return time histories on a common grid of ``n_time`` points of t/t_c from 0 to
@@ -785,7 +807,7 @@ def stronge_solve(
     Kensrud et al. (2017) and Stronge (1994). Phase changes within SEPARATION_TOL of
     separation are ignored.
     """
-    p = _prepare(psi, eta2, e_y, mu, r_x, r_y, alpha)
+    p = _prepare(psi, contact)
     n = p.rho.size
     idx = np.arange(n)
     pc = _engine(p, idx)

@@ -19,19 +19,13 @@ from typing import Any
 import numpy as np
 from numpy.typing import ArrayLike
 
+from .model import ContactParams
+
 __all__ = ["stronge_reference"]
 
 
 def stronge_reference(
-    psi: ArrayLike,
-    eta2: ArrayLike,
-    e_y: ArrayLike,
-    mu: ArrayLike,
-    r_x: ArrayLike = 0.0,
-    r_y: ArrayLike = 0.0,
-    alpha: ArrayLike = 0.4,
-    rtol: float = 1e-12,
-    atol: float = 1e-14,
+    psi: ArrayLike, contact: ContactParams, rtol: float = 1e-12, atol: float = 1e-14
 ) -> dict[str, Any]:
     """Solve the same model by numerical integration, as a reference for tests.
 
@@ -44,7 +38,7 @@ def stronge_reference(
 
     Parameters
     ----------
-    psi, eta2, e_y, mu, r_x, r_y, alpha : array_like
+    psi, contact
         As in :func:`ballbat.stronge.model.stronge_ex`; they broadcast against each other.
     rtol, atol : float
         Relative and absolute tolerances of ``solve_ivp``.
@@ -62,7 +56,7 @@ def stronge_reference(
     integrating with unit tangential speed and no friction limit (stick throughout), which
     is the limit of the model as tan(psi)/(mu eta2) -> 0.
     """
-    arrs = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (psi, eta2, e_y, mu, r_x, r_y, alpha)))
+    arrs = contact.broadcast(psi)
     shape = arrs[0].shape
     out = [_reference_one(*args, rtol=rtol, atol=atol) for args in zip(*(a.ravel() for a in arrs), strict=True)]
     ex = np.array([o[0] for o in out])

@@ -22,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import NDArray
 
-from .model import omega_ratio, stronge_solve
+from .model import ContactParams, stronge_solve
 
 __all__ = ["Regime", "RegimeBoundaries", "regime_boundaries"]
 
@@ -109,21 +109,12 @@ class RegimeBoundaries:
     psi_gross_model: float
 
 
-def regime_boundaries(
-    eta2: float,
-    e_y: float,
-    mu: float,
-    r_x: float = 0.0,
-    r_y: float = 0.0,
-    alpha: float = 0.4,
-    n_grid: int = 721,
-    psi_max: float = np.deg2rad(89.9),
-) -> RegimeBoundaries:
+def regime_boundaries(contact: ContactParams, n_grid: int = 721, psi_max: float = np.deg2rad(89.9)) -> RegimeBoundaries:
     """Find where the regime (phase sequence) of :func:`stronge_solve` changes with psi.
 
     Parameters
     ----------
-    eta2, e_y, mu, r_x, r_y, alpha : scalars, as in :func:`stronge_ex`.
+    contact : the model's parameters, scalars (:class:`ballbat.stronge.model.ContactParams`).
     n_grid : number of psi values scanned in (0, psi_max].
     psi_max : largest psi scanned, rad.
 
@@ -140,9 +131,9 @@ def regime_boundaries(
     the scan (there the tangential motion vanishes and the limit psi -> 0 is pure stick).
     Two changes closer together than the scan step may be missed.
     """
-    args = [float(a) for a in (eta2, e_y, mu, r_x, r_y, alpha)]
+    c = contact.scalars()
     psi = np.linspace(0.0, psi_max, int(n_grid) + 1)[1:]
-    reg = stronge_solve(psi, *args).regime
+    reg = stronge_solve(psi, c).regime
     ch = np.flatnonzero(reg[1:] != reg[:-1])
     lo, hi = psi[ch], psi[ch + 1]
     left = reg[ch]
@@ -150,12 +141,12 @@ def regime_boundaries(
         if lo.size == 0:
             break
         mid = 0.5 * (lo + hi)
-        same = stronge_solve(mid, *args).regime == left
+        same = stronge_solve(mid, c).regime == left
         lo = np.where(same, mid, lo)
         hi = np.where(same, hi, mid)
         if np.all(hi - lo < 1e-13):
             break
-    rho = omega_ratio(args[0], args[3], args[4], args[5])
+    rho, mu, eta2, e_y = c.omega_ratio(), c.mu, c.eta2, c.e_y
     return RegimeBoundaries(
         psi=0.5 * (lo + hi),
         below=tuple(str(r) for r in reg[ch]),
