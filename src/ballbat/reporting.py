@@ -68,7 +68,7 @@ def _header(impacts) -> list[str]:
     return [f"- Impacts shown: {n - k} of {n} ({k} flagged as not reconstructable and left out)."]
 
 
-def _slope_lines(fit, var, unit, paper_key, fmt=".3g") -> list[str]:
+def _slope_lines(fit, var, unit, fmt=".3g") -> list[str]:
     lines = []
     for ball in fit["ball"].values.astype(str):
         v = fit[var].sel(ball=ball)
@@ -79,35 +79,24 @@ def _slope_lines(fit, var, unit, paper_key, fmt=".3g") -> list[str]:
         lines.append(
             f"- {ball}: {_pm(from_si(v.values, unit), from_si(e.values, unit), fmt)} {unit}"
             f" (95 % interval {_f(lo, fmt)} to {_f(hi, fmt)}; n = {int(fit[f'{var}_n'].sel(ball=ball))});"
-            f" paper {_paper(paper_key, ball, fmt)} {unit}."
+            f" paper {_paper(var, ball, fmt)} {unit}."
         )
     return lines
 
 
+def _slope_numbers(impacts: xr.Dataset, fit: xr.Dataset, var: str, unit: str) -> str:
+    """Fitted slopes ``var`` of fit_ex.nc per ball in ``unit``, beside the paper's (Figs. 3 and 4)."""
+    return "\n".join(["Fitted slopes (standard errors):", "", *_slope_lines(fit, var, unit), "", *_header(impacts)])
+
+
 def fig3_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     """Fitted slopes of normalised spin against launch angle (Fig. 3)."""
-    return "\n".join(
-        [
-            "Fitted slopes (standard errors):",
-            "",
-            *_slope_lines(fit, "spin_theta_slope", "rpm/deg", "spin_theta_slope"),
-            "",
-            *_header(impacts),
-        ]
-    )
+    return _slope_numbers(impacts, fit, "spin_theta_slope", "rpm/deg")
 
 
 def fig4_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     """Fitted slopes of normalised exit speed against launch angle (Fig. 4)."""
-    return "\n".join(
-        [
-            "Fitted slopes (standard errors):",
-            "",
-            *_slope_lines(fit, "speed_theta_slope", "mph/deg", "speed_theta_slope"),
-            "",
-            *_header(impacts),
-        ]
-    )
+    return _slope_numbers(impacts, fit, "speed_theta_slope", "mph/deg")
 
 
 def _ex_text(fit: xr.Dataset, pre: str, offset: float = 0.0, **sel: str) -> str:
@@ -163,7 +152,7 @@ def fig6_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     lines = [
         "Fitted slopes through the origin (standard errors):",
         "",
-        *_slope_lines(fit, "tan_ratio_slope", "1", "tan_ratio_slope"),
+        *_slope_lines(fit, "tan_ratio_slope", "1"),
     ]
     lines += ["", "What they imply (Eqs. ratio and muk):", ""]
     for ball in fit["ball"].values.astype(str):
