@@ -113,6 +113,23 @@ def test_wls_slope():
     assert wls_slope(x, 2 * x + 1, through_origin=False) == pytest.approx((2.0, 1.0))
 
 
+def test_measured_reads_the_jacobian_columns_in_order():
+    """Measured holds v_bat, v_ball, theta, omega (MEASURED) as floats; measured_sigma needs every *_err."""
+    import xarray as xr
+
+    from ballbat.designs import MEASURED, Measured, measured_sigma
+
+    values = {k: ("impact", np.arange(3) + 10 * i) for i, k in enumerate(MEASURED)}
+    errs = {f"{k}_err": ("impact", np.full(3, 0.1 * (i + 1))) for i, k in enumerate(MEASURED)}
+    ds = xr.Dataset({**values, **errs, **{f"truth_{k}": v for k, v in values.items()}})
+    sel = np.array([True, False, True])
+    m = Measured.from_dataset(ds, sel)
+    assert m.theta.dtype == float and m.theta.tolist() == [20.0, 22.0] and m.omega.tolist() == [30.0, 32.0]
+    assert np.array_equal(np.stack(Measured.from_dataset(ds, sel, "truth_")), np.stack(m))
+    np.testing.assert_array_equal(measured_sigma(ds, sel), [[0.1, 0.2, 0.1 * 3, 0.4]] * 2)
+    assert measured_sigma(ds.drop_vars("omega_err"), sel) is None
+
+
 @pytest.mark.parametrize("design", ["spin", "tan_ratio", "vtf", "theta_spin", "theta_speed"])
 def test_design_jacobians_match_finite_differences(design):
     """The effective-variance weights rest on these derivatives: check them numerically."""

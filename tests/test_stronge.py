@@ -169,6 +169,23 @@ def test_initial_stick_iff_tan_psi_below_mu_eta2(r):
     np.testing.assert_allclose(below.e_x, above.e_x, atol=1e-6)
 
 
+def test_contact_params_are_one_argument():
+    """ContactParams broadcast like separate arguments; scalars() refuses arrays; omega_ratio agrees."""
+    c = ContactParams(np.array([4.0, 5.0]), 0.5, np.array([[0.3], [0.5]]), 0.29, 0.27)
+    arrays = c.broadcast(0.2)
+    assert [a.shape for a in arrays] == [(2, 2)] * 7
+    _, eta2, _, mu, _, _, alpha = arrays
+    assert mu[1, 0] == 0.5 and eta2[1, 0] == 4.0 and alpha[0, 0] == 0.4
+    ex = stronge_ex(0.2, c)
+    assert ex[1, 0] == stronge_ex(0.2, ContactParams(4.0, 0.5, 0.5, 0.29, 0.27))
+    assert c.omega_ratio() == pytest.approx(omega_ratio(np.array([4.0, 5.0]), 0.29, 0.27))
+    assert ContactParams(np.float64(4.75), 0.5, 0.5).scalars() == ContactParams(4.75, 0.5, 0.5)
+    with pytest.raises(TypeError):
+        c.scalars()
+    with pytest.raises(TypeError):
+        regime_boundaries(c)
+
+
 def test_omega_ratio_published():
     """Paper, Sec. V.A: Omega_t/Omega_n = 0.86 (eta^2 4.75) and 0.75 (6.30), given to 2 decimals."""
     assert omega_ratio(4.75) == pytest.approx(0.86, abs=0.005)
