@@ -216,30 +216,48 @@ def _slope_figure(impacts, fit, yvar, var, unit_y, ylabel, what):
     return fig
 
 
-def fig3_spin_vs_theta(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
-    """Fig. 3: normalised spin against launch angle, with the fitted and published slopes."""
-    return _slope_figure(
-        impacts,
-        fit,
+#: Figs. 3 and 4: what each plots against theta (variable, slope's name, unit, axis label, title).
+_SLOPE_FIGURES = {
+    "fig3": (
         "omega_norm",
         "spin_theta_slope",
         "rpm",
         "normalised spin ω (rpm)",
         "Fig. 3: normalised spin vs launch angle",
-    )
-
-
-def fig4_speed_vs_theta(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
-    """Fig. 4: normalised exit speed against launch angle, with the fitted and published slopes."""
-    return _slope_figure(
-        impacts,
-        fit,
+    ),
+    "fig4": (
         "v_ball_norm",
         "speed_theta_slope",
         "mph",
         "normalised exit speed (mph)",
         "Fig. 4: normalised exit speed vs launch angle",
-    )
+    ),
+}
+
+
+def fig3_spin_vs_theta(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
+    """Fig. 3: normalised spin against launch angle, with the fitted and published slopes."""
+    return _slope_figure(impacts, fit, *_SLOPE_FIGURES["fig3"])
+
+
+def fig4_speed_vs_theta(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
+    """Fig. 4: normalised exit speed against launch angle, with the fitted and published slopes."""
+    return _slope_figure(impacts, fit, *_SLOPE_FIGURES["fig4"])
+
+
+def _lines_through_origin(ax, x, imp, balls, fit, var, paper_key, offset, name):
+    """Figs. 5 and 6: each ball's fitted line through the origin (slope ``offset + fit[var]``) and the paper's."""
+    ball_of = imp["ball"].values.astype(str)
+    for ball in balls:
+        if ball not in fit["ball"].values or not np.isfinite(float(fit[var].sel(ball=ball))):
+            continue
+        xb = np.linspace(0.0, np.nanmax(x[ball_of == ball]) * 1.05, 50)
+        slope, err = offset + float(fit[var].sel(ball=ball)), float(fit[f"{var}_err"].sel(ball=ball))
+        c = ball_color(ball, balls)
+        ax.plot(xb, slope * xb, "--", color=c, lw=1.5, label=f"{ball} fit: {name}{slope:.3f} ± {err:.3f}")
+        paper = reporting.PAPER[paper_key].get(ball)
+        if paper is not None:
+            ax.plot(xb, paper * xb, ":", color=c, lw=2.2, alpha=0.6, label=f"{ball} paper: {paper:g}")
 
 
 def fig5_spin_vs_bracket(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
@@ -253,17 +271,7 @@ def fig5_spin_vs_bracket(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
     balls = _errorbars(ax, imp, x, y, None, yerr)
     xs = np.linspace(0.0, np.nanmax(x) * 1.05, 50)
     ax.plot(xs, xs, "-", color="0.2", lw=1.0, label="unit slope (e_x = 0)")
-    ball_of = imp["ball"].values.astype(str)
-    for ball in balls:
-        if ball not in fit["ball"].values or not np.isfinite(float(fit["e_x_pooled"].sel(ball=ball))):
-            continue
-        xb = np.linspace(0.0, np.nanmax(x[ball_of == ball]) * 1.05, 50)
-        e, err = float(fit["e_x_pooled"].sel(ball=ball)), float(fit["e_x_pooled_err"].sel(ball=ball))
-        c = ball_color(ball, balls)
-        ax.plot(xb, (1 + e) * xb, "--", color=c, lw=1.5, label=f"{ball} fit: 1 + e_x = {1 + e:.3f} ± {err:.3f}")
-        paper = reporting.PAPER["fig5_slope"].get(ball)
-        if paper is not None:
-            ax.plot(xb, paper * xb, ":", color=c, lw=2.2, alpha=0.6, label=f"{ball} paper: {paper:g}")
+    _lines_through_origin(ax, x, imp, balls, fit, "e_x_pooled", "fig5_slope", offset=1.0, name="1 + e_x = ")
     # e_x per bat (Table II) in a corner.
     rows = []
     for ball in fit["ball"].values.astype(str):
@@ -299,17 +307,7 @@ def fig6_tan_ratio(impacts: xr.Dataset, fit: xr.Dataset) -> Figure:
     y = imp["tan_psi_minus_theta"].values
     fig, ax = _new(WIDE)
     balls = _errorbars(ax, imp, x, y)
-    ball_of = imp["ball"].values.astype(str)
-    for ball in balls:
-        if ball not in fit["ball"].values or not np.isfinite(float(fit["tan_ratio_slope"].sel(ball=ball))):
-            continue
-        xb = np.linspace(0.0, np.nanmax(x[ball_of == ball]) * 1.05, 50)
-        s, err = float(fit["tan_ratio_slope"].sel(ball=ball)), float(fit["tan_ratio_slope_err"].sel(ball=ball))
-        c = ball_color(ball, balls)
-        ax.plot(xb, s * xb, "--", color=c, lw=1.5, label=f"{ball} fit: {s:.3f} ± {err:.3f}")
-        paper = reporting.PAPER["tan_ratio_slope"].get(ball)
-        if paper is not None:
-            ax.plot(xb, paper * xb, ":", color=c, lw=2.2, alpha=0.6, label=f"{ball} paper: {paper:g}")
+    _lines_through_origin(ax, x, imp, balls, fit, "tan_ratio_slope", "tan_ratio_slope", offset=0.0, name="")
     _axes_from_origin(ax, "tan ψ", "tan(ψ − θ)", "Fig. 6: tan(ψ − θ) vs tan ψ (Eq. ratio)")
     _legend_outside(fig, ax)
     _excluded_note(ax, n_excluded)
@@ -368,25 +366,12 @@ def fig9a_stronge_fit(stronge: xr.Dataset) -> Figure:
         xmax = np.nanmax(xd) * 1.05 if xd.size else np.inf
         x = s["vtf_x_model"].values
         keep = x <= xmax
-        c = ball_color(ball, balls)
-        ax.plot(
-            x[keep],
-            s["vtf_y_model"].values[keep],
-            "--",
-            color=c,
-            lw=1.5,
-            label=f"{ball} fit: η² = {float(s['eta2']):.2f} ± {float(s['eta2_err']):.2f}",
-        )
+        lines = [("vtf_y_model", "--", f"{ball} fit: η² = {float(s['eta2']):.2f} ± {float(s['eta2_err']):.2f}")]
         if "vtf_y_published" in s:
             paper = _eta2_paper(s, ball)
-            ax.plot(
-                x[keep],
-                s["vtf_y_published"].values[keep],
-                ":",
-                color=c,
-                lw=1.5,
-                label=f"{ball} paper: η² = {paper:g}" if paper else f"{ball} paper η²",
-            )
+            lines.append(("vtf_y_published", ":", f"{ball} paper: η² = {paper:g}" if paper else f"{ball} paper η²"))
+        for var, style, label in lines:
+            ax.plot(x[keep], s[var].values[keep], style, color=ball_color(ball, balls), lw=1.5, label=label)
     _axes_from_origin(
         ax, "tan ψ / (1 + r_x)", "(v_ball,t + r ω) / v_bat,n", "Fig. 9a: data and Stronge's model (fitted η²)"
     )
