@@ -10,6 +10,7 @@ import functools
 
 import numpy as np
 import pytest
+from test_tracks import BALLS, BATS, experiment, render, render_cfg
 
 from ballbat import systematics
 from ballbat.analysis import normalize, reconstruct
@@ -18,9 +19,14 @@ from ballbat.stronge.analysis import stronge_dataset
 from ballbat.tracks.data import camera_block
 from ballbat.tracks.reduce import reduction_dataset
 from ballbat.tracks.stage import reduce_in_memory
-from test_tracks import BALLS, BATS, experiment, render, render_cfg
 
-STRONGE = {"e_y": 0.5, "mu": 0.5, "psi_grid_deg": {"start": 0, "stop": 60, "num": 7}, "psi_history_deg": 30, "n_time": 20}
+STRONGE = {
+    "e_y": 0.5,
+    "mu": 0.5,
+    "psi_grid_deg": {"start": 0, "stop": 60, "num": 7},
+    "psi_history_deg": 30,
+    "n_time": 20,
+}
 SOURCE = list(systematics.SOURCES)
 
 
@@ -133,7 +139,8 @@ def test_no_shifts_no_systematics():
     """Impacts without shifts (direct-noise synthetic data, a measured file): no systematic variables."""
     rec, _, _ = chain(swing=(("fps_err", 0.002),))
     bare = rec.drop_vars(
-        [v for v in rec.data_vars if v.endswith("_shift")] + ["systematic_rel_sigma", "v_bat_err_scale", "v_ball_err_scale"]
+        [v for v in rec.data_vars if v.endswith("_shift")]
+        + ["systematic_rel_sigma", "v_bat_err_scale", "v_ball_err_scale"]
     )
     fit = fit_dataset(bare, mu_k_example=0.5)
     st = stronge_dataset(bare, vary_e_y=False, vary_mu=False, **STRONGE)

@@ -141,6 +141,40 @@ def test_camera_settings():
         assert any(e in p for p in ps), (e, ps)
 
 
+def test_calibration_uncertainties():
+    """fps_err (relative) and the rig's length uncertainties (inches): read, and each wrong one named."""
+    good = {
+        "cameras": {
+            "swing": {"fps": 3000, "m_per_px": 0.00074, "mirror": False, "fps_err": 0.001},
+            "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False},
+        },
+        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0, "pivot_to_impact_err_in": 0.1},
+    }
+    cams, rig = cameras_from_config(good)
+    assert cams["swing"].fps_err == 0.001 and cams["spin"].fps_err == 0.0
+    assert rig.pivot_to_impact_err == pytest.approx(0.1 * 0.0254) and rig.pivot_to_tip_err == 0.0
+    bad = {
+        "cameras": {**good["cameras"], "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False, "fps_err": 2}},
+        "rig": {
+            "pivot_to_tip_in": 34.0,
+            "pivot_to_impact_in": 28.0,
+            "pivot_to_tip_err_in": -1,
+            "pivot_to_impact_err_in": 5,
+        },
+    }
+    with pytest.raises(InputError) as exc:
+        cameras_from_config(bad, "datasets.lab.tracks")
+    ps = exc.value.problems
+    expected = (
+        "datasets.lab.tracks.cameras.spin.fps_err: 2 must be a relative uncertainty >= 0 and below 0.1",
+        "datasets.lab.tracks.rig.pivot_to_tip_err_in: -1 must be a number >= 0",
+        "datasets.lab.tracks.rig.pivot_to_impact_err_in: 5 in is 17.9 % of pivot_to_impact_in 28.0",
+    )
+    for e in expected:
+        assert any(e in p for p in ps), (e, ps)
+    assert len(ps) == 3
+
+
 def test_camera_settings_good():
     cams, rig = cameras_from_config(
         {
