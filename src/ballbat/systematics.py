@@ -152,6 +152,14 @@ def _coords() -> dict[str, tuple]:
     }
 
 
+def _rel_sigma_var(rel: np.ndarray) -> tuple:
+    return (
+        ("systematic",),
+        np.asarray(rel, dtype=float),
+        {"units": "1", "long_name": "relative standard uncertainty of each calibration source (0: none stated)"},
+    )
+
+
 def add_shifts(ds: xr.Dataset, shifts: Shifts | None) -> xr.Dataset:
     """Return reduce.nc's dataset with the shifts of :func:`reduce_shifts` (unchanged for None)."""
     if shifts is None:
@@ -164,11 +172,7 @@ def add_shifts(ds: xr.Dataset, shifts: Shifts | None) -> xr.Dataset:
             {"units": "1", "long_name": "calibration shifted by this many standard uncertainties"},
         ),
     )
-    out["systematic_rel_sigma"] = (
-        ("systematic",),
-        shifts.rel_sigma,
-        {"units": "1", "long_name": "relative standard uncertainty of each calibration source (0: none stated)"},
-    )
+    out["systematic_rel_sigma"] = _rel_sigma_var(shifts.rel_sigma)
     for k in SHIFTED:
         base = k.removesuffix("_err")
         what = f"the standard uncertainty of {base}" if k.endswith("_err") else base
@@ -220,9 +224,10 @@ def _combine(by_source: np.ndarray) -> np.ndarray:
     return np.sqrt(np.sum(by_source**2, axis=0))
 
 
-def _systematic_vars(ds: xr.Dataset, by_source: dict[str, np.ndarray], what: str) -> xr.Dataset:
+def _systematic_vars(ds: xr.Dataset, by_source: dict[str, np.ndarray], what: str, rel: np.ndarray) -> xr.Dataset:
     """``ds`` with ``<q>_syst_by_source``, ``<q>_syst`` and (where ``<q>_err`` is) ``<q>_err_total``."""
     out = ds.assign_coords(**_coords()) if "systematic" not in ds.coords else ds
+    out["systematic_rel_sigma"] = _rel_sigma_var(rel)
     for q, per in by_source.items():
         dims, attrs = ds[q].dims, ds[q].attrs
         units = {"units": attrs["units"]} if "units" in attrs else {}
@@ -263,6 +268,7 @@ class FitSystematics:
     """Per source (first axis), the systematic of each quantity of :data:`FIT_QUANTITIES`."""
 
     by_source: dict[str, np.ndarray]
+    rel_sigma: np.ndarray
 
 
 def fit_systematics(rec: xr.Dataset, res: Sec4) -> FitSystematics:
@@ -295,7 +301,7 @@ def fit_systematics(rec: xr.Dataset, res: Sec4) -> FitSystematics:
         ]
         for q in FIT_QUANTITIES:
             out[q][i] = 0.5 * np.abs(fits[0][q].values - fits[1][q].values)
-    return FitSystematics(out)
+    return FitSystematics(out, rel)
 
 
 def scale_entries(fs: FitSystematics) -> dict[str, np.ndarray]:
@@ -308,7 +314,8 @@ def add_fit_systematics(ds: xr.Dataset, fs: FitSystematics | None) -> xr.Dataset
     """fit_ex.nc's dataset with the systematics of :func:`fit_systematics` (unchanged for None)."""
     if fs is None:
         return ds
-    return _systematic_vars(ds, fs.by_source, "the tracks reduced again, then normalize, reconstruct and the fit")
+    what = "the tracks reduced again, then normalize, reconstruct and the fit"
+    return _systematic_vars(ds, fs.by_source, what, fs.rel_sigma)
 
 
 # ---------------------------------------------------------------------------------------
@@ -356,4 +363,27 @@ def stronge_systematics(
         for q in names:
             plus, minus = (np.array([getattr(f, q) for f in side]) for side in fits)
             out[q][i] = 0.5 * np.abs(plus - minus)
-    return _systematic_vars(ds, out, "the tracks reduced again, then normalize, reconstruct and the eta^2 fit")
+    what = "the tracks reduced again, then normalize, reconstruct and the eta^2 fit"
+    return _systematic_vars(ds, out, what, rel)
+
+
+# ---------------------------------------------------------------------------------------
+# readers of the results (tables, summary, front page)
+def systematic_var(ds: xr.Dataset, var: str) -> str | None:
+    """Return the name of the combined systematic of ``var`` in ``ds``, or None when it has none.
+
+    ``<var>_syst`` (every calibration source), else ``<var>_err_scale`` (the pixel-scale one
+    of e_x, in files made before the other sources were propagated).
+    """
+    for name in (f"{var}_syst", f"{var}_err_scale"):
+        if name in ds:
+            return name
+    return None
+
+
+#: What the combined systematic holds, in the tables' notes.
+SYSTEMATIC_NOTE = (
+    "every stated calibration uncertainty (pixel scale and frame rate of each camera, the rig's lengths), "
+    "each propagated by reducing the tracks again at +-1 sigma, combined in quadrature; shared by every "
+    "impact, apart from the standard error"
+)
