@@ -158,3 +158,49 @@ def test_fitted_e_y_gets_a_systematic():
 def test_every_fit_family_is_covered():
     """Every line-fit family of fit_ex.nc is a quantity with systematics."""
     assert set(FIT_FAMILIES) <= set(systematics.FIT_QUANTITIES)
+
+
+def test_tables_carry_the_systematics(tmp_path):
+    """The comparison rows have a systematic for every quantity that has one; the workbook has stat, syst
+    and total columns for every estimate and a sheet of each source's part.
+    """
+    import openpyxl
+
+    from ballbat.compare import comparison_table, fit_rows, stronge_rows
+    from ballbat.workbook import dataset_workbook
+
+    rec, fit, st = chain(swing=(("m_per_px_err", 0.005),), spin=(("fps_err", 0.002),))
+    rows = fit_rows(fit) + stronge_rows(st)
+    with_syst = {r["quantity"] for r in rows if r.get("systematic") is not None}
+    assert with_syst == {*systematics.FIT_QUANTITIES, "eta2"} - {
+        "spin_theta_slope_intercept",
+        "speed_theta_slope_intercept",
+    }  # the comparison table has no intercepts
+    row = next(r for r in rows if r["quantity"] == "e_x_pooled" and r["ball"] == "softball")
+    assert row["systematic"] == pytest.approx(float(fit.e_x_pooled_syst.sel(ball="softball")))
+    row = next(r for r in rows if r["quantity"] == "spin_theta_slope" and r["ball"] == "baseball")
+    assert row["systematic"] == pytest.approx(
+        float(fit.spin_theta_slope_syst.sel(ball="baseball")) * 60 / (2 * np.pi) * np.pi / 180
+    )
+    table = comparison_table(rows)
+    path = tmp_path / "results.xlsx"
+    dataset_workbook(path, rec, fit, st, [{k: r[k] for k in ("quantity", "value")} for r in table])
+    book = openpyxl.load_workbook(path)
+    sec4 = [c.value for c in book["sec4"][1]]
+    for q in ("tan_ratio_slope", "e_y_implied", "mu_k_lower_bound", "spin_theta_slope", "speed_theta_slope"):
+        i = sec4.index(q)
+        assert sec4[i : i + 4] == [q, f"{q}_err", f"{q}_syst", f"{q}_err_total"], sec4
+    assert "gross_slip_psi_syst" in sec4 and "spin_theta_slope_intercept_syst" in sec4
+    eta2 = [c.value for c in book["eta2"][1]]
+    assert eta2[1:5] == ["eta2", "eta2_err", "eta2_syst", "eta2_err_total"]
+    assert [c.value for c in book["e_x"][1]][2:6] == ["e_x", "e_x_err", "e_x_syst", "e_x_err_total"]
+    per = list(book["systematics"].iter_rows(min_row=3, values_only=True))
+    sources = {r[3] for r in per}
+    assert sources == {"swing_m_per_px", "spin_fps"}  # sources with a stated uncertainty only
+    got = {(r[0], r[1], r[2] or "", r[3]): r[5] for r in per}  # an empty cell reads back as None
+    assert got[("eta2", "baseball", "", "spin_fps")] == pytest.approx(
+        float(st.eta2_syst_by_source.sel(ball="baseball", systematic="spin_fps"))
+    )
+    assert got[("e_x", "baseball", "wood", "swing_m_per_px")] == pytest.approx(
+        float(fit.e_x_err_scale.sel(ball="baseball", bat="wood"))
+    )
