@@ -384,6 +384,6 @@ def systematic_var(ds: xr.Dataset, var: str) -> str | None:
 #: What the combined systematic holds, in the tables' notes.
 SYSTEMATIC_NOTE = (
     "every stated calibration uncertainty (pixel scale and frame rate of each camera, the rig's lengths), "
-    "each propagated by reducing the tracks again at +-1 sigma, combined in quadrature; shared by every "
-    "impact, apart from the standard error"
+    "each propagated by reducing the tracks again at ± one standard uncertainty, combined in quadrature; "
+    "shared by every impact, apart from the standard error"
 )
