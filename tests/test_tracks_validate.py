@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from ballbat.properties import InputError, load_balls, load_bats
@@ -202,3 +203,9 @@ def test_shipped_example_reduces():
     assert list(flagged) == ["W04"]
     assert ds.sizes["impact"] == 12
     assert ds["v_bat_err_scale"].values[0] == pytest.approx(0.005 * ds["v_bat"].values[0])
+    # the reduce rule's file carries the calibration shifts: the swing camera's scale (0.5 %) only
+    sigma = dict(zip(ds["systematic"].values.astype(str), ds["systematic_rel_sigma"].values, strict=True))
+    assert sigma["swing_m_per_px"] == 0.005 and sum(sigma.values()) == 0.005
+    up = ds["v_ball_shift"].sel(systematic="swing_m_per_px", shift=1).values
+    np.testing.assert_allclose(up, 0.005 * ds["v_ball"].values, rtol=0.01)  # the flight's gravity term aside
+    assert not ds["v_bat_shift"].sel(systematic="swing_fps").values.any()
