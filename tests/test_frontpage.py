@@ -173,7 +173,7 @@ def test_front_page_renders_numbers_before_warnings():
     assert "e_x (softball, metal_rough): too few" in html
     assert "commit <tt" in html or "commit <code" in html
     assert "0123456789ab" in html and "clean tree" in html
-    assert "pixel-scale systematic" in html and "the synthetic experiment was drawn with" in html
+    assert "calibration systematic" in html and "the synthetic experiment was drawn with" in html
 
 
 def test_notes_follow_the_columns():

@@ -1,4 +1,4 @@
-"""The numbers a lab reads: e_x with its pixel-scale systematic (summary, workbook, captions),
+"""The numbers a lab reads: e_x with its calibration systematic (summary, workbook, captions),
 rounded as the field does, and the workbook's formats, units, dates and provenance (issue 21).
 """
 
@@ -72,7 +72,7 @@ def test_workbook_e_x_sheet(default_run, fit):
     book = openpyxl.load_workbook(default_run / "results" / "synthetic" / "results.xlsx")
     ws = book["e_x"]
     names = [c.value for c in ws[1]]
-    assert names[:6] == ["ball", "bat", "e_x", "e_x_err", "e_x_err_scale", "e_x_err_total"]
+    assert names[:6] == ["ball", "bat", "e_x", "e_x_err", "e_x_syst", "e_x_err_total"]
     assert all(c.value is None for c in ws[2])  # dimensionless: blank units
     rows = {(r[0].value, r[1].value): r for r in ws.iter_rows(min_row=3)}
     row = rows[("baseball", "wood")]

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import numpy as np
 import pytest
 
 from ballbat.properties import InputError, load_balls, load_bats
@@ -141,6 +142,40 @@ def test_camera_settings():
         assert any(e in p for p in ps), (e, ps)
 
 
+def test_calibration_uncertainties():
+    """fps_err (relative) and the rig's length uncertainties (inches): read, and each wrong one named."""
+    good = {
+        "cameras": {
+            "swing": {"fps": 3000, "m_per_px": 0.00074, "mirror": False, "fps_err": 0.001},
+            "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False},
+        },
+        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0, "pivot_to_impact_err_in": 0.1},
+    }
+    cams, rig = cameras_from_config(good)
+    assert cams["swing"].fps_err == 0.001 and cams["spin"].fps_err == 0.0
+    assert rig.pivot_to_impact_err == pytest.approx(0.1 * 0.0254) and rig.pivot_to_tip_err == 0.0
+    bad = {
+        "cameras": {**good["cameras"], "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False, "fps_err": 2}},
+        "rig": {
+            "pivot_to_tip_in": 34.0,
+            "pivot_to_impact_in": 28.0,
+            "pivot_to_tip_err_in": -1,
+            "pivot_to_impact_err_in": 5,
+        },
+    }
+    with pytest.raises(InputError) as exc:
+        cameras_from_config(bad, "datasets.lab.tracks")
+    ps = exc.value.problems
+    expected = (
+        "datasets.lab.tracks.cameras.spin.fps_err: 2 must be a relative uncertainty >= 0 and below 0.1",
+        "datasets.lab.tracks.rig.pivot_to_tip_err_in: -1 must be a number >= 0",
+        "datasets.lab.tracks.rig.pivot_to_impact_err_in: 5 in is 17.9 % of pivot_to_impact_in 28.0",
+    )
+    for e in expected:
+        assert any(e in p for p in ps), (e, ps)
+    assert len(ps) == 3
+
+
 def test_camera_settings_good():
     cams, rig = cameras_from_config(
         {
@@ -168,3 +203,9 @@ def test_shipped_example_reduces():
     assert list(flagged) == ["W04"]
     assert ds.sizes["impact"] == 12
     assert ds["v_bat_err_scale"].values[0] == pytest.approx(0.005 * ds["v_bat"].values[0])
+    # the reduce rule's file carries the calibration shifts: the swing camera's scale (0.5 %) only
+    sigma = dict(zip(ds["systematic"].values.astype(str), ds["systematic_rel_sigma"].values, strict=True))
+    assert sigma["swing_m_per_px"] == 0.005 and sum(sigma.values()) == 0.005
+    up = ds["v_ball_shift"].sel(systematic="swing_m_per_px", shift=1).values
+    np.testing.assert_allclose(up, 0.005 * ds["v_ball"].values, rtol=0.01)  # the flight's gravity term aside
+    assert not ds["v_bat_shift"].sel(systematic="swing_fps").values.any()

@@ -121,8 +121,7 @@ def reconstruct(ds: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]) ->
     r_x = np.array([pairs[(b, t)][0] for b, t in zip(ball_ids, bat_ids, strict=True)])
     R = np.array([bats[t].R for t in bat_ids])
 
-    v_bat, v_ball, theta, omega = (ds[k].values for k in ("v_bat", "v_ball", "theta", "omega"))
-    psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
+    psi, flag, geometry = _geometry(ds, r, alpha, r_x, R)
     reasons = np.array([FLAG_TEXT[ImpactFlag(int(f))] for f in flag], dtype=object).astype(str)
     if "ingest_flag" in ds:  # measured data: keep the ingest's exclusions out of every fit
         excluded = ds["ingest_flag"].values != 0
@@ -140,16 +139,36 @@ def reconstruct(ds: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]) ->
         "flag": flag,
         "flag_reason": reasons,
     }
-    with np.errstate(invalid="ignore"):
-        values.update(
-            D=offset_from_psi(psi, r, R),
-            v_n=v_ball * np.cos(psi - theta),
-            v_t=v_ball * np.sin(psi - theta),
-            v_bat_n=v_bat * np.cos(psi),
-            spin_bracket=spin_bracket(v_bat, psi, r, r_x, alpha),
-            vtf_x=vtf_bracket(psi, r_x),
-            vtf_y=vtf_ordinate(v_ball, theta, omega, v_bat, psi, r),
-            tan_psi=np.tan(psi),
-            tan_psi_minus_theta=tan_psi_minus_theta(v_ball, omega, r, alpha),
-        )
+    values.update(geometry)
     return add_variables(ds, RECONSTRUCT_TABLE, values)
+
+
+def _geometry(ds: xr.Dataset, r, alpha, r_x, R) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
+    """Return psi (Eq. angmom), its flag, and the derived Sec. III quantities of the measured values of ``ds``."""
+    v_bat, v_ball, theta, omega = (ds[k].values for k in ("v_bat", "v_ball", "theta", "omega"))
+    psi, flag = reconstruct_psi(v_ball, theta, omega, r, alpha)
+    with np.errstate(invalid="ignore"):
+        geometry = {
+            "D": offset_from_psi(psi, r, R),
+            "v_n": v_ball * np.cos(psi - theta),
+            "v_t": v_ball * np.sin(psi - theta),
+            "v_bat_n": v_bat * np.cos(psi),
+            "spin_bracket": spin_bracket(v_bat, psi, r, r_x, alpha),
+            "vtf_x": vtf_bracket(psi, r_x),
+            "vtf_y": vtf_ordinate(v_ball, theta, omega, v_bat, psi, r),
+            "tan_psi": np.tan(psi),
+            "tan_psi_minus_theta": tan_psi_minus_theta(v_ball, omega, r, alpha),
+        }
+    return psi, flag, geometry
+
+
+def reconstruct_again(rec: xr.Dataset) -> xr.Dataset:
+    """Recompute psi and the derived Sec. III quantities of a reconstructed dataset whose measured values changed.
+
+    The ball and bat properties are those ``reconstruct`` stored per impact (r, alpha, r_x,
+    R_bat), so no property table is needed; the flags are kept as they are (the same impacts
+    are used). For the calibration systematics (:mod:`ballbat.systematics`).
+    """
+    values = {k: rec[k].values for k in ("r", "alpha", "r_x", "R_bat")}
+    psi, _, geometry = _geometry(rec, values["r"], values["alpha"], values["r_x"], values["R_bat"])
+    return add_variables(rec, RECONSTRUCT_TABLE, {"psi": psi, **geometry})

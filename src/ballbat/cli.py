@@ -558,8 +558,9 @@ def summary_lines(folder: Path) -> list[str]:
     rec, fit, st = read
     lines = [f"{folder.name}: {rec.sizes['impact']} impacts, {int((rec['flag'].values != 0).sum())} not used (flagged)"]
     from .compare import format_measurement, total_uncertainty
+    from .systematics import SYSTEMATIC_NOTE, systematic_var
 
-    scale = "e_x_err_scale" in fit
+    scale = systematic_var(fit, "e_x") is not None
     head = f"{'ball':<10} {'bat':<20} {'e_x':>8} {'± stat':>8}"
     head += f" {'± syst':>8} {'± total':>8}" if scale else ""
     lines += ["", head + f" {'95 % interval (stat)':>22} {'n':>4}"]
@@ -571,7 +572,7 @@ def summary_lines(folder: Path) -> list[str]:
             if n == 0:
                 continue
             v, e = float(f[pre]), float(f[f"{pre}_err"])
-            sys_ = float(f[f"{pre}_err_scale"]) if scale else None
+            sys_ = float(f[systematic_var(f, pre)]) if scale else None
             errs = (e, sys_, total_uncertainty(e, sys_)) if scale else (e,)
             # rounded as the field does: the errors to two significant digits, the value to match
             cells = format_measurement(v, *errs)
@@ -583,10 +584,7 @@ def summary_lines(folder: Path) -> list[str]:
                 f"{ball:<10} {bat:<20} " + " ".join(f"{c:>8}" for c in cells) + f" {f'[{lo}, {hi}]':>22} {n:4d}"
             )
     if scale:
-        lines += [
-            "syst: the pixel-scale systematic of the swing camera, shared by every impact of a bat "
-            "(not in stat); total: both in quadrature."
-        ]
+        lines += [f"syst: {SYSTEMATIC_NOTE}; total: both in quadrature."]
     lines += ["", f"{'ball':<10} {'eta^2':>7} {'± se':>7} {'95 % interval':>17} {'n':>4}"]
     for ball in st["ball"].values.astype(str):
         s = st.sel(ball=ball)
@@ -595,11 +593,57 @@ def summary_lines(folder: Path) -> list[str]:
             f"{ball:<10} {float(s['eta2']):7.3f} {float(s['eta2_err']):7.3f} {f'[{lo:.3f}, {hi:.3f}]':>17} "
             f"{int(s['eta2_n']):4d}"
         )
+    lines += _systematic_lines(fit, st)
     bad = rec["flag"].values != 0
     reasons = rec["flag_reason"].values[bad].astype(str)
     if reasons.size:
         labels = impact_labels(rec)[bad]
         lines += ["", "not used:"] + [f"  {lab}: {r}" for lab, r in zip(labels, reasons, strict=True)]
+    return lines
+
+
+#: The per-ball quantities the summary lists with their systematics: (file, variable, unit shown).
+SUMMARY_SYSTEMATICS = (
+    ("fit", "tan_ratio_slope", "1"),
+    ("fit", "e_y_implied", "1"),
+    ("fit", "mu_k_lower_bound", "1"),
+    ("fit", "spin_theta_slope", "rpm/deg"),
+    ("fit", "speed_theta_slope", "mph/deg"),
+    ("stronge", "eta2", "1"),
+)
+
+
+def _systematic_lines(fit, st) -> list[str]:
+    """Lines of the per-ball quantities with stat, syst and total (datasets with calibration systematics only)."""
+    from .compare import total_uncertainty, uncertainty_decimals
+    from .units import from_si
+
+    files = {"fit": fit, "stronge": st}
+    if not any(f"{var}_syst" in files[k] for k, var, _ in SUMMARY_SYSTEMATICS):
+        return []
+    lines = ["", f"{'ball':<10} {'quantity':<18} {'value':>9} {'± stat':>8} {'± syst':>8} {'± total':>8}  unit"]
+    for k, var, unit in SUMMARY_SYSTEMATICS:
+        ds = files[k]
+        if f"{var}_syst" not in ds:
+            continue
+        for ball in ds["ball"].values.astype(str):
+            f = ds.sel(ball=ball)
+            v, e, y = (from_si(float(f[n]), unit) for n in (var, f"{var}_err", f"{var}_syst"))
+            total = total_uncertainty(e, y)
+            # the decimals of the standard error and the total (a negligible systematic shows as 0)
+            d = max(uncertainty_decimals(e, total) or 0, 0)
+            cells = [f"{x:.{d}f}" if math.isfinite(x) else "" for x in (v, e, y, total)]
+            lines.append(f"{ball:<10} {var:<18} " + " ".join(f"{c:>8}" for c in cells) + f"  {unit}")
+    per_source = (
+        [
+            f"{src} ({float(r):g})"
+            for src, r in zip(fit["systematic"].values.astype(str), fit["systematic_rel_sigma"].values, strict=True)
+            if r > 0
+        ]
+        if "systematic_rel_sigma" in fit
+        else []
+    )
+    lines.append("calibration sources (relative sigma): " + (", ".join(per_source) or "none stated"))
     return lines
 
 

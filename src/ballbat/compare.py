@@ -2,10 +2,11 @@
 
 Columns: ``quantity, ball, bat, paper, paper_uncertainty, value, uncertainty, systematic,
 truth, unit``, in the paper's units. ``uncertainty`` is the statistical standard error;
-``systematic`` a systematic error reported apart from it (e_x of a dataset reduced from
-camera tracks with a pixel-scale uncertainty). One row per published number (``ballbat.published``) and one per
-result of ours that the paper does not publish (e.g. e_x of a bat not in the paper, or
-e_y implied by Eq. ratio). Cells that do not apply are empty.
+``systematic`` the systematic error reported apart from it (a dataset reduced from camera
+tracks: every stated calibration uncertainty, in quadrature; :mod:`ballbat.systematics`).
+One row per published number (``ballbat.published``) and one per result of ours that the
+paper does not publish (e.g. e_x of a bat not in the paper, or e_y implied by Eq. ratio).
+Cells that do not apply are empty.
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ import numpy as np
 
 from .kinematics import offset_from_psi
 from .published import PUBLISHED, UNPUBLISHED
+from .systematics import SYSTEMATIC_NOTE, systematic_var
 from .units import from_si
 
 if TYPE_CHECKING:
@@ -140,7 +142,8 @@ def fit_rows(fit: xr.Dataset) -> list[dict]:
                     continue
                 err = _pick(fit, f"{var}_err", ball, bat or None)
                 tru = _pick(fit, f"truth_{var}", ball, bat or None)
-                sys_ = _pick(fit, f"{var}_err_scale", ball, bat or None)
+                syst = systematic_var(fit, var)
+                sys_ = _pick(fit, syst, ball, bat or None) if syst else None
                 conv = (lambda x, unit=unit: None if x is None else from_si(x, unit)) if unit != "1" else (lambda x: x)
                 rows.append(
                     {
@@ -254,7 +257,7 @@ def to_markdown(table: list[dict], title: str) -> str:
     present = {r["quantity"] for r in table if r.get("uncertainty") is not None}
     notes = [f"- `{q}`: uncertainty is {UNCERTAINTY_NOTES[q]}" for q in UNCERTAINTY_NOTES if q in present]
     if any(r.get("systematic") is not None for r in table):
-        notes.append("- `systematic`: from the swing camera's pixel-scale uncertainty, apart from the standard error")
+        notes.append(f"- `systematic`: {SYSTEMATIC_NOTE}")
     notes.append(
         "- `value`, `uncertainty`, `systematic`: rounded as the field does (the uncertainty to two significant "
         "digits, the value to match); paper_comparison.csv has them to 6 significant digits"
@@ -334,7 +337,14 @@ def stronge_rows(stronge: xr.Dataset) -> list[dict]:
     for b in map(str, stronge["ball"].values):
         s = stronge.sel(ball=b)
         rows += [
-            result_row("eta2", b, float(s.eta2), "1", uncertainty=float(s.eta2_err)),
+            result_row(
+                "eta2",
+                b,
+                float(s.eta2),
+                "1",
+                uncertainty=float(s.eta2_err),
+                systematic=float(s.eta2_syst) if "eta2_syst" in s else None,
+            ),
             result_row("omega_t_over_omega_n", b, float(s.omega_ratio), "1"),
             result_row("stretch_max_time" + at, b, float(s.t_stretch_max), "t_c"),
             result_row("stick_end_time" + at, b, float(s.t_stick_end), "t_c"),

@@ -102,6 +102,7 @@ class Sec4:
     speed_theta_slope: FitGrid
     per_ball: dict[str, np.ndarray] = field(default_factory=dict)
     systematic: dict[str, np.ndarray] | None = None  # pixel-scale systematic of e_x (scale_systematic)
+    systematics: object = None  # every calibration source to every quantity (ballbat.systematics)
 
 
 #: Per-ball quantities that are not line fits (values of :attr:`Sec4.per_ball`).
@@ -204,6 +205,11 @@ def scale_systematic(ds: xr.Dataset, res: Sec4) -> dict[str, np.ndarray] | None:
         ``e_x_err_scale`` (ball x bat) and ``e_x_pooled_err_scale`` (ball); None when the
         dataset has no pixel-scale uncertainty.
     """
+    from . import systematics
+
+    if systematics.has_shifts(ds):  # every calibration source, the tracks reduced again (exact)
+        res.systematics = systematics.fit_systematics(ds, res)
+        return systematics.scale_entries(res.systematics)
     if not all(k in ds for k in SCALE_VARS):
         return None
     fits = []
@@ -494,12 +500,15 @@ def results_dataset(res: Sec4) -> xr.Dataset:
         "ball": (Var(("ball",), None, "ball type"), np.array(res.balls, dtype=str)),
         "bat": (Var(("bat",), None, "bat"), np.array(res.bats, dtype=str)),
     }
-    return build_dataset(
+    from .systematics import add_fit_systematics
+
+    ds = build_dataset(
         fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None),
         values,
         coords,
         {"mu_k_example": res.mu_k_example},
     )
+    return add_fit_systematics(ds, res.systematics)
 
 
 #: Physical bounds of a tangential COR: |u_final| <= |u_initial| (no tangential energy gain).

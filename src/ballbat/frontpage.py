@@ -27,6 +27,7 @@ from urllib.parse import quote
 import numpy as np
 
 from .published import PUBLISHED, per_ball
+from .systematics import SYSTEMATIC_NOTE, systematic_var
 
 if TYPE_CHECKING:
     import os
@@ -85,10 +86,22 @@ def round_pm(value: float, *uncertainties: float) -> tuple[str, ...]:
     return (fixed(value, d), *(fixed(e, d) if math.isfinite(float(e)) else "n/a" for e in uncertainties))
 
 
-def pm(value: float, err: float) -> str:
-    """``value ± err`` rounded as the field does (the value alone when the error is unusable)."""
+def pm(value: float, err: float, syst: float = math.nan) -> str:
+    """``value ± err`` rounded as the field does (the value alone when the error is unusable).
+
+    With a systematic error (finite and positive): ``value ± err ± syst syst.``.
+    """
+    if math.isfinite(float(syst)) and float(syst) > 0:
+        v, e, y = round_pm(value, err, syst)
+        return f"{v} ± {e} ± {y} syst." if e != "n/a" else f"{v} ± {y} syst."
     v, e = round_pm(value, err)
     return v if e == "n/a" else f"{v} ± {e}"
+
+
+def _syst(ds: xr.Dataset, var: str) -> float:
+    """Return the combined systematic of ``var`` in ``ds`` (a one-ball selection), NaN when it has none."""
+    name = systematic_var(ds, var)
+    return float(ds[name]) if name else math.nan
 
 
 def _published(quantity: str, ball: str, bat: str = "") -> tuple[float, float | None] | None:
@@ -194,7 +207,7 @@ def e_x_rows(fit: xr.Dataset) -> list[list[str]]:
     """Rows ball, bat, e_x, stat., syst., paper (and truth for synthetic data) of the headline table.
 
     Per bat x ball with a value, then the pooled fit (Eq. ex) of each ball. The systematic is the
-    pixel-scale one of tracked data (``e_x_err_scale``); '—' where there is none.
+    calibration one of tracked data (``e_x_syst``: every source in quadrature); '—' where there is none.
     """
     truth = "truth_e_x" in fit
     rows = []
@@ -206,7 +219,7 @@ def e_x_rows(fit: xr.Dataset) -> list[list[str]]:
             if not math.isfinite(value):
                 continue
             stat = float(f[f"{var}_err"])
-            syst = float(f[f"{var}_err_scale"]) if f"{var}_err_scale" in f else math.nan
+            syst = _syst(f, var)
             has_syst = math.isfinite(syst) and syst > 0
             v, s, y = round_pm(value, stat, syst) if has_syst else (*round_pm(value, stat), "—")
             paper = _paper("e_x", ball, bat) if var == "e_x" else _paper("e_x_pooled", ball)
@@ -230,11 +243,13 @@ def per_ball_rows(fit: xr.Dataset, stronge: xr.Dataset) -> list[list[str]]:
         e_y = mu_k = "n/a"
         if ball in fit["ball"].values.astype(str):
             f = fit.sel(ball=ball)
-            e_y = pm(float(f["e_y_implied"]), float(f["e_y_implied_err"]))
-            mu_k = "≥ " + pm(float(f["mu_k_lower_bound"]), float(f["mu_k_lower_bound_err"]))
+            e_y = pm(float(f["e_y_implied"]), float(f["e_y_implied_err"]), _syst(f, "e_y_implied"))
+            mu_k = "≥ " + pm(
+                float(f["mu_k_lower_bound"]), float(f["mu_k_lower_bound_err"]), _syst(f, "mu_k_lower_bound")
+            )
         paper_mu = _published("mu_k_lower_bound", ball)
         paper_mu_text = "—" if paper_mu is None else f"≥ {paper_mu[0]:g}"
-        rows.append([escape(ball), f"**{pm(eta2, err)}**", interval, paper, e_y, mu_k, paper_mu_text])
+        rows.append([escape(ball), f"**{pm(eta2, err, _syst(s, 'eta2'))}**", interval, paper, e_y, mu_k, paper_mu_text])
     return rows
 
 
@@ -320,11 +335,9 @@ def dataset_section(
     has_syst = any(r[4] != "—" for r in e_x_rows(fit))
     note = ["stat.: the standard error."]
     if has_syst:
-        note.append(
-            "syst.: the swing camera's pixel-scale systematic, shared by every impact, not in the standard error."
-        )
+        note.append(f"syst.: the calibration systematic, {SYSTEMATIC_NOTE}.")
     else:
-        note.append("syst. —: none is estimated here (the pixel-scale systematic comes with camera tracks).")
+        note.append("syst. —: none is estimated here (the calibration systematics come with camera tracks).")
     if "truth_e_x" in fit:
         note.append("truth: the value the synthetic experiment was drawn with.")
     lines += [" ".join(note), ""]

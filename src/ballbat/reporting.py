@@ -21,6 +21,7 @@ import numpy as np
 from .compare import COLUMNS, format_measurement, read_csv, total_uncertainty
 from .pipeline.ncio import atomic_write_text
 from .published import per_ball
+from .systematics import SYSTEMATIC_NOTE, systematic_var
 from .units import from_si
 
 if TYPE_CHECKING:
@@ -102,12 +103,14 @@ def fig4_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
 def _ex_text(fit: xr.Dataset, pre: str, offset: float = 0.0, **sel: str) -> str:
     """Return e_x (plus ``offset``) with its errors as text.
 
-    The standard error and, for tracked data, the pixel-scale systematic and the total, rounded
-    as the field does (errors to two significant digits, the value to match).
+    The standard error and, for tracked data, the calibration systematic (every source in
+    quadrature) and the total, rounded as the field does (errors to two significant digits,
+    the value to match).
     """
     f = fit.sel(**sel)
     v, e = float(f[pre]) + offset, float(f[f"{pre}_err"])
-    syst = float(f[f"{pre}_err_scale"]) if f"{pre}_err_scale" in f else math.nan
+    syst_var = systematic_var(f, pre)
+    syst = float(f[syst_var]) if syst_var else math.nan
     if not math.isfinite(syst):
         value, err = format_measurement(v, e)
         return f"{value} ± {err}" if err else value
@@ -116,9 +119,10 @@ def _ex_text(fit: xr.Dataset, pre: str, offset: float = 0.0, **sel: str) -> str:
 
 
 def fig5_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
-    """Pooled and per-bat e_x (Fig. 5, Eq. ex, Table II), with the pixel-scale systematic of tracked data."""
-    tracked = "e_x_err_scale" in fit and bool(np.isfinite(fit["e_x_err_scale"].values).any())
-    what = "standard errors and the pixel-scale systematic" if tracked else "standard errors"
+    """Pooled and per-bat e_x (Fig. 5, Eq. ex, Table II), with the calibration systematic of tracked data."""
+    syst_var = systematic_var(fit, "e_x")
+    tracked = syst_var is not None and bool(np.isfinite(fit[syst_var].values).any())
+    what = "standard errors and the calibration systematic" if tracked else "standard errors"
     lines = [f"Slopes 1 + e_x of the pooled fits through the origin ({what}):", ""]
     for ball in fit["ball"].values.astype(str):
         v = float(fit["e_x_pooled"].sel(ball=ball))
@@ -141,8 +145,7 @@ def fig5_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     if tracked:
         lines += [
             "",
-            "The systematic is the pixel-scale uncertainty of the swing camera, shared by every impact "
-            "of a bat; it is not in the standard error and the two add in quadrature to the total.",
+            f"The systematic is {SYSTEMATIC_NOTE}; the two add in quadrature to the total.",
         ]
     return "\n".join([*lines, "", *_header(impacts)])
 

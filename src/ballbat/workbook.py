@@ -10,9 +10,11 @@ second; the last sheet records the provenance of every file it was made from.
 Units ``1`` (dimensionless numbers) are shown as a blank unit cell. Cells keep the full
 precision of the NetCDF files; number formats show them as the field rounds them: an estimate
 and its errors with the error to two significant digits (the finest error of the row setting
-the decimals), other numbers to a fixed number of decimals per unit. The e_x sheet gives the
-statistical standard error, the pixel-scale systematic (``e_x_err_scale``, camera-tracked data)
-and their total in quadrature.
+the decimals), other numbers to a fixed number of decimals per unit. Every estimate of a
+dataset reduced from camera tracks has its statistical standard error, its systematic error
+(``<name>_syst``: every stated calibration uncertainty in quadrature, :mod:`ballbat.systematics`)
+and their total (``<name>_err_total``); the ``systematics`` sheet gives each calibration
+source's part.
 
 The workbook is byte-identical on rerun: its document properties and the zip entries carry the
 date of the git commit the results were made with (``SOURCE_DATE_EPOCH`` when set; the paper's
@@ -38,6 +40,7 @@ import numpy as np
 
 from .compare import total_uncertainty
 from .pipeline.atomic import atomic_target
+from .systematics import systematic_var
 from .units import from_si
 
 if TYPE_CHECKING:
@@ -137,7 +140,9 @@ SEC4_COLUMNS = (
     ("e_y_implied", "1", "e_y_implied_err"),
     ("mu_k_lower_bound", "1", "mu_k_lower_bound_err"),
     ("spin_theta_slope", "rpm/deg", "spin_theta_slope_err"),
+    ("spin_theta_slope_intercept", "rpm", None),
     ("speed_theta_slope", "mph/deg", "speed_theta_slope_err"),
+    ("speed_theta_slope_intercept", "mph", None),
     ("gross_slip_psi", "deg", None),
     ("gross_slip_theta", "deg", None),
     ("gross_slip_omega", "rpm", None),
@@ -147,13 +152,17 @@ SEC4_COLUMNS = (
 STRONGE_COLUMNS = (
     Column("eta2", "1"),
     Column("eta2_err", "1"),
+    Column("eta2_syst", "1"),
+    Column("eta2_err_total", "1"),
     Column("eta2_ci_low", "1"),
     Column("eta2_ci_high", "1"),
     Column("eta2_dof", "1"),
     Column("eta2_n", "1"),
     Column("eta2_redchi", "1"),
     Column("e_y", "1"),
+    Column("e_y_syst", "1"),
     Column("mu", "1"),
+    Column("mu_syst", "1"),
     Column("omega_ratio", "1"),
     Column("psi_stick_boundary", "deg"),
     Column("psi_gross_slip_boundary", "deg"),
@@ -232,13 +241,19 @@ Group = tuple[list[int], list[int]]
 
 
 def _error_groups(names: Sequence[str]) -> list[Group]:
-    """Return the groups of each estimate with a ``<name>_err`` column among ``names``: value, error, interval."""
+    """Return the groups of each estimate with an error column among ``names``: value, errors, interval.
+
+    The errors that set the decimals are the standard error ``<name>_err`` and the systematic
+    ``<name>_syst``; the total ``<name>_err_total`` and the interval are shown with them.
+    """
     index = {n: i for i, n in enumerate(names)}
     groups = []
     for name, i in index.items():
-        if f"{name}_err" in index:
-            members = [i] + [index[f"{name}{s}"] for s in ("_err", "_ci_low", "_ci_high") if f"{name}{s}" in index]
-            groups.append(([index[f"{name}_err"]], members))
+        errors = [index[f"{name}{s}"] for s in ("_err", "_syst") if f"{name}{s}" in index]
+        if errors:
+            others = ("_err", "_syst", "_err_total", "_ci_low", "_ci_high")
+            members = [i] + [index[f"{name}{s}"] for s in others if f"{name}{s}" in index]
+            groups.append((errors, members))
     return groups
 
 
@@ -367,7 +382,7 @@ def dataset_workbook(
     _table_sheet(wb, "impacts", impacts, IMPACT_COLUMNS, "impact")
 
     ws = wb.create_sheet("e_x")
-    names = ["ball", "bat", *(c.name for c in FIT_FIELDS[:2]), "e_x_err_scale", "e_x_err_total"]
+    names = ["ball", "bat", *(c.name for c in FIT_FIELDS[:2]), "e_x_syst", "e_x_err_total"]
     names += [*(c.name for c in FIT_FIELDS[2:]), "e_x_status"]
     units = ["", "", *("1" for _ in names[2:])]
     _header(ws, names, units)
@@ -380,7 +395,8 @@ def dataset_workbook(
             if int(f[f"{pre}_n"]) == 0:
                 continue
             stat = _cell(f[f"{pre}_err"].values, "1")
-            syst = _cell(f[f"{pre}_err_scale"].values, "1") if f"{pre}_err_scale" in f else None
+            syst_var = systematic_var(f, pre)
+            syst = _cell(f[syst_var].values, "1") if syst_var else None
             total = None if stat is None else total_uncertainty(stat, syst)
             row = [ball, bat, _cell(f[pre].values, "1"), stat, syst, total]
             row += [_cell(f[f"{pre}{c.var}"].values, "1") for c in FIT_FIELDS[2:]]
@@ -388,19 +404,18 @@ def dataset_workbook(
 
     ws = wb.create_sheet("sec4")
     names, units = ["ball"], [""]
+    # each quantity: value, standard error, and where the dataset has them its systematic and total
+    cols = []
     for var, unit, err in SEC4_COLUMNS:
-        names += [var] + ([err] if err else [])
-        units += [unit] + ([unit] if err else [])
+        cols += [(var, unit)] + ([(err, unit)] if err else [])
+        cols += [(f"{var}{s}", unit) for s in ("_syst", "_err_total") if f"{var}{s}" in fit]
+    names += [c for c, _ in cols]
+    units += [u for _, u in cols]
     _header(ws, names, units)
     groups = _error_groups(names)
     for ball in fit["ball"].values.astype(str):
         f = fit.sel(ball=ball)
-        row = [ball]
-        for var, unit, err in SEC4_COLUMNS:
-            row.append(_cell(f[var].values, unit))
-            if err:
-                row.append(_cell(f[err].values, unit))
-        _format_row(ws, row, units, groups)
+        _format_row(ws, [ball, *(_cell(f[c].values, u) for c, u in cols)], units, groups)
 
     _table_sheet(
         wb,
@@ -409,6 +424,8 @@ def dataset_workbook(
         (Column("ball_name", "", "ball"), *STRONGE_COLUMNS),
         "ball",
     )
+
+    _systematics_sheet(wb, fit, stronge)
 
     ws = wb.create_sheet("paper_comparison")
     if comparison:
@@ -424,6 +441,45 @@ def dataset_workbook(
         ws.append([text])
     _provenance_sheet(wb, {"reconstruct.nc": impacts, "fit_ex.nc": fit, "stronge.nc": stronge})
     _write(wb, path, document_time(fit.attrs), properties)
+
+
+#: Units in the field's units of the quantities with systematics (fit_ex.nc, stronge.nc).
+SYSTEMATIC_UNITS = {
+    **{var: unit for var, unit, _ in SEC4_COLUMNS},
+    "e_x": "1",
+    "e_x_pooled": "1",
+    "eta2": "1",
+    "e_y": "1",
+    "mu": "1",
+}
+
+
+def _systematics_sheet(wb: object, fit: xr.Dataset, stronge: xr.Dataset) -> None:
+    """Add the ``systematics`` sheet: each quantity's systematic from each calibration source (tracked data).
+
+    One row per quantity, ball (and bat), and source with a stated uncertainty, with its
+    relative standard uncertainty; the sheet has its header rows only when the dataset has none.
+    """
+    ws = wb.create_sheet("systematics")
+    ws.append(["quantity", "ball", "bat", "source", "source_rel_sigma", "systematic", "unit"])
+    ws.append(["", "", "", "", "", "", ""])
+    for ds in (fit, stronge):
+        if "systematic" not in ds.coords:
+            continue
+        sources = ds["systematic"].values.astype(str)
+        rel = dict(zip(sources, ds["systematic_rel_sigma"].values.astype(float), strict=True))
+        for q, unit in SYSTEMATIC_UNITS.items():
+            if f"{q}_syst_by_source" not in ds:
+                continue
+            per = ds[f"{q}_syst_by_source"]
+            for idx in np.ndindex(per.shape[1:]):
+                where = {d: str(ds[d].values[i]) for d, i in zip(per.dims[1:], idx, strict=True)}
+                for k, src in enumerate(sources):
+                    if not rel[src] > 0 or not np.isfinite(per.values[(k, *idx)]):
+                        continue
+                    row = [q, where.get("ball", ""), where.get("bat", ""), src, rel[src]]
+                    row += [_cell(per.values[(k, *idx)], unit), _unit_label(unit)]
+                    _format_row(ws, row, ["", "", "", "", "1", unit, ""], [([5], [5])])
 
 
 def _number_or_text(value: object) -> object:

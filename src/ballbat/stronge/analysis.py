@@ -570,9 +570,12 @@ def stronge_dataset(
         attrs["balls_not_fitted"] = "; ".join(
             f"{b}: {n} usable impacts (< {MIN_FIT_IMPACTS})" for b, n in sorted(skipped.items())
         )
-    return build_dataset(
+    from ..systematics import stronge_systematics
+
+    ds = build_dataset(
         stronge_variables(vary_e_y, vary_mu),
         values,
         coords={k: (var, coords[k]) for k, var in STRONGE_COORDS.items()},
         attrs=attrs,
     )
+    return stronge_systematics(ds, rec, e_y=e_y, mu=mu, vary_e_y=vary_e_y, vary_mu=vary_mu)

@@ -37,12 +37,15 @@ class Camera:
         True when the swing goes towards -x on the image.
     m_per_px_err : float
         Relative standard uncertainty of ``m_per_px`` (a systematic shared by every impact).
+    fps_err : float
+        Relative standard uncertainty of ``fps`` (a systematic shared by every impact).
     """
 
     fps: float
     m_per_px: float
     mirror: bool = False
     m_per_px_err: float = 0.0
+    fps_err: float = 0.0
 
     @property
     def sign(self) -> float:
@@ -52,15 +55,25 @@ class Camera:
 
 @dataclass(frozen=True)
 class Rig:
-    """Distances from the swing machine's pivot axis (m)."""
+    """Distances from the swing machine's pivot axis (m), with their standard uncertainties (m, systematics)."""
 
     pivot_to_tip: float
     pivot_to_impact: float
+    pivot_to_tip_err: float = 0.0
+    pivot_to_impact_err: float = 0.0
 
     @classmethod
-    def from_inches(cls, pivot_to_tip_in: float, pivot_to_impact_in: float) -> Rig:
+    def from_inches(
+        cls,
+        pivot_to_tip_in: float,
+        pivot_to_impact_in: float,
+        pivot_to_tip_err_in: float = 0.0,
+        pivot_to_impact_err_in: float = 0.0,
+    ) -> Rig:
         """Return a rig from the config's inches."""
-        return cls(pivot_to_tip_in * INCH, pivot_to_impact_in * INCH)
+        return cls(
+            pivot_to_tip_in * INCH, pivot_to_impact_in * INCH, pivot_to_tip_err_in * INCH, pivot_to_impact_err_in * INCH
+        )
 
 
 @dataclass
@@ -156,7 +169,7 @@ def to_dense(
 
 def camera_block(cfg: dict) -> dict:
     """``cameras`` and ``rig`` of a ``tracks`` or ``render`` block, with only the reduction's settings."""
-    keep = ("fps", "m_per_px", "mirror", "m_per_px_err")
+    keep = ("fps", "m_per_px", "mirror", "m_per_px_err", "fps_err")
     return {
         "cameras": {n: {k: v for k, v in c.items() if k in keep} for n, c in cfg["cameras"].items()},
         "rig": dict(cfg["rig"]),

@@ -96,10 +96,11 @@ def cameras_from_config(cfg: dict, where: str = "tracks") -> tuple[dict[str, Cam
             m_per_px=float(c["m_per_px"]),
             mirror=bool(c["mirror"]),
             m_per_px_err=float(c.get("m_per_px_err", 0.0)),
+            fps_err=float(c.get("fps_err", 0.0)),
         )
         for name, c in cfg["cameras"].items()
     }
-    rig = Rig.from_inches(cfg["rig"]["pivot_to_tip_in"], cfg["rig"]["pivot_to_impact_in"])
+    rig = Rig.from_inches(**{k: float(v) for k, v in cfg["rig"].items()})
     return cams, rig
 
 

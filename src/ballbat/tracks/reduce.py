@@ -733,6 +733,7 @@ class Reduction:
     n_outliers: dict
     agreement: object = None
     contact: Contact | None = None
+    shifts: object = None  # calibration systematics (ballbat.systematics.reduce_shifts), when asked for
 
 
 def remove_glitches(tracks: Tracks, cameras: dict[str, Camera]) -> tuple[Tracks, dict[str, np.ndarray]]:
@@ -1125,4 +1126,6 @@ def reduction_dataset(red: Reduction) -> xr.Dataset:
         attrs[f"{cam}_m_per_px_rel_err"] = float(c.m_per_px_err)
     attrs["pivot_to_tip_m"] = float(red.rig.pivot_to_tip)
     attrs["pivot_to_impact_m"] = float(red.rig.pivot_to_impact)
-    return build_dataset(reduction_table(sorted(truth)), values, coords, attrs)
+    from ..systematics import add_shifts
+
+    return add_shifts(build_dataset(reduction_table(sorted(truth)), values, coords, attrs), red.shifts)

@@ -79,7 +79,9 @@ def reduce_options(cfg: dict) -> ReduceOptions:
     )
 
 
-def reduce_in_memory(tracks: Tracks, cfg: dict, balls: dict, bats: dict, where: str) -> tuple[Reduction, Verdict]:
+def reduce_in_memory(
+    tracks: Tracks, cfg: dict, balls: dict, bats: dict, where: str, systematics: bool = False
+) -> tuple[Reduction, Verdict]:
     """Reduce and cross-check tracks already read (the reduce rule, the checker and the studies).
 
     Parameters
@@ -92,6 +94,9 @@ def reduce_in_memory(tracks: Tracks, cfg: dict, balls: dict, bats: dict, where: 
         Property tables.
     where : str
         Config key of ``cfg``, for messages.
+    systematics : bool
+        Also reduce the tracks again at +-1 sigma of each stated calibration uncertainty
+        (:func:`ballbat.systematics.reduce_shifts`; the reduce rule, not the replicate studies).
 
     Returns
     -------
@@ -104,7 +109,12 @@ def reduce_in_memory(tracks: Tracks, cfg: dict, balls: dict, bats: dict, where: 
     """
     cameras, rig = cameras_from_config(cfg, where)
     red = reduce_tracks(tracks, cameras, rig, reduce_options(cfg))
-    return red, cross_check(red, balls, bats, where)
+    verdict = cross_check(red, balls, bats, where)
+    if systematics:
+        from ..systematics import reduce_shifts
+
+        red.shifts = reduce_shifts(tracks, cameras, rig, reduce_options(cfg), red)
+    return red, verdict
 
 
 def reduce_checked(
@@ -141,7 +151,7 @@ def reduce_checked(
     balls, bats = load_balls(balls_path), load_bats(bats_path)
     cameras_from_config(cfg, where)  # the settings are checked before the files are read
     tracks = load_tracks(tracks_path, impacts_path, balls, bats)
-    return reduce_in_memory(tracks, cfg, balls, bats, where)
+    return reduce_in_memory(tracks, cfg, balls, bats, where, systematics=True)
 
 
 def reduce_stage(

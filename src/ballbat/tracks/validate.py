@@ -23,9 +23,11 @@ TRACK_COLUMNS = ("impact_id", "camera", "point", "frame", "x_px", "y_px")
 #: Columns of an impacts file.
 IMPACT_COLUMNS = ("impact_id", "bat", "ball")
 #: Keys of a camera's settings and of the rig.
-CAMERA_KEYS = {"fps", "m_per_px", "mirror", "m_per_px_err"}
+CAMERA_KEYS = {"fps", "m_per_px", "mirror", "m_per_px_err", "fps_err"}
 CAMERA_REQUIRED = ("fps", "m_per_px", "mirror")
 RIG_KEYS = ("pivot_to_tip_in", "pivot_to_impact_in")
+#: Optional standard uncertainties of the rig's lengths (in; systematics, docs/tracks.md).
+RIG_ERR_KEYS = ("pivot_to_tip_err_in", "pivot_to_impact_err_in")
 
 
 def check_header(path: str | os.PathLike[str], header: list[str], required: tuple[str, ...]) -> list[str]:
@@ -193,6 +195,11 @@ def check_cameras(cfg: object, where: str) -> list[str]:
                 f"a pixel scale known no better than {100 * SCALE_ERR_MAX:g} % shifts e_x by about as much as e_x "
                 f"varies between bats. For {c['m_per_px_err']!r} % write {c['m_per_px_err'] / 100:g}"
             )
+        if "fps_err" in c and not (_is_number(c["fps_err"]) and 0 <= c["fps_err"] < SCALE_ERR_MAX):
+            problems.append(
+                f"{at}.fps_err: {c['fps_err']!r} must be a relative uncertainty >= 0 and below {SCALE_ERR_MAX:g} "
+                "(0.001 for 0.1 %)"
+            )
         if "mirror" in c and not isinstance(c["mirror"], bool):
             problems.append(f"{at}.mirror: {c['mirror']!r} must be true or false")
     rig = cfg.get("rig")
@@ -205,8 +212,16 @@ def check_cameras(cfg: object, where: str) -> list[str]:
         elif not (_is_number(rig[k]) and rig[k] > 0):
             problems.append(f"{where}.rig.{k}: {rig[k]!r} must be a positive number (inches)")
     for k in rig:
-        if k not in RIG_KEYS:
-            problems.append(f"{where}.rig.{k}: unknown setting (known: {', '.join(RIG_KEYS)})")
+        if k not in RIG_KEYS + RIG_ERR_KEYS:
+            problems.append(f"{where}.rig.{k}: unknown setting (known: {', '.join(RIG_KEYS + RIG_ERR_KEYS)})")
+    for k, length in zip(RIG_ERR_KEYS, RIG_KEYS, strict=True):
+        if k in rig and not (_is_number(rig[k]) and rig[k] >= 0):
+            problems.append(f"{where}.rig.{k}: {rig[k]!r} must be a number >= 0 (standard uncertainty, inches)")
+        elif k in rig and _is_number(rig.get(length)) and rig[k] >= SCALE_ERR_MAX * rig[length]:
+            problems.append(
+                f"{where}.rig.{k}: {rig[k]!r} in is {100 * rig[k] / rig[length]:.3g} % of {length} {rig[length]}: "
+                f"give a standard uncertainty below {100 * SCALE_ERR_MAX:g} % of the length (inches)"
+            )
     if all(_is_number(rig.get(k)) for k in RIG_KEYS) and rig["pivot_to_impact_in"] > rig["pivot_to_tip_in"]:
         problems.append(
             f"{where}.rig: pivot_to_impact_in {rig['pivot_to_impact_in']} is beyond pivot_to_tip_in "
