@@ -37,12 +37,14 @@ class Camera:
         True when the swing goes towards -x on the image.
     m_per_px_err : float
         Relative standard uncertainty of ``m_per_px`` (a systematic shared by every impact).
+
+    No field has a default: the defaults are the config schema's alone.
     """
 
     fps: float
     m_per_px: float
-    mirror: bool = False
-    m_per_px_err: float = 0.0
+    mirror: bool
+    m_per_px_err: float
 
     @property
     def sign(self) -> float:
