@@ -511,3 +511,34 @@ def test_enabled_and_seed(config, small, balls, bats, baselines, tmp_path):
     own = _workflow(ds, tmp_path, balls, bats, seed=False)  # the workflow draws from render.seed 999
     assert _differs(own, baselines[()])
     assert not math.isnan(float(own["v_bat"].values[0]))
+
+
+# ---------------------------------------------------------------------------------------
+# studies store SI values with their units; the tables convert for display
+
+
+def test_study_files_hold_si_and_the_table_prints_paper_units():
+    """A slope stored in rad s-1 rad-1 with its unit: coverage.nc keeps SI, coverage.csv prints rpm/deg."""
+    from test_studies import fake_replicates
+
+    from ballbat.pipeline.ncio import MetadataError, check_metadata
+    from ballbat.units import DEGREE, RPM
+
+    rep = fake_replicates(200, se=2.0, spread=2.0, truth=-60.0)
+    rep = rep.assign_coords(
+        quantity=["spin_theta_slope:baseball:"],
+        quantity_name=("quantity", ["spin_theta_slope"]),
+        bat=("quantity", [""]),
+    )
+    rep = rep.assign_coords(units=("quantity", ["rad s-1 rad-1"]))
+    cov = studies.coverage(rep)
+    assert cov["mean_uncertainty"].values[0, 0] == pytest.approx(2.0)  # SI, as the batches hold it
+    assert cov["units"].values[0] == "rad s-1 rad-1" and cov["mean_uncertainty"].attrs["units_from"] == "units"
+    assert "units" not in cov["mean_uncertainty"].attrs
+    check_metadata(cov, "coverage")  # units_from names a text coordinate along quantity
+    row = dict(zip(studies.COVERAGE_COLUMNS, studies.coverage_csv(cov).splitlines()[1].split(","), strict=False))
+    assert row["unit"] == "rpm/deg"
+    assert float(row["mean_uncertainty"]) == pytest.approx(2.0 / (RPM / DEGREE), rel=1e-5)  # 0.349 rpm/deg
+    assert float(row["coverage_95"]) == pytest.approx(float(cov["coverage_95"].values[0, 0]), rel=1e-5)
+    with pytest.raises(MetadataError, match="spread: units"):
+        check_metadata(cov.drop_vars("units"), "coverage")

@@ -802,7 +802,7 @@ DESIGN_TABLE = {
 }
 
 
-def design(cov: xr.Dataset, settings: StudySettings, delta_e_x: float, confidence: float, power: float) -> xr.Dataset:
+def design(cov: xr.Dataset, settings: StudySettings) -> xr.Dataset:
     """Spread of e_x per bat and ball at each sweep point and the impacts a lab would need.
 
     Parameters
@@ -810,10 +810,8 @@ def design(cov: xr.Dataset, settings: StudySettings, delta_e_x: float, confidenc
     cov : xarray.Dataset
         :func:`coverage` of the study.
     settings : StudySettings
-    delta_e_x : float
-        Difference in e_x between two bats to detect.
-    confidence, power : float
-        Of the two-sided test.
+        Its sweep, and the difference in e_x between two bats to detect (``delta_e_x``) with
+        the ``confidence`` and ``power`` of the two-sided test.
 
     Returns
     -------
@@ -835,7 +833,9 @@ def design(cov: xr.Dataset, settings: StudySettings, delta_e_x: float, confidenc
             out["sigma_e_x"][p, j] = sigma
             out["sigma_e_x_err"][p, j] = sigma / math.sqrt(2 * max(n - 1, 1))
             out["mean_se_e_x"][p, j] = float(cov["mean_uncertainty"].values[p, q])
-            out["impacts_required"][p, j] = impacts_required(sigma, n_at, delta_e_x, confidence, power)
+            out["impacts_required"][p, j] = impacts_required(
+                sigma, n_at, settings.delta_e_x, settings.confidence, settings.power
+            )
     out["setting"] = cov["setting"].values
     coords = {
         "point": (Var(("point",), "1", "sweep point"), np.arange(npt, dtype=np.int64)),
@@ -845,9 +845,9 @@ def design(cov: xr.Dataset, settings: StudySettings, delta_e_x: float, confidenc
     }
     attrs = {
         "sweep_parameter": settings.parameter or "",
-        "delta_e_x": float(delta_e_x),
-        "confidence": float(confidence),
-        "power": float(power),
+        "delta_e_x": settings.delta_e_x,
+        "confidence": settings.confidence,
+        "power": settings.power,
     }
     return build_dataset(DESIGN_TABLE, out, coords, attrs)
 

@@ -10,7 +10,7 @@ with logged(snakemake.log[0], snakemake.rule):
     study = snakemake.wildcards.study
     settings = StudySettings.from_block(snakemake.params.study)
     cov = read_dataset(snakemake.input.coverage)
-    des = design(cov, settings, settings.delta_e_x, settings.confidence, settings.power)
+    des = design(cov, settings)
     write_job_output(des, snakemake, "design", f"Study {study}: spread of e_x and impacts per bat needed")
     atomic_write_text(snakemake.output.csv, design_csv(des))
     save_figure(design_figure(des), snakemake.output.png, png_text(*job_provenance(snakemake)))
