@@ -11,6 +11,7 @@ import time
 
 import numpy as np
 
+from ballbat.pipeline.config import checked_block
 from ballbat.tracks.data import POINTS, to_dense, to_long
 from ballbat.tracks.reduce import reduce_tracks
 from ballbat.tracks.render import render_tracks, settings_from_config
@@ -36,7 +37,7 @@ truth = {
 }
 r = np.full(N, 0.0366)
 ids = np.arange(N).astype(str)
-s = settings_from_config(CFG)
+s = settings_from_config(checked_block(CFG, "render"))  # the schema's defaults filled
 
 t0 = time.perf_counter()
 tracks = render_tracks(truth, r, s, ids, np.full(N, "baseball"), np.full(N, "wood"))

@@ -76,11 +76,11 @@ def mistakes(tr, cameras, rig):
             )
     out["rig in metres"] = (
         cameras,
-        Rig(rig.pivot_to_tip / 39.37, rig.pivot_to_impact / 39.37),
+        Rig(rig.pivot_to_tip / 39.37, rig.pivot_to_impact / 39.37, 0.0, 0.0),
         tr,
         "the rig lengths are in metres",
     )
-    cm = Rig(rig.pivot_to_tip * 2.54, rig.pivot_to_impact * 2.54)
+    cm = Rig(rig.pivot_to_tip * 2.54, rig.pivot_to_impact * 2.54, 0.0, 0.0)
     out["rig in cm"] = (cameras, cm, tr, "the rig lengths are in cm")
     out["y up, both cameras"] = (cameras, rig, _mapped(tr, lambda c, x, y: (x, 800.0 - y)), "y points up in both")
     out["y up, swing camera"] = (

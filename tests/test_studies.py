@@ -139,7 +139,7 @@ def fake_replicates(n, se, spread, truth=1.0, dof=np.inf, seed=0):
             "quantity_name": ("quantity", ["e_x"]),
             "ball": ("quantity", ["baseball"]),
             "bat": ("quantity", ["wood"]),
-            "table_unit": ("quantity", ["1"]),
+            "units": ("quantity", ["1"]),
         },
         attrs={"sweep_values": np.array([np.nan]), "study_seed": 0, "replicates_per_point": n, "sweep_parameter": ""},
     )

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 import yaml
 
-from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.pipeline.config import ConfigError, checked_block, validate_config
 from ballbat.properties import InputError
 from ballbat.tracks.data import with_found_settings
 from ballbat.tracks.formats import FormatError
@@ -289,7 +289,9 @@ def test_layout_problems_are_named(tmp_path, rows):
         "points": POINTS,
         "impacts": str(EXAMPLE / "tracked_impacts.csv"),
         "cameras": {"swing": {"mirror": False}, "spin": {"mirror": True}},
+        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
     }
+    cfg = checked_block(cfg, "tracks")  # the schema's defaults (pattern), as the workflow's config has them
     (tmp_path / "W01-swing.trk").rename(tmp_path / "W01_swing.trk")
     (tmp_path / "W99_swing.trk").write_text((tmp_path / "W02_swing.trk").read_text())
     with pytest.raises(InputError) as exc:
@@ -308,7 +310,7 @@ def test_import_block_gives_the_example_tracks(tmp_path, rows):
         "cameras": {"swing": {"mirror": False, "m_per_px_err": 0.005}, "spin": {"mirror": True}},
         "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
     }
-    tracks, imp = import_block(cfg, "datasets.lab.tracks")
+    tracks, imp = import_block(checked_block(cfg, "tracks"), "datasets.lab.tracks")
     assert tracks.n == 12 and list(tracks.bat) == ["wood"] * 12
     merged = with_found_settings({"cameras": cfg["cameras"], "rig": cfg["rig"]}, imp.settings_yaml())
     assert merged["cameras"]["swing"]["fps"] == 3000.0 and merged["cameras"]["swing"]["m_per_px_err"] == 0.005

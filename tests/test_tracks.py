@@ -7,6 +7,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 
+from ballbat.pipeline.config import checked_block
 from ballbat.pipeline.ncio import read_dataset, write_dataset
 from ballbat.properties import load_balls, load_bats
 from ballbat.synthetic import SyntheticSettings, simulate_experiment
@@ -60,7 +61,7 @@ def experiment(seed=0, per_bat=8):
 
 
 def render(ds, cfg, truth_over=None):
-    s = settings_from_config(cfg)
+    s = settings_from_config(checked_block(cfg, "render"))  # the schema's defaults, as the workflow's config has them
     truth = {k: ds[f"truth_{k}"].values.copy() for k in ("v_bat", "v_ball", "theta", "omega", "psi")}
     truth.update(truth_over or {})
     r = np.array([BALLS[b].r for b in ds["ball"].values])

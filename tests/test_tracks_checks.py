@@ -87,7 +87,7 @@ def test_frame_rate_off_by_two(rendered, camera, factor):
 def test_rig_lengths_in_other_units(rendered, unit, inches_per_unit):
     """pivot_to_tip_in and pivot_to_impact_in given in metres or cm (the numbers read as inches)."""
     tr, s = rendered
-    rig = Rig(s.rig.pivot_to_tip / inches_per_unit, s.rig.pivot_to_impact / inches_per_unit)
+    rig = Rig(s.rig.pivot_to_tip / inches_per_unit, s.rig.pivot_to_impact / inches_per_unit, 0.0, 0.0)
     msg = stopped(tr, s, rig=rig)
     assert "the bat tip's arc radius" in msg and "pivot_to_tip_in" in msg
     assert f"most likely the rig lengths are in {unit}, not inches" in msg, msg

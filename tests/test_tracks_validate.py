@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from ballbat.pipeline.config import checked_block
 from ballbat.properties import InputError, load_balls, load_bats
 from ballbat.tracks.io import cameras_from_config, load_tracks
 
@@ -177,16 +178,18 @@ def test_calibration_uncertainties():
 
 
 def test_camera_settings_good():
-    cams, rig = cameras_from_config(
-        {
-            "cameras": {
-                "swing": {"fps": 3000, "m_per_px": 0.00074, "mirror": True, "m_per_px_err": 0.005},
-                "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False},
-            },
-            "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
-        }
-    )
+    block = {
+        "file": "tracks.csv",
+        "impacts": "impacts.csv",
+        "cameras": {
+            "swing": {"fps": 3000, "m_per_px": 0.00074, "mirror": True, "m_per_px_err": 0.005},
+            "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False},
+        },
+        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
+    }
+    cams, rig = cameras_from_config(checked_block(block, "tracks"))  # the schema's defaults filled
     assert cams["swing"].sign == -1 and cams["swing"].m_per_px_err == 0.005
+    assert cams["spin"].m_per_px_err == 0.0  # the schema's default
     assert rig.pivot_to_impact == pytest.approx(28 * 0.0254)
 
 
@@ -197,7 +200,7 @@ def test_shipped_example_reduces():
     from ballbat.tracks.stage import reduce_stage
 
     with open("config/examples/tracked.yaml") as fh:
-        cfg = yaml.safe_load(fh)["datasets"]["tracked"]["tracks"]
+        cfg = checked_block(yaml.safe_load(fh)["datasets"]["tracked"]["tracks"], "tracks")
     ds = reduce_stage(cfg["file"], cfg["impacts"], cfg, "config/balls.csv", "config/bats.csv", "tracked")
     flagged = ds["impact_id"].values[ds["ingest_flag"].values != 0]
     assert list(flagged) == ["W04"]

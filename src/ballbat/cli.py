@@ -195,7 +195,13 @@ def _tracks_dataset(args: argparse.Namespace, defaults: dict) -> tuple[str, dict
         raise UsageError(f"argument --dataset: {cfg_path} has no dataset {args.dataset!r} with a tracks block")
     ds = datasets[args.dataset]
     tables = {**defaults, **(cfg.get("tables") or {})}
-    return args.dataset, ds["tracks"], {k: ds.get(k, tables[k]) for k in ("balls", "bats")}
+    from .pipeline.config import ConfigError, checked_block
+
+    try:  # the block with the schema's defaults, as the workflow's validated config has it
+        block = checked_block(ds["tracks"], "tracks", f"datasets.{args.dataset}.tracks")
+    except ConfigError as exc:
+        raise UsageError(f"argument --config: {cfg_path}: {exc}") from None
+    return args.dataset, block, {k: ds.get(k, tables[k]) for k in ("balls", "bats")}
 
 
 def _reduce_tool_files(block: dict, where: str, balls_path: str, bats_path: str) -> tuple:

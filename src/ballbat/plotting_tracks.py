@@ -33,6 +33,7 @@ def _cameras(red: xr.Dataset) -> dict[str, Camera]:
             float(red.attrs[f"{c}_m_per_px"]),
             bool(red.attrs[f"{c}_mirror"]),
             float(red.attrs[f"{c}_m_per_px_rel_err"]),
+            0.0,  # fps_err: the figures draw the tracks, not the systematics
         )
         for c in ("swing", "spin")
     }

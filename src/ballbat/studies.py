@@ -12,7 +12,9 @@ replicate). Seeds: replicate ``k`` draws its experiment and its tracks from
 (common random numbers: the sweep's points differ by their setting, not by their luck).
 
 Every quantity of ``paper_comparison.csv`` with an uncertainty and a synthetic truth is
-recorded (value, standard error, truth, degrees of freedom), in the table's units. The truth
+recorded (value, standard error, truth, degrees of freedom) in SI, as ``fit_ex.nc`` holds it,
+with its unit (the coordinate ``units`` of the study's files); the tables (coverage.csv) print
+them in paper_comparison.csv's units (:func:`display_unit`). The truth
 of a fitted quantity is, as in the workflow, the same estimator applied to the noise-free
 truth of the same replicate with the same weights; for eta^2 it is the eta^2 fitted to the
 noise-free impacts (the synthetic experiment is not drawn from Stronge's model, so eta^2 has
@@ -36,6 +38,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import xarray as xr
 
+from .pipeline.config import renders
 from .pipeline.products import Var, build_dataset
 from .sweeps import point_dataset
 
@@ -59,7 +62,10 @@ STUDY_QUANTITIES = (
 
 @dataclass(frozen=True)
 class StudySettings:
-    """One study, as in the config's ``studies.<name>`` (paper units).
+    """One study, as in the config's ``studies.<name>`` (paper units), built once from the validated config.
+
+    No field has a default: the defaults are the config schema's alone (:meth:`from_block`
+    reads the validated config, every default filled).
 
     Attributes
     ----------
@@ -82,6 +88,8 @@ class StudySettings:
     truth_impacts : int
         Impacts per ball and bat of the large noise-free experiment that gives the design's
         truth (:func:`population_truth`).
+    delta_e_x, confidence, power : float
+        The design table's difference in e_x to detect and its test's confidence and power.
     """
 
     dataset: dict
@@ -94,24 +102,34 @@ class StudySettings:
     mu_k_example: float
     stronge: dict
     truth_impacts: int
+    delta_e_x: float
+    confidence: float
+    power: float
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> StudySettings:
         """Return the settings of study ``name`` from the validated workflow config."""
-        s = config["studies"][name]
-        ds = config["datasets"][s["dataset"]]
-        sweep = s.get("sweep")
+        return cls.from_block(study_block(config, name))
+
+    @classmethod
+    def from_block(cls, block: dict) -> StudySettings:
+        """Return the settings from a study's block of the validated config (:func:`study_block`; the rules' params)."""
+        s = block["study"]
+        sweep = s.get("sweep")  # optional, no default: None is no sweep
         return cls(
-            dataset=copy.deepcopy(ds),
+            dataset=copy.deepcopy(block["dataset"]),
             replicates=int(s["replicates"]),
             seed=int(s["seed"]),
             batch_size=int(s["batch_size"]),
             parameter=sweep["parameter"] if sweep else None,
             values=tuple(float(v) for v in sweep["values"]) if sweep else (math.nan,),
-            v_ref_mph=float(config["normalize"]["v_ref_mph"]),
-            mu_k_example=float(config["analysis"]["mu_k_example"]),
-            stronge={k: config["stronge"][k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")},
+            v_ref_mph=float(block["normalize"]["v_ref_mph"]),
+            mu_k_example=float(block["analysis"]["mu_k_example"]),
+            stronge={k: block["stronge"][k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")},
             truth_impacts=int(s["truth_impacts"]),
+            delta_e_x=float(s["delta_e_x"]),
+            confidence=float(s["confidence"]),
+            power=float(s["power"]),
         )
 
     @property
@@ -136,26 +154,19 @@ class StudySettings:
         return range(batch * self.batch_size, min((batch + 1) * self.batch_size, self.total))
 
 
-def study_config(params: dict) -> dict:
-    """Rebuild the minimal workflow config a study needs from the rules' ``study`` params.
+def study_block(config: dict, name: str) -> dict:
+    """Everything study ``name`` depends on, from the validated config: its block, its dataset's and the chain's.
 
-    Parameters
-    ----------
-    params : dict
-        ``study``, ``dataset``, ``normalize``, ``analysis`` and ``stronge`` (the workflow's
-        ``get_study_config``).
-
-    Returns
-    -------
-    dict
-        A config whose ``studies`` hold the one study under every name asked for.
+    The study rules' ``study`` param (so that a change of any of it reruns them) and what
+    :meth:`StudySettings.from_block` reads.
     """
-    from collections import defaultdict
-
+    s = config["studies"][name]
     return {
-        "studies": defaultdict(lambda: params["study"]),
-        "datasets": defaultdict(lambda: params["dataset"]),
-        **{k: params[k] for k in ("normalize", "analysis", "stronge")},
+        "study": s,
+        "dataset": config["datasets"][s["dataset"]],
+        "normalize": config["normalize"],
+        "analysis": config["analysis"],
+        "stronge": config["stronge"],
     }
 
 
@@ -181,7 +192,7 @@ def _source(
 
     sim = simulate_experiment(SyntheticSettings(**{**dataset["synthetic"], "seed": seeds[0]}), balls, bats)
     render = dataset.get("render") or {}
-    if not render.get("enabled", False):
+    if not renders(dataset):
         return sim
     from .tracks.data import camera_block
     from .tracks.reduce import reduction_dataset
@@ -239,47 +250,102 @@ def run_replicate(
     Returns
     -------
     list of dict
-        ``quantity, ball, bat, value, uncertainty, truth, dof`` (the table's units).
+        ``quantity, ball, bat, value, uncertainty, truth, dof, units`` (SI, as fit_ex.nc holds them).
     """
     from .analysis import normalize, reconstruct
-    from .compare import fit_rows
     from .fitting import analyze_impacts, results_dataset
 
     src = _source(dataset, replicate_seeds(settings.seed, replicate), balls, bats, f"render (replicate {replicate})")
     rec = reconstruct(normalize(src, v_ref_mph=settings.v_ref_mph), balls, bats)
     res = analyze_impacts(rec, settings.mu_k_example, systematic=False)  # no study quantity is a systematic
     fit = results_dataset(res)
-    rows = []
-    dof_of = {"spin_theta_slope": 2, "speed_theta_slope": 2}  # fitted parameters; others: 1
-    for row in fit_rows(fit):
-        q = row["quantity"]
-        if q not in STUDY_QUANTITIES:
-            continue
-        var = "tan_ratio_slope" if q == "e_y_implied" else q
-        n = fit[f"{var}_n"].sel(ball=row["ball"]) if q != "mu_k_lower_bound" else None
-        if n is not None and "bat" in n.dims:
-            n = n.sel(bat=row["bat"])
-        dof = math.inf if n is None else int(n) - dof_of.get(var, 1)
-        if q == "e_y_implied":  # its sandwich has n / (n - k) for the k = bats + 1 slopes it rests on
-            dof = int(n) - (int((fit["e_x_n"].sel(ball=row["ball"]) > 0).sum()) + 1)
-        rows.append({**{k: row[k] for k in ("quantity", "ball", "bat", "value", "uncertainty", "truth")}, "dof": dof})
+    rows = fit_quantity_rows(fit)
     if "eta2" in STUDY_QUANTITIES:
         rec_truth = reconstruct(normalize(_truth_source(src), v_ref_mph=settings.v_ref_mph), balls, bats)
         for ball in res.balls:
             v, e, t, dof = _eta2(rec, rec_truth, ball, settings.stronge)
             rows.append(
-                {"quantity": "eta2", "ball": ball, "bat": "", "value": v, "uncertainty": e, "truth": t, "dof": dof}
+                {
+                    "quantity": "eta2",
+                    "ball": ball,
+                    "bat": "",
+                    "value": v,
+                    "uncertainty": e,
+                    "truth": t,
+                    "dof": dof,
+                    "units": "1",
+                }
             )
+    return rows
+
+
+def _at(fit: xr.Dataset, var: str, ball: str, bat: str) -> float | None:
+    """One number of ``fit_ex.nc`` (None when the file has no such variable)."""
+    if var not in fit:
+        return None
+    v = fit[var].sel(ball=ball)
+    return float((v.sel(bat=bat) if "bat" in v.dims else v).values)
+
+
+def fit_quantity_rows(fit: xr.Dataset) -> list[dict]:
+    """Return the study's quantities of ``fit_ex.nc`` (:func:`ballbat.fitting.results_dataset`), SI as it holds them.
+
+    One row per quantity, ball and bat (a per-bat quantity of a pair without impacts is left
+    out, as in paper_comparison.csv): ``quantity, ball, bat, value, uncertainty, truth, dof``
+    and ``units`` (the file's units attribute of the quantity).
+    """
+    dof_of = {"spin_theta_slope": 2, "speed_theta_slope": 2}  # fitted parameters; others: 1
+    balls = [str(b) for b in fit["ball"].values]
+    bats = [str(b) for b in fit["bat"].values]
+    rows = []
+    for q in STUDY_QUANTITIES:
+        if q not in fit:  # eta2: Stronge's fit (_eta2)
+            continue
+        per_bat = "bat" in fit[q].dims
+        for ball in balls:
+            for bat in bats if per_bat else [""]:
+                val = _at(fit, q, ball, bat)
+                if per_bat and not math.isfinite(val) and _at(fit, f"{q}_n", ball, bat) == 0:
+                    continue
+                var = "tan_ratio_slope" if q == "e_y_implied" else q
+                n = _at(fit, f"{var}_n", ball, bat) if q != "mu_k_lower_bound" else None
+                dof = math.inf if n is None else int(n) - dof_of.get(var, 1)
+                if q == "e_y_implied":  # its sandwich has n / (n - k) for the k = bats + 1 slopes it rests on
+                    dof = int(n) - (int((fit["e_x_n"].sel(ball=ball) > 0).sum()) + 1)
+                rows.append(
+                    {
+                        "quantity": q,
+                        "ball": ball,
+                        "bat": bat,
+                        "value": val,
+                        "uncertainty": _at(fit, f"{q}_err", ball, bat),
+                        "truth": _at(fit, f"truth_{q}", ball, bat),
+                        "dof": dof,
+                        "units": str(fit[q].attrs["units"]),
+                    }
+                )
     return rows
 
 
 # ---------------------------------------------------------------------------------------
 # a batch: the file of one job
 
+#: Attributes of a variable whose values along ``quantity`` are in different units: SI, the unit of each
+#: quantity in the coordinate ``units`` (CF has no units attribute for such a variable; ``units_from``
+#: names the coordinate, :func:`ballbat.pipeline.ncio.check_metadata`).
+PER_QUANTITY_UNITS = {"units_from": "units"}
+
 BATCH_TABLE = {
-    "value": Var(("replicate", "quantity"), "1", "estimate, in the unit of its quantity (attribute units of quantity)"),
-    "uncertainty": Var(("replicate", "quantity"), "1", "reported uncertainty of the estimate (same unit)"),
-    "truth": Var(("replicate", "quantity"), "1", "the same estimator on the replicate's noise-free truth (same unit)"),
+    "value": Var(("replicate", "quantity"), None, "estimate (SI: unit of its quantity in units)", PER_QUANTITY_UNITS),
+    "uncertainty": Var(
+        ("replicate", "quantity"), None, "reported uncertainty of the estimate (same unit)", PER_QUANTITY_UNITS
+    ),
+    "truth": Var(
+        ("replicate", "quantity"),
+        None,
+        "the same estimator on the replicate's noise-free truth (same unit)",
+        PER_QUANTITY_UNITS,
+    ),
     "dof": Var(("replicate", "quantity"), "1", "degrees of freedom of the uncertainty (inf: normal)"),
     "point": Var(("replicate",), "1", "sweep point of the replicate (index into setting)"),
     "seed_replicate": Var(("replicate",), "1", "replicate number within its point (its seeds' spawn key)"),
@@ -315,13 +381,15 @@ def run_batch(
     """
     indices = settings.batch_range(batch)
     table: dict[str, int] = {}
+    units: dict[str, str] = {}
     records = []
     for done, g in enumerate(indices, 1):
         point, rep = divmod(g, settings.replicates)
         dataset = point_dataset(settings.dataset, settings.parameter, settings.values[point])
         rows = run_replicate(settings, dataset, rep, balls, bats)
-        for label in _labels(rows):
+        for label, r in zip(_labels(rows), rows, strict=True):
             table.setdefault(label, len(table))
+            units.setdefault(label, r["units"])
         records.append((g, point, rep, rows))
         if progress is not None:
             progress(done, len(indices))
@@ -340,7 +408,7 @@ def run_batch(
         "point": np.array([p for _, p, _, _ in records], dtype=np.int64),
         "seed_replicate": np.array([r for _, _, r, _ in records], dtype=np.int64),
     }
-    coords = _coords(settings, labels, parts)
+    coords = _coords(labels, parts, [units[lab] for lab in labels])
     coords["replicate"] = (
         Var(("replicate",), "1", "replicate number over the whole study"),
         np.array([g for g, _, _, _ in records], dtype=np.int64),
@@ -348,17 +416,21 @@ def run_batch(
     return build_dataset(BATCH_TABLE, values, coords, _attrs(settings, batch))
 
 
-def _coords(settings: StudySettings, labels: list[str], parts: list[list[str]]) -> dict:
-    from .compare import FIT_QUANTITIES
-
-    unit = {q: FIT_QUANTITIES[q][1] if q in FIT_QUANTITIES else "1" for q in STUDY_QUANTITIES}
+def _coords(labels: list[str], parts: list[list[str]], units: list[str]) -> dict:
     return {
         "quantity": (Var(("quantity",), None, "quantity:ball:bat, as in paper_comparison.csv"), np.array(labels)),
         "quantity_name": (Var(("quantity",), None, "quantity"), np.array([p[0] for p in parts])),
         "ball": (Var(("quantity",), None, "ball type"), np.array([p[1] for p in parts])),
         "bat": (Var(("quantity",), None, "bat (empty: per ball)"), np.array([p[2] for p in parts])),
-        "table_unit": (Var(("quantity",), None, "unit of the quantity"), np.array([unit[p[0]] for p in parts])),
+        "units": (Var(("quantity",), None, "SI unit of the quantity (UDUNITS)"), np.array(units, dtype=str)),
     }
+
+
+def display_unit(quantity: str) -> str:
+    """Return the unit the tables print a study quantity in (paper_comparison.csv's: rpm/deg, mph/deg; else 1)."""
+    from .compare import FIT_QUANTITIES
+
+    return FIT_QUANTITIES[quantity][1] if quantity in FIT_QUANTITIES else "1"
 
 
 def _attrs(settings: StudySettings, batch: int | None = None) -> dict:
@@ -382,7 +454,19 @@ CONDITIONAL_TRUTH = ("mu_k_lower_bound",)
 
 
 def population_truth(settings: StudySettings, point: int, balls: dict[str, Ball], bats: dict[str, Bat]) -> dict:
-    """Truth of every quantity for the experiment design at sweep point ``point``.
+    """Truth of every quantity for the experiment design at sweep point ``point`` (SI; :func:`_population_rows`).
+
+    Returns
+    -------
+    dict
+        ``quantity:ball:bat`` label -> truth.
+    """
+    rows = _population_rows(settings, point, balls, bats)
+    return dict(zip(_labels(rows), (r["truth"] for r in rows), strict=True))
+
+
+def _population_rows(settings: StudySettings, point: int, balls: dict[str, Ball], bats: dict[str, Bat]) -> list[dict]:
+    """Return the rows of the design's large noise-free experiment at sweep point ``point`` (:func:`run_replicate`'s).
 
     A pooled e_x, a slope or eta^2 describes the population the impacts are drawn from (the
     bats in the design's proportions, psi and bat speed drawn as configured), not the handful
@@ -393,11 +477,6 @@ def population_truth(settings: StudySettings, point: int, balls: dict[str, Ball]
     experiment of the same design (about ``settings.truth_impacts`` impacts per ball and bat,
     in the design's proportions), the same for every replicate of the point. e_x of one bat
     is the same either way (the model is exact); :data:`CONDITIONAL_TRUTH` keep their own.
-
-    Returns
-    -------
-    dict
-        ``quantity:ball:bat`` label -> truth.
     """
     ds = point_dataset(settings.dataset, settings.parameter, settings.values[point])
     counts = [n for per_bat in ds["synthetic"]["impacts"].values() for n in per_bat.values() if n > 0]
@@ -408,16 +487,16 @@ def population_truth(settings: StudySettings, point: int, balls: dict[str, Ball]
     big = replace(
         settings, seed=int(np.random.SeedSequence(settings.seed, spawn_key=(2**31 - 1, point)).generate_state(1)[0])
     )
-    rows = run_replicate(big, ds, 0, balls, bats)
-    return dict(zip(_labels(rows), (r["truth"] for r in rows), strict=True))
+    return run_replicate(big, ds, 0, balls, bats)
 
 
 #: The truth file of a study (``results/{study}/truth.nc``; dims point x quantity).
 TRUTH_TABLE = {
     "truth": Var(
         ("point", "quantity"),
-        "1",
-        "the estimator on the design's large noise-free experiment (unit of its quantity; NaN: not fitted)",
+        None,
+        "the estimator on the design's large noise-free experiment (SI: unit of its quantity in units; NaN: none)",
+        PER_QUANTITY_UNITS,
     ),
     "setting": Var(("point",), "1", "value of the swept setting (NaN: no sweep)"),
 }
@@ -431,13 +510,15 @@ def truth_dataset(settings: StudySettings, balls: dict[str, Ball], bats: dict[st
     xarray.Dataset
         ``truth`` (point x quantity, labels as the batches'), ``setting``.
     """
-    truths = [population_truth(settings, p, balls, bats) for p in range(settings.n_points)]
+    points = [_population_rows(settings, p, balls, bats) for p in range(settings.n_points)]
+    truths = [dict(zip(_labels(rows), (r["truth"] for r in rows), strict=True)) for rows in points]
+    units = {lab: r["units"] for rows in points for lab, r in zip(_labels(rows), rows, strict=True)}
     labels = list(dict.fromkeys(lab for t in truths for lab in t))
     values = {
         "truth": np.array([[np.nan if t.get(lab) is None else float(t[lab]) for lab in labels] for t in truths]),
         "setting": np.asarray(settings.values, dtype=float),
     }
-    coords = _coords(settings, labels, [lab.split(":") for lab in labels])
+    coords = _coords(labels, [lab.split(":") for lab in labels], [units[lab] for lab in labels])
     coords["point"] = (Var(("point",), "1", "sweep point"), np.arange(settings.n_points, dtype=np.int64))
     return build_dataset(TRUTH_TABLE, values, coords, {**_attrs(settings), "truth_impacts": settings.truth_impacts})
 
@@ -484,10 +565,14 @@ COVERAGE_TABLE = {
     "coverage_68_err": Var(("point", "quantity"), "1", "binomial standard error of coverage_68"),
     "coverage_95": Var(("point", "quantity"), "1", "fraction of 95 % intervals (t quantile) that cover the truth"),
     "coverage_95_err": Var(("point", "quantity"), "1", "binomial standard error of coverage_95"),
-    "mean_uncertainty": Var(("point", "quantity"), "1", "mean reported uncertainty (unit of the quantity)"),
-    "spread": Var(("point", "quantity"), "1", "standard deviation of value - truth (unit of the quantity)"),
-    "mean_value": Var(("point", "quantity"), "1", "mean estimate (unit of the quantity)"),
-    "mean_truth": Var(("point", "quantity"), "1", "mean truth (unit of the quantity)"),
+    "mean_uncertainty": Var(
+        ("point", "quantity"), None, "mean reported uncertainty (SI: unit of the quantity in units)", PER_QUANTITY_UNITS
+    ),
+    "spread": Var(
+        ("point", "quantity"), None, "standard deviation of value - truth (SI: unit in units)", PER_QUANTITY_UNITS
+    ),
+    "mean_value": Var(("point", "quantity"), None, "mean estimate (SI: unit in units)", PER_QUANTITY_UNITS),
+    "mean_truth": Var(("point", "quantity"), None, "mean truth (SI: unit in units)", PER_QUANTITY_UNITS),
     "mean_dof": Var(("point", "quantity"), "1", "mean degrees of freedom of the uncertainty"),
     "setting": Var(("point",), "1", "value of the swept setting (NaN: no sweep)"),
 }
@@ -567,7 +652,7 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
             out["mean_truth"][p] = np.nanmean(np.where(ok, t, np.nan), axis=0)
             out["mean_dof"][p] = np.nanmean(np.where(ok, dof, np.nan), axis=0)
     out["setting"] = values
-    coords = {k: _copy_coord(rep, k) for k in ("quantity", "quantity_name", "ball", "bat", "table_unit")}
+    coords = {k: _copy_coord(rep, k) for k in ("quantity", "quantity_name", "ball", "bat", "units")}
     coords["point"] = (Var(("point",), "1", "sweep point"), np.arange(npt, dtype=np.int64))
     from .compare import STANDARD_ERROR, UNCERTAINTY_NOTES
 
@@ -626,15 +711,25 @@ def _csv_text(header: Sequence[str], rows: Iterable[Sequence]) -> str:
     return sealed_csv(buf.getvalue())  # its check line: a table cut short is never used
 
 
+#: Columns of the coverage table in the unit of their quantity: SI in coverage.nc, the table's units in the CSV.
+COVERAGE_IN_UNITS = ("mean_uncertainty", "spread")
+
+
 def coverage_csv(cov: xr.Dataset) -> str:
-    """Return the coverage table as CSV text (one row per sweep point and quantity)."""
-    labels = {
-        "quantity": "quantity_name",
-        "ball": "ball",
-        "bat": "bat",
-        "unit": "table_unit",
-        "error_kind": "error_kind",
-    }
+    """Return the coverage table as CSV text (one row per sweep point and quantity).
+
+    Values in a quantity's unit are converted from coverage.nc's SI to the unit the tables
+    print (``unit``, :func:`display_unit`: rpm/deg, mph/deg as in paper_comparison.csv).
+    """
+    from .units import from_si
+
+    labels = {"quantity": "quantity_name", "ball": "ball", "bat": "bat", "error_kind": "error_kind"}
+    shown = [display_unit(str(q)) for q in cov["quantity_name"].values]
+    for j, (unit, si) in enumerate(zip(shown, cov["units"].values.astype(str), strict=True)):
+        if unit == "1" and si != "1":
+            raise ValueError(
+                f"coverage: quantity {cov['quantity'].values[j]} is in {si}, but the table has no unit for it"
+            )
 
     def row(p, j):
         for k in COVERAGE_COLUMNS:
@@ -642,8 +737,12 @@ def coverage_csv(cov: xr.Dataset) -> str:
                 yield cov["setting"].values[p]
             elif k == "warning":
                 yield str(cov["warning"].values[p, j])
+            elif k == "unit":
+                yield shown[j]
             elif k in labels:
                 yield str(cov[labels[k]].values[j])
+            elif k in COVERAGE_IN_UNITS:
+                yield from_si(float(cov[k].values[p, j]), shown[j])
             else:
                 yield cov[k].values[p, j]
 
@@ -703,7 +802,7 @@ DESIGN_TABLE = {
 }
 
 
-def design(cov: xr.Dataset, settings: StudySettings, delta_e_x: float, confidence: float, power: float) -> xr.Dataset:
+def design(cov: xr.Dataset, settings: StudySettings) -> xr.Dataset:
     """Spread of e_x per bat and ball at each sweep point and the impacts a lab would need.
 
     Parameters
@@ -711,10 +810,8 @@ def design(cov: xr.Dataset, settings: StudySettings, delta_e_x: float, confidenc
     cov : xarray.Dataset
         :func:`coverage` of the study.
     settings : StudySettings
-    delta_e_x : float
-        Difference in e_x between two bats to detect.
-    confidence, power : float
-        Of the two-sided test.
+        Its sweep, and the difference in e_x between two bats to detect (``delta_e_x``) with
+        the ``confidence`` and ``power`` of the two-sided test.
 
     Returns
     -------
@@ -736,7 +833,9 @@ def design(cov: xr.Dataset, settings: StudySettings, delta_e_x: float, confidenc
             out["sigma_e_x"][p, j] = sigma
             out["sigma_e_x_err"][p, j] = sigma / math.sqrt(2 * max(n - 1, 1))
             out["mean_se_e_x"][p, j] = float(cov["mean_uncertainty"].values[p, q])
-            out["impacts_required"][p, j] = impacts_required(sigma, n_at, delta_e_x, confidence, power)
+            out["impacts_required"][p, j] = impacts_required(
+                sigma, n_at, settings.delta_e_x, settings.confidence, settings.power
+            )
     out["setting"] = cov["setting"].values
     coords = {
         "point": (Var(("point",), "1", "sweep point"), np.arange(npt, dtype=np.int64)),
@@ -746,9 +845,9 @@ def design(cov: xr.Dataset, settings: StudySettings, delta_e_x: float, confidenc
     }
     attrs = {
         "sweep_parameter": settings.parameter or "",
-        "delta_e_x": float(delta_e_x),
-        "confidence": float(confidence),
-        "power": float(power),
+        "delta_e_x": settings.delta_e_x,
+        "confidence": settings.confidence,
+        "power": settings.power,
     }
     return build_dataset(DESIGN_TABLE, out, coords, attrs)
 

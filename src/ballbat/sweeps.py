@@ -26,11 +26,13 @@ SWEEP_PARAMETERS = {
 
 
 def check_sweep(dataset: dict, parameter: str | None, values: Sequence[float], where: str) -> list[str]:
-    """Problems of a study's sweep against its dataset (empty when fine), each naming ``where``."""
+    """Problems of a study's sweep against its validated dataset (empty when fine), each naming ``where``."""
+    from .pipeline.config import renders as renders_tracks
+
     if parameter is None:
         return []
     problems = []
-    renders = bool(dataset.get("render", {}).get("enabled", False))
+    renders = renders_tracks(dataset)
     if parameter in ("pixel_noise_px", "swing_fps", "spin_fps") and not renders:
         problems.append(f"{where}.sweep.parameter: {parameter} needs a dataset that renders camera tracks")
     if parameter == "noise_scale" and renders:

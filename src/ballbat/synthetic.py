@@ -21,7 +21,7 @@ from .properties import Ball, Bat, recoil_factors
 from .units import DEGREE, MPH, RPM
 
 
-@dataclass
+@dataclass(frozen=True)
 class SyntheticSettings:
     """Settings of a synthetic experiment, in the paper's units (as in the config).
 

@@ -14,6 +14,7 @@ from ballbat.pipeline.config import (
     STUDY_BYTES_PER_REPLICATE,
     drop_nulls,
     impact_bytes,
+    renders,
     study_impacts,
     validate_config,
 )
@@ -172,14 +173,14 @@ def scenario_mem_mb(wildcards):
         n = int(sc["sweep"]["D_in"]["num"])
     else:
         sizes = [len(v) if isinstance(v, list) else 1 for k, v in sc["launch"].items() if k != "combine"]
-        n = math.prod(sizes) if sc["launch"].get("combine", "grid") == "grid" else max(sizes)
+        n = math.prod(sizes) if sc["launch"]["combine"] == "grid" else max(sizes)
     return 500 + n * BYTES_PER_CASE // 1_000_000
 
 
 def uses_tracks(name):
     """Whether a dataset starts from raw camera tracks (reduce.nc is its source)."""
     d = config["datasets"][name]
-    return "tracks" in d or bool((d.get("render") or {}).get("enabled", False))
+    return "tracks" in d or renders(d)
 
 
 TRACKED = [d for d in DATASETS if uses_tracks(d)]
@@ -299,15 +300,10 @@ def study_settings(name):
 
 
 def get_study_config(wildcards):
-    """Everything a study's results depend on: its settings, its dataset's and the chain's."""
-    s = config["studies"][wildcards.study]
-    return {
-        "study": s,
-        "dataset": config["datasets"][s["dataset"]],
-        "normalize": config["normalize"],
-        "analysis": config["analysis"],
-        "stronge": config["stronge"],
-    }
+    """Everything a study's results depend on: its settings, its dataset's and the chain's (StudySettings.from_block)."""
+    from ballbat.studies import study_block
+
+    return study_block(config, wildcards.study)
 
 
 def _study_dataset(wildcards):

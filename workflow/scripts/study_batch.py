@@ -3,11 +3,11 @@
 from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
-from ballbat.studies import StudySettings, run_batch, study_config
+from ballbat.studies import StudySettings, run_batch
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     study, batch = snakemake.wildcards.study, int(snakemake.wildcards.batch)
-    settings = StudySettings.from_config(study_config(snakemake.params.study), study)
+    settings = StudySettings.from_block(snakemake.params.study)
     step = max(1, settings.batch_size // 10)
 
     def progress(done, n):

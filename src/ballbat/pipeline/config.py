@@ -40,10 +40,14 @@ BYTES_PER_CASE = 60_000
 BYTES_PER_TRACKED_IMPACT = 50_000
 
 
+def renders(dataset: dict) -> bool:
+    """Whether a validated dataset renders camera tracks (its render block's ``enabled``, default filled)."""
+    return "render" in dataset and bool(dataset["render"]["enabled"])
+
+
 def impact_bytes(dataset: dict) -> int:
-    """Return the memory one impact of a dataset's chain may need (bytes): more when it renders tracks."""
-    renders = bool((dataset.get("render") or {}).get("enabled", False)) or "tracks" in dataset
-    return BYTES_PER_TRACKED_IMPACT if renders else BYTES_PER_IMPACT
+    """Return the memory one impact of a validated dataset's chain may need (bytes): more when it renders tracks."""
+    return BYTES_PER_TRACKED_IMPACT if renders(dataset) or "tracks" in dataset else BYTES_PER_IMPACT
 
 
 #: Share of the machine's available memory one job may plan to use.
@@ -272,7 +276,7 @@ def _sizes(config: dict, available: int) -> list[str]:
             )
         elif "launch" in sc:
             sizes = [len(v) if isinstance(v, list) else 1 for k, v in sc["launch"].items() if k != "combine"]
-            grid = sc["launch"].get("combine", "grid") == "grid"
+            grid = sc["launch"]["combine"] == "grid"
             count = math.prod(sizes) if grid else max(sizes)
             check(f"implications.scenarios.{name}.launch", count, BYTES_PER_CASE, "cases")
     return problems
@@ -395,3 +399,65 @@ def load_config(path: str | os.PathLike[str] | None = None, schema_path: str | o
     with open(path) as fh:
         config = yaml.safe_load(fh)
     return validate_config(config, schema, source=str(path))
+
+
+#: Where each config block that becomes typed settings lives in the schema (:func:`checked_block`).
+SCHEMA_BLOCKS = {
+    "render": ("$defs", "dataset", "properties", "render"),
+    "tracks": ("$defs", "dataset", "properties", "tracks"),
+    "synthetic": ("$defs", "dataset", "properties", "synthetic"),
+    "render_camera": ("$defs", "render_camera"),
+    "track_camera": ("$defs", "track_camera"),
+    "min_frames": ("$defs", "min_frames"),
+    "study": ("properties", "studies", "additionalProperties"),
+    "stronge": ("properties", "stronge"),
+}
+
+
+def packaged_schema() -> dict:
+    """Return the config schema shipped with the package (``data/config.schema.yaml``; a fresh copy)."""
+    from pathlib import Path
+
+    import yaml
+
+    path = Path(__file__).resolve().parents[1] / "data" / "config.schema.yaml"
+    with open(path) as fh:
+        return yaml.load(fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
+
+
+def block_schema(kind: str, schema: dict | None = None) -> dict:
+    """Return the schema of one config block (a key of :data:`SCHEMA_BLOCKS`), with the ``$defs`` it refers to."""
+    schema = packaged_schema() if schema is None else schema
+    node = schema
+    for part in SCHEMA_BLOCKS[kind]:
+        node = node[part]
+    return {**_resolve(node, schema), "$defs": schema["$defs"]}
+
+
+def checked_block(block: dict, kind: str, where: str | None = None, schema: dict | None = None) -> dict:
+    """Return a copy of one config block, checked against its part of the schema, with the schema's defaults filled.
+
+    For callers that hold one block rather than the whole workflow config (``ballbat check
+    --config``, tests, benchmarks): the block then carries every default, as the validated
+    config's does, and the settings built from it (``settings_from_config``...) need no
+    defaults of their own.
+
+    Raises
+    ------
+    ConfigError
+        Every problem, each naming its key under ``where`` (default: ``kind``).
+    """
+    import jsonschema
+
+    sub = block_schema(kind, schema)
+    out = copy.deepcopy(block)
+    where = where or kind
+    errors = sorted(
+        jsonschema.Draft202012Validator(sub).iter_errors(out),
+        key=lambda e: (list(map(str, e.absolute_path)), e.message),
+    )
+    lines = [f"{where}.{m}" if not m.startswith("<top level>") else where + m[11:] for m in map(_message, errors)]
+    lines += _finite(out, where)
+    if lines:
+        raise ConfigError(f"{where} is not valid:\n  " + "\n  ".join(lines))
+    return fill_defaults(out, sub, sub)

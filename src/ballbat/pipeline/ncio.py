@@ -37,16 +37,28 @@ class MetadataError(ValueError):
 
 
 def check_metadata(ds: xr.Dataset, where: str = "dataset") -> None:
-    """Raise :class:`MetadataError` naming every variable without ``units`` or ``long_name``."""
+    """Raise :class:`MetadataError` naming every variable without ``units`` or ``long_name``.
+
+    A variable whose values along a dimension are in different units (a study's estimates of
+    several quantities) has, instead of ``units``, ``units_from``: the name of a text coordinate
+    along that dimension that holds each element's unit.
+    """
     missing = []
     for name, var in {**ds.data_vars, **ds.coords}.items():
         if var.dtype.kind in "OSU":  # labels: long_name only
             if "long_name" not in var.attrs:
                 missing.append(f"{name}: long_name")
             continue
-        for attr in ("units", "long_name"):
-            if attr not in var.attrs:
-                missing.append(f"{name}: {attr}")
+        if "units" not in var.attrs and "units_from" in var.attrs:  # units per element: an aligned text coordinate
+            ref = ds.coords.get(var.attrs["units_from"])
+            if ref is None or ref.dtype.kind not in "OSU" or not set(ref.dims) <= set(var.dims):
+                missing.append(
+                    f"{name}: units (its units_from {var.attrs['units_from']!r} is no text coordinate of it)"
+                )
+        elif "units" not in var.attrs:
+            missing.append(f"{name}: units")
+        if "long_name" not in var.attrs:
+            missing.append(f"{name}: long_name")
     if missing:
         raise MetadataError(f"{where}: variables lack metadata: " + "; ".join(missing))
 

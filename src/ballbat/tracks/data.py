@@ -39,13 +39,15 @@ class Camera:
         Relative standard uncertainty of ``m_per_px`` (a systematic shared by every impact).
     fps_err : float
         Relative standard uncertainty of ``fps`` (a systematic shared by every impact).
+
+    No field has a default: the defaults are the config schema's alone.
     """
 
     fps: float
     m_per_px: float
-    mirror: bool = False
-    m_per_px_err: float = 0.0
-    fps_err: float = 0.0
+    mirror: bool
+    m_per_px_err: float
+    fps_err: float
 
     @property
     def sign(self) -> float:
@@ -59,16 +61,16 @@ class Rig:
 
     pivot_to_tip: float
     pivot_to_impact: float
-    pivot_to_tip_err: float = 0.0
-    pivot_to_impact_err: float = 0.0
+    pivot_to_tip_err: float
+    pivot_to_impact_err: float
 
     @classmethod
     def from_inches(
         cls,
         pivot_to_tip_in: float,
         pivot_to_impact_in: float,
-        pivot_to_tip_err_in: float = 0.0,
-        pivot_to_impact_err_in: float = 0.0,
+        pivot_to_tip_err_in: float,
+        pivot_to_impact_err_in: float,
     ) -> Rig:
         """Return a rig from the config's inches."""
         return cls(

@@ -79,7 +79,8 @@ def cameras_from_config(cfg: dict, where: str = "tracks") -> tuple[dict[str, Cam
     Parameters
     ----------
     cfg : dict
-        The block (``cameras``, ``rig``; other keys are ignored).
+        The block (``cameras``, ``rig``; other keys are ignored), validated, every default
+        filled (the schema's ``m_per_px_err``: 0).
     where : str
         Config key of the block, for messages.
 
@@ -95,8 +96,8 @@ def cameras_from_config(cfg: dict, where: str = "tracks") -> tuple[dict[str, Cam
             fps=float(c["fps"]),
             m_per_px=float(c["m_per_px"]),
             mirror=bool(c["mirror"]),
-            m_per_px_err=float(c.get("m_per_px_err", 0.0)),
-            fps_err=float(c.get("fps_err", 0.0)),
+            m_per_px_err=float(c["m_per_px_err"]),
+            fps_err=float(c["fps_err"]),
         )
         for name, c in cfg["cameras"].items()
     }

@@ -110,11 +110,23 @@ STAGE = "reduce"
 
 @dataclass(frozen=True)
 class ReduceOptions:
-    """Fewest frames per fit (the fits need at least two more than their parameters)."""
+    """Fewest frames per fit (the fits need at least two more than their parameters).
 
-    min_tip_frames: int = 5
-    min_flight_frames: int = 5
-    min_spin_frames: int = 4
+    No field has a default: the defaults are the config schema's ``min_frames`` alone
+    (:func:`ballbat.tracks.stage.reduce_options`; :meth:`schema_defaults`).
+    """
+
+    min_tip_frames: int
+    min_flight_frames: int
+    min_spin_frames: int
+
+    @classmethod
+    def schema_defaults(cls) -> ReduceOptions:
+        """Return the options the config schema gives a block without ``min_frames``."""
+        from ..pipeline.config import checked_block
+
+        mf = checked_block({}, "min_frames")
+        return cls(int(mf["tip"]), int(mf["flight"]), int(mf["spin"]))
 
 
 # ---------------------------------------------------------------------------------------
@@ -779,14 +791,14 @@ def reduce_tracks(
     rig : Rig
         Pivot-to-tip and pivot-to-impact distances.
     options : ReduceOptions, optional
-        Fewest frames per fit.
+        Fewest frames per fit (default: the config schema's, :meth:`ReduceOptions.schema_defaults`).
 
     Returns
     -------
     Reduction
         The fits, the values (SI) and the flag and reason of every impact.
     """
-    opt = options or ReduceOptions()
+    opt = options or ReduceOptions.schema_defaults()
     n = tracks.n
     tracks, n_outliers = remove_glitches(tracks, cameras)
     onset, flight, times, phys = {}, {}, {}, {}

@@ -24,7 +24,7 @@ leaves its view. Vectorised over impacts and frames.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -56,39 +56,44 @@ class RenderCamera:
     """
 
     camera: Camera
-    width_px: int = 1200
-    height_px: int = 800
-    tee_px: tuple[float, float] = (540.0, 480.0)
-    pixel_noise_px: float = 2.0
-    pre_impact_frames: int = 20
-    max_frames: int = 200
+    width_px: int
+    height_px: int
+    tee_px: tuple[float, float]
+    pixel_noise_px: float
+    pre_impact_frames: int
+    max_frames: int
 
 
 @dataclass(frozen=True)
 class RenderSettings:
-    """Settings of the rendering (SI inside; see :func:`settings_from_config`)."""
+    """Settings of the rendering (SI inside), built by :func:`settings_from_config`.
+
+    No field has a default: the defaults are the config schema's alone (the block given to
+    :func:`settings_from_config` is validated, its defaults filled).
+    """
 
     swing: RenderCamera
     spin: RenderCamera
     rig: Rig
-    seed: int = 0
-    swing_plane: tuple[float, float] = (-5 * DEGREE, 10 * DEGREE)
-    contact_time: tuple[float, float] = (0.5e-3, 1.2e-3)
-    bat_slowdown: tuple[float, float] = (0.10, 0.25)
-    bat_axis_to_ball: float = 0.07
-    axis_offset: float = 5e-3
-    tilted_fraction: float = 0.03
-    tilt: tuple[float, float] = (15 * DEGREE, 40 * DEGREE)
-    extra: dict = field(default_factory=dict)
+    seed: int
+    swing_plane: tuple[float, float]
+    contact_time: tuple[float, float]
+    bat_slowdown: tuple[float, float]
+    bat_axis_to_ball: float
+    axis_offset: float
+    tilted_fraction: float
+    tilt: tuple[float, float]
 
 
 def settings_from_config(cfg: dict) -> RenderSettings:
-    """Render settings from a dataset's ``render`` config block (paper units: in, deg, ms, mm).
+    """Render settings from a dataset's validated ``render`` config block (paper units: in, deg, ms, mm).
 
     Parameters
     ----------
     cfg : dict
-        The block as in config/config.yaml (``cameras``, ``rig`` and the optional keys).
+        The block of the validated config, every default filled (the workflow's config;
+        :func:`ballbat.pipeline.config.checked_block` for a block of one's own). A key
+        missing is a ``KeyError``: no default is restated here.
 
     Returns
     -------
@@ -100,30 +105,31 @@ def settings_from_config(cfg: dict) -> RenderSettings:
             camera=Camera(
                 fps=float(c["fps"]),
                 m_per_px=float(c["m_per_px"]),
-                mirror=bool(c.get("mirror", False)),
-                m_per_px_err=float(c.get("m_per_px_err", 0.0)),
+                mirror=bool(c["mirror"]),
+                m_per_px_err=float(c["m_per_px_err"]),
+                fps_err=float(c["fps_err"]),
             ),
-            width_px=int(c.get("width_px", 1200)),
-            height_px=int(c.get("height_px", 800)),
-            tee_px=tuple(float(v) for v in c.get("tee_px", (540.0, 480.0))),
-            pixel_noise_px=float(c.get("pixel_noise_px", 2.0)),
-            pre_impact_frames=int(c.get("pre_impact_frames", 20)),
-            max_frames=int(c.get("max_frames", 200)),
+            width_px=int(c["width_px"]),
+            height_px=int(c["height_px"]),
+            tee_px=tuple(float(v) for v in c["tee_px"]),
+            pixel_noise_px=float(c["pixel_noise_px"]),
+            pre_impact_frames=int(c["pre_impact_frames"]),
+            max_frames=int(c["max_frames"]),
         )
-    rig = Rig.from_inches(cfg["rig"]["pivot_to_tip_in"], cfg["rig"]["pivot_to_impact_in"])
-    deg = lambda k, d: tuple(v * DEGREE for v in cfg.get(k, d))  # noqa: E731
+    rig = Rig.from_inches(**{k: float(v) for k, v in cfg["rig"].items()})
+    deg = lambda k: tuple(v * DEGREE for v in cfg[k])  # noqa: E731
     return RenderSettings(
         swing=cams["swing"],
         spin=cams["spin"],
         rig=rig,
-        seed=int(cfg.get("seed", 0)),
-        swing_plane=deg("swing_plane_deg", (-5.0, 10.0)),
-        contact_time=tuple(v * 1e-3 for v in cfg.get("contact_ms", (0.5, 1.2))),
-        bat_slowdown=tuple(cfg.get("bat_slowdown", (0.10, 0.25))),
-        bat_axis_to_ball=float(cfg.get("bat_axis_to_ball_mm", 70.0)) * 1e-3,
-        axis_offset=float(cfg.get("axis_offset_mm", 5.0)) * 1e-3,
-        tilted_fraction=float(cfg.get("tilted_fraction", 0.03)),
-        tilt=deg("tilt_deg", (15.0, 40.0)),
+        seed=int(cfg["seed"]),
+        swing_plane=deg("swing_plane_deg"),
+        contact_time=tuple(v * 1e-3 for v in cfg["contact_ms"]),
+        bat_slowdown=tuple(cfg["bat_slowdown"]),
+        bat_axis_to_ball=float(cfg["bat_axis_to_ball_mm"]) * 1e-3,
+        axis_offset=float(cfg["axis_offset_mm"]) * 1e-3,
+        tilted_fraction=float(cfg["tilted_fraction"]),
+        tilt=deg("tilt_deg"),
     )
 
 

@@ -70,12 +70,12 @@ def render_stage(simulated: xr.Dataset, balls_path: str | os.PathLike[str], rend
 
 
 def reduce_options(cfg: dict) -> ReduceOptions:
-    """Return the reduction's options of a ``tracks`` or ``render`` block (``min_frames``)."""
-    mf = cfg.get("min_frames", {})
+    """Return the reduction's options of a validated ``tracks`` or ``render`` block (``min_frames``, filled)."""
+    mf = cfg["min_frames"]
     return ReduceOptions(
-        min_tip_frames=int(mf.get("tip", 5)),
-        min_flight_frames=int(mf.get("flight", 5)),
-        min_spin_frames=int(mf.get("spin", 4)),
+        min_tip_frames=int(mf["tip"]),
+        min_flight_frames=int(mf["flight"]),
+        min_spin_frames=int(mf["spin"]),
     )
 
 

@@ -294,7 +294,7 @@ def _src(files: list[FileTracks], path: str, key: str) -> str:
 
 
 def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | None = None) -> tuple[Tracks, Imported]:
-    """Read a dataset's ``tracks`` block that names a folder (``dir``): return (Tracks, Imported).
+    """Read a dataset's validated ``tracks`` block that names a folder (``dir``): return (Tracks, Imported).
 
     The impacts file (``impacts``) gives each impact's bat and ball; every impact must have a
     file of each camera and every file an impact. Every problem is raised at once as an
@@ -310,7 +310,7 @@ def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | 
         imp = import_files(
             [cfg["dir"]],
             cfg.get("points"),
-            pattern=cfg.get("pattern", DEFAULT_PATTERN),
+            pattern=cfg["pattern"],
             fmt=cfg.get("format"),
             units=cfg.get("units"),
             cameras=cfg.get("cameras"),
@@ -326,9 +326,7 @@ def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | 
     for iid, label in impacts.items():
         miss = [c for c in CAMERAS if c not in have.get(iid, set())]
         if miss:
-            names = " and ".join(
-                cfg.get("pattern", DEFAULT_PATTERN).replace("{impact_id}", iid).replace("{camera}", c) for c in miss
-            )
+            names = " and ".join(cfg["pattern"].replace("{impact_id}", iid).replace("{camera}", c) for c in miss)
             problems.append(
                 f"{ipath}: {label}: impact {iid!r} has no file of the {' and '.join(miss)} camera "
                 f"in {cfg['dir']} ({names})"
