@@ -34,7 +34,7 @@ from ballbat.tracks.io import cameras_from_config
 from ballbat.tracks.reduce import ReduceOptions
 from ballbat.tracks.render import RenderCamera, RenderSettings, settings_from_config
 from ballbat.tracks.stage import reduce_options, reduce_stage, render_stage
-from ballbat.units import DEGREE
+from ballbat.units import DEGREE, INCH
 
 ROOT = Path(__file__).resolve().parents[1]
 SCHEMA = packaged_schema()
@@ -52,7 +52,7 @@ SETTINGS = {
     Camera: (
         "render_camera",
         {"fps": (("fps",), _same), "m_per_px": (("m_per_px",), _same), "mirror": (("mirror",), _same)}
-        | {"m_per_px_err": (("m_per_px_err",), _same)},
+        | {"m_per_px_err": (("m_per_px_err",), _same), "fps_err": (("fps_err",), _same)},
     ),
     Rig: ("render", {}),  # pivot distances: required (no default), converted from inches
     RenderCamera: (
@@ -198,9 +198,11 @@ def _render_value(s: RenderSettings, path: tuple) -> object:
     if path[0] == "cameras":
         cam = getattr(s, path[1])
         key = path[2]
-        if key in ("fps", "m_per_px", "mirror", "m_per_px_err"):
+        if key in ("fps", "m_per_px", "mirror", "m_per_px_err", "fps_err"):
             return getattr(cam.camera, key)
         return list(cam.tee_px) if key == "tee_px" else getattr(cam, key)
+    if path[0] == "rig":
+        return getattr(s.rig, path[1].removesuffix("_in")) / INCH
     if path[0] == "min_frames":
         return getattr(reduce_options(checked_block(MINIMAL_RENDER, "render")), f"min_{path[1]}_frames")
     field = {k[0]: f for f, (k, _) in SETTINGS[RenderSettings][1].items()}[path[0]]
@@ -320,6 +322,8 @@ def test_no_code_restates_a_schema_default():
 RENDER_CHANGES = {
     ("rig", "pivot_to_tip_in"): 36.0,
     ("rig", "pivot_to_impact_in"): 26.0,
+    ("rig", "pivot_to_tip_err_in"): 0.1,
+    ("rig", "pivot_to_impact_err_in"): 0.1,
     ("min_frames", "tip"): 21,
     ("min_frames", "flight"): 20,
     ("min_frames", "spin"): 18,
@@ -337,6 +341,7 @@ CAMERA_CHANGES = {
         "m_per_px": 0.0008,
         "mirror": True,
         "m_per_px_err": 0.02,
+        "fps_err": 0.001,
         "width_px": 1000,
         "height_px": 560,
         "tee_px": [500.0, 420.0],
@@ -349,6 +354,7 @@ CAMERA_CHANGES = {
         "m_per_px": 0.0011,
         "mirror": True,
         "m_per_px_err": 0.02,
+        "fps_err": 0.001,
         "width_px": 900,
         "height_px": 490,
         "tee_px": [560.0, 430.0],
@@ -358,6 +364,14 @@ CAMERA_CHANGES = {
     },
 }
 RENDER_CHANGES |= {("cameras", cam, k): v for cam, kv in CAMERA_CHANGES.items() for k, v in kv.items()}
+#: Stated calibration uncertainties: systematics only (ballbat.systematics), which a replicate does not
+#: rerun; the workflow's reduce states them (source, relative sigma) and reduces again at +-1 sigma.
+CALIBRATION_ERRORS = {
+    ("cameras", "swing", "fps_err"): ("swing_fps", 0.001),
+    ("cameras", "spin", "fps_err"): ("spin_fps", 0.001),
+    ("rig", "pivot_to_tip_err_in"): ("pivot_to_tip", 0.1 / 34.0),
+    ("rig", "pivot_to_impact_err_in"): ("pivot_to_impact", 0.1 / 28.0),
+}
 #: Changes that need another first: a tilt only shows on impacts whose spin axis is tilted.
 WITH = {("tilt_deg",): {("tilted_fraction",): 0.5}}
 #: Keys with a test of their own below: enabled (the chain) and seed (a study's replicates draw their own).
@@ -446,8 +460,11 @@ def _same_reduction(a, b, what: str) -> None:
     if isinstance(a, list):  # both stopped: by the same problems
         assert a == b, what
         return
-    assert set(a.data_vars) == set(b.data_vars), what
-    for name in b.data_vars:
+    # the workflow's reduce (b) also reduces again at +-1 sigma of each calibration (ballbat.systematics);
+    # a replicate (a) skips those reruns: every other variable is the same
+    calibration = {n for ds in (a, b) for n in ds.data_vars if "systematic" in ds[n].dims}
+    assert set(a.data_vars) - calibration == set(b.data_vars) - calibration, what
+    for name in set(a.data_vars) - calibration:
         x, y = a[name].values, b[name].values
         if x.dtype.kind == "f":  # the workflow's tracks make a round trip through tracks.nc: dense columns
             np.testing.assert_allclose(x, y, rtol=1e-12, atol=0, err_msg=f"{what}: {name}")  # may start elsewhere
@@ -488,7 +505,19 @@ def test_a_replicate_and_the_workflow_honour_every_setting(config, small, balls,
     _set(ds["render"], path, RENDER_CHANGES[path])
     ds = _validated(config, ds)
     replicate = _replicate(ds, balls, bats)
-    _same_reduction(replicate, _workflow(ds, tmp_path, balls, bats), ".".join(path))
+    workflow = _workflow(ds, tmp_path, balls, bats)
+    _same_reduction(replicate, workflow, ".".join(path))
+    if path in CALIBRATION_ERRORS:  # a stated uncertainty: the workflow reduces again at +-1 sigma of it
+        source, rel = CALIBRATION_ERRORS[path]
+        stated = float(workflow["systematic_rel_sigma"].sel(systematic=source))
+        assert stated == pytest.approx(rel), ".".join(path)
+        moved = [
+            k
+            for k in workflow.data_vars
+            if k.endswith("_shift") and np.nanmax(np.abs(workflow[k].sel(systematic=source).values)) > 0
+        ]
+        assert moved, ".".join(path)
+        return
     assert _differs(replicate, baselines[tuple(sorted(first.items()))]), f"{'.'.join(path)} changed nothing"
 
 

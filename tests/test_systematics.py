@@ -15,6 +15,7 @@ from test_tracks import BALLS, BATS, experiment, render, render_cfg
 from ballbat import systematics
 from ballbat.analysis import normalize, reconstruct
 from ballbat.fitting import FIT_FAMILIES, fit_dataset
+from ballbat.pipeline.config import checked_block
 from ballbat.stronge.analysis import stronge_dataset
 from ballbat.tracks.data import camera_block
 from ballbat.tracks.reduce import reduction_dataset
@@ -37,7 +38,7 @@ def chain(swing=(), spin=(), rig=(), vary_e_y=False):
     cfg = render_cfg(swing=dict(swing), spin=dict(spin))
     cfg["rig"].update(dict(rig))
     tr, _ = render(ds, cfg, {k: ds[f"truth_{k}"].values for k in ("e_x", "e_y")})
-    red, _ = reduce_in_memory(tr, camera_block(cfg), BALLS, BATS, "test", systematics=True)
+    red, _ = reduce_in_memory(tr, camera_block(checked_block(cfg, "render")), BALLS, BATS, "test", systematics=True)
     rec = reconstruct(normalize(reduction_dataset(red), 77.0), BALLS, BATS)
     fit = fit_dataset(rec, mu_k_example=0.5)
     st = stronge_dataset(rec, vary_e_y=vary_e_y, vary_mu=False, **STRONGE)

@@ -146,16 +146,19 @@ def test_camera_settings():
 def test_calibration_uncertainties():
     """fps_err (relative) and the rig's length uncertainties (inches): read, and each wrong one named."""
     good = {
+        "file": "tracks.csv",
+        "impacts": "impacts.csv",
         "cameras": {
             "swing": {"fps": 3000, "m_per_px": 0.00074, "mirror": False, "fps_err": 0.001},
             "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False},
         },
         "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0, "pivot_to_impact_err_in": 0.1},
     }
-    cams, rig = cameras_from_config(good)
+    cams, rig = cameras_from_config(checked_block(good, "tracks"))  # the schema's defaults filled
     assert cams["swing"].fps_err == 0.001 and cams["spin"].fps_err == 0.0
     assert rig.pivot_to_impact_err == pytest.approx(0.1 * 0.0254) and rig.pivot_to_tip_err == 0.0
     bad = {
+        **good,
         "cameras": {**good["cameras"], "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False, "fps_err": 2}},
         "rig": {
             "pivot_to_tip_in": 34.0,
