@@ -1,7 +1,7 @@
 """The ``ballbat`` command: everyday questions without editing a config.
 
 ``ballbat check FILE`` validates a measured impacts file exactly as the workflow's ``ingest``
-rule does (the same function, :func:`ballbat.ingest.ingest`); ``ballbat fly`` flies batted
+rule does (the same function, :func:`ballbat.stages.ingest.run`); ``ballbat fly`` flies batted
 balls with Nathan's trajectory model (:func:`ballbat.flight.fly`), one from options or many
 from a CSV file; ``ballbat summary results/{dataset}`` prints a dataset's headline numbers; ``ballbat import-tracks``
 reads Tracker or Kinovea files into the long tracks CSV (:mod:`ballbat.tracks.formats`).
@@ -128,9 +128,9 @@ def _range_problem(val: float, limits: dict, unit: str) -> str | None:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Validate a measured impacts file as the ingest rule does; print every problem and warning."""
-    from .fitting import fit_problems
-    from .ingest import excluded_listing, ingest
     from .properties import InputError, load_balls, load_bats
+    from .stages import ingest
+    from .stages.fit_ex import fit_problems
 
     defaults = _schema_defaults()["tables"]
     if args.kind == "tracks" and args.file is None:
@@ -149,7 +149,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     if args.impacts:
         raise UsageError("argument --impacts: only with --kind tracks (the impact table of a tracks file)")
     try:
-        ds, warnings = ingest(path, balls_path=args.balls or defaults["balls"], bats_path=args.bats or defaults["bats"])
+        ds = ingest.run(
+            ingest.IngestSettings(), path, balls=args.balls or defaults["balls"], bats=args.bats or defaults["bats"]
+        )
+        warnings = ingest.warnings(ds)
     except InputError as exc:
         for problem in exc.problems:
             print(problem)
@@ -163,7 +166,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         return 1
     for text in warnings:
         print(f"warning: {text}")
-    for line in excluded_listing(ds):
+    for line in ingest.excluded_listing(ds):
         print(f"excluded: {line}")
     print(
         f"{path}: usable: {ds.sizes['impact']} impacts, {int(ds.attrs['n_excluded'])} excluded, "
