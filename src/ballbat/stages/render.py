@@ -14,7 +14,7 @@ import numpy as np
 from ..pipeline.products import Var, build_dataset
 from ..tracks.data import to_long
 from ..tracks.render import RenderSettings, render_tracks, settings_from_config
-from .impacts import SIMULATED_TRUTH, truth_var
+from .impacts import IMPACT_COORDS, SIMULATED_TRUTH, truth_var
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -23,6 +23,20 @@ if TYPE_CHECKING:
     from ..tracks.data import Tracks
 
 __all__ = ["RenderSettings", "from_config", "render", "run", "tracks_dataset"]
+
+
+#: The variables of a tracks file (long rows along ``row``, the impact table along ``impact``);
+#: a rendered file adds the truth of each impact (:func:`.impacts.truth_var`).
+TRACKS_TABLE = {
+    "camera": Var(("row",), None, "camera of the row (swing: Camera 1, spin: Camera 2)"),
+    "point": Var(("row",), None, "tracked point (bat_tip, ball, dot_a, dot_b)"),
+    "frame": Var(("row",), "1", "frame number of that camera (origin arbitrary)"),
+    "x_px": Var(("row",), "1", "image x of the point (pixels, to the right)"),
+    "y_px": Var(("row",), "1", "image y of the point (pixels, downward)"),
+    "impact_id": Var(("row",), None, "impact of the row"),
+    "bat": IMPACT_COORDS["bat"],
+    "ball": IMPACT_COORDS["ball"],
+}
 
 
 def from_config(config: dict, dataset: str) -> RenderSettings:
@@ -69,16 +83,7 @@ def tracks_dataset(tracks: Tracks) -> xr.Dataset:
     xarray.Dataset
     """
     rows = to_long(tracks)
-    table = {
-        "camera": Var(("row",), None, "camera of the row (swing: Camera 1, spin: Camera 2)"),
-        "point": Var(("row",), None, "tracked point (bat_tip, ball, dot_a, dot_b)"),
-        "frame": Var(("row",), "1", "frame number of that camera (origin arbitrary)"),
-        "x_px": Var(("row",), "1", "image x of the point (pixels, to the right)"),
-        "y_px": Var(("row",), "1", "image y of the point (pixels, downward)"),
-        "impact_id": Var(("row",), None, "impact of the row"),
-        "bat": Var(("impact",), None, "bat (key of the bat table)"),
-        "ball": Var(("impact",), None, "ball type (key of the ball table)"),
-    }
+    table = dict(TRACKS_TABLE)
     values = {
         "camera": rows["camera"].astype(str),
         "point": rows["point"].astype(str),
