@@ -10,7 +10,8 @@ place the workflow's defaults live. Errors are one line naming the bad argument 
 ``check`` exits 1 when the file is not usable.
 
 ``ballbat check --kind tracks --config YAML`` checks raw camera tracks as the ``reduce`` rule
-does (the same function, :func:`ballbat.tracks.stage.reduce_checked`).
+does (the same steps: read and check the files, reduce, cross-check;
+:func:`ballbat.tracks.stage.reduce_checked`).
 """
 
 from __future__ import annotations
@@ -221,7 +222,7 @@ def _reduce_tool_files(block: dict, where: str, balls_path: str, bats_path: str)
 def _check_tracks(path: Path | None, args: argparse.Namespace, defaults: dict) -> int:
     """Check raw tracks as the workflow's reduce rule does: read, validate, reduce, cross-check.
 
-    With ``--config``: the same function as the reduce rule (:func:`ballbat.tracks.stage.reduce_checked`),
+    With ``--config``: the reduce rule's steps (:func:`ballbat.tracks.stage.reduce_checked`),
     then what the workflow would do with every impact; exit 1 when the dataset would stop or
     a ball would have fewer than three usable impacts. Without: the files are only read.
     """

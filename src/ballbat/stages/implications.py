@@ -24,7 +24,15 @@ C, CP = ("case",), ("case", "point")
 
 @dataclass(frozen=True)
 class ImplicationsSettings:
-    """Settings of one scenario: its config block (``implications.scenarios.<name>``, paper units) and the air."""
+    """Settings of one batted-ball scenario.
+
+    Attributes
+    ----------
+    scenario : dict
+        Its config block (``implications.scenarios.<name>``, paper units).
+    air : dict
+        The atmospheric conditions (``implications.air``).
+    """
 
     scenario: dict
     air: dict
