@@ -34,6 +34,9 @@ Exclusions (flag > 0, values kept where they could be computed): no impact found
 few frames for a fit; a dot whose distance from the ball's centre is not constant (the
 dots do not rotate about the centre: a tilted spin axis); a spin too fast for the frame
 rate to unwrap. Exclude, never drop.
+
+:func:`reduce_tracks` returns a :class:`Reduction` (arrays and fits); the stage
+:mod:`ballbat.stages.reduce` declares ``reduce.nc`` and assembles it.
 """
 
 from __future__ import annotations

@@ -1,6 +1,7 @@
-"""Read, check, reduce and cross-check a dataset's tracks (the reduce stage, ``ballbat check`` and the studies).
+"""Read, check, reduce and cross-check a dataset's tracks in one call (``ballbat check --kind tracks``).
 
-The results file itself (``reduce.nc``) is the stage :mod:`ballbat.stages.reduce`'s.
+The reduce rule takes the same steps through the stage :mod:`ballbat.stages.reduce`, which also
+writes the results file ``reduce.nc`` (its options: :func:`reduce_options`).
 """
 
 from __future__ import annotations
