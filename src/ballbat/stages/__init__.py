@@ -8,20 +8,16 @@ the warnings carried from a measured file). The rule scripts in ``workflow/scrip
 one ``run`` and write its Dataset (:func:`~ballbat.pipeline.ncio.write_job_output`); the replicate studies
 (:mod:`ballbat.studies`) call the same ``run`` functions in memory.
 
-========================  =============================  ===========================
-stage                     results file                   compute modules
-========================  =============================  ===========================
-:mod:`.simulate`          ``simulate.nc``                :mod:`ballbat.synthetic`
-:mod:`.ingest`            ``ingest.nc``                  :mod:`ballbat.ingest`
-:mod:`.render`            ``tracks.nc``                  :mod:`ballbat.tracks.render`
-:mod:`.import_tracks`     ``imported_tracks.nc``         :mod:`ballbat.tracks.formats`
-:mod:`.reduce`            ``reduce.nc``                  :mod:`ballbat.tracks.reduce`, :mod:`ballbat.tracks.stage`
-:mod:`.normalize`         ``normalize.nc``               :mod:`ballbat.analysis`
-:mod:`.reconstruct`       ``reconstruct.nc``             :mod:`ballbat.analysis`
-:mod:`.fit_ex`            ``fit_ex.nc``                  :mod:`ballbat.fitting`
-:mod:`.stronge`           ``stronge.nc``                 :mod:`ballbat.stronge.analysis`
-:mod:`.implications`      ``implications/{scenario}.nc`` :mod:`ballbat.implications`
-========================  =============================  ===========================
+* :mod:`.simulate`: ``simulate.nc`` (compute: :mod:`ballbat.synthetic`)
+* :mod:`.ingest`: ``ingest.nc`` (:mod:`ballbat.ingest`)
+* :mod:`.render`: ``tracks.nc`` (:mod:`ballbat.tracks.render`); its :func:`.render.tracks_dataset` also
+  lays out ``imported_tracks.nc`` (:mod:`ballbat.tracks.formats`)
+* :mod:`.reduce`: ``reduce.nc`` (:mod:`ballbat.tracks.io`, :mod:`ballbat.tracks.reduce`, :mod:`ballbat.tracks.checks`)
+* :mod:`.normalize`: ``normalize.nc`` (:mod:`ballbat.analysis`)
+* :mod:`.reconstruct`: ``reconstruct.nc`` (:mod:`ballbat.analysis`)
+* :mod:`.fit_ex`: ``fit_ex.nc`` (:mod:`ballbat.fitting`)
+* :mod:`.stronge`: ``stronge.nc`` (:mod:`ballbat.stronge.analysis`)
+* :mod:`.implications`: ``implications/{scenario}.nc`` (:mod:`ballbat.implications`)
 
 :mod:`.impacts` holds the one table of the impacts every source stage writes (simulate, ingest, reduce).
 """

@@ -2,7 +2,8 @@
 
 :func:`render` draws the tracks in memory (:func:`ballbat.tracks.render.render_tracks`; the replicate
 studies reduce them as they are); :func:`tracks_dataset` is the file's layout (long rows and the
-impact table), which the stage :mod:`.import_tracks` writes too; :func:`run` is both.
+impact table), which the import_tracks rule writes too (tool files read by
+:func:`ballbat.tracks.formats.layout.import_block`); :func:`run` is both.
 """
 
 from __future__ import annotations
