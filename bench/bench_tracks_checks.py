@@ -25,13 +25,14 @@ import numpy as np
 
 from ballbat.pipeline.config import load_config
 from ballbat.properties import InputError, load_balls, load_bats
-from ballbat.synthetic import SyntheticSettings, simulate_experiment
+from ballbat.stages import simulate
+from ballbat.stages.impacts import SIMULATED_TRUTH
+from ballbat.synthetic import SyntheticSettings
 from ballbat.tracks.checks import cross_check
 from ballbat.tracks.data import CameraTracks, Rig, camera_block
 from ballbat.tracks.io import cameras_from_config
 from ballbat.tracks.reduce import ReduceFlag, reduce_tracks
 from ballbat.tracks.render import render_tracks, settings_from_config
-from ballbat.tracks.stage import SIMULATED_TRUTH
 
 ROOT = Path(__file__).resolve().parents[1]
 ARGS = [a for a in sys.argv[1:] if not a.startswith("--")]
@@ -105,7 +106,7 @@ stopped, flags, glitches, warnings, impacts = [], Counter(), 0, 0, 0
 observed = {k: [] for k in ("g_swing", "g_spin", "speed", "arc")}
 t0 = time.perf_counter()
 for seed in range(N):
-    sim = simulate_experiment(SyntheticSettings(**{**cfg["synthetic"], "seed": 1000 + seed}), balls, bats)
+    sim = simulate.run(SyntheticSettings(**{**cfg["synthetic"], "seed": 1000 + seed}), balls, bats)
     truth = {k: sim[f"truth_{k}"].values for k in SIMULATED_TRUTH if f"truth_{k}" in sim}
     r = np.array([balls[b].r for b in sim["ball"].values.astype(str)])
     s = settings_from_config({**cfg["render"], "seed": 2000 + seed})

@@ -2,7 +2,7 @@
 
 1. Cold ``snakemake -c2`` of the default workflow in a fresh copy of the repository.
 2. A no-op rerun, against Snakemake's own no-op on a one-rule workflow (target: within 1.5x).
-3. The fit stage alone (``ballbat.fitting.fit_dataset``) at 10^3 .. 10^5 impacts
+3. The fit stage alone (``ballbat.stages.fit_ex.run``) at 10^3 .. 10^5 impacts
    (targets: linear in the number of impacts, 10^5 impacts in under 5 s).
 
 Run: ``.venv/bin/python bench/bench_workflow.py`` (or ``make bench``). Prints a table.
@@ -57,29 +57,29 @@ def snakemake_times(repeats: int = 5) -> dict:
 
 def fit_times(sizes=(1_000, 10_000, 100_000)) -> list[tuple[int, float]]:
     """Return the fit-stage time for each number of impacts."""
-    from ballbat.analysis import normalize, reconstruct
-    from ballbat.fitting import fit_dataset
     from ballbat.properties import load_balls, load_bats
-    from ballbat.synthetic import SyntheticSettings, simulate_experiment
+    from ballbat.stages import fit_ex, normalize, reconstruct, simulate
+    from ballbat.synthetic import SyntheticSettings
+
+    norm, rec = normalize.NormalizeSettings(v_ref_mph=77.0), reconstruct.ReconstructSettings()
+    fit = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True)
 
     balls = load_balls(ROOT / "config" / "balls.csv")
     bats = load_bats(ROOT / "config" / "bats.csv")
     base = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())["datasets"]["synthetic"]["synthetic"]
     total = sum(sum(v.values()) for v in base["impacts"].values())
-    fit_dataset(
-        reconstruct(normalize(simulate_experiment(SyntheticSettings(**base), balls, bats), 77.0), balls, bats), 0.5
+    fit_ex.run(
+        fit,
+        reconstruct.run(rec, normalize.run(norm, simulate.run(SyntheticSettings(**base), balls, bats)), balls, bats),
     )
     out = []
     for n in sizes:
         scale = n / total
         impacts = {b: {t: max(3, round(k * scale)) for t, k in v.items()} for b, v in base["impacts"].items()}
-        ds = reconstruct(
-            normalize(simulate_experiment(SyntheticSettings(**{**base, "impacts": impacts}), balls, bats), 77.0),
-            balls,
-            bats,
-        )
+        sim = simulate.run(SyntheticSettings(**{**base, "impacts": impacts}), balls, bats)
+        ds = reconstruct.run(rec, normalize.run(norm, sim), balls, bats)
         t0 = time.perf_counter()
-        fit_dataset(ds, 0.5)
+        fit_ex.run(fit, ds)
         out.append((ds.sizes["impact"], time.perf_counter() - t0))
     return out
 
@@ -92,7 +92,7 @@ def main() -> None:
     print(f"  no-op rerun (median of 5)      {sm['noop']:7.2f} s")
     print(f"  one-rule workflow no-op        {sm['noop_one_rule']:7.2f} s")
     print(f"  ratio (target <= 1.5)          {sm['noop'] / sm['noop_one_rule']:7.2f}")
-    print("fit stage alone (fit_dataset, all fits of Sec. IV)")
+    print("fit stage alone (stages.fit_ex.run, all fits of Sec. IV)")
     fits = fit_times()
     for n, t in fits:
         print(f"  {n:>7d} impacts                {t:7.3f} s   {1e6 * t / n:8.2f} us/impact")

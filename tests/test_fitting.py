@@ -4,11 +4,14 @@ import numpy as np
 import pytest
 import yaml
 
-from ballbat.analysis import normalize, reconstruct
-from ballbat.fitting import fit_dataset
 from ballbat.linefit import fit_line, sandwich_cov, sandwich_dof, wls_slope
-from ballbat.synthetic import SyntheticSettings, simulate_experiment
+from ballbat.stages import fit_ex, normalize, reconstruct, simulate, stronge
+from ballbat.synthetic import SyntheticSettings
 from ballbat.units import MPH
+
+NORM = normalize.NormalizeSettings(v_ref_mph=77.0)
+REC = reconstruct.ReconstructSettings()
+FIT = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True)
 
 
 @pytest.fixture(scope="module")
@@ -19,7 +22,7 @@ def default_settings(root):
 
 def run(settings, balls, bats, **over):
     s = SyntheticSettings(**{**settings, **over})
-    return fit_dataset(reconstruct(normalize(simulate_experiment(s, balls, bats), 77.0), balls, bats), 0.5)
+    return fit_ex.run(FIT, reconstruct.run(REC, normalize.run(NORM, simulate.run(s, balls, bats)), balls, bats))
 
 
 def test_fit_line_matches_closed_form():
@@ -90,10 +93,10 @@ def test_standard_errors_are_honest(default_settings, balls, bats):
 
 
 def test_synthetic_is_seeded(default_settings, balls, bats):
-    a = simulate_experiment(SyntheticSettings(**default_settings), balls, bats)
-    b = simulate_experiment(SyntheticSettings(**default_settings), balls, bats)
+    a = simulate.run(SyntheticSettings(**default_settings), balls, bats)
+    b = simulate.run(SyntheticSettings(**default_settings), balls, bats)
     np.testing.assert_array_equal(a.omega.values, b.omega.values)
-    c = simulate_experiment(SyntheticSettings(**{**default_settings, "seed": 1}), balls, bats)
+    c = simulate.run(SyntheticSettings(**{**default_settings, "seed": 1}), balls, bats)
     assert not np.array_equal(a.omega.values, c.omega.values)
     assert a.sizes["impact"] == 108 and int((a.ball == "baseball").sum()) == 58  # Table I counts
 
@@ -163,17 +166,17 @@ def test_design_jacobians_match_finite_differences(design):
 
 def test_ball_with_too_few_usable_impacts_is_reported_not_fitted(default_settings, config, balls, bats):
     """A ball with 2 usable impacts: every per-ball result NaN with n = 2, no warnings, no crash."""
-    from ballbat.stronge.analysis import stronge_dataset
-
     settings = {**default_settings, "impacts": {"baseball": {"wood": 12}, "softball": {"wood": 2}}}
-    rec = reconstruct(normalize(simulate_experiment(SyntheticSettings(**settings), balls, bats), 77.0), balls, bats)
-    fit = fit_dataset(rec, 0.5)
+    rec = reconstruct.run(
+        REC, normalize.run(NORM, simulate.run(SyntheticSettings(**settings), balls, bats)), balls, bats
+    )
+    fit = fit_ex.run(FIT, rec)
     soft = fit.sel(ball="softball")
     assert int(soft.e_x_pooled_n) == 2 and np.isnan(soft.e_x_pooled)
     for q in ("tan_ratio_slope", "spin_theta_slope", "e_y_implied", "mu_k_lower_bound"):
         assert np.isnan(soft[q]), q
     assert np.isfinite(fit.e_x_pooled.sel(ball="baseball"))
-    st = stronge_dataset(rec, **{**config["stronge"], "n_time": 50})
+    st = stronge.run(stronge.StrongeSettings(**{**config["stronge"], "n_time": 50}), rec)
     assert list(st.ball.values) == ["baseball"]
     assert "softball: 2 usable impacts" in st.attrs["balls_not_fitted"]
 
@@ -192,16 +195,17 @@ def test_implied_e_y_is_exact_for_bats_of_different_e_x(default_settings, balls,
     fit = run(default_settings, balls, bats, noise=tiny, impacts={"baseball": {"wood": 60, "metal_rough": 10}})
     f = fit.sel(ball="baseball")
     assert float(f.e_y_implied) == pytest.approx(0.45, abs=1e-4)
-    rec = reconstruct(
-        normalize(
-            simulate_experiment(
+    rec = reconstruct.run(
+        REC,
+        normalize.run(
+            NORM,
+            simulate.run(
                 SyntheticSettings(
                     **{**default_settings, "noise": tiny, "impacts": {"baseball": {"wood": 60, "metal_rough": 10}}}
                 ),
                 balls,
                 bats,
             ),
-            77.0,
         ),
         balls,
         bats,

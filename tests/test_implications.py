@@ -6,8 +6,10 @@ import numpy as np
 import pytest
 import yaml
 
-from ballbat.implications import comparison_rows, density_from_conditions, launch_conditions, run_scenario
+from ballbat.implications import comparison_rows, density_from_conditions, launch_conditions
 from ballbat.pipeline.config import validate_config
+from ballbat.stages.implications import ImplicationsSettings
+from ballbat.stages.implications import run as run_scenario
 from ballbat.units import DEGREE, FOOT, INCH, MPH, RPM
 
 
@@ -31,7 +33,7 @@ def complete(config, root):
 
 @pytest.fixture(scope="module")
 def paper(cfg, balls, bats):
-    return run_scenario(cfg["scenarios"]["paper"], balls, bats, cfg["air"])
+    return run_scenario(ImplicationsSettings(cfg["scenarios"]["paper"], cfg["air"]), balls, bats)
 
 
 def test_default_air_density(cfg):
@@ -91,7 +93,7 @@ def test_launch_scenario_flies_calculator_case(cfg, complete, balls, bats):
     # The calculator's published case with our baseball (5.04 oz, r = 1.42 in), not its 5.125 oz:
     # a lighter, smaller ball; only check it flies to the right neighbourhood and is sane.
     sc = complete({"ball": "baseball", "launch": {"exit_speed_mph": 103, "launch_deg": 27.5, "backspin_rpm": 2500}})
-    ds = run_scenario(sc, balls, bats, cfg["air"])
+    ds = run_scenario(ImplicationsSettings(sc, cfg["air"]), balls, bats)
     assert ds.sizes["case"] == 1
     assert 400 < float(ds.carry[0]) / FOOT < 440
     assert float(ds.trajectory_z[0, -1]) == pytest.approx(0.0, abs=1e-6)
@@ -100,7 +102,7 @@ def test_launch_scenario_flies_calculator_case(cfg, complete, balls, bats):
 def test_unknown_ball_or_bat(cfg, complete, balls, bats):
     cricket = complete({"ball": "cricket", "launch": {"exit_speed_mph": 90, "launch_deg": 20}})
     with pytest.raises(ValueError, match="scenario ball 'cricket' is not in the ball table"):
-        run_scenario(cricket, balls, bats, cfg["air"])
+        run_scenario(ImplicationsSettings(cricket, cfg["air"]), balls, bats)
     sc = {**cfg["scenarios"]["paper"], "bat": "oak"}
     with pytest.raises(ValueError, match="scenario bat 'oak' is not in the bat table"):
-        run_scenario(sc, balls, bats, cfg["air"])
+        run_scenario(ImplicationsSettings(sc, cfg["air"]), balls, bats)

@@ -12,13 +12,14 @@ import pytest
 import xarray as xr
 import yaml
 
-from ballbat import fitting, ingest
-from ballbat.analysis import normalize, reconstruct
+from ballbat import ingest
 from ballbat.fitting import FitStatus
 from ballbat.kinematics import ImpactFlag
 from ballbat.pipeline.config import ConfigError, validate_config
 from ballbat.pipeline.ncio import check_metadata
 from ballbat.properties import InputError, load_balls, load_bats
+from ballbat.stages import fit_ex, normalize, reconstruct
+from ballbat.stages import ingest as ingest_stage
 from ballbat.units import DEGREE, MPH, RPM
 from workflow_helpers import ROOT
 
@@ -36,6 +37,17 @@ GOOD = [  # wood bat, baseball: plausible impacts (Sec. III forward model, e_x ~
 ]
 
 
+NORM = normalize.NormalizeSettings(v_ref_mph=77.0)
+REC = reconstruct.ReconstructSettings()
+FIT = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True)
+
+
+def ingested(path, balls=BALLS, bats=BATS):
+    """The ingest stage's file of ``path`` and its warnings."""
+    ds = ingest_stage.run(ingest_stage.IngestSettings(), path, balls, bats)
+    return ds, ingest_stage.warnings(ds)
+
+
 def write_csv(path, rows, header=HEADER):
     with open(path, "w", newline="") as fh:
         w = csv.writer(fh, lineterminator="\n")
@@ -51,7 +63,7 @@ def example_rows() -> list[dict]:
 
 def problems_of(path, balls=BALLS, bats=BATS) -> list[str]:
     with pytest.raises(InputError) as exc:
-        ingest.ingest(path, balls, bats)
+        ingested(path, balls, bats)
     return exc.value.problems
 
 
@@ -67,7 +79,7 @@ def one(problems, *parts):
 
 
 def test_example_reads_clean():
-    ds, warnings = ingest.ingest(EXAMPLE, BALLS, MAPLE_BATS)
+    ds, warnings = ingested(EXAMPLE, BALLS, MAPLE_BATS)
     check_metadata(ds, "ingest")
     assert warnings == []
     assert ds.sizes["impact"] == 31 and set(ds["bat"].values) == {"maple"}
@@ -78,21 +90,21 @@ def test_example_reads_clean():
     i = int(np.flatnonzero(ds["ingest_flag"].values)[0])
     assert ds["impact_id"].values[i] == "MP31" and ds["source_row"].values[i] == "row 32"
     assert "psi cannot be reconstructed" in ds["ingest_flag_reason"].values[i]
-    assert ingest.excluded_listing(ds) == [
+    assert ingest_stage.excluded_listing(ds) == [
         "impact MP31 (row 32): alpha r omega / v_ball = 1.04: psi cannot be reconstructed (Eq. angmom)"
     ]
 
 
 def test_exclusion_reaches_reconstruct_and_is_kept_out_of_fits():
-    ds, _ = ingest.ingest(EXAMPLE, BALLS, MAPLE_BATS)
-    rec = reconstruct(normalize(ds, 77.0), load_balls(BALLS), load_bats(MAPLE_BATS))
+    ds, _ = ingested(EXAMPLE, BALLS, MAPLE_BATS)
+    rec = reconstruct.run(REC, normalize.run(NORM, ds), load_balls(BALLS), load_bats(MAPLE_BATS))
     check_metadata(rec, "reconstruct")
     excluded = rec["flag"].values == ImpactFlag.EXCLUDED_AT_INGEST
     assert excluded.sum() == 1 and (rec["flag"].values[~excluded] == 0).all()
     assert rec["flag_reason"].values[excluded][0].startswith("excluded at ingest: alpha r omega / v_ball")
     meanings = rec["flag"].attrs["flag_meanings"].split()
     assert meanings[list(rec["flag"].attrs["flag_values"]).index(4)] == "excluded_at_ingest"
-    fit = fitting.fit_dataset(rec, 0.5)
+    fit = fit_ex.run(FIT, rec)
     assert int(fit["e_x_n"].sel(ball="baseball", bat="maple")) == 30
     assert int(fit["e_x_status"].sel(ball="baseball", bat="maple")) == FitStatus.OK
     assert fit.attrs["n_excluded"] == 1
@@ -109,8 +121,8 @@ def test_netcdf_same_content(tmp_path):
         for k, v in cols.items()
     }
     xr.Dataset(data).to_netcdf(tmp_path / "maple.nc")
-    a, _ = ingest.ingest(EXAMPLE, BALLS, MAPLE_BATS)
-    b, _ = ingest.ingest(tmp_path / "maple.nc", BALLS, MAPLE_BATS)
+    a, _ = ingested(EXAMPLE, BALLS, MAPLE_BATS)
+    b, _ = ingested(tmp_path / "maple.nc", BALLS, MAPLE_BATS)
     for v in ("v_bat", "v_ball", "theta", "omega", "omega_err", "ingest_flag"):
         np.testing.assert_allclose(a[v].values, b[v].values)
     assert b["source_row"].values[3] == "entry 4"
@@ -228,7 +240,7 @@ def test_unreconstructable_psi_is_excluded_not_fatal(tmp_path):
     rows = copy.deepcopy(GOOD)
     rows.append(["A5", "wood", "baseball", "75.0", "40.0", "8.0", "30000"])  # line 6
     rows.append(["B1", "metal_rough", "baseball", "75.0", "84.0", "10.0", "1900"])
-    ds, warnings = ingest.ingest(write_csv(tmp_path / "p.csv", rows), BALLS, BATS)
+    ds, warnings = ingested(write_csv(tmp_path / "p.csv", rows), BALLS, BATS)
     assert ds["ingest_flag"].values.tolist() == [0, 0, 0, 0, 1, 0]
     assert ds["source_row"].values[4] == "row 6"
     assert "psi cannot be reconstructed" in ds["ingest_flag_reason"].values[4]
@@ -237,7 +249,7 @@ def test_unreconstructable_psi_is_excluded_not_fatal(tmp_path):
 
 def test_partial_uncertainties_warn(tmp_path):
     rows = [[*r, "0.5"] for r in GOOD]
-    _, warnings = ingest.ingest(write_csv(tmp_path / "w.csv", rows, [*HEADER, "theta_deg_err"]), BALLS, BATS)
+    _, warnings = ingested(write_csv(tmp_path / "w.csv", rows, [*HEADER, "theta_deg_err"]), BALLS, BATS)
     one(warnings, "w.csv", "only theta_deg_err of the four uncertainty columns", "unweighted")
 
 
@@ -268,7 +280,7 @@ def test_unit_mistakes_warn_naming_the_column(tmp_path, column, factor, expected
         ("theta_deg", False): "radians, not degrees",
     }[(column, factor < 0)]
     try:
-        ds, warnings = ingest.ingest(path, BALLS, MAPLE_BATS)
+        ds, warnings = ingested(path, BALLS, MAPLE_BATS)
     except ingest.InputError as exc:  # most rows implausible: the dataset stops, the column named (issue 10)
         assert "more than half: the file's units are likely wrong" in exc.problems[0]
         one(exc.problems, "units.csv", expected, hint)
@@ -289,12 +301,12 @@ def test_small_group_not_fitted(tmp_path):
         ["B1", "metal_rough", "baseball", "75.0", "84.0", "10.0", "1900"],
         ["B2", "metal_rough", "baseball", "78.0", "86.0", "12.0", "2300"],
     ]
-    ds, _ = ingest.ingest(write_csv(tmp_path / "g.csv", rows), BALLS, BATS)
-    fit = fitting.fit_dataset(reconstruct(normalize(ds, 77.0), load_balls(BALLS), load_bats(BATS)), 0.5)
+    ds, _ = ingested(write_csv(tmp_path / "g.csv", rows), BALLS, BATS)
+    fit = fit_ex.run(FIT, reconstruct.run(REC, normalize.run(NORM, ds), load_balls(BALLS), load_bats(BATS)))
     small = fit.sel(ball="baseball", bat="metal_rough")
     assert np.isnan(float(small["e_x"])) and int(small["e_x_n"]) == 2
     assert int(small["e_x_status"]) == FitStatus.TOO_FEW_IMPACTS
-    assert fitting.not_fitted(fit) == [
+    assert fit_ex.not_fitted(fit) == [
         "e_x (ball baseball, bat metal_rough): not fitted: too few impacts (2 usable impacts)"
     ]
     assert np.isfinite(float(fit["e_x"].sel(ball="baseball", bat="wood")))

@@ -13,18 +13,24 @@ import numpy as np
 import pytest
 from conftest import ROOT
 
-from ballbat.analysis import normalize, reconstruct
-from ballbat.fitting import ImplausibleFit, fit_dataset
-from ballbat.ingest import ingest
+from ballbat.fitting import ImplausibleFit
 from ballbat.kinematics import ImpactFlag
 from ballbat.properties import InputError, load_balls, load_bats
-from ballbat.synthetic import SyntheticSettings, simulate_experiment
+from ballbat.stages import fit_ex, normalize, reconstruct, simulate
+from ballbat.stages import ingest as ingest_stage
+from ballbat.synthetic import SyntheticSettings
 from ballbat.units import DEGREE, MPH, RPM
 
 MAPLE = ROOT / "config" / "examples" / "maple_impacts.csv"
 BALLS = ROOT / "config" / "balls.csv"
 MAPLE_BATS = ROOT / "config" / "examples" / "maple_bats.csv"
 RPM_PER_RAD_S = 2 * math.pi / 60
+
+
+def ingest(path, balls, bats):
+    """The ingest stage's file of ``path`` and its warnings."""
+    ds = ingest_stage.run(ingest_stage.IngestSettings(), path, balls, bats)
+    return ds, ingest_stage.warnings(ds)
 
 
 def rewritten(tmp_path, columns, factor, rows=lambda i: True):
@@ -43,8 +49,13 @@ def rewritten(tmp_path, columns, factor, rows=lambda i: True):
 
 def fitted(path):
     ds, _ = ingest(path, BALLS, MAPLE_BATS)
-    rec = reconstruct(normalize(ds, 77.0), load_balls(BALLS), load_bats(MAPLE_BATS))
-    return ds, fit_dataset(rec, 0.5)
+    rec = reconstruct.run(
+        reconstruct.ReconstructSettings(),
+        normalize.run(normalize.NormalizeSettings(v_ref_mph=77.0), ds),
+        load_balls(BALLS),
+        load_bats(MAPLE_BATS),
+    )
+    return ds, fit_ex.run(fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True), rec)
 
 
 def test_clean_file_flags_nothing():
@@ -112,7 +123,7 @@ def test_no_false_alarms_on_clean_synthetic_experiments(tmp_path, config, balls,
     flagged = 0
     for seed in range(10):
         s = SyntheticSettings(**{**config["datasets"]["synthetic"]["synthetic"], "seed": seed})
-        ds = simulate_experiment(s, balls, bats)
+        ds = simulate.run(s, balls, bats)
         path = tmp_path / f"s{seed}.csv"
         with open(path, "w", newline="") as fh:
             w = csv.writer(fh)

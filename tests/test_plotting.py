@@ -12,7 +12,8 @@ from ballbat import plotting, reporting
 from ballbat.pipeline.checked import sealed_csv
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.pipeline.products import build_dataset
-from ballbat.stronge.analysis import PUBLISHED_ETA2, STRONGE_COORDS, stronge_variables
+from ballbat.stages.stronge import STRONGE_COORDS, stronge_variables
+from ballbat.stronge.analysis import PUBLISHED_ETA2
 from ballbat.stronge.regimes import Regime
 from workflow_helpers import assert_not_blank
 

@@ -27,13 +27,13 @@ from ballbat import studies
 from ballbat.pipeline.config import block_schema, checked_block, packaged_schema, renders, validate_config
 from ballbat.properties import InputError
 from ballbat.studies import StudySettings
-from ballbat.synthetic import SyntheticSettings, simulate_experiment
+from ballbat.synthetic import SyntheticSettings
 from ballbat.tracks.data import Camera, Rig, camera_block
 from ballbat.tracks.formats.layout import DEFAULT_PATTERN
 from ballbat.tracks.io import cameras_from_config
 from ballbat.tracks.reduce import ReduceOptions
 from ballbat.tracks.render import RenderCamera, RenderSettings, settings_from_config
-from ballbat.tracks.stage import reduce_options, reduce_stage, render_stage
+from ballbat.tracks.stage import reduce_options
 from ballbat.units import DEGREE, INCH
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -440,17 +440,17 @@ def _workflow(ds: dict, tmp_path: Path, balls, bats, seed: bool = True):
     false: the dataset's own render.seed).
     """
     from ballbat.pipeline.ncio import read_dataset
+    from ballbat.stages import reduce, render, simulate
+    from ballbat.tracks.io import load_tracks
 
-    sim = simulate_experiment(SyntheticSettings(**{**ds["synthetic"], "seed": SEEDS[0]}), balls, bats)
+    sim = simulate.run(SyntheticSettings(**{**ds["synthetic"], "seed": SEEDS[0]}), balls, bats)
     sim.to_netcdf(tmp_path / "simulate.nc")
-    render = {**ds["render"], "seed": SEEDS[1]} if seed else ds["render"]  # common.smk: get_render_settings
-    tracks = render_stage(read_dataset(tmp_path / "simulate.nc"), ROOT / "config" / "balls.csv", render)
+    block = {**ds["render"], "seed": SEEDS[1]} if seed else ds["render"]  # common.smk: get_render_settings
+    tracks = render.run(settings_from_config(block), read_dataset(tmp_path / "simulate.nc"), balls)
     tracks.to_netcdf(tmp_path / "tracks.nc")
-    try:  # common.smk: get_reduce_settings
-        return reduce_stage(
-            tmp_path / "tracks.nc", None, camera_block(render), ROOT / "config" / "balls.csv",
-            ROOT / "config" / "bats.csv", "render",
-        )  # fmt: skip
+    try:  # common.smk: get_reduce_settings; the reduce rule
+        settings = reduce.ReduceSettings.from_config(camera_block(block), "render", systematics=True)
+        return reduce.run(settings, load_tracks(tmp_path / "tracks.nc", None, balls, bats), balls, bats)
     except InputError as exc:
         return exc.problems
 
@@ -530,7 +530,9 @@ def test_enabled_and_seed(config, small, balls, bats, baselines, tmp_path):
     ds["render"]["enabled"] = False
     ds = _validated(config, ds)
     replicate = studies._source(ds, SEEDS, balls, bats)
-    sim = simulate_experiment(SyntheticSettings(**{**ds["synthetic"], "seed": SEEDS[0]}), balls, bats)
+    from ballbat.stages import simulate
+
+    sim = simulate.run(SyntheticSettings(**{**ds["synthetic"], "seed": SEEDS[0]}), balls, bats)
     assert "truth_psi" in replicate and replicate.identical(sim)
     ds = copy.deepcopy(small)
     ds["render"]["seed"] = 999

@@ -12,12 +12,12 @@ to 30 deg (baseball) and 41 deg (softball).
 import numpy as np
 import pytest
 
-from ballbat.analysis import normalize, reconstruct
 from ballbat.compare import stronge_rows
 from ballbat.pipeline.ncio import read_dataset, write_dataset
-from ballbat.stronge.analysis import STRONGE_COORDS, stronge_dataset, stronge_variables
+from ballbat.stages import normalize, reconstruct, simulate, stronge
+from ballbat.stages.stronge import STRONGE_COORDS, stronge_variables
 from ballbat.stronge.regimes import Regime
-from ballbat.synthetic import SyntheticSettings, simulate_experiment
+from ballbat.synthetic import SyntheticSettings
 
 ETA2_PAPER = {"baseball": 4.75, "softball": 6.30}  # Sec. V.A
 EX_POOLED = {"baseball": (0.405, 0.010), "softball": (0.146, 0.009)}  # Eq. ex, Sec. IV
@@ -27,8 +27,11 @@ PSI_MAX_DEG = {"baseball": 30.0, "softball": 41.0}  # Table I
 @pytest.fixture(scope="module")
 def products(config, balls, bats):
     s = SyntheticSettings(**config["datasets"]["synthetic"]["synthetic"])
-    rec = reconstruct(normalize(simulate_experiment(s, balls, bats), config["normalize"]["v_ref_mph"]), balls, bats)
-    return stronge_dataset(rec, **{**config["stronge"], "n_time": 201})
+    norm = normalize.NormalizeSettings.from_config(config)
+    rec = reconstruct.run(
+        reconstruct.ReconstructSettings(), normalize.run(norm, simulate.run(s, balls, bats)), balls, bats
+    )
+    return stronge.run(stronge.StrongeSettings(**{**config["stronge"], "n_time": 201}), rec)
 
 
 def test_eta2_near_published(products):

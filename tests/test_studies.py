@@ -302,9 +302,11 @@ def test_a_replicate_and_the_workflow_reduce_alike(config, balls, bats, root, tm
     honoured by the workflow alone).
     """
     from ballbat import systematics
-    from ballbat.synthetic import SyntheticSettings, simulate_experiment
+    from ballbat.stages import reduce, render, simulate
+    from ballbat.synthetic import SyntheticSettings
     from ballbat.tracks.data import camera_block
-    from ballbat.tracks.stage import reduce_stage, render_stage
+    from ballbat.tracks.io import load_tracks
+    from ballbat.tracks.render import settings_from_config
 
     raw = copy.deepcopy(config)
     ds = _small_dataset(raw)
@@ -315,13 +317,12 @@ def test_a_replicate_and_the_workflow_reduce_alike(config, balls, bats, root, tm
     ds = validate_config(raw, schema)["datasets"]["synthetic"]
     seeds = (11, 12)
     replicate = studies._source(ds, seeds, balls, bats)
-    sim = simulate_experiment(SyntheticSettings(**{**ds["synthetic"], "seed": seeds[0]}), balls, bats)
+    sim = simulate.run(SyntheticSettings(**{**ds["synthetic"], "seed": seeds[0]}), balls, bats)
     cfg = {**ds["render"], "seed": seeds[1]}
     tracks_nc = tmp_path / "tracks.nc"
-    render_stage(sim, root / "config" / "balls.csv", cfg).to_netcdf(tracks_nc)
-    workflow = reduce_stage(
-        tracks_nc, None, camera_block(cfg), root / "config" / "balls.csv", root / "config" / "bats.csv", "render"
-    )
+    render.run(settings_from_config(cfg), sim, balls).to_netcdf(tracks_nc)
+    settings = reduce.ReduceSettings.from_config(camera_block(cfg), "render", systematics=True)
+    workflow = reduce.run(settings, load_tracks(tracks_nc, None, balls, bats), balls, bats)
     # the workflow's reduce also reduces again at +-1 sigma of each calibration (ballbat.systematics);
     # a replicate judges no systematic
     calibration = {n for n in workflow.data_vars if "systematic" in workflow[n].dims}

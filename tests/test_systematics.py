@@ -13,12 +13,11 @@ import pytest
 from test_tracks import BALLS, BATS, experiment, render, render_cfg
 
 from ballbat import systematics
-from ballbat.analysis import normalize, reconstruct
-from ballbat.fitting import FIT_FAMILIES, fit_dataset
 from ballbat.pipeline.config import checked_block
-from ballbat.stronge.analysis import stronge_dataset
+from ballbat.stages import fit_ex, normalize, reconstruct, stronge
+from ballbat.stages.fit_ex import FIT_FAMILIES
+from ballbat.stages.reduce import reduction_dataset
 from ballbat.tracks.data import camera_block
-from ballbat.tracks.reduce import reduction_dataset
 from ballbat.tracks.stage import reduce_in_memory
 
 STRONGE = {
@@ -29,6 +28,7 @@ STRONGE = {
     "n_time": 20,
 }
 SOURCE = list(systematics.SOURCES)
+FIT_SETTINGS = fit_ex.FitExSettings(0.5, systematic=True, check_physical=True)  # as the workflow's
 
 
 @functools.cache
@@ -39,9 +39,14 @@ def chain(swing=(), spin=(), rig=(), vary_e_y=False):
     cfg["rig"].update(dict(rig))
     tr, _ = render(ds, cfg, {k: ds[f"truth_{k}"].values for k in ("e_x", "e_y")})
     red, _ = reduce_in_memory(tr, camera_block(checked_block(cfg, "render")), BALLS, BATS, "test", systematics=True)
-    rec = reconstruct(normalize(reduction_dataset(red), 77.0), BALLS, BATS)
-    fit = fit_dataset(rec, mu_k_example=0.5)
-    st = stronge_dataset(rec, vary_e_y=vary_e_y, vary_mu=False, **STRONGE)
+    rec = reconstruct.run(
+        reconstruct.ReconstructSettings(),
+        normalize.run(normalize.NormalizeSettings(77.0), reduction_dataset(red)),
+        BALLS,
+        BATS,
+    )
+    fit = fit_ex.run(FIT_SETTINGS, rec)
+    st = stronge.run(stronge.StrongeSettings(vary_e_y=vary_e_y, vary_mu=False, **STRONGE), rec)
     return rec, fit, st
 
 
@@ -143,8 +148,8 @@ def test_no_shifts_no_systematics():
         [v for v in rec.data_vars if v.endswith("_shift")]
         + ["systematic_rel_sigma", "v_bat_err_scale", "v_ball_err_scale"]
     )
-    fit = fit_dataset(bare, mu_k_example=0.5)
-    st = stronge_dataset(bare, vary_e_y=False, vary_mu=False, **STRONGE)
+    fit = fit_ex.run(FIT_SETTINGS, bare)
+    st = stronge.run(stronge.StrongeSettings(vary_e_y=False, vary_mu=False, **STRONGE), bare)
     for ds in (fit, st):
         assert not [v for v in ds.data_vars if "syst" in v or "err_scale" in v]
 

@@ -10,9 +10,12 @@ import pytest
 from ballbat.pipeline.config import checked_block
 from ballbat.pipeline.ncio import read_dataset, write_dataset
 from ballbat.properties import load_balls, load_bats
-from ballbat.synthetic import SyntheticSettings, simulate_experiment
-from ballbat.tracks.io import load_tracks, tracks_dataset
-from ballbat.tracks.reduce import FLAG_VAR, ReduceFlag, reduce_tracks, reduction_dataset
+from ballbat.stages import simulate
+from ballbat.stages.reduce import reduction_dataset
+from ballbat.stages.render import tracks_dataset
+from ballbat.synthetic import SyntheticSettings
+from ballbat.tracks.io import load_tracks
+from ballbat.tracks.reduce import FLAG_VAR, ReduceFlag, reduce_tracks
 from ballbat.tracks.render import render_tracks, settings_from_config
 from ballbat.units import RPM
 
@@ -57,7 +60,7 @@ def experiment(seed=0, per_bat=8):
         e_x_scatter=0.0,
         noise={"v_bat_mph": 0.5, "v_ball_mph": 0.5, "theta_deg": 0.5, "omega_rpm": 75.0},
     )
-    return simulate_experiment(settings, BALLS, BATS)
+    return simulate.run(settings, BALLS, BATS)
 
 
 def render(ds, cfg, truth_over=None):
@@ -298,8 +301,7 @@ def test_noisy_tracking_finds_every_impact_and_keeps_v_bat_unbiased():
 
 def test_pixel_scale_systematic_reaches_e_x():
     """m_per_px_err gives e_x a systematic error: the shift of e_x when the scale is off by that much."""
-    from ballbat.analysis import normalize, reconstruct
-    from ballbat.fitting import fit_dataset
+    from ballbat.stages import fit_ex, normalize, reconstruct
 
     ds = experiment(11, per_bat=20)
 
@@ -310,7 +312,13 @@ def test_pixel_scale_systematic_reaches_e_x():
         cam = replace(s.swing.camera, m_per_px=s.swing.camera.m_per_px * scale)
         spin = replace(s.spin.camera, m_per_px=s.spin.camera.m_per_px * scale)
         red = reduction_dataset(reduce(tr, s, swing=cam, spin=spin))
-        return fit_dataset(reconstruct(normalize(red, 77.0), BALLS, BATS), mu_k_example=0.5)
+        rec = reconstruct.run(
+            reconstruct.ReconstructSettings(),
+            normalize.run(normalize.NormalizeSettings(v_ref_mph=77.0), red),
+            BALLS,
+            BATS,
+        )
+        return fit_ex.run(fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True), rec)
 
     base, sys1, sys2 = fit(0.0), fit(0.01), fit(0.02)
     assert "e_x_err_scale" in sys1 and "e_x_pooled_err_scale" in sys1

@@ -13,10 +13,11 @@ import pytest
 from test_tracks import BALLS, BATS, experiment, render, render_cfg
 
 from ballbat.properties import InputError
+from ballbat.stages.reduce import reduction_dataset
 from ballbat.tracks.checks import cross_check
 from ballbat.tracks.data import CameraTracks, Rig, to_long
 from ballbat.tracks.io import cameras_from_config, load_tracks
-from ballbat.tracks.reduce import ReduceFlag, reduce_tracks, reduction_dataset
+from ballbat.tracks.reduce import ReduceFlag, reduce_tracks
 
 
 @pytest.fixture(scope="module")
@@ -137,7 +138,7 @@ def test_ball_rows_filed_under_the_other_camera(rendered):
 def test_frame_number_typo_in_netcdf_names_the_row(tmp_path, rendered):
     """The same in a NetCDF tracks file (the fast path of well-formed files)."""
     from ballbat.pipeline.ncio import write_dataset
-    from ballbat.tracks.io import tracks_dataset
+    from ballbat.stages.render import tracks_dataset
 
     tr, _ = rendered
     ds = tracks_dataset(tr)

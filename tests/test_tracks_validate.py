@@ -200,11 +200,17 @@ def test_shipped_example_reduces():
     """config/examples/tracked.yaml: 12 impacts, the one with a tilted spin axis (W04) excluded."""
     import yaml
 
-    from ballbat.tracks.stage import reduce_stage
+    from ballbat.properties import load_balls, load_bats
+    from ballbat.stages import reduce
+    from ballbat.tracks.io import load_tracks
 
     with open("config/examples/tracked.yaml") as fh:
         cfg = checked_block(yaml.safe_load(fh)["datasets"]["tracked"]["tracks"], "tracks")
-    ds = reduce_stage(cfg["file"], cfg["impacts"], cfg, "config/balls.csv", "config/bats.csv", "tracked")
+    balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
+    tracks = load_tracks(cfg["file"], cfg["impacts"], balls, bats)
+    settings = reduce.ReduceSettings.from_config(cfg, "tracked", systematics=True)
+    ds = reduce.run(settings, tracks, balls, bats, source_file=cfg["file"])
+    assert ds.attrs["source_file"] == cfg["file"]
     flagged = ds["impact_id"].values[ds["ingest_flag"].values != 0]
     assert list(flagged) == ["W04"]
     assert ds.sizes["impact"] == 12

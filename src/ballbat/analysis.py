@@ -1,7 +1,8 @@
-"""Per-impact analysis stages: normalisation to the reference bat speed and psi reconstruction (Secs. II-III).
+"""Per-impact analysis: normalisation to the reference bat speed and psi reconstruction (Secs. II-III).
 
 Each function takes the impacts as an :class:`xarray.Dataset` (dimension ``impact``, SI
-units) and returns a copy with new variables, every one with units and a long name.
+units) and returns the new per-impact arrays by name; the stages :mod:`ballbat.stages.normalize`
+and :mod:`ballbat.stages.reconstruct` declare them and add them to the file.
 Nothing is dropped: impacts that cannot be reconstructed keep their row, with ``flag`` > 0
 and the reason in ``flag_reason``.
 """
@@ -22,17 +23,7 @@ from .kinematics import (
     vtf_bracket,
     vtf_ordinate,
 )
-from .pipeline.products import Var, add_variables, flag_attrs
 from .properties import Ball, Bat, recoil_factors
-from .units import MPH
-
-#: Variables that ``normalize`` adds.
-NORMALIZE_TABLE = {
-    "omega_norm": Var(("impact",), "rad s-1", "spin normalised to the reference bat speed"),
-    "omega_norm_err": Var(("impact",), "rad s-1", "standard uncertainty of normalised spin"),
-    "v_ball_norm": Var(("impact",), "m s-1", "exit speed normalised to the reference bat speed"),
-    "v_ball_norm_err": Var(("impact",), "m s-1", "standard uncertainty of normalised exit speed"),
-}
 
 
 def impact_labels(ds: xr.Dataset) -> np.ndarray:
@@ -52,14 +43,12 @@ def impact_labels(ds: xr.Dataset) -> np.ndarray:
     return np.array(out, dtype=str)
 
 
-def normalize(ds: xr.Dataset, v_ref_mph: float) -> xr.Dataset:
-    """Add spin and exit speed normalised to the reference bat speed (Sec. II, Figs. 3-4).
+def normalize_values(ds: xr.Dataset, v_ref: float) -> dict[str, np.ndarray]:
+    """Return spin and exit speed normalised to the reference bat speed (Sec. II, Figs. 3-4).
 
-    Adds ``omega_norm`` and ``v_ball_norm`` (and their propagated standard uncertainties
-    when the measurements carry ``*_err``): value * v_ref / v_bat, with v_ref =
-    ``v_ref_mph`` (the config's value, in mph) recorded in SI as the attribute ``v_ref``.
+    ``omega_norm`` and ``v_ball_norm`` (and their propagated standard uncertainties
+    when the measurements carry ``*_err``): value * v_ref / v_bat, v_ref in m s-1.
     """
-    v_ref = v_ref_mph * MPH
     values = {}
     for k in ("omega", "v_ball"):
         val = normalize_to_bat_speed(ds[k].values, ds["v_bat"].values, v_ref)
@@ -69,41 +58,13 @@ def normalize(ds: xr.Dataset, v_ref_mph: float) -> xr.Dataset:
                 ds[f"{k}_err"].values * v_ref / ds["v_bat"].values,
                 np.abs(val) * ds["v_bat_err"].values / ds["v_bat"].values,
             )
-    out = add_variables(ds, NORMALIZE_TABLE, values)
-    out.attrs["v_ref"] = float(v_ref)
-    out.attrs["v_ref_units"] = "m s-1"
-    return out
+    return values
 
 
-#: Variables that ``reconstruct`` adds.
-RECONSTRUCT_TABLE = {
-    "r": Var(("impact",), "m", "ball radius"),
-    "m": Var(("impact",), "kg", "ball mass"),
-    "alpha": Var(("impact",), "1", "ball moment of inertia over m r^2 (Eq. iball)"),
-    "R_bat": Var(("impact",), "m", "bat radius R at the impact location (Table II)"),
-    "r_x": Var(("impact",), "1", "tangential recoil factor r_x (Eq. rx)"),
-    "r_y": Var(("impact",), "1", "normal recoil factor r_y (Eq. ry)"),
-    "psi": Var(("impact",), "rad", "impact angle psi reconstructed from Eq. angmom"),
-    "flag": Var(("impact",), "1", "reconstruction flag (0: usable)", flag_attrs(ImpactFlag)),
-    "flag_reason": Var(("impact",), None, "why the impact is not used (ok if it is)"),
-    "D": Var(("impact",), "m", "ball-bat offset D (Eq. D)"),
-    "v_n": Var(("impact",), "m s-1", "normal component of the exit velocity"),
-    "v_t": Var(("impact",), "m s-1", "tangential component of the exit velocity"),
-    "v_bat_n": Var(("impact",), "m s-1", "normal component of the bat velocity"),
-    "spin_bracket": Var(("impact",), "rad s-1", "bracket of Eq. omega: v_bat sin psi / (r (1 + r_x)(1 + alpha))"),
-    "vtf_x": Var(("impact",), "1", "bracket of Eq. vtf: tan psi / (1 + r_x)"),
-    "vtf_y": Var(("impact",), "1", "left side of Eq. vtf: (v_ball,t + r omega) / v_bat,n"),
-    "tan_psi": Var(("impact",), "1", "tan psi (Fig. 6 abscissa)"),
-    "tan_psi_minus_theta": Var(
-        ("impact",), "1", "tan(psi - theta) = v_ball,t / v_ball,n (Eqs. muk, ratio; Fig. 6 ordinate)"
-    ),
-}
-
-
-def reconstruct(ds: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]) -> xr.Dataset:
+def reconstruct_values(ds: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]) -> dict[str, np.ndarray]:
     """Reconstruct psi and the Sec. III quantities of every impact.
 
-    Adds the ball and bat properties used (r, alpha, R, r_x, r_y), psi (Eq. angmom), the
+    Returns the ball and bat properties used (r, alpha, R, r_x, r_y), psi (Eq. angmom), the
     flag and its reason, D (Eq. D), v_n and v_t, and the bracket terms of Eq. omega
     (``spin_bracket``) and Eq. vtf (``vtf_x``, with the left side ``vtf_y``), plus
     tan(psi - theta) of Eq. ratio.
@@ -140,7 +101,7 @@ def reconstruct(ds: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]) ->
         "flag_reason": reasons,
     }
     values.update(geometry)
-    return add_variables(ds, RECONSTRUCT_TABLE, values)
+    return values
 
 
 def _geometry(ds: xr.Dataset, r, alpha, r_x, R) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:
@@ -162,7 +123,7 @@ def _geometry(ds: xr.Dataset, r, alpha, r_x, R) -> tuple[np.ndarray, np.ndarray,
     return psi, flag, geometry
 
 
-def reconstruct_again(rec: xr.Dataset) -> xr.Dataset:
+def reconstruct_again_values(rec: xr.Dataset) -> dict[str, np.ndarray]:
     """Recompute psi and the derived Sec. III quantities of a reconstructed dataset whose measured values changed.
 
     The ball and bat properties are those ``reconstruct`` stored per impact (r, alpha, r_x,
@@ -171,4 +132,4 @@ def reconstruct_again(rec: xr.Dataset) -> xr.Dataset:
     """
     values = {k: rec[k].values for k in ("r", "alpha", "r_x", "R_bat")}
     psi, _, geometry = _geometry(rec, values["r"], values["alpha"], values["r_x"], values["R_bat"])
-    return add_variables(rec, RECONSTRUCT_TABLE, {"psi": psi, **geometry})
+    return {"psi": psi, **geometry}

@@ -1,7 +1,7 @@
 """The ``ballbat`` command: everyday questions without editing a config.
 
 ``ballbat check FILE`` validates a measured impacts file exactly as the workflow's ``ingest``
-rule does (the same function, :func:`ballbat.ingest.ingest`); ``ballbat fly`` flies batted
+rule does (the same function, :func:`ballbat.stages.ingest.run`); ``ballbat fly`` flies batted
 balls with Nathan's trajectory model (:func:`ballbat.flight.fly`), one from options or many
 from a CSV file; ``ballbat summary results/{dataset}`` prints a dataset's headline numbers; ``ballbat import-tracks``
 reads Tracker or Kinovea files into the long tracks CSV (:mod:`ballbat.tracks.formats`).
@@ -10,7 +10,8 @@ place the workflow's defaults live. Errors are one line naming the bad argument 
 ``check`` exits 1 when the file is not usable.
 
 ``ballbat check --kind tracks --config YAML`` checks raw camera tracks as the ``reduce`` rule
-does (the same function, :func:`ballbat.tracks.stage.reduce_checked`).
+does (the same steps: read and check the files, reduce, cross-check;
+:func:`ballbat.tracks.stage.reduce_checked`).
 """
 
 from __future__ import annotations
@@ -128,9 +129,9 @@ def _range_problem(val: float, limits: dict, unit: str) -> str | None:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Validate a measured impacts file as the ingest rule does; print every problem and warning."""
-    from .fitting import fit_problems
-    from .ingest import excluded_listing, ingest
     from .properties import InputError, load_balls, load_bats
+    from .stages import ingest
+    from .stages.fit_ex import fit_problems
 
     defaults = _schema_defaults()["tables"]
     if args.kind == "tracks" and args.file is None:
@@ -149,7 +150,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     if args.impacts:
         raise UsageError("argument --impacts: only with --kind tracks (the impact table of a tracks file)")
     try:
-        ds, warnings = ingest(path, balls_path=args.balls or defaults["balls"], bats_path=args.bats or defaults["bats"])
+        ds = ingest.run(
+            ingest.IngestSettings(), path, balls=args.balls or defaults["balls"], bats=args.bats or defaults["bats"]
+        )
+        warnings = ingest.warnings(ds)
     except InputError as exc:
         for problem in exc.problems:
             print(problem)
@@ -163,7 +167,7 @@ def cmd_check(args: argparse.Namespace) -> int:
         return 1
     for text in warnings:
         print(f"warning: {text}")
-    for line in excluded_listing(ds):
+    for line in ingest.excluded_listing(ds):
         print(f"excluded: {line}")
     print(
         f"{path}: usable: {ds.sizes['impact']} impacts, {int(ds.attrs['n_excluded'])} excluded, "
@@ -224,7 +228,7 @@ def _reduce_tool_files(block: dict, where: str, balls_path: str, bats_path: str)
 def _check_tracks(path: Path | None, args: argparse.Namespace, defaults: dict) -> int:
     """Check raw tracks as the workflow's reduce rule does: read, validate, reduce, cross-check.
 
-    With ``--config``: the same function as the reduce rule (:func:`ballbat.tracks.stage.reduce_checked`),
+    With ``--config``: the reduce rule's steps (:func:`ballbat.tracks.stage.reduce_checked`),
     then what the workflow would do with every impact; exit 1 when the dataset would stop or
     a ball would have fewer than three usable impacts. Without: the files are only read.
     """

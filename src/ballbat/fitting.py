@@ -1,11 +1,11 @@
 """Sec. IV of one dataset: e_x per bat and ball (Eq. omega), Eq. ratio, Eq. muk and Figs. 3-4 slopes.
 
-:func:`analyze_impacts` computes (a :class:`Sec4` of arrays and line fits);
-:func:`results_dataset` assembles the fit_ex.nc file from the declared table
-:func:`fit_ex_table`. Every fit is a straight line fitted with lmfit (:mod:`ballbat.linefit`)
-on a design of :mod:`ballbat.designs`. Measurement uncertainties enter through
-the *effective variance* of each impact's residual: the abscissa and the ordinate are
-both functions of the measured (v_bat, v_ball, theta, omega), so the residual
+:func:`analyze_impacts` computes (a :class:`Sec4` of arrays and line fits); the stage
+:mod:`ballbat.stages.fit_ex` declares the fit_ex.nc file and assembles it. Every fit is a
+straight line fitted with lmfit (:mod:`ballbat.linefit`) on a design of :mod:`ballbat.designs`.
+Measurement uncertainties enter through the *effective variance* of each impact's residual:
+the abscissa and the ordinate are both functions of the measured (v_bat, v_ball, theta,
+omega), so the residual
 y - (a + s x) has variance sum_k (dy/dm_k - s dx/dm_k)^2 sigma_k^2 over the measured
 quantities m_k (correlations between x and y through psi included). The weights depend
 on the slope, so the fit is iterated (three passes converge to far below the standard
@@ -43,7 +43,6 @@ import numpy as np
 from .designs import MEASURED, Measured, measured_sigma, normalized_theta_design, spin_design, tan_ratio_design
 from .kinematics import gross_slip_onset, normalize_to_bat_speed, tan_ratio_slope_model
 from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, wls_slope
-from .pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -395,122 +394,6 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
     return res
 
 
-# ---------------------------------------------------------------------------------------
-# fit_ex.nc: the declared table and its assembly
-
-#: The line-fit families of fit_ex.nc: name -> (dims, units, what).
-FIT_FAMILIES = {
-    "e_x": (("ball", "bat"), "1", "tangential coefficient of restitution e_x per bat and ball (Eq. omega)"),
-    "e_x_pooled": (("ball",), "1", "tangential coefficient of restitution e_x pooled over bats (Eq. ex, Fig. 5)"),
-    "tan_ratio_slope": (("ball",), "1", "slope of tan(psi - theta) against tan psi (Eq. ratio, Fig. 6)"),
-    "spin_theta_slope": (("ball",), "rad s-1 rad-1", "slope of normalised spin against theta (Fig. 3)"),
-    "speed_theta_slope": (("ball",), "m s-1 rad-1", "slope of normalised exit speed against theta (Fig. 4)"),
-}
-
-#: Families whose fitted slope is 1 + e_x (Eq. omega): the file holds e_x = slope - 1.
-_SLOPE_IS_ONE_PLUS = ("e_x", "e_x_pooled")
-
-
-def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) -> dict[str, Var]:
-    """Return the variables of fit_ex.nc, declared once (name -> :class:`Var`).
-
-    ``has_scale``: the dataset carries a pixel-scale uncertainty (reduced from camera
-    tracks), so e_x gets a systematic error (``*_err_scale``).
-    """
-    table: dict[str, Var] = {}
-    for name, (dims, units, what) in FIT_FAMILIES.items():
-        table.update(estimate_vars(name, dims, units, what))
-        if has_scale and name in _SLOPE_IS_ONE_PLUS:
-            table[f"{name}_err_scale"] = Var(
-                dims,
-                units,
-                f"systematic error of {name} from the pixel-scale uncertainty of the swing camera "
-                "(shared by every impact; not included in the standard error)",
-            )
-        if has_truth:
-            table[f"truth_{name}"] = Var(
-                dims, units, f"true {what} (same estimator on the noise-free truth)", {"ballbat_role": "truth"}
-            )
-    for name in ("spin_theta_slope", "speed_theta_slope"):
-        units = FIT_FAMILIES[name][1].replace(" rad-1", "")
-        table[f"{name}_intercept"] = Var(("ball",), units, f"intercept at theta = 0 of the fit of {name}")
-    for name in _SLOPE_IS_ONE_PLUS:
-        dims = FIT_FAMILIES[name][0]
-        table[f"{name}_status"] = Var(
-            dims, "1", f"why {name} has no value (0: it has one; the count is {name}_n)", flag_attrs(FitStatus)
-        )
-    table["e_y_implied"] = Var(
-        ("ball",),
-        "1",
-        "normal COR e_y implied by the Eq. ratio slope (each impact's r_x, r_y and its bat's e_x)",
-        {"ancillary_variables": "e_y_implied_err"},
-    )
-    table["e_y_implied_err"] = Var(
-        ("ball",), "1", "standard error of e_y implied (sandwich: the impacts' influences via the slope and e_x)"
-    )
-    table["mu_k_lower_bound"] = Var(
-        ("ball",),
-        "1",
-        "lower bound on mu_k: largest tan(psi - theta) (Eq. muk)",
-        {"ancillary_variables": "mu_k_lower_bound_err mu_k_lower_bound_impact"},
-    )
-    table["mu_k_lower_bound_err"] = Var(
-        ("ball",),
-        "1",
-        "measurement uncertainty of that largest tan(psi - theta) (not the spread of a sample maximum: "
-        "it says how well the largest value of these impacts is measured)",
-    )
-    table["mu_k_lower_bound_impact"] = Var(("ball",), "1", "impact number of the largest tan(psi - theta)")
-    for nm, units, what in (
-        ("psi", "rad", "impact angle psi"),
-        ("theta", "rad", "angle theta"),
-        ("omega", "rad s-1", "spin at the reference bat speed"),
-    ):
-        table[f"gross_slip_{nm}"] = Var(
-            ("ball",), units, f"{what} where gross slip sets in for mu_k = {mu_k_example} (Sec. IV)"
-        )
-    if has_truth:
-        for q in ("e_y_implied", "mu_k_lower_bound"):
-            table[f"truth_{q}"] = Var(("ball",), "1", f"true {q.replace('_', ' ')}", {"ballbat_role": "truth"})
-    return table
-
-
-def results_dataset(res: Sec4) -> xr.Dataset:
-    """fit_ex.nc's contents: the :class:`Sec4` results on the declared table (dims ball, bat)."""
-    values: dict[str, np.ndarray] = {}
-    for name in FIT_FAMILIES:
-        grid: FitGrid = getattr(res, name)
-        shift = -1.0 if name in _SLOPE_IS_ONE_PLUS else 0.0
-        values[name] = grid.field("slope", shift)
-        values[f"{name}_err"] = grid.field("slope_err")
-        values[f"{name}_ci_low"] = grid.field("slope_ci_low", shift)
-        values[f"{name}_ci_high"] = grid.field("slope_ci_high", shift)
-        values[f"{name}_n"] = grid.field("n").astype(np.int64)
-        values[f"{name}_redchi"] = grid.field("redchi")
-        if res.has_truth:
-            values[f"truth_{name}"] = grid.truth
-    for name in ("spin_theta_slope", "speed_theta_slope"):
-        values[f"{name}_intercept"] = getattr(res, name).field("intercept")
-    for name in _SLOPE_IS_ONE_PLUS:
-        values[f"{name}_status"] = np.vectorize(lambda f: int(fit_status(f)), otypes=[np.int8])(getattr(res, name).fits)
-    values.update({k: v for k, v in res.per_ball.items() if res.has_truth or not k.startswith("truth_")})
-    if res.systematic is not None:
-        values.update(res.systematic)
-    coords = {
-        "ball": (Var(("ball",), None, "ball type"), np.array(res.balls, dtype=str)),
-        "bat": (Var(("bat",), None, "bat"), np.array(res.bats, dtype=str)),
-    }
-    from .systematics import add_fit_systematics
-
-    ds = build_dataset(
-        fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None),
-        values,
-        coords,
-        {"mu_k_example": res.mu_k_example},
-    )
-    return add_fit_systematics(ds, res.systematics)
-
-
 #: Physical bounds of a tangential COR: |u_final| <= |u_initial| (no tangential energy gain).
 E_X_BOUNDS = (-1.0, 1.0)
 
@@ -534,50 +417,3 @@ def check_physical(res: Sec4, source: str = "fit_ex") -> None:
             "collision gives such a value: check the units and the spin sign of the measurements (mph, deg, "
             "rpm; omega > 0 is backspin)."
         )
-
-
-def fit_dataset(impacts: xr.Dataset, mu_k_example: float) -> xr.Dataset:
-    """Return the Sec. IV fits of a reconstructed dataset, as a Dataset ready to write.
-
-    Raises :class:`ImplausibleFit` when a fitted e_x lies outside [-1, 1] (an error for the
-    dataset, not a note: such a number is always a mistake in the data).
-    """
-    res = analyze_impacts(impacts, mu_k_example)
-    check_physical(res)
-    ds = results_dataset(res)
-    ds.attrs["n_impacts"] = int(impacts.sizes["impact"])
-    ds.attrs["n_excluded"] = int((impacts["flag"].values != 0).sum())
-    ds.attrs["v_ref"] = float(impacts.attrs["v_ref"])
-    ds.attrs.update(carried_warnings(impacts))
-    return ds
-
-
-def not_fitted(ds: xr.Dataset) -> list[str]:
-    """List the fits of e_x in fit_ex.nc that have impacts but no value, one line each (for the log)."""
-    lines = []
-    for name in _SLOPE_IS_ONE_PLUS:
-        status, n = ds[f"{name}_status"], ds[f"{name}_n"]
-        for idx in zip(*np.nonzero(status.values > FitStatus.NO_IMPACTS), strict=True):
-            where = ", ".join(f"{d} {ds[d].values[i]}" for d, i in zip(status.dims, idx, strict=True))
-            reason = FitStatus(int(status.values[idx])).name.lower().replace("_", " ")
-            lines.append(f"{name} ({where}): not fitted: {reason} ({int(n.values[idx])} usable impacts)")
-    return lines
-
-
-def fit_problems(ds: xr.Dataset, balls: dict, bats: dict) -> list[str]:
-    """Return why the workflow's fit_ex would stop on these impacts (empty when it would not).
-
-    The same chain as the workflow's (normalize, reconstruct, the Sec. IV fits) and the same
-    test (:func:`ballbat.fitting.check_physical`: every fitted e_x in [-1, 1]), so that
-    ``ballbat check`` never calls usable a file that fit_ex refuses (the ingest job itself
-    stays light: it imports no fitting). The
-    reference bat speed and the friction of the Sec. IV example do not enter e_x.
-    """
-    from .analysis import normalize, reconstruct
-
-    rec = reconstruct(normalize(ds, v_ref_mph=77.0), balls, bats)
-    try:
-        check_physical(analyze_impacts(rec, mu_k_example=0.5, systematic=False), source="the fit of e_x (fit_ex)")
-    except ImplausibleFit as exc:
-        return [str(exc)]
-    return []

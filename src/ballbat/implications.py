@@ -15,19 +15,20 @@ References
 from __future__ import annotations
 
 import itertools
+from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
 from .collision import pitched_ball_collision
-from .flight import air_density, fly
-from .pipeline.products import variable
+from .flight import FlightResult, air_density, fly
 from .properties import Ball, Bat
 from .units import DEGREE, FOOT, INCH, INHG_IN_MMHG, MPH, RPM, fahrenheit_to_celsius
 
 if TYPE_CHECKING:
     import os
+
+    import xarray as xr
 
 LAUNCH_KEYS = ("exit_speed_mph", "launch_deg", "spray_deg", "backspin_rpm", "sidespin_rpm")
 
@@ -70,10 +71,21 @@ def launch_conditions(launch: dict) -> dict:
     }
 
 
+@dataclass(frozen=True)
+class ScenarioResult:
+    """One scenario's cases (SI): launch conditions, the D sweep's collisions (None: none) and the flights."""
+
+    launch: dict[str, np.ndarray]
+    sweep: dict[str, np.ndarray] | None
+    flight: FlightResult
+    e_x: float
+    air_density: float
+
+
 def run_scenario(
     scenario: dict, balls: dict[str, Ball], bats: dict[str, Bat], air: dict, e_x: float | None = None
-) -> xr.Dataset:
-    """Run one scenario; return an xarray Dataset with one entry per case.
+) -> ScenarioResult:
+    """Run one scenario, one entry per case (the stage :mod:`ballbat.stages.implications` writes it).
 
     Parameters
     ----------
@@ -94,7 +106,7 @@ def run_scenario(
     if "sweep" in scenario:
         launch, data = _sweep(scenario, ball, bats[scenario["bat"]], e_x_used)
     else:
-        launch, data = launch_conditions(scenario["launch"]), {}
+        launch, data = launch_conditions(scenario["launch"]), None
     res = fly(
         launch["exit_speed"],
         launch["launch_angle"],
@@ -109,36 +121,14 @@ def run_scenario(
         method=flight["method"],
         n_points=int(flight["n_points"]),
     )
-    n = np.size(launch["exit_speed"])
-    coords = {
-        "case": ("case", np.arange(n, dtype=np.int64), {"units": "1", "long_name": "case number"}),
-        "point": (
-            "point",
-            np.arange(res.points.shape[-2], dtype=np.int64),
-            {"units": "1", "long_name": "trajectory sample"},
-        ),
-    }
-    data.update(_flight_variables(launch, res))
-    ds = xr.Dataset(data, coords=coords)
-    ds.attrs.update(
-        {
-            "ball": scenario["ball"],
-            "bat": scenario.get("bat", ""),
-            "kind": "D sweep" if "sweep" in scenario else "launch conditions",
-            "e_x": e_x_used,
-            "air_density": rho,
-            "air_density_units": "kg m-3",
-            "flight_method": flight["method"],
-        }
-    )
-    return ds
+    return ScenarioResult(launch, data, res, e_x_used, rho)
 
 
 def _sweep(scenario: dict, ball: Ball, bat: Bat, e_x: float) -> tuple[dict, dict]:
     """Collide the pitched ball with the bat over the scenario's sweep of D (Sec. V.B).
 
-    Returns the launch conditions (SI, one per D) and the sweep's own variables (D, psi, the
-    friction the impacts need).
+    Returns the launch conditions (SI, one per D) and the sweep's own arrays (D, psi, the
+    friction the impacts need and whether it exceeds mu).
     """
     sw = scenario["sweep"]
     D = np.linspace(sw["D_in"]["start"], sw["D_in"]["stop"], int(sw["D_in"]["num"])) * INCH
@@ -163,41 +153,8 @@ def _sweep(scenario: dict, ball: Ball, bat: Bat, e_x: float) -> tuple[dict, dict
         "backspin": col.backspin,
         "sidespin": np.zeros(n),
     }
-    data = {
-        "D": variable("case", D, "m", "ball-bat offset D (along the relative velocity)"),
-        "psi": variable("case", col.psi, "rad", "impact angle psi"),
-        "friction_ratio": variable("case", col.friction_ratio, "1", "required friction |J_t / J_n|"),
-        "exceeds_mu": variable(
-            "case",
-            col.exceeds_mu.astype(np.int8),
-            "1",
-            f"1 where the impact needs more friction than mu = {scenario['mu']} (e_x model kept as is)",
-            flag_values=np.array([0, 1], dtype=np.int8),
-            flag_meanings="within_friction needs_more_friction_than_mu",
-        ),
-    }
+    data = {"D": D, "psi": col.psi, "friction_ratio": col.friction_ratio, "exceeds_mu": col.exceeds_mu.astype(np.int8)}
     return launch, data
-
-
-def _flight_variables(launch: dict, res) -> dict:
-    """Return the variables of the launch conditions and of the flights (:func:`ballbat.flight.fly`)."""
-    data = {}
-    data["exit_speed"] = variable("case", launch["exit_speed"], "m s-1", "exit speed of the batted ball")
-    data["launch_angle"] = variable("case", launch["launch_angle"], "rad", "launch angle above the horizontal")
-    data["spray_angle"] = variable(
-        "case", launch["spray_angle"], "rad", "spray angle from centre field toward first base"
-    )
-    data["backspin"] = variable("case", launch["backspin"], "rad s-1", "backspin (negative: topspin)")
-    data["sidespin"] = variable("case", launch["sidespin"], "rad s-1", "sidespin (positive curves toward third base)")
-    data["carry"] = variable("case", res.carry, "m", "carry: horizontal distance from home plate at landing")
-    data["apex"] = variable("case", res.apex, "m", "apex height above the ground")
-    data["hang_time"] = variable("case", res.hang_time, "s", "hang time")
-    data["landing_x"] = variable("case", res.landing[..., 0], "m", "landing point x (toward first base)")
-    data["landing_y"] = variable("case", res.landing[..., 1], "m", "landing point y (toward centre field)")
-    data["trajectory_t"] = variable(("case", "point"), res.t, "s", "time since contact")
-    for i, axis in enumerate("xyz"):
-        data[f"trajectory_{axis}"] = variable(("case", "point"), res.points[..., i], "m", f"trajectory {axis}")
-    return data
 
 
 def comparison_rows(ds: xr.Dataset) -> list[dict]:

@@ -2,10 +2,11 @@
 
 A measured dataset is a CSV file (or a NetCDF file with the same content) with one row per
 impact and the columns of :data:`REQUIRED` in the paper's units (mph, deg, rpm), optional
-``impact_id`` and optional per-row standard uncertainties ``<column>_err``. :func:`ingest`
-checks the file whole against the ball and bat tables and returns the impacts in SI with
-the variable names of a synthetic experiment (``v_bat``, ``v_ball``, ``theta``, ``omega``
-and ``*_err``), so every later stage treats both alike.
+``impact_id`` and optional per-row standard uncertainties ``<column>_err``. :func:`read_measured`
+checks the file whole against the ball and bat tables and returns the impacts in SI; the
+stage :mod:`ballbat.stages.ingest` writes them with the variable names of a synthetic
+experiment (``v_bat``, ``v_ball``, ``theta``, ``omega`` and ``*_err``), so every later
+stage treats both alike.
 
 Two kinds of problems (docs/ingest.md):
 
@@ -48,7 +49,6 @@ from .kinematics import (
     spin_bracket,
 )
 from .linefit import MIN_FIT_IMPACTS
-from .pipeline.products import flag_attrs, variable
 from .properties import (
     EXTRA,
     Ball,
@@ -74,14 +74,14 @@ if TYPE_CHECKING:
 #: Required columns of an impacts file.
 REQUIRED = ("bat", "ball", "v_bat_mph", "v_ball_mph", "theta_deg", "omega_rpm")
 
-#: Measured columns: file column -> (variable in SI, factor to SI, long name).
+#: Measured columns: file column -> (variable in SI, factor to SI); the variables are declared
+#: in the impacts table (:data:`ballbat.stages.impacts.IMPACTS`).
 MEASURED_COLUMNS = {
-    "v_bat_mph": ("v_bat", MPH, "bat speed at the impact point"),
-    "v_ball_mph": ("v_ball", MPH, "exit speed of the ball"),
-    "theta_deg": ("theta", DEGREE, "angle of the batted ball from the bat's direction of travel"),
-    "omega_rpm": ("omega", RPM, "spin of the batted ball (positive: backspin, Fig. 2)"),
+    "v_bat_mph": ("v_bat", MPH),
+    "v_ball_mph": ("v_ball", MPH),
+    "theta_deg": ("theta", DEGREE),
+    "omega_rpm": ("omega", RPM),
 }
-SI_UNITS = {"v_bat": "m s-1", "v_ball": "m s-1", "theta": "rad", "omega": "rad s-1"}
 
 #: Optional columns: an impact's own id and the standard uncertainty of each measurement.
 OPTIONAL = ("impact_id", *(f"{c}_err" for c in MEASURED_COLUMNS))
@@ -566,27 +566,40 @@ def unit_warnings(path: str | os.PathLike[str], m: Measured) -> list[str]:
 # The whole file
 
 
-def ingest(
+@dataclass(frozen=True)
+class Ingested:
+    """A measured file read and checked (:func:`read_measured`), one entry per impact.
+
+    ``columns`` are the file's columns in its units (``label``: each impact's place in the
+    file; ``impact_id``; ``<column>_err`` where given), ``measured`` the impacts in SI,
+    ``flag`` and ``reason`` the exclusions (:class:`~ballbat.kinematics.ImpactFlag`),
+    ``warnings`` what is possible but suspicious.
+    """
+
+    columns: dict
+    measured: Measured
+    flag: np.ndarray
+    reason: np.ndarray
+    ball: np.ndarray
+    bat: np.ndarray
+    warnings: list[str]
+
+
+def read_measured(
     impacts_path: str | os.PathLike[str], balls_path: str | os.PathLike[str], bats_path: str | os.PathLike[str]
-) -> tuple[xr.Dataset, list[str]]:
-    """Read and check a measured dataset; return ``(impacts in SI, warnings)``.
+) -> Ingested:
+    """Read and check a measured dataset (the stage :mod:`ballbat.stages.ingest` writes it as ingest.nc).
 
     Raises :class:`~ballbat.properties.InputError` listing every problem that stops the
-    dataset (bad property tables included). Impacts psi cannot use stay in the output with
-    ``ingest_flag`` > 0 and the reason in ``ingest_flag_reason``.
+    dataset (bad property tables included). Impacts psi cannot use are kept with a flag > 0
+    and the reason.
     """
     cols, balls, bats = _read_checked(impacts_path, balls_path, bats_path)
     ball_ids, bat_ids = cols["ball"].astype(str), cols["bat"].astype(str)
     m = _measured(cols, ball_ids, bat_ids, balls, bats)
     flag, reason = _flags(impacts_path, cols, m, ball_ids, bat_ids)
     warnings = _dataset_checks(impacts_path, cols, m, flag, ball_ids, bat_ids)
-    ds = _impacts_dataset(cols, m, flag, reason, ball_ids, bat_ids)
-    ds.attrs["source_file"] = str(impacts_path)
-    ds.attrs["n_impacts"] = len(ball_ids)
-    ds.attrs["n_excluded"] = int((flag != 0).sum())
-    ds.attrs["n_warnings"] = len(warnings)
-    ds.attrs["ingest_warnings"] = "\n".join(warnings)
-    return ds, warnings
+    return Ingested(cols, m, flag, reason, ball_ids, bat_ids, warnings)
 
 
 def _read_checked(impacts_path, balls_path, bats_path) -> tuple[dict, dict[str, Ball], dict[str, Bat]]:
@@ -619,7 +632,7 @@ def _read_checked(impacts_path, balls_path, bats_path) -> tuple[dict, dict[str, 
 
 def _measured(cols: dict, ball_ids, bat_ids, balls: dict[str, Ball], bats: dict[str, Bat]) -> Measured:
     """Return the impacts in SI with each one's ball radius, alpha and recoil factors (Eqs. rx, ry)."""
-    si = {name: cols[c] * factor for c, (name, factor, _) in MEASURED_COLUMNS.items()}
+    si = {name: cols[c] * factor for c, (name, factor) in MEASURED_COLUMNS.items()}
     r = np.array([balls[b].r for b in ball_ids])
     alpha = np.array([balls[b].alpha for b in ball_ids])
     rxy = {(b, t): recoil_factors(balls[b], bats[t]) for b, t in set(zip(ball_ids, bat_ids, strict=True))}
@@ -635,7 +648,7 @@ def _flags(impacts_path, cols: dict, m: Measured, ball_ids, bat_ids) -> tuple[np
     :class:`~ballbat.properties.InputError` (its units are likely wrong).
     """
     flag, reason = exclusions(m.v_ball, m.theta, m.omega, m.r, m.alpha)
-    sigma = {si: cols[f"{c}_err"] * factor for c, (si, factor, _) in MEASURED_COLUMNS.items() if f"{c}_err" in cols}
+    sigma = {si: cols[f"{c}_err"] * factor for c, (si, factor) in MEASURED_COLUMNS.items() if f"{c}_err" in cols}
     why = implausible_rows(m, np.char.add(ball_ids, bat_ids), sigma=sigma, coarse=ball_ids)
     bad = why != ""
     flag = np.where(bad, ImpactFlag.IMPLAUSIBLE, flag).astype(np.int8)
@@ -689,53 +702,3 @@ def _dataset_checks(impacts_path, cols: dict, m: Measured, flag: np.ndarray, bal
         )
     warnings += unit_warnings(impacts_path, m)
     return warnings
-
-
-def _impacts_dataset(cols: dict, m: Measured, flag, reason, ball_ids, bat_ids) -> xr.Dataset:
-    """Return the impacts as a Dataset along ``impact``: measurements and uncertainties in SI, ids, flags."""
-    out = {}
-    for c, (si, factor, long_name) in MEASURED_COLUMNS.items():
-        out[si] = variable("impact", getattr(m, si), SI_UNITS[si], f"measured {long_name}", ballbat_role="measurement")
-        if f"{c}_err" in cols:
-            out[f"{si}_err"] = variable(
-                "impact",
-                cols[f"{c}_err"] * factor,
-                SI_UNITS[si],
-                f"standard uncertainty of measured {long_name}",
-                ballbat_role="uncertainty",
-            )
-    out["impact_id"] = ("impact", cols["impact_id"].astype(str), {"long_name": "impact id given in the source file"})
-    out["source_row"] = (
-        "impact",
-        cols["label"].astype(str),
-        {"long_name": "where the impact is in the source file (CSV line number, header = 1; NetCDF index)"},
-    )
-    out["ingest_flag"] = variable(
-        "impact",
-        flag,
-        "1",
-        "exclusion flag set when the file was read (0: usable)",
-        **flag_attrs(ImpactFlag),
-    )
-    out["ingest_flag_reason"] = ("impact", reason, {"long_name": "why the impact is excluded (ok if it is not)"})
-    return xr.Dataset(
-        out,
-        coords={
-            "impact": (
-                "impact",
-                np.arange(len(ball_ids), dtype=np.int64),
-                {"long_name": "impact number", "units": "1"},
-            ),
-            "ball": ("impact", ball_ids, {"long_name": "ball type (key of the ball table)"}),
-            "bat": ("impact", bat_ids, {"long_name": "bat (key of the bat table)"}),
-        },
-    )
-
-
-def excluded_listing(ds: xr.Dataset) -> list[str]:
-    """One line per excluded impact: id, where it is in the file, and why."""
-    from .analysis import impact_labels
-
-    bad = np.flatnonzero(ds["ingest_flag"].values != 0)
-    labels = impact_labels(ds)
-    return [f"{labels[i]}: {ds['ingest_flag_reason'].values[i]}" for i in bad]

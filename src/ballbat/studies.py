@@ -1,10 +1,8 @@
 """Replicate studies: the whole chain on many synthetic experiments (coverage and design).
 
-A study takes a synthetic dataset's settings and runs the chain the workflow runs
-(:func:`ballbat.synthetic.simulate_experiment`; when the dataset renders camera tracks,
-:func:`ballbat.tracks.render.render_tracks` and :func:`ballbat.tracks.reduce.reduce_tracks`;
-:func:`ballbat.analysis.normalize`, :func:`ballbat.analysis.reconstruct`,
-:func:`ballbat.fitting.analyze_impacts` and Stronge's eta^2 fit,
+A study takes a synthetic dataset's settings and runs the stages the workflow runs
+(:mod:`ballbat.stages`: simulate; when the dataset renders camera tracks, render and reduce;
+normalize, reconstruct, fit_ex; and Stronge's eta^2 fit,
 :func:`ballbat.stronge.fit.fit_eta2`) on independent replicate experiments, in memory and
 in batches (:func:`run_batch`: one process per batch, one NetCDF file per batch, nothing per
 replicate). Seeds: replicate ``k`` draws its experiment and its tracks from
@@ -185,23 +183,25 @@ def _source(
 ) -> xr.Dataset:
     """Simulate one experiment and, when the dataset renders tracks, render, reduce and cross-check them.
 
-    The same stage functions as the workflow's render_tracks and reduce rules
-    (:mod:`ballbat.tracks.stage`), so every render and reduce setting is honoured alike.
+    The same stages as the workflow's simulate, render_tracks and reduce rules
+    (:mod:`ballbat.stages`), so every render and reduce setting is honoured alike; the tracks
+    stay in memory (the workflow's make a round trip through tracks.nc).
     """
-    from .synthetic import SyntheticSettings, simulate_experiment
+    from .stages import reduce, render, simulate
+    from .synthetic import SyntheticSettings
 
-    sim = simulate_experiment(SyntheticSettings(**{**dataset["synthetic"], "seed": seeds[0]}), balls, bats)
-    render = dataset.get("render") or {}
+    sim = simulate.run(SyntheticSettings(**{**dataset["synthetic"], "seed": seeds[0]}), balls, bats)
+    block = dataset.get("render") or {}
     if not renders(dataset):
         return sim
     from .tracks.data import camera_block
-    from .tracks.reduce import reduction_dataset
-    from .tracks.stage import reduce_in_memory, render_in_memory
+    from .tracks.render import settings_from_config
 
-    cfg = {**render, "seed": seeds[1]}
-    tracks = render_in_memory(sim, balls, cfg)
-    red, _ = reduce_in_memory(tracks, camera_block(cfg), balls, bats, where)
-    return reduction_dataset(red)
+    cfg = {**block, "seed": seeds[1]}
+    tracks = render.render(settings_from_config(cfg), sim, balls)
+    return reduce.run(
+        reduce.ReduceSettings.from_config(camera_block(cfg), where, systematics=False), tracks, balls, bats
+    )
 
 
 def _truth_source(src: xr.Dataset) -> xr.Dataset:
@@ -252,17 +252,19 @@ def run_replicate(
     list of dict
         ``quantity, ball, bat, value, uncertainty, truth, dof, units`` (SI, as fit_ex.nc holds them).
     """
-    from .analysis import normalize, reconstruct
-    from .fitting import analyze_impacts, results_dataset
+    from .stages import fit_ex, normalize, reconstruct
 
     src = _source(dataset, replicate_seeds(settings.seed, replicate), balls, bats, f"render (replicate {replicate})")
-    rec = reconstruct(normalize(src, v_ref_mph=settings.v_ref_mph), balls, bats)
-    res = analyze_impacts(rec, settings.mu_k_example, systematic=False)  # no study quantity is a systematic
-    fit = results_dataset(res)
+    norm = normalize.NormalizeSettings(v_ref_mph=settings.v_ref_mph)
+    rec = reconstruct.run(reconstruct.ReconstructSettings(), normalize.run(norm, src), balls, bats)
+    # no study quantity is a systematic; every replicate's numbers are recorded as they come
+    fit = fit_ex.run(fit_ex.FitExSettings(settings.mu_k_example, systematic=False, check_physical=False), rec)
     rows = fit_quantity_rows(fit)
     if "eta2" in STUDY_QUANTITIES:
-        rec_truth = reconstruct(normalize(_truth_source(src), v_ref_mph=settings.v_ref_mph), balls, bats)
-        for ball in res.balls:
+        rec_truth = reconstruct.run(
+            reconstruct.ReconstructSettings(), normalize.run(norm, _truth_source(src)), balls, bats
+        )
+        for ball in fit["ball"].values.astype(str):
             v, e, t, dof = _eta2(rec, rec_truth, ball, settings.stronge)
             rows.append(
                 {

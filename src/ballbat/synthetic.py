@@ -13,10 +13,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import xarray as xr
 
 from .kinematics import ball_at_rest_collision
-from .pipeline.products import variable
 from .properties import Ball, Bat, recoil_factors
 from .units import DEGREE, MPH, RPM
 
@@ -46,12 +44,24 @@ class SyntheticSettings:
     e_x_scatter: float
 
 
-def _var(data, units, long_name, role):
-    return variable("impact", data, units, long_name, ballbat_role=role)
+@dataclass(frozen=True)
+class Experiment:
+    """A drawn synthetic experiment, one entry per impact (SI).
+
+    ``measured``, ``sd`` and ``truth`` map a quantity (``v_bat``, ``v_ball``, ``theta``,
+    ``omega``; the truth also ``psi``, ``e_x``, ``e_y``) to its per-impact values.
+    """
+
+    ball: np.ndarray
+    bat: np.ndarray
+    measured: dict[str, np.ndarray]
+    sd: dict[str, np.ndarray]
+    truth: dict[str, np.ndarray]
+    seed: int
 
 
-def simulate_experiment(settings: SyntheticSettings, balls: dict[str, Ball], bats: dict[str, Bat]) -> xr.Dataset:
-    """Draw a synthetic experiment; return one row per impact (dimension ``impact``).
+def draw_experiment(settings: SyntheticSettings, balls: dict[str, Ball], bats: dict[str, Bat]) -> Experiment:
+    """Draw a synthetic experiment (the stage :mod:`ballbat.stages.simulate` writes it as simulate.nc).
 
     Raises ``KeyError``-free ``ValueError`` naming any ball or bat missing from the
     property tables or from the e_x/e_y settings.
@@ -108,30 +118,11 @@ def simulate_experiment(settings: SyntheticSettings, balls: dict[str, Ball], bat
     true = {"v_bat": v_bat, "v_ball": out.v_ball, "theta": out.theta, "omega": out.omega}
     meas = {k: true[k] + sd[k] * rng.standard_normal(n) for k in ("v_bat", "v_ball", "theta", "omega")}
 
-    names = {
-        "v_bat": ("m s-1", "bat speed at the impact point"),
-        "v_ball": ("m s-1", "exit speed of the ball"),
-        "theta": ("rad", "angle of the batted ball from the bat's direction of travel"),
-        "omega": ("rad s-1", "spin of the batted ball (positive: backspin, Fig. 2)"),
-    }
-    data = {}
-    for k, (units, long_name) in names.items():
-        data[k] = _var(meas[k], units, f"measured {long_name}", "measurement")
-        data[f"{k}_err"] = _var(
-            np.full(n, sd[k]), units, f"standard uncertainty of measured {long_name}", "uncertainty"
-        )
-    for k, (units, long_name) in names.items():
-        data[f"truth_{k}"] = _var(true[k], units, f"true {long_name}", "truth")
-    data["truth_psi"] = _var(psi, "rad", "true impact angle psi between bat velocity and normal", "truth")
-    data["truth_e_x"] = _var(e_x, "1", "true tangential coefficient of restitution e_x", "truth")
-    data["truth_e_y"] = _var(e_y, "1", "true normal coefficient of restitution e_y", "truth")
-    ds = xr.Dataset(
-        data,
-        coords={
-            "impact": ("impact", np.arange(n, dtype=np.int64), {"long_name": "impact number", "units": "1"}),
-            "ball": ("impact", ball_ids.astype(str), {"long_name": "ball type (key of the ball table)"}),
-            "bat": ("impact", bat_ids.astype(str), {"long_name": "bat (key of the bat table)"}),
-        },
+    return Experiment(
+        ball=ball_ids.astype(str),
+        bat=bat_ids.astype(str),
+        measured=meas,
+        sd={k: np.full(n, sd[k]) for k in sd},
+        truth={**true, "psi": psi, "e_x": e_x, "e_y": e_y},
+        seed=int(settings.seed),
     )
-    ds.attrs["synthetic_seed"] = int(settings.seed)
-    return ds

@@ -210,14 +210,14 @@ def shifted_impacts(rec: xr.Dataset, source: int, side: int) -> xr.Dataset:
         The same impacts and flags, without the ``truth_*`` variables (the estimators' truth
         is no systematic).
     """
-    from .analysis import normalize, reconstruct_again
-    from .units import MPH
+    from .analysis import normalize_values, reconstruct_again_values
 
     out = rec.drop_vars([k for k in rec.data_vars if k.startswith("truth_")])
     for k in SHIFTED:
         out[k] = (rec[k].dims, rec[k].values + rec[f"{k}_shift"].values[source, side], rec[k].attrs)
-    out = normalize(out, v_ref_mph=float(rec.attrs["v_ref"]) / MPH)
-    return reconstruct_again(out)
+    # the normalize and reconstruct stages' steps, at the nominal reference speed and properties
+    out = out.assign({k: ("impact", v) for k, v in normalize_values(out, float(rec.attrs["v_ref"])).items()})
+    return out.assign({k: ("impact", v) for k, v in reconstruct_again_values(out).items()})
 
 
 def _combine(by_source: np.ndarray) -> np.ndarray:
@@ -285,7 +285,8 @@ def fit_systematics(rec: xr.Dataset, res: Sec4) -> FitSystematics:
     -------
     FitSystematics
     """
-    from .fitting import analyze_impacts, results_dataset
+    from .fitting import analyze_impacts
+    from .stages.fit_ex import results_dataset  # the same table of quantities as fit_ex.nc
 
     nominal = results_dataset(res)
     rel = rec["systematic_rel_sigma"].values

@@ -1,12 +1,13 @@
-"""Rule fit_ex: adapter around ballbat.fitting.fit_dataset."""
+"""Rule fit_ex: adapter around ballbat.stages.fit_ex.run."""
 
-from ballbat.fitting import fit_dataset, not_fitted
 from ballbat.pipeline.ncio import read_dataset, write_job_output
 from ballbat.pipeline.runlog import logged
+from ballbat.stages import fit_ex
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    ds = fit_dataset(read_dataset(snakemake.input.impacts), mu_k_example=snakemake.params.mu_k_example)
-    for line in not_fitted(ds):
+    settings = fit_ex.FitExSettings.from_config(snakemake.config)
+    ds = fit_ex.run(settings, read_dataset(snakemake.input.impacts))
+    for line in fit_ex.not_fitted(ds):
         log.warning(line)
     write_job_output(
         ds,

@@ -1,11 +1,11 @@
-"""Rule fit_stronge: adapter around ballbat.stronge.analysis.stronge_dataset."""
+"""Rule fit_stronge: adapter around ballbat.stages.stronge.run."""
 
 from ballbat.pipeline.ncio import read_dataset, write_job_output
 from ballbat.pipeline.runlog import logged
-from ballbat.stronge.analysis import stronge_dataset
+from ballbat.stages import stronge
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    ds = stronge_dataset(read_dataset(snakemake.input.impacts), **snakemake.params.stronge)
+    ds = stronge.run(stronge.StrongeSettings.from_config(snakemake.config), read_dataset(snakemake.input.impacts))
     for b in ds.ball.values:
         f = ds.sel(ball=b)
         log.info("%s: eta2 = %.3f +- %.3f (n = %d, reduced chi2 %.2f)", b, f.eta2, f.eta2_err, f.eta2_n, f.eta2_redchi)

@@ -1,4 +1,4 @@
-"""Rule import_tracks: adapter around ballbat.tracks.formats.layout.import_block."""
+"""Rule import_tracks: adapter around ballbat.tracks.formats.layout.import_block (the file: ballbat.stages.render)."""
 
 import yaml
 
@@ -6,8 +6,8 @@ from ballbat.pipeline.ncio import atomic_write_text, write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
+from ballbat.stages.render import tracks_dataset
 from ballbat.tracks.formats.layout import import_block
-from ballbat.tracks.io import tracks_dataset
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     inp = snakemake.input

@@ -1,15 +1,17 @@
-"""Rule ingest: adapter around ballbat.ingest.ingest."""
+"""Rule ingest: adapter around ballbat.stages.ingest.run."""
 
-from ballbat.ingest import excluded_listing, ingest
 from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import log_exclusions, logged
+from ballbat.stages import ingest
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     files = snakemake.params.files  # as the config names them: a missing one is reported by the ingest
-    ds, warnings = ingest(files["impacts"], balls_path=files["balls"], bats_path=files["bats"])
-    for text in warnings:
+    ds = ingest.run(
+        ingest.IngestSettings.from_config(snakemake.config), files["impacts"], balls=files["balls"], bats=files["bats"]
+    )
+    for text in ingest.warnings(ds):
         log.warning(text)
-    log_exclusions(log, excluded_listing(ds), ds.sizes["impact"])
+    log_exclusions(log, ingest.excluded_listing(ds), ds.sizes["impact"])
     write_job_output(
         ds,
         snakemake,

@@ -1,12 +1,14 @@
-"""Rule reconstruct: adapter around ballbat.analysis.reconstruct."""
+"""Rule reconstruct: adapter around ballbat.stages.reconstruct.run."""
 
-from ballbat.analysis import impact_labels, reconstruct
+from ballbat.analysis import impact_labels
 from ballbat.pipeline.ncio import read_dataset, write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
+from ballbat.stages import reconstruct
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    ds = reconstruct(
+    ds = reconstruct.run(
+        reconstruct.ReconstructSettings.from_config(snakemake.config),
         read_dataset(snakemake.input.impacts),
         balls=load_balls(snakemake.params.files["balls"]),
         bats=load_bats(snakemake.params.files["bats"]),

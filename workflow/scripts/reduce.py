@@ -1,35 +1,36 @@
-"""Rule reduce: adapter around ballbat.tracks.stage.reduce_stage."""
+"""Rule reduce: adapter around ballbat.stages.reduce.run."""
 
 import yaml
 
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import log_exclusions, logged
+from ballbat.properties import load_balls, load_bats
+from ballbat.stages import reduce
 from ballbat.tracks.data import with_found_settings
-from ballbat.tracks.stage import excluded_listing, reduce_stage
+from ballbat.tracks.io import load_tracks
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     inp = snakemake.input
-    settings = snakemake.params.settings
+    block = snakemake.params.settings
     if "cameras" in inp.keys():  # a folder of tool files: the camera settings found in them
-        settings = with_found_settings(settings, yaml.safe_load(open(inp.cameras)))
+        block = with_found_settings(block, yaml.safe_load(open(inp.cameras)))
     # a file the config names but that is missing is no input (common.smk: existing); reading it
     # by its configured name fails this job alone, with a message naming the file
     named = snakemake.config["datasets"][snakemake.wildcards.dataset]
     tables = {k: named.get(k, snakemake.config["tables"][k]) for k in ("balls", "bats")}
-    ds = reduce_stage(
-        inp.get("tracks") or named["tracks"]["file"],
-        inp.get("impacts") or named.get("tracks", {}).get("impacts"),
-        settings,
-        inp.get("balls") or tables["balls"],
-        inp.get("bats") or tables["bats"],
-        where=snakemake.params.where,
-    )
+    tracks_path = inp.get("tracks") or named["tracks"]["file"]
+    balls, bats = load_balls(inp.get("balls") or tables["balls"]), load_bats(inp.get("bats") or tables["bats"])
+    settings = reduce.ReduceSettings.from_config(
+        block, snakemake.params.where, systematics=True
+    )  # checked before the files are read
+    tracks = load_tracks(tracks_path, inp.get("impacts") or named.get("tracks", {}).get("impacts"), balls, bats)
+    ds = reduce.run(settings, tracks, balls, bats, source_file=tracks_path)
     for line in ds.attrs["reduce_checks"].splitlines():
         log.info("cross-check: %s", line)
     for text in ds.attrs["reduce_warnings"].splitlines():
         log.warning(text)
-    log_exclusions(log, excluded_listing(ds), ds.sizes["impact"])
+    log_exclusions(log, reduce.excluded_listing(ds), ds.sizes["impact"])
     write_dataset(
         ds,
         snakemake.output.impacts,

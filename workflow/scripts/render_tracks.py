@@ -1,12 +1,14 @@
-"""Rule render_tracks: adapter around ballbat.tracks.stage.render_stage."""
+"""Rule render_tracks: adapter around ballbat.stages.render.run."""
 
 from ballbat.pipeline.ncio import read_dataset, write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import logged
-from ballbat.tracks.stage import render_stage
+from ballbat.properties import load_balls
+from ballbat.stages import render
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    ds = render_stage(read_dataset(snakemake.input.truth), snakemake.input.balls, snakemake.params.settings)
+    settings = render.from_config(snakemake.config, snakemake.wildcards.dataset)
+    ds = render.run(settings, read_dataset(snakemake.input.truth), load_balls(snakemake.input.balls))
     log.info("%d impacts, %d tracked points", ds.sizes["impact"], ds.sizes["row"])
     write_dataset(
         ds,

@@ -1,13 +1,13 @@
-"""Rule simulate: adapter around ballbat.synthetic.simulate_experiment."""
+"""Rule simulate: adapter around ballbat.stages.simulate.run."""
 
 from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
-from ballbat.synthetic import SyntheticSettings, simulate_experiment
+from ballbat.stages import simulate
 
 with logged(snakemake.log[0], snakemake.rule):
-    ds = simulate_experiment(
-        SyntheticSettings(**snakemake.params.settings),
+    ds = simulate.run(
+        simulate.from_config(snakemake.config, snakemake.wildcards.dataset),
         balls=load_balls(snakemake.params.files["balls"]),
         bats=load_bats(snakemake.params.files["bats"]),
     )

@@ -1,4 +1,4 @@
-"""Read a lab's raw camera tracks (CSV or NetCDF) and write rendered ones (docs/tracks.md).
+"""Read a lab's raw camera tracks (CSV or NetCDF) (docs/tracks.md; the stage :mod:`ballbat.stages.render` writes them).
 
 ``tracks.csv`` is long: ``impact_id,camera,point,frame,x_px,y_px``, one row per tracked
 point per frame (a NetCDF file holds the same variables along one dimension ``row``).
@@ -17,10 +17,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import xarray as xr
 
-from ..pipeline.products import Var, build_dataset
 from ..properties import InputError, cell_text, read_csv_table
 from .checks import check_frame_runs
-from .data import POINTS, Camera, Rig, Tracks, to_dense, to_long
+from .data import POINTS, Camera, Rig, Tracks, to_dense
 from .validate import (
     IMPACT_COLUMNS,
     TRACK_COLUMNS,
@@ -244,50 +243,3 @@ def _assemble(cols: dict, irows, truth_path) -> Tracks:
         cameras=cams,
         truth=truth,
     )
-
-
-def tracks_dataset(tracks: Tracks) -> xr.Dataset:
-    """Return the rendered tracks as NetCDF: long rows (dimension ``row``) and the impact table (``impact``).
-
-    Parameters
-    ----------
-    tracks : Tracks
-
-    Returns
-    -------
-    xarray.Dataset
-    """
-    from .reduce import _truth_meta
-
-    rows = to_long(tracks)
-    table = {
-        "camera": Var(("row",), None, "camera of the row (swing: Camera 1, spin: Camera 2)"),
-        "point": Var(("row",), None, "tracked point (bat_tip, ball, dot_a, dot_b)"),
-        "frame": Var(("row",), "1", "frame number of that camera (origin arbitrary)"),
-        "x_px": Var(("row",), "1", "image x of the point (pixels, to the right)"),
-        "y_px": Var(("row",), "1", "image y of the point (pixels, downward)"),
-        "impact_id": Var(("row",), None, "impact of the row"),
-        "bat": Var(("impact",), None, "bat (key of the bat table)"),
-        "ball": Var(("impact",), None, "ball type (key of the ball table)"),
-    }
-    values = {
-        "camera": rows["camera"].astype(str),
-        "point": rows["point"].astype(str),
-        "frame": rows["frame"].astype(np.int64),
-        "x_px": rows["x_px"],
-        "y_px": rows["y_px"],
-        "impact_id": rows["impact_id"].astype(str),
-        "bat": tracks.bat.astype(str),
-        "ball": tracks.ball.astype(str),
-    }
-    for k, v in tracks.truth.items():
-        units, long_name = _truth_meta(k)
-        table[k] = Var(("impact",), units, long_name, {"ballbat_role": "truth"})
-        values[k] = v
-    ds = build_dataset(
-        table,
-        values,
-        coords={"impact": (Var(("impact",), None, "impact id"), tracks.impact_id.astype(str))},
-        attrs={"n_impacts": int(tracks.n), "n_rows": int(rows["frame"].size)},
-    )
-    return ds

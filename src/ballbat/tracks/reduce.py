@@ -34,6 +34,9 @@ Exclusions (flag > 0, values kept where they could be computed): no impact found
 few frames for a fit; a dot whose distance from the ball's centre is not constant (the
 dots do not rotate about the centre: a tilted spin axis); a spin too fast for the frame
 rate to unwrap. Exclude, never drop.
+
+:func:`reduce_tracks` returns a :class:`Reduction` (arrays and fits); the stage
+:mod:`ballbat.stages.reduce` declares ``reduce.nc`` and assembles it.
 """
 
 from __future__ import annotations
@@ -44,17 +47,13 @@ from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
-import xarray as xr
 
-from ..pipeline.products import Var, build_dataset, flag_attrs
 from ..units import G
 from .checks import IMPACT_Z, camera_agreement, glitch_mask
 from .data import POINTS, Camera, CameraTracks, Rig, Tracks
 from .render import contact_distance
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
-
     from numpy.typing import ArrayLike
 
 #: Frames at rest whose median is the ball's rest position.
@@ -968,176 +967,3 @@ def reduce_tracks(
         agree,
         contact,
     )
-
-
-def _frame(ct: CameraTracks, col):
-    return np.where(col >= 0, ct.frame0 + col, -1).astype(np.int64)
-
-
-def _v(units, long_name, role=None, **extra):
-    attrs = dict(extra)
-    if role:
-        attrs["ballbat_role"] = role
-    return Var(("impact",), units, long_name, attrs)
-
-
-_MEAS = {
-    "v_bat": ("m s-1", "bat speed at the impact point"),
-    "v_ball": ("m s-1", "exit speed of the ball"),
-    "theta": ("rad", "angle of the batted ball from the bat's direction of travel"),
-    "omega": ("rad s-1", "spin of the batted ball (positive: backspin, Fig. 2)"),
-}
-
-
-def reduction_table(truth_names: Sequence[str] = ()) -> dict[str, Var]:
-    """Return the declared variables of ``reduce.nc``."""
-    table: dict[str, Var] = {}
-    for k, (u, what) in _MEAS.items():
-        anc = f"{k}_err {k}_err_scale" if k in ("v_bat", "v_ball") else f"{k}_err"
-        table[k] = _v(u, f"measured {what} (from the camera tracks)", "measurement", ancillary_variables=anc)
-        table[f"{k}_err"] = _v(u, f"standard uncertainty of measured {what} (from the fit)", "uncertainty")
-    for k in ("v_bat", "v_ball"):
-        table[f"{k}_err_scale"] = _v(
-            "m s-1",
-            f"systematic uncertainty of measured {_MEAS[k][1]} from the swing camera's pixel scale "
-            "(common to every impact)",
-            "systematic",
-        )
-    table["swing_plane_angle"] = _v("rad", "angle of the bat's velocity above the horizontal before impact")
-    table["swing_plane_angle_err"] = _v("rad", "standard uncertainty of the swing-plane angle")
-    table["launch_angle"] = _v("rad", "angle of the batted ball above the horizontal (in the swing direction)")
-    table["launch_angle_err"] = _v("rad", "standard uncertainty of the launch angle")
-    table["contact_time"] = _v("s", "duration of the ball-bat contact, fitted from the ball's departure from rest")
-    table["contact_time_err"] = _v("s", "standard uncertainty of the fitted contact time")
-    table["contact_start_time"] = _v(
-        "s", "fitted time the contact began (end of the bat-tip fit), from the swing camera's frame origin"
-    )
-    table["contact_start_time_err"] = _v("s", "standard uncertainty of the fitted contact start")
-    for cam in ("swing", "spin"):
-        table[f"impact_frame_{cam}"] = _v("1", f"first {cam}-camera frame with the ball moving (-1: none)")
-        table[f"separation_frame_{cam}"] = _v("1", f"first {cam}-camera frame of the ball's free flight (-1: none)")
-        table[f"n_frames_flight_{cam}"] = _v("1", f"{cam}-camera frames in the ball's free-flight fit")
-        table[f"flight_rms_{cam}"] = _v(
-            "m", f"rms distance of the ball's tracked centre from its fitted free flight, {cam} camera"
-        )
-    table["n_frames_tip"] = _v("1", "swing-camera frames before impact in the bat-tip fit")
-    table["tip_rms"] = _v("m", "rms residual of the bat-tip fit along the swing")
-    table["bat_alignment_time"] = _v(
-        "s", "fitted time the bat is aligned with the swing camera, from its frame origin (tau)"
-    )
-    for cam in ("swing", "spin"):
-        table[f"frame0_{cam}"] = _v("1", f"{cam}-camera frame number of time 0 of the fitted motions")
-        table[f"flight_t_ref_{cam}"] = _v("s", f"separation time in the {cam} camera (reference of its flight fit)")
-        for c, what in (("x", "along the swing"), ("y", "upward")):
-            table[f"flight_{c}0_{cam}"] = _v("m", f"fitted ball position {what} at separation, {cam} camera")
-            table[f"flight_v{c}_{cam}"] = _v("m s-1", f"fitted ball velocity {what} at separation, {cam} camera")
-    table["tip_offset"] = _v("m", "fitted tip position along the swing at the alignment time (from the tip centroid)")
-    table["tip_centroid_x"] = _v("m", "centroid of the fitted tip positions along the image x (swing-positive)")
-    table["tip_centroid_y"] = _v("m", "centroid of the fitted tip positions, upward")
-    table["bat_angular_speed"] = _v("rad s-1", "fitted angular speed of the bat about the pivot before impact")
-    for p in ("dot_a", "dot_b"):
-        table[f"{p}_phase"] = _v("rad", f"fitted angle of {p} about the ball's centre at time 0 (unwrapped)")
-    table["n_frames_spin"] = _v("1", "spin-camera dot frames in the spin fit (both dots)")
-    table["dot_angle_rms"] = _v("rad", "rms residual of the dot angles about the fitted spin")
-    for p in ("dot_a", "dot_b"):
-        table[f"{p}_radius"] = _v("m", f"mean distance of {p} from the ball's centre after separation")
-        table[f"{p}_radius_sd"] = _v("m", f"standard deviation of the distance of {p} from the ball's centre")
-    for cam in ("swing", "spin"):
-        table[f"n_outliers_{cam}"] = _v(
-            "1", f"single-frame tracking glitches removed from the {cam} camera's tracks before the fits"
-        )
-    table[FLAG_VAR] = Var(
-        ("impact",), "1", "exclusion flag set when the camera tracks were reduced (0: usable)", flag_attrs(ReduceFlag)
-    )
-    table[f"{FLAG_VAR}_reason"] = Var(("impact",), None, "why the impact is excluded (ok if it is not)")
-    for k in truth_names:
-        table[k] = _v(*_truth_meta(k), "truth")
-    return table
-
-
-def _truth_meta(k):
-    base = k[len("truth_") :]
-    known = {
-        **{m: (u, f"true {w}") for m, (u, w) in _MEAS.items()},
-        "psi": ("rad", "true impact angle psi between bat velocity and normal"),
-        "e_x": ("1", "true tangential coefficient of restitution e_x"),
-        "e_y": ("1", "true normal coefficient of restitution e_y"),
-        "swing_plane": ("rad", "true swing-plane angle (rendering)"),
-        "launch_angle": ("rad", "true launch angle to the horizontal (rendering)"),
-        "contact_time": ("s", "true contact time (rendering)"),
-        "bat_slowdown": ("1", "true fraction of the bat's angular speed lost in the collision (rendering)"),
-        "spin_axis_tilt": ("rad", "true tilt of the spin axis from the line of sight (rendering)"),
-        "dot_a_radius": ("m", "true distance of dot_a from the spin axis (rendering)"),
-        "dot_b_radius": ("m", "true distance of dot_b from the spin axis (rendering)"),
-    }
-    return known.get(base, ("1", f"true {base}"))
-
-
-def reduction_dataset(red: Reduction) -> xr.Dataset:
-    """Return the reduced impacts as the chain reads them (dimension ``impact``), with fit diagnostics.
-
-    Parameters
-    ----------
-    red : Reduction
-
-    Returns
-    -------
-    xarray.Dataset
-    """
-    tr = red.tracks
-    values = dict(red.values)
-    for cam in ("swing", "spin"):
-        ct = tr.cameras[cam]
-        values[f"impact_frame_{cam}"] = _frame(ct, red.onset[cam].onset)
-        values[f"separation_frame_{cam}"] = _frame(ct, red.flight[cam].separation)
-        values[f"n_frames_flight_{cam}"] = red.flight[cam].n
-        values[f"flight_rms_{cam}"] = red.flight[cam].sigma * np.sqrt(
-            2 * np.maximum(red.flight[cam].n - 2, 0) / np.maximum(red.flight[cam].n, 1)
-        )
-    for cam in ("swing", "spin"):
-        fl = red.flight[cam]
-        values[f"frame0_{cam}"] = tr.cameras[cam].frame0.astype(np.int64)
-        values[f"flight_t_ref_{cam}"] = fl.t_ref
-        values[f"flight_x0_{cam}"], values[f"flight_y0_{cam}"] = fl.x0, fl.y0
-        values[f"flight_vx_{cam}"], values[f"flight_vy_{cam}"] = fl.vx, fl.vy
-    values["tip_offset"] = red.swing.a
-    values["tip_centroid_x"], values["tip_centroid_y"] = red.swing.cx, red.swing.cy
-    values["bat_angular_speed"] = red.swing.omega
-    for p in ("dot_a", "dot_b"):
-        values[f"{p}_phase"] = red.spin.intercept[p]
-    values["n_frames_tip"] = red.swing.n
-    values["tip_rms"] = red.swing.rms
-    values["bat_alignment_time"] = red.swing.tau
-    if red.contact is not None:
-        values["contact_start_time"] = red.contact.t_start
-        values["contact_start_time_err"] = red.contact.t_start_err
-    values["n_frames_spin"] = red.spin.n
-    values["dot_angle_rms"] = red.spin.rms
-    for p in ("dot_a", "dot_b"):
-        values[f"{p}_radius"] = red.spin.radius[p]
-        values[f"{p}_radius_sd"] = red.spin.radius_sd[p]
-    values[FLAG_VAR] = red.flag
-    values[f"{FLAG_VAR}_reason"] = red.reason
-    for cam in ("swing", "spin"):
-        values[f"n_outliers_{cam}"] = red.n_outliers[cam]
-    truth = {k: v for k, v in tr.truth.items() if k.startswith("truth_")}
-    values.update(truth)
-    n = tr.n
-    coords = {
-        "impact": (Var(("impact",), "1", "impact number"), np.arange(n, dtype=np.int64)),
-        "impact_id": (Var(("impact",), None, "impact id given in the tracks"), tr.impact_id.astype(str)),
-        "ball": (Var(("impact",), None, "ball type (key of the ball table)"), tr.ball.astype(str)),
-        "bat": (Var(("impact",), None, "bat (key of the bat table)"), tr.bat.astype(str)),
-    }
-    attrs = {"n_impacts": int(n), "n_excluded": int((red.flag != 0).sum())}
-    attrs["n_outliers"] = int(sum(int(v.sum()) for v in red.n_outliers.values()))
-    for cam, c in red.cameras.items():
-        attrs[f"{cam}_fps"] = float(c.fps)
-        attrs[f"{cam}_m_per_px"] = float(c.m_per_px)
-        attrs[f"{cam}_mirror"] = int(bool(c.mirror))
-        attrs[f"{cam}_m_per_px_rel_err"] = float(c.m_per_px_err)
-    attrs["pivot_to_tip_m"] = float(red.rig.pivot_to_tip)
-    attrs["pivot_to_impact_m"] = float(red.rig.pivot_to_impact)
-    from ..systematics import add_shifts
-
-    return add_shifts(build_dataset(reduction_table(sorted(truth)), values, coords, attrs), red.shifts)

@@ -1,72 +1,22 @@
-"""The two workflow stages of the raw-track chain, for the thin scripts of workflow/rules/tracks.smk."""
+"""Read, check, reduce and cross-check a dataset's tracks in one call (``ballbat check --kind tracks``).
+
+The reduce rule takes the same steps through the stage :mod:`ballbat.stages.reduce`, which also
+writes the results file ``reduce.nc`` (its options: :func:`reduce_options`).
+"""
 
 from __future__ import annotations
 
 from typing import TYPE_CHECKING
 
-import numpy as np
-import xarray as xr
-
 from ..properties import load_balls, load_bats
 from .checks import Verdict, cross_check
-from .data import Tracks
-from .io import cameras_from_config, load_tracks, tracks_dataset
-from .reduce import FLAG_VAR, ReduceOptions, Reduction, reduce_tracks, reduction_dataset
-from .render import render_tracks, settings_from_config
+from .io import cameras_from_config, load_tracks
+from .reduce import ReduceOptions, Reduction, reduce_tracks
 
 if TYPE_CHECKING:
     import os
 
-#: Truth of a synthetic experiment that rendered tracks carry to the reduced file.
-SIMULATED_TRUTH = ("v_bat", "v_ball", "theta", "omega", "psi", "e_x", "e_y")
-
-
-def render_in_memory(simulated: xr.Dataset, balls: dict, render_cfg: dict) -> Tracks:
-    """Render both cameras' tracks of a synthetic experiment, in memory (the workflow and the studies).
-
-    Parameters
-    ----------
-    simulated : xarray.Dataset
-        The synthetic experiment, with its ``truth_*`` variables.
-    balls : dict
-        Ball table (radii).
-    render_cfg : dict
-        The dataset's ``render`` config block.
-
-    Returns
-    -------
-    Tracks
-    """
-    truth = {k: simulated[f"truth_{k}"].values for k in SIMULATED_TRUTH if f"truth_{k}" in simulated}
-    r = np.array([balls[b].r for b in simulated["ball"].values.astype(str)])
-    return render_tracks(
-        truth,
-        r,
-        settings_from_config(render_cfg),
-        simulated["impact"].values.astype(str),
-        simulated["ball"].values,
-        simulated["bat"].values,
-    )
-
-
-def render_stage(simulated: xr.Dataset, balls_path: str | os.PathLike[str], render_cfg: dict) -> xr.Dataset:
-    """Render both cameras' tracks of a synthetic experiment (``simulate.nc``); return ``tracks.nc``.
-
-    Parameters
-    ----------
-    simulated : xarray.Dataset
-        The synthetic experiment, with its ``truth_*`` variables.
-    balls_path : path-like
-        Ball table (radii).
-    render_cfg : dict
-        The dataset's ``render`` config block.
-
-    Returns
-    -------
-    xarray.Dataset
-        ``tracks.nc``: long rows and the impact table with the truth.
-    """
-    return tracks_dataset(render_in_memory(simulated, load_balls(balls_path), render_cfg))
+    from .data import Tracks
 
 
 def reduce_options(cfg: dict) -> ReduceOptions:
@@ -125,57 +75,14 @@ def reduce_checked(
     bats_path: str | os.PathLike[str],
     where: str,
 ) -> tuple[Reduction, Verdict]:
-    """Read, check, reduce and cross-check a dataset's tracks (the reduce rule and ``ballbat check --kind tracks``).
+    """Read and check a dataset's tracks files, then :func:`reduce_in_memory` (``ballbat check --kind tracks``).
 
-    Parameters
-    ----------
-    tracks_path, impacts_path : path-like
-        The tracks (CSV or NetCDF) and impacts (None: the tracks NetCDF's own table).
-    cfg : dict
-        ``cameras`` and ``rig`` (and optional ``min_frames``) as in the config.
-    balls_path, bats_path : path-like
-        Property tables (every ball and bat must be in them).
-    where : str
-        Config key of ``cfg``, for messages.
-
-    Returns
-    -------
-    (Reduction, Verdict)
-
-    Raises
-    ------
-    ballbat.properties.InputError
-        Every problem of the files and settings, or a cross-check that stops the dataset
-        (:func:`.checks.cross_check`).
+    ``tracks_path`` and ``impacts_path`` are the tracks (CSV or NetCDF) and impacts (None: the
+    tracks NetCDF's own table), ``balls_path`` and ``bats_path`` the property tables (every ball
+    and bat must be in them); ``cfg`` and ``where`` as for :func:`reduce_in_memory`. Every
+    problem of the files and settings is raised at once (:class:`~ballbat.properties.InputError`).
     """
     balls, bats = load_balls(balls_path), load_bats(bats_path)
     cameras_from_config(cfg, where)  # the settings are checked before the files are read
     tracks = load_tracks(tracks_path, impacts_path, balls, bats)
     return reduce_in_memory(tracks, cfg, balls, bats, where, systematics=True)
-
-
-def reduce_stage(
-    tracks_path: str | os.PathLike[str],
-    impacts_path: str | os.PathLike[str] | None,
-    cfg: dict,
-    balls_path: str | os.PathLike[str],
-    bats_path: str | os.PathLike[str],
-    where: str,
-) -> xr.Dataset:
-    """Read, check, reduce and cross-check a dataset's tracks; return ``reduce.nc`` (:func:`reduce_checked`).
-
-    The cross-checks' figures are the attribute ``reduce_checks`` (one per line), their
-    warnings ``reduce_warnings``.
-    """
-    red, verdict = reduce_checked(tracks_path, impacts_path, cfg, balls_path, bats_path, where)
-    ds = reduction_dataset(red)
-    ds.attrs["source_file"] = str(tracks_path)
-    ds.attrs["reduce_checks"] = "\n".join(verdict.lines)
-    ds.attrs["reduce_warnings"] = "\n".join(verdict.warnings)
-    return ds
-
-
-def excluded_listing(ds: xr.Dataset) -> list[str]:
-    """One line per excluded impact: id and why."""
-    bad = np.flatnonzero(ds[FLAG_VAR].values != 0)
-    return [f"impact {ds['impact_id'].values[i]}: {ds[f'{FLAG_VAR}_reason'].values[i]}" for i in bad]

@@ -1,0 +1,64 @@
+"""Stage reconstruct: ``results/{dataset}/reconstruct.nc``, psi and the Sec. III quantities of every impact.
+
+The normalised impacts with :data:`RECONSTRUCT_TABLE` added (:func:`ballbat.analysis.reconstruct_values`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+from ..analysis import reconstruct_values
+from ..kinematics import ImpactFlag
+from ..pipeline.products import Var, add_variables, flag_attrs
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from ..properties import Ball, Bat
+
+
+@dataclass(frozen=True)
+class ReconstructSettings:
+    """Settings of the reconstruct stage: none (the property tables are inputs)."""
+
+    @classmethod
+    def from_config(cls, config: dict) -> ReconstructSettings:
+        """Return the workflow's settings from the validated config."""
+        return cls()
+
+
+#: Variables that ``reconstruct`` adds.
+RECONSTRUCT_TABLE = {
+    "r": Var(("impact",), "m", "ball radius"),
+    "m": Var(("impact",), "kg", "ball mass"),
+    "alpha": Var(("impact",), "1", "ball moment of inertia over m r^2 (Eq. iball)"),
+    "R_bat": Var(("impact",), "m", "bat radius R at the impact location (Table II)"),
+    "r_x": Var(("impact",), "1", "tangential recoil factor r_x (Eq. rx)"),
+    "r_y": Var(("impact",), "1", "normal recoil factor r_y (Eq. ry)"),
+    "psi": Var(("impact",), "rad", "impact angle psi reconstructed from Eq. angmom"),
+    "flag": Var(("impact",), "1", "reconstruction flag (0: usable)", flag_attrs(ImpactFlag)),
+    "flag_reason": Var(("impact",), None, "why the impact is not used (ok if it is)"),
+    "D": Var(("impact",), "m", "ball-bat offset D (Eq. D)"),
+    "v_n": Var(("impact",), "m s-1", "normal component of the exit velocity"),
+    "v_t": Var(("impact",), "m s-1", "tangential component of the exit velocity"),
+    "v_bat_n": Var(("impact",), "m s-1", "normal component of the bat velocity"),
+    "spin_bracket": Var(("impact",), "rad s-1", "bracket of Eq. omega: v_bat sin psi / (r (1 + r_x)(1 + alpha))"),
+    "vtf_x": Var(("impact",), "1", "bracket of Eq. vtf: tan psi / (1 + r_x)"),
+    "vtf_y": Var(("impact",), "1", "left side of Eq. vtf: (v_ball,t + r omega) / v_bat,n"),
+    "tan_psi": Var(("impact",), "1", "tan psi (Fig. 6 abscissa)"),
+    "tan_psi_minus_theta": Var(
+        ("impact",), "1", "tan(psi - theta) = v_ball,t / v_ball,n (Eqs. muk, ratio; Fig. 6 ordinate)"
+    ),
+}
+
+
+def run(settings: ReconstructSettings, impacts: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]) -> xr.Dataset:
+    """Reconstruct psi and the Sec. III quantities of every impact (:func:`ballbat.analysis.reconstruct_values`).
+
+    Adds the ball and bat properties used (r, alpha, R, r_x, r_y), psi (Eq. angmom), the
+    flag and its reason, D (Eq. D), v_n and v_t, and the bracket terms of Eq. omega
+    (``spin_bracket``) and Eq. vtf (``vtf_x``, with the left side ``vtf_y``), plus
+    tan(psi - theta) of Eq. ratio.
+    """
+    return add_variables(impacts, RECONSTRUCT_TABLE, reconstruct_values(impacts, balls, bats))

@@ -1,0 +1,247 @@
+"""Stage reduce: ``results/{dataset}/reduce.nc``, the impacts reduced from raw camera tracks (Sec. II).
+
+:func:`reduction_table` declares the file (the impacts table of :mod:`.impacts` with the fits'
+diagnostics); :func:`run` reduces the tracks (:func:`ballbat.tracks.reduce.reduce_tracks`),
+cross-checks the result (:func:`ballbat.tracks.checks.cross_check`) and assembles the file.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from ..pipeline.products import Var, build_dataset, flag_attrs
+from ..systematics import add_shifts, reduce_shifts
+from ..tracks.checks import cross_check
+from ..tracks.io import cameras_from_config
+from ..tracks.reduce import FLAG_VAR, ReduceFlag, ReduceOptions, Reduction, reduce_tracks
+from ..tracks.stage import reduce_options
+from .impacts import IMPACT_COORDS, QUANTITIES, measured, truth_var
+
+if TYPE_CHECKING:
+    from collections.abc import Sequence
+
+    import xarray as xr
+
+    from ..properties import Ball, Bat
+    from ..tracks.data import Camera, CameraTracks, Rig, Tracks
+
+
+@dataclass(frozen=True)
+class ReduceSettings:
+    """Settings of the reduce stage.
+
+    Attributes
+    ----------
+    cameras : dict of str to Camera
+        ``swing`` and ``spin`` camera settings.
+    rig : Rig
+        Pivot-to-tip and pivot-to-impact distances.
+    options : ReduceOptions
+        Fewest frames per fit.
+    where : str
+        Config key of the settings' block, for messages.
+    systematics : bool
+        Also reduce the tracks again at +-1 sigma of each stated calibration uncertainty
+        (:func:`ballbat.systematics.reduce_shifts`): the workflow does, a replicate of a study
+        does not.
+    """
+
+    cameras: dict[str, Camera]
+    rig: Rig
+    options: ReduceOptions
+    where: str
+    systematics: bool
+
+    @classmethod
+    def from_config(cls, block: dict, where: str, *, systematics: bool) -> ReduceSettings:
+        """Return the settings of a dataset's ``tracks`` or ``render`` block (``cameras``, ``rig``, ``min_frames``).
+
+        ``where`` is the block's config key. Raises :class:`~ballbat.properties.InputError`
+        naming every wrong camera or rig setting.
+        """
+        cameras, rig = cameras_from_config(block, where)
+        return cls(cameras=cameras, rig=rig, options=reduce_options(block), where=where, systematics=systematics)
+
+
+def _frame(ct: CameraTracks, col):
+    return np.where(col >= 0, ct.frame0 + col, -1).astype(np.int64)
+
+
+def _v(units, long_name, role=None, **extra):
+    attrs = dict(extra)
+    if role:
+        attrs["ballbat_role"] = role
+    return Var(("impact",), units, long_name, attrs)
+
+
+def reduction_table(truth_names: Sequence[str] = ()) -> dict[str, Var]:
+    """Return the declared variables of ``reduce.nc``."""
+    table: dict[str, Var] = {}
+    for k in QUANTITIES:
+        anc = f"{k}_err {k}_err_scale" if k in ("v_bat", "v_ball") else f"{k}_err"
+        table[k] = measured(k, " (from the camera tracks)", ancillary_variables=anc)
+        table[f"{k}_err"] = measured(f"{k}_err", " (from the fit)")
+    for k in ("v_bat", "v_ball"):
+        table[f"{k}_err_scale"] = _v(
+            "m s-1",
+            f"systematic uncertainty of measured {QUANTITIES[k][1]} from the swing camera's pixel scale "
+            "(common to every impact)",
+            "systematic",
+        )
+    table["swing_plane_angle"] = _v("rad", "angle of the bat's velocity above the horizontal before impact")
+    table["swing_plane_angle_err"] = _v("rad", "standard uncertainty of the swing-plane angle")
+    table["launch_angle"] = _v("rad", "angle of the batted ball above the horizontal (in the swing direction)")
+    table["launch_angle_err"] = _v("rad", "standard uncertainty of the launch angle")
+    table["contact_time"] = _v("s", "duration of the ball-bat contact, fitted from the ball's departure from rest")
+    table["contact_time_err"] = _v("s", "standard uncertainty of the fitted contact time")
+    table["contact_start_time"] = _v(
+        "s", "fitted time the contact began (end of the bat-tip fit), from the swing camera's frame origin"
+    )
+    table["contact_start_time_err"] = _v("s", "standard uncertainty of the fitted contact start")
+    for cam in ("swing", "spin"):
+        table[f"impact_frame_{cam}"] = _v("1", f"first {cam}-camera frame with the ball moving (-1: none)")
+        table[f"separation_frame_{cam}"] = _v("1", f"first {cam}-camera frame of the ball's free flight (-1: none)")
+        table[f"n_frames_flight_{cam}"] = _v("1", f"{cam}-camera frames in the ball's free-flight fit")
+        table[f"flight_rms_{cam}"] = _v(
+            "m", f"rms distance of the ball's tracked centre from its fitted free flight, {cam} camera"
+        )
+    table["n_frames_tip"] = _v("1", "swing-camera frames before impact in the bat-tip fit")
+    table["tip_rms"] = _v("m", "rms residual of the bat-tip fit along the swing")
+    table["bat_alignment_time"] = _v(
+        "s", "fitted time the bat is aligned with the swing camera, from its frame origin (tau)"
+    )
+    for cam in ("swing", "spin"):
+        table[f"frame0_{cam}"] = _v("1", f"{cam}-camera frame number of time 0 of the fitted motions")
+        table[f"flight_t_ref_{cam}"] = _v("s", f"separation time in the {cam} camera (reference of its flight fit)")
+        for c, what in (("x", "along the swing"), ("y", "upward")):
+            table[f"flight_{c}0_{cam}"] = _v("m", f"fitted ball position {what} at separation, {cam} camera")
+            table[f"flight_v{c}_{cam}"] = _v("m s-1", f"fitted ball velocity {what} at separation, {cam} camera")
+    table["tip_offset"] = _v("m", "fitted tip position along the swing at the alignment time (from the tip centroid)")
+    table["tip_centroid_x"] = _v("m", "centroid of the fitted tip positions along the image x (swing-positive)")
+    table["tip_centroid_y"] = _v("m", "centroid of the fitted tip positions, upward")
+    table["bat_angular_speed"] = _v("rad s-1", "fitted angular speed of the bat about the pivot before impact")
+    for p in ("dot_a", "dot_b"):
+        table[f"{p}_phase"] = _v("rad", f"fitted angle of {p} about the ball's centre at time 0 (unwrapped)")
+    table["n_frames_spin"] = _v("1", "spin-camera dot frames in the spin fit (both dots)")
+    table["dot_angle_rms"] = _v("rad", "rms residual of the dot angles about the fitted spin")
+    for p in ("dot_a", "dot_b"):
+        table[f"{p}_radius"] = _v("m", f"mean distance of {p} from the ball's centre after separation")
+        table[f"{p}_radius_sd"] = _v("m", f"standard deviation of the distance of {p} from the ball's centre")
+    for cam in ("swing", "spin"):
+        table[f"n_outliers_{cam}"] = _v(
+            "1", f"single-frame tracking glitches removed from the {cam} camera's tracks before the fits"
+        )
+    table[FLAG_VAR] = Var(
+        ("impact",), "1", "exclusion flag set when the camera tracks were reduced (0: usable)", flag_attrs(ReduceFlag)
+    )
+    table[f"{FLAG_VAR}_reason"] = Var(("impact",), None, "why the impact is excluded (ok if it is not)")
+    for k in truth_names:
+        table[k] = truth_var(k)
+    return table
+
+
+def reduction_dataset(red: Reduction) -> xr.Dataset:
+    """Return the reduced impacts as the chain reads them (dimension ``impact``), with fit diagnostics.
+
+    Parameters
+    ----------
+    red : Reduction
+
+    Returns
+    -------
+    xarray.Dataset
+    """
+    tr = red.tracks
+    values = dict(red.values)
+    for cam in ("swing", "spin"):
+        ct = tr.cameras[cam]
+        values[f"impact_frame_{cam}"] = _frame(ct, red.onset[cam].onset)
+        values[f"separation_frame_{cam}"] = _frame(ct, red.flight[cam].separation)
+        values[f"n_frames_flight_{cam}"] = red.flight[cam].n
+        values[f"flight_rms_{cam}"] = red.flight[cam].sigma * np.sqrt(
+            2 * np.maximum(red.flight[cam].n - 2, 0) / np.maximum(red.flight[cam].n, 1)
+        )
+    for cam in ("swing", "spin"):
+        fl = red.flight[cam]
+        values[f"frame0_{cam}"] = tr.cameras[cam].frame0.astype(np.int64)
+        values[f"flight_t_ref_{cam}"] = fl.t_ref
+        values[f"flight_x0_{cam}"], values[f"flight_y0_{cam}"] = fl.x0, fl.y0
+        values[f"flight_vx_{cam}"], values[f"flight_vy_{cam}"] = fl.vx, fl.vy
+    values["tip_offset"] = red.swing.a
+    values["tip_centroid_x"], values["tip_centroid_y"] = red.swing.cx, red.swing.cy
+    values["bat_angular_speed"] = red.swing.omega
+    for p in ("dot_a", "dot_b"):
+        values[f"{p}_phase"] = red.spin.intercept[p]
+    values["n_frames_tip"] = red.swing.n
+    values["tip_rms"] = red.swing.rms
+    values["bat_alignment_time"] = red.swing.tau
+    if red.contact is not None:
+        values["contact_start_time"] = red.contact.t_start
+        values["contact_start_time_err"] = red.contact.t_start_err
+    values["n_frames_spin"] = red.spin.n
+    values["dot_angle_rms"] = red.spin.rms
+    for p in ("dot_a", "dot_b"):
+        values[f"{p}_radius"] = red.spin.radius[p]
+        values[f"{p}_radius_sd"] = red.spin.radius_sd[p]
+    values[FLAG_VAR] = red.flag
+    values[f"{FLAG_VAR}_reason"] = red.reason
+    for cam in ("swing", "spin"):
+        values[f"n_outliers_{cam}"] = red.n_outliers[cam]
+    truth = {k: v for k, v in tr.truth.items() if k.startswith("truth_")}
+    values.update(truth)
+    n = tr.n
+    coords = {
+        "impact": (IMPACT_COORDS["impact"], np.arange(n, dtype=np.int64)),
+        "impact_id": (Var(("impact",), None, "impact id given in the tracks"), tr.impact_id.astype(str)),
+        "ball": (IMPACT_COORDS["ball"], tr.ball.astype(str)),
+        "bat": (IMPACT_COORDS["bat"], tr.bat.astype(str)),
+    }
+    attrs = {"n_impacts": int(n), "n_excluded": int((red.flag != 0).sum())}
+    attrs["n_outliers"] = int(sum(int(v.sum()) for v in red.n_outliers.values()))
+    for cam, c in red.cameras.items():
+        attrs[f"{cam}_fps"] = float(c.fps)
+        attrs[f"{cam}_m_per_px"] = float(c.m_per_px)
+        attrs[f"{cam}_mirror"] = int(bool(c.mirror))
+        attrs[f"{cam}_m_per_px_rel_err"] = float(c.m_per_px_err)
+    attrs["pivot_to_tip_m"] = float(red.rig.pivot_to_tip)
+    attrs["pivot_to_impact_m"] = float(red.rig.pivot_to_impact)
+    return add_shifts(build_dataset(reduction_table(sorted(truth)), values, coords, attrs), red.shifts)
+
+
+def run(
+    settings: ReduceSettings,
+    tracks: Tracks,
+    balls: dict[str, Ball],
+    bats: dict[str, Bat],
+    source_file: str | None = None,
+) -> xr.Dataset:
+    """Reduce and cross-check a dataset's tracks (read and checked: :func:`ballbat.tracks.io.load_tracks`).
+
+    Returns ``reduce.nc``: the impacts and the fits' diagnostics. The cross-checks' figures are
+    the attribute ``reduce_checks`` (one per line), their warnings ``reduce_warnings``;
+    ``source_file`` (the tracks file read) the attribute of that name.
+
+    Raises
+    ------
+    ballbat.properties.InputError
+        A cross-check that stops the dataset (:func:`ballbat.tracks.checks.cross_check`).
+    """
+    red = reduce_tracks(tracks, settings.cameras, settings.rig, settings.options)
+    verdict = cross_check(red, balls, bats, settings.where)
+    if settings.systematics:
+        red.shifts = reduce_shifts(tracks, settings.cameras, settings.rig, settings.options, red)
+    ds = reduction_dataset(red)
+    if source_file is not None:
+        ds.attrs["source_file"] = str(source_file)
+    ds.attrs["reduce_checks"] = "\n".join(verdict.lines)
+    ds.attrs["reduce_warnings"] = "\n".join(verdict.warnings)
+    return ds
+
+
+def excluded_listing(ds: xr.Dataset) -> list[str]:
+    """One line per excluded impact: id and why."""
+    bad = np.flatnonzero(ds[FLAG_VAR].values != 0)
+    return [f"impact {ds['impact_id'].values[i]}: {ds[f'{FLAG_VAR}_reason'].values[i]}" for i in bad]
