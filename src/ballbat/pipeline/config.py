@@ -411,6 +411,9 @@ SCHEMA_BLOCKS = {
     "min_frames": ("$defs", "min_frames"),
     "study": ("properties", "studies", "additionalProperties"),
     "stronge": ("properties", "stronge"),
+    "normalize": ("properties", "normalize"),
+    "analysis": ("properties", "analysis"),
+    "implications": ("properties", "implications"),
 }
 
 
