@@ -43,6 +43,7 @@ import numpy as np
 from .designs import MEASURED, Measured, measured_sigma, normalized_theta_design, spin_design, tan_ratio_design
 from .kinematics import gross_slip_onset, normalize_to_bat_speed, tan_ratio_slope_model
 from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, wls_slope
+from .systematics import has_shifts
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -204,11 +205,6 @@ def scale_systematic(ds: xr.Dataset, res: Sec4) -> dict[str, np.ndarray] | None:
         ``e_x_err_scale`` (ball x bat) and ``e_x_pooled_err_scale`` (ball); None when the
         dataset has no pixel-scale uncertainty.
     """
-    from . import systematics
-
-    if systematics.has_shifts(ds):  # every calibration source, the tracks reduced again (exact)
-        res.systematics = systematics.fit_systematics(ds, res)
-        return systematics.scale_entries(res.systematics)
     if not all(k in ds for k in SCALE_VARS):
         return None
     fits = []
@@ -390,7 +386,9 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
                 yt_norm = normalize_to_bat_speed(tv[MEASURED.index(which)], tv[0], v_ref)
                 xt, yt, _, _ = normalized_theta_design(tv[0], yt_norm, tv[2], which, v_ref)
                 grid.truth[i] = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope), through_origin=False)[0]
-    res.systematic = scale_systematic(ds, res) if systematic else None
+    # impacts that carry the calibration shifts get every source by the exact rerun instead
+    # (the fit_ex stage: ballbat.stages.systematics)
+    res.systematic = scale_systematic(ds, res) if systematic and not has_shifts(ds) else None
     return res
 
 

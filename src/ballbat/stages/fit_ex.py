@@ -14,7 +14,8 @@ import numpy as np
 
 from ..fitting import FitGrid, FitStatus, ImplausibleFit, Sec4, analyze_impacts, check_physical, fit_status
 from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
-from ..systematics import add_fit_systematics
+from ..systematics import has_shifts
+from .systematics import add_fit_systematics, fit_systematics, scale_entries
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -168,6 +169,9 @@ def run(settings: FitExSettings, impacts: xr.Dataset) -> xr.Dataset:
     unless ``settings.check_physical`` is false).
     """
     res = analyze_impacts(impacts, settings.mu_k_example, systematic=settings.systematic)
+    if settings.systematic and has_shifts(impacts):  # every calibration source, the tracks reduced again
+        res.systematics = fit_systematics(impacts, res)
+        res.systematic = scale_entries(res.systematics)
     if settings.check_physical:
         check_physical(res)
     ds = results_dataset(res)

@@ -13,12 +13,13 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..pipeline.products import Var, build_dataset, flag_attrs
-from ..systematics import add_shifts, reduce_shifts
+from ..systematics import reduce_shifts
 from ..tracks.checks import cross_check
 from ..tracks.io import cameras_from_config
 from ..tracks.reduce import FLAG_VAR, ReduceFlag, ReduceOptions, Reduction, reduce_tracks
 from ..tracks.stage import reduce_options
 from .impacts import IMPACT_COORDS, QUANTITIES, measured, truth_var
+from .systematics import add_shifts
 
 if TYPE_CHECKING:
     from collections.abc import Sequence

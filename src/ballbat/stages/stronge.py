@@ -17,7 +17,7 @@ from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_v
 from ..published import STRONGE_E_Y, STRONGE_MU
 from ..stronge.analysis import HISTORY_VARIABLES, PUBLISHED_ETA2, ModelCurves, analyse_ball, time_history, vtf_data
 from ..stronge.regimes import Regime
-from ..systematics import stronge_systematics
+from .systematics import stronge_systematics
 
 if TYPE_CHECKING:
     import xarray as xr
