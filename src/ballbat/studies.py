@@ -28,7 +28,6 @@ of impacts per bat needed to tell two bats ``delta_e_x`` apart.
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
@@ -37,7 +36,7 @@ import numpy as np
 import xarray as xr
 
 from .pipeline.products import Var, build_dataset
-from .sweeps import point_dataset
+from .sweeps import point_dataset, study_dataset, sweep_points
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterable, Sequence
@@ -71,10 +70,12 @@ class StudySettings:
         The study's seed (every replicate's seeds derive from it).
     batch_size : int
         Replicates per batch job.
-    parameter : str or None
-        Swept setting (a key of :data:`ballbat.sweeps.SWEEP_PARAMETERS`), None for no sweep.
-    values : tuple of float
-        Its values (one point, NaN, without a sweep).
+    parameter : str, tuple of str or None
+        Swept setting (a key of :data:`ballbat.sweeps.SWEEP_PARAMETERS`), None for no sweep;
+        for a grid sweep the tuple of its settings.
+    values : tuple
+        Its values (one point, NaN, without a sweep); for a grid one tuple per point, every
+        combination of the settings' values (:func:`ballbat.sweeps.sweep_points`).
     v_ref_mph, mu_k_example : float
         The workflow's ``normalize.v_ref_mph`` and ``analysis.mu_k_example``.
     stronge : dict
@@ -101,18 +102,36 @@ class StudySettings:
         s = config["studies"][name]
         ds = config["datasets"][s["dataset"]]
         sweep = s.get("sweep")
+        names, points = sweep_points(sweep)
+        grid = bool(sweep) and "grid" in sweep
         return cls(
-            dataset=copy.deepcopy(ds),
+            dataset=study_dataset(ds, s),
             replicates=int(s["replicates"]),
             seed=int(s["seed"]),
             batch_size=int(s["batch_size"]),
-            parameter=sweep["parameter"] if sweep else None,
-            values=tuple(float(v) for v in sweep["values"]) if sweep else (math.nan,),
+            parameter=(names if grid else names[0]) if sweep else None,
+            values=(tuple(points) if grid else tuple(p[0] for p in points)) if sweep else (math.nan,),
             v_ref_mph=float(config["normalize"]["v_ref_mph"]),
             mu_k_example=float(config["analysis"]["mu_k_example"]),
             stronge={k: config["stronge"][k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")},
             truth_impacts=int(s["truth_impacts"]),
         )
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """Names of the swept settings (one for a one-parameter sweep, none without a sweep)."""
+        if self.parameter is None:
+            return ()
+        return (self.parameter,) if isinstance(self.parameter, str) else tuple(self.parameter)
+
+    @property
+    def is_grid(self) -> bool:
+        """Whether the sweep is a grid (several settings at once)."""
+        return self.parameter is not None and not isinstance(self.parameter, str)
+
+    def point_settings(self) -> np.ndarray:
+        """Return the settings at every point (point x setting; one column of NaN without a sweep)."""
+        return np.asarray([v if self.is_grid else (v,) for v in self.values], dtype=float).reshape(self.n_points, -1)
 
     @property
     def n_points(self) -> int:
@@ -247,7 +266,7 @@ def run_replicate(
 
     src = _source(dataset, replicate_seeds(settings.seed, replicate), balls, bats, f"render (replicate {replicate})")
     rec = reconstruct(normalize(src, v_ref_mph=settings.v_ref_mph), balls, bats)
-    res = analyze_impacts(rec, settings.mu_k_example, systematic=False)  # no study quantity is a systematic
+    res = analyze_impacts(rec, settings.mu_k_example)  # with the systematics: the combined interval's coverage
     fit = results_dataset(res)
     rows = []
     dof_of = {"spin_theta_slope": 2, "speed_theta_slope": 2}  # fitted parameters; others: 1
@@ -262,7 +281,13 @@ def run_replicate(
         dof = math.inf if n is None else int(n) - dof_of.get(var, 1)
         if q == "e_y_implied":  # its sandwich has n / (n - k) for the k = bats + 1 slopes it rests on
             dof = int(n) - (int((fit["e_x_n"].sel(ball=row["ball"]) > 0).sum()) + 1)
-        rows.append({**{k: row[k] for k in ("quantity", "ball", "bat", "value", "uncertainty", "truth")}, "dof": dof})
+        rows.append(
+            {
+                **{k: row[k] for k in ("quantity", "ball", "bat", "value", "uncertainty", "truth")},
+                "dof": dof,
+                "systematic": _systematic(fit, row),
+            }
+        )
     if "eta2" in STUDY_QUANTITIES:
         rec_truth = reconstruct(normalize(_truth_source(src), v_ref_mph=settings.v_ref_mph), balls, bats)
         for ball in res.balls:
@@ -273,6 +298,28 @@ def run_replicate(
     return rows
 
 
+#: Where a quantity's systematic uncertainty is read from ``fit_ex.nc`` (the first present),
+#: ``{q}`` its variable: ``{q}_err_scale`` (the pixel-scale systematic of e_x,
+#: :func:`ballbat.fitting.scale_systematic`), ``{q}_syst`` (a systematic of every calibration).
+SYSTEMATIC_NAMES = ("{q}_err_scale", "{q}_syst")
+
+
+def _systematic(fit: xr.Dataset, row: dict) -> float:
+    """Return the systematic uncertainty of a row of :func:`.compare.fit_rows` (its unit); NaN: none."""
+    from .compare import FIT_QUANTITIES, _pick
+    from .units import from_si
+
+    var, unit = FIT_QUANTITIES[row["quantity"]]
+    for name in SYSTEMATIC_NAMES:
+        key = name.format(q=var)
+        if key in fit:
+            v = _pick(fit, key, row["ball"], row["bat"] or None)
+            if v is None or not np.isfinite(v):
+                return math.nan
+            return float(v) if unit == "1" else float(from_si(v, unit))
+    return math.nan
+
+
 # ---------------------------------------------------------------------------------------
 # a batch: the file of one job
 
@@ -281,6 +328,9 @@ BATCH_TABLE = {
     "uncertainty": Var(("replicate", "quantity"), "1", "reported uncertainty of the estimate (same unit)"),
     "truth": Var(("replicate", "quantity"), "1", "the same estimator on the replicate's noise-free truth (same unit)"),
     "dof": Var(("replicate", "quantity"), "1", "degrees of freedom of the uncertainty (inf: normal)"),
+    "systematic": Var(
+        ("replicate", "quantity"), "1", "reported systematic uncertainty of the estimate (same unit; NaN: none)"
+    ),
     "point": Var(("replicate",), "1", "sweep point of the replicate (index into setting)"),
     "seed_replicate": Var(("replicate",), "1", "replicate number within its point (its seeds' spawn key)"),
 }
@@ -327,12 +377,12 @@ def run_batch(
             progress(done, len(indices))
     labels = list(table)
     nq = len(labels)
-    arrays = {k: np.full((len(records), nq), np.nan) for k in ("value", "uncertainty", "truth", "dof")}
+    arrays = {k: np.full((len(records), nq), np.nan) for k in ("value", "uncertainty", "truth", "dof", "systematic")}
     for i, (_, _, _, rows) in enumerate(records):
         for label, r in zip(_labels(rows), rows, strict=True):
             j = table[label]
             for k in arrays:
-                v = r[k]
+                v = r.get(k)
                 arrays[k][i, j] = np.nan if v is None else float(v)
     parts = [lab.split(":") for lab in labels]
     values = {
@@ -362,15 +412,46 @@ def _coords(settings: StudySettings, labels: list[str], parts: list[list[str]]) 
 
 
 def _attrs(settings: StudySettings, batch: int | None = None) -> dict:
+    """Return the study's attributes: a grid's settings are comma-joined, its values flattened point by point."""
     attrs = {
         "study_seed": settings.seed,
         "replicates_per_point": settings.replicates,
-        "sweep_parameter": settings.parameter or "",
-        "sweep_values": np.asarray(settings.values, dtype=float),
+        "sweep_parameter": ",".join(settings.parameters),
+        "sweep_values": settings.point_settings().ravel(),
     }
     if batch is not None:
         attrs["batch"] = batch
     return attrs
+
+
+def sweep_table(attrs: dict) -> tuple[tuple[str, ...], np.ndarray]:
+    """Return the swept settings' names and their values at every point (point x setting) from a file's attrs.
+
+    Without a sweep: no name and one point of NaN.
+    """
+    names = tuple(n for n in str(attrs.get("sweep_parameter", "")).split(",") if n)
+    flat = np.atleast_1d(np.asarray(attrs["sweep_values"], dtype=float))
+    return names, flat.reshape(-1, max(1, len(names)))
+
+
+def _setting_column(names: tuple[str, ...], table: np.ndarray) -> np.ndarray:
+    """Return the ``setting`` of a file: the swept value at each point; NaN for a grid (see ``grid_setting``)."""
+    return table[:, 0] if len(names) <= 1 else np.full(table.shape[0], np.nan)
+
+
+def _grid_coords(names: tuple[str, ...], table: np.ndarray) -> dict:
+    """Return a grid's coordinates: ``parameter`` (its settings) and ``grid_setting`` (point x parameter), or none."""
+    if len(names) <= 1:
+        return {}
+    return {
+        "parameter": (Var(("parameter",), None, "swept setting of the grid"), np.array(names)),
+        "grid_setting": (Var(("point", "parameter"), "1", "value of each swept setting at each point"), table),
+    }
+
+
+def point_label(names: Sequence[str], values: Sequence[float]) -> str:
+    """``name = value, ...`` of a sweep point (empty without a sweep)."""
+    return ", ".join(f"{n} = {v:g}" for n, v in zip(names, values, strict=True) if np.isfinite(v))
 
 
 # ---------------------------------------------------------------------------------------
@@ -433,12 +514,14 @@ def truth_dataset(settings: StudySettings, balls: dict[str, Ball], bats: dict[st
     """
     truths = [population_truth(settings, p, balls, bats) for p in range(settings.n_points)]
     labels = list(dict.fromkeys(lab for t in truths for lab in t))
+    names, table = sweep_table(_attrs(settings))
     values = {
         "truth": np.array([[np.nan if t.get(lab) is None else float(t[lab]) for lab in labels] for t in truths]),
-        "setting": np.asarray(settings.values, dtype=float),
+        "setting": _setting_column(names, table),
     }
     coords = _coords(settings, labels, [lab.split(":") for lab in labels])
     coords["point"] = (Var(("point",), "1", "sweep point"), np.arange(settings.n_points, dtype=np.int64))
+    coords.update(_grid_coords(names, table))
     return build_dataset(TRUTH_TABLE, values, coords, {**_attrs(settings), "truth_impacts": settings.truth_impacts})
 
 
@@ -489,7 +572,23 @@ COVERAGE_TABLE = {
     "mean_value": Var(("point", "quantity"), "1", "mean estimate (unit of the quantity)"),
     "mean_truth": Var(("point", "quantity"), "1", "mean truth (unit of the quantity)"),
     "mean_dof": Var(("point", "quantity"), "1", "mean degrees of freedom of the uncertainty"),
-    "setting": Var(("point",), "1", "value of the swept setting (NaN: no sweep)"),
+    "n_systematic": Var(("point", "quantity"), "1", "replicates of n_replicates with a systematic uncertainty"),
+    "mean_systematic": Var(("point", "quantity"), "1", "mean reported systematic uncertainty (unit of the quantity)"),
+    "coverage_68_combined": Var(
+        ("point", "quantity"),
+        "1",
+        "fraction of 68 % combined intervals (t quantile x sqrt(uncertainty^2 + systematic^2)) that cover the truth "
+        "(NaN: no systematic)",
+    ),
+    "coverage_68_combined_err": Var(("point", "quantity"), "1", "binomial standard error of coverage_68_combined"),
+    "coverage_95_combined": Var(
+        ("point", "quantity"),
+        "1",
+        "fraction of 95 % combined intervals (t quantile x sqrt(uncertainty^2 + systematic^2)) that cover the truth "
+        "(NaN: no systematic)",
+    ),
+    "coverage_95_combined_err": Var(("point", "quantity"), "1", "binomial standard error of coverage_95_combined"),
+    "setting": Var(("point",), "1", "value of the swept setting (NaN: no sweep, or a grid: grid_setting)"),
 }
 
 
@@ -523,13 +622,15 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
     has a usable estimate of any quantity raises :class:`EmptySweepPoint` naming it; a quantity
     with fewer than :data:`MIN_COVERAGE_REPLICATES` replicates gets a warning (``warning``).
     """
-    values = np.atleast_1d(np.asarray(rep.attrs["sweep_values"], dtype=float))
-    npt, nq = values.size, rep.sizes["quantity"]
+    swept, table = sweep_table(rep.attrs)
+    npt, nq = table.shape[0], rep.sizes["quantity"]
     out = {k: np.full((npt, nq), np.nan) for k in COVERAGE_TABLE if k != "setting"}
     point = rep["point"].values
+    syst_all = rep["systematic"].values if "systematic" in rep else np.full(rep["value"].shape, np.nan)
     for p in range(npt):
         sel = point == p
         v, e, t, dof = (rep[k].values[sel] for k in ("value", "uncertainty", "truth", "dof"))
+        syst = syst_all[sel]
         if truths is not None:
             labels = rep["quantity"].values.astype(str)
             names = rep["quantity_name"].values.astype(str)
@@ -539,7 +640,7 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
         ok = np.isfinite(v) & np.isfinite(e) & np.isfinite(t) & (e > 0)
         n = ok.sum(axis=0)
         if not n.any():
-            what = f"{rep.attrs.get('sweep_parameter') or 'setting'} = {values[p]:g}" if np.isfinite(values[p]) else ""
+            what = point_label(swept, table[p]) if swept else ""
             raise EmptySweepPoint(
                 f"sweep point {p}{f' ({what})' if what else ''}: none of its {int(sel.sum())} replicates gave a "
                 "usable estimate (value, uncertainty and truth) of any quantity; the setting is beyond what the "
@@ -563,12 +664,24 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
                 frac = hit.sum(axis=0) / n
                 out[f"coverage_{q}"][p] = frac
                 out[f"coverage_{q}_err"][p] = np.sqrt(frac * (1 - frac) / n)
+            # the combined interval (statistical and systematic in quadrature, the same t quantile), where a
+            # systematic is reported; a quantity without one gets NaN, not the statistical coverage again
+            oks = ok & np.isfinite(syst) & (syst >= 0)
+            ns = oks.sum(axis=0)
+            out["n_systematic"][p] = ns
+            out["mean_systematic"][p] = np.where(oks, syst, 0.0).sum(axis=0) / np.where(ns > 0, ns, np.nan)
+            for q in (68, 95):
+                half = _t(q / 100, dof) * np.hypot(e, np.where(oks, syst, 0.0))
+                frac = np.where(oks, np.abs(d) <= half, False).sum(axis=0) / np.where(ns > 0, ns, np.nan)
+                out[f"coverage_{q}_combined"][p] = frac
+                out[f"coverage_{q}_combined_err"][p] = np.sqrt(frac * (1 - frac) / ns)
             out["mean_value"][p] = np.nanmean(np.where(ok, v, np.nan), axis=0)
             out["mean_truth"][p] = np.nanmean(np.where(ok, t, np.nan), axis=0)
             out["mean_dof"][p] = np.nanmean(np.where(ok, dof, np.nan), axis=0)
-    out["setting"] = values
+    out["setting"] = _setting_column(swept, table)
     coords = {k: _copy_coord(rep, k) for k in ("quantity", "quantity_name", "ball", "bat", "table_unit")}
     coords["point"] = (Var(("point",), "1", "sweep point"), np.arange(npt, dtype=np.int64))
+    coords.update(_grid_coords(swept, table))
     from .compare import STANDARD_ERROR, UNCERTAINTY_NOTES
 
     kinds = np.array([UNCERTAINTY_NOTES.get(str(q), STANDARD_ERROR) for q in rep["quantity_name"].values])
@@ -599,6 +712,11 @@ COVERAGE_COLUMNS = (
     "coverage_68_err",
     "coverage_95",
     "coverage_95_err",
+    "mean_systematic",
+    "coverage_68_combined",
+    "coverage_68_combined_err",
+    "coverage_95_combined",
+    "coverage_95_combined_err",
     "mean_uncertainty",
     "spread",
     "mean_dof",
@@ -636,9 +754,13 @@ def coverage_csv(cov: xr.Dataset) -> str:
         "error_kind": "error_kind",
     }
 
+    grid = [str(n) for n in cov["parameter"].values] if "grid_setting" in cov else []
+
     def row(p, j):
         for k in COVERAGE_COLUMNS:
-            if k == "setting":
+            if k == "setting" and grid:  # a grid: one column per swept setting
+                yield from cov["grid_setting"].values[p]
+            elif k == "setting":
                 yield cov["setting"].values[p]
             elif k == "warning":
                 yield str(cov["warning"].values[p, j])
@@ -647,8 +769,9 @@ def coverage_csv(cov: xr.Dataset) -> str:
             else:
                 yield cov[k].values[p, j]
 
+    header = [c for k in COVERAGE_COLUMNS for c in (grid if k == "setting" and grid else [k])]
     points, quantities = range(cov.sizes["point"]), range(cov.sizes["quantity"])
-    return _csv_text(COVERAGE_COLUMNS, (list(row(p, j)) for p in points for j in quantities))
+    return _csv_text(header, (list(row(p, j)) for p in points for j in quantities))
 
 
 # ---------------------------------------------------------------------------------------
