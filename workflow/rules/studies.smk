@@ -1,6 +1,7 @@
 # Replicate studies (docs/studies.md): the whole chain on many replicates of a synthetic
 # dataset, one job per batch of replicates, then the coverage of every uncertainty and, for a
-# sweep, the design table. Not part of `rule all`: `make study` (or `snakemake studies`).
+# sweep, the design table; a grid's coverage figure. Not part of `rule all`: `make study` (or `snakemake
+# studies`); the studies marked on_request: `make study-robustness` (`snakemake studies_on_request`).
 
 
 rule study_batch:
@@ -113,7 +114,34 @@ rule study_design:
         "../scripts/study_design.py"
 
 
+rule study_grid:
+    """A grid study's coverage at a glance: quantities x grid points, statistical and combined intervals."""
+    input:
+        coverage=rules.study_aggregate.output.coverage,
+        code=code("study_grid.py"),
+    output:
+        png=report(
+            "results/studies/{study}/grid.png",
+            caption="../report/study_grid.rst",
+            category="Studies",
+            subcategory="{study}",
+            labels={"figure": "grid", "shows": "95 % coverage at every grid point"},
+        ),
+    log:
+        "results/studies/{study}/logs/grid.log",
+    conda:
+        ENV
+    script:
+        "../scripts/study_grid.py"
+
+
 rule studies:
-    """Every study of the config (`make study`)."""
+    """Every study of the config but those on request (`make study`)."""
     input:
         study_targets() + (["results/studies/front.rst"] if STUDIES else []),
+
+
+rule studies_on_request:
+    """The studies marked on_request (`make study-robustness`): too long to run with the others."""
+    input:
+        study_targets(on_request=True),
