@@ -285,9 +285,11 @@ def test_grid_coverage_table_and_figure(tmp_path):
     assert np.all(np.isnan(cov.setting.values))
     text = studies.coverage_csv(cov)
     header = text.splitlines()[0].split(",")
-    assert header[:4] == ["pixel_noise_px", "impacts_per_bat", "contact_ms", "quantity"]
+    assert header[:4] == ["setting", "quantity", "ball", "bat"]  # the header the damaged-product guards know
+    assert header[-3:] == ["pixel_noise_px", "impacts_per_bat", "contact_ms"]
     assert "coverage_95_combined" in header
-    assert text.splitlines()[8].startswith("5,60,1,e_x,")
+    last = text.splitlines()[8].split(",")
+    assert last[:2] == ["pixel_noise_px=5 impacts_per_bat=60 contact_ms=1", "e_x"] and last[-3:] == ["5", "60", "1"]
     save_figure(grid_coverage_figure(cov), tmp_path / "grid.png")
     assert_not_blank(tmp_path / "grid.png")
 
@@ -324,4 +326,4 @@ def test_the_robustness_figure_is_in_the_dag(tmp_path):
     out = snakemake(wd, "-n", "studies_on_request").stdout
     assert "rule study_grid:" in out and "results/studies/robustness/grid.png" in out
     assert "results/studies/robustness/batches/batch107.nc" in out  # 27 points x 400 replicates in 100s
-    assert "robustness" not in snakemake(wd, "-n", "studies").stdout
+    assert "results/studies/robustness/" not in snakemake(wd, "-n", "studies").stdout

@@ -758,8 +758,8 @@ def coverage_csv(cov: xr.Dataset) -> str:
 
     def row(p, j):
         for k in COVERAGE_COLUMNS:
-            if k == "setting" and grid:  # a grid: one column per swept setting
-                yield from cov["grid_setting"].values[p]
+            if k == "setting" and grid:  # a grid: its settings in words, and in columns of their own at the end
+                yield " ".join(f"{n}={v:g}" for n, v in zip(grid, cov["grid_setting"].values[p], strict=True))
             elif k == "setting":
                 yield cov["setting"].values[p]
             elif k == "warning":
@@ -768,8 +768,10 @@ def coverage_csv(cov: xr.Dataset) -> str:
                 yield str(cov[labels[k]].values[j])
             else:
                 yield cov[k].values[p, j]
+        if grid:
+            yield from cov["grid_setting"].values[p]
 
-    header = [c for k in COVERAGE_COLUMNS for c in (grid if k == "setting" and grid else [k])]
+    header = [*COVERAGE_COLUMNS, *grid]  # "setting,quantity,ball,bat,...": the header the guards know
     points, quantities = range(cov.sizes["point"]), range(cov.sizes["quantity"])
     return _csv_text(header, (list(row(p, j)) for p in points for j in quantities))
 
