@@ -327,3 +327,22 @@ def test_the_robustness_figure_is_in_the_dag(tmp_path):
     assert "rule study_grid:" in out and "results/studies/robustness/grid.png" in out
     assert "results/studies/robustness/batches/batch107.nc" in out  # 27 points x 400 replicates in 100s
     assert "results/studies/robustness/" not in snakemake(wd, "-n", "studies").stdout
+
+
+def test_truth_files_of_single_points_merge_into_the_study_truth(config, balls, bats):
+    """One truth job per sweep point (rule study_truth_point), joined by study_truth: the same as all at once."""
+    cfg = copy.deepcopy(config)
+    cfg["studies"]["robustness"].update(truth_impacts=30)
+    cfg["studies"]["robustness"]["sweep"] = {"grid": {"pixel_noise_px": [2.0], "impacts_per_bat": [6, 9]}}
+    s = studies.StudySettings.from_config(cfg, "robustness")
+    whole = studies.truth_dataset(s, balls, bats)
+    parts = [studies.truth_dataset(s, balls, bats, points=[p]) for p in (1, 0)]
+    assert [p.point.values.tolist() for p in parts] == [[1], [0]]
+    merged = studies.merge_truths(parts)
+    np.testing.assert_array_equal(merged.truth.values, whole.truth.values)
+    np.testing.assert_array_equal(merged.grid_setting.values, whole.grid_setting.values)
+    assert list(merged.quantity.values) == list(whole.quantity.values)
+    assert merged.attrs["truth_impacts"] == 30 and merged.attrs["sweep_parameter"] == "pixel_noise_px,impacts_per_bat"
+    assert studies.truths_from_dataset(merged) == studies.truths_from_dataset(whole)
+    with pytest.raises(ValueError, match=r"missing \[0\], repeated \[1\]"):
+        studies.merge_truths([parts[0], parts[0]])

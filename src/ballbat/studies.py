@@ -528,25 +528,59 @@ TRUTH_TABLE = {
 }
 
 
-def truth_dataset(settings: StudySettings, balls: dict[str, Ball], bats: dict[str, Bat]) -> xr.Dataset:
+def truth_dataset(
+    settings: StudySettings, balls: dict[str, Ball], bats: dict[str, Bat], points: Sequence[int] | None = None
+) -> xr.Dataset:
     """:func:`population_truth` of every sweep point, as a dataset (its own job: it runs beside the batches).
+
+    ``points``: only these sweep points (one job per point, :func:`merge_truths` joins them);
+    None: every point.
 
     Returns
     -------
     xarray.Dataset
         ``truth`` (point x quantity, labels as the batches'), ``setting``.
     """
-    truths = [population_truth(settings, p, balls, bats) for p in range(settings.n_points)]
+    points = list(range(settings.n_points)) if points is None else [int(p) for p in points]
+    truths = [population_truth(settings, p, balls, bats) for p in points]
     labels = list(dict.fromkeys(lab for t in truths for lab in t))
     names, table = sweep_table(_attrs(settings))
+    table = table[points]
     values = {
         "truth": np.array([[np.nan if t.get(lab) is None else float(t[lab]) for lab in labels] for t in truths]),
         "setting": _setting_column(names, table),
     }
     coords = _coords(settings, labels, [lab.split(":") for lab in labels])
-    coords["point"] = (Var(("point",), "1", "sweep point"), np.arange(settings.n_points, dtype=np.int64))
+    coords["point"] = (Var(("point",), "1", "sweep point"), np.asarray(points, dtype=np.int64))
     coords.update(_grid_coords(names, table))
     return build_dataset(TRUTH_TABLE, values, coords, {**_attrs(settings), "truth_impacts": settings.truth_impacts})
+
+
+def merge_truths(parts: Iterable[xr.Dataset]) -> xr.Dataset:
+    """Join the truth files of single sweep points (:func:`truth_dataset` with ``points``) into the study's.
+
+    Quantities are aligned by label (NaN where a point has none); every point of the study must
+    be there exactly once, or a :class:`ValueError` names the missing or repeated ones.
+    """
+    parts = list(parts)
+    if not parts:
+        raise ValueError("no truth files to merge")
+    n = int(np.asarray(parts[0].attrs["sweep_values"]).size // max(1, len(sweep_table(parts[0].attrs)[0])))
+    have = [int(p) for part in parts for p in part["point"].values]
+    if sorted(have) != list(range(n)):
+        missing = sorted(set(range(n)) - set(have))
+        repeated = sorted({p for p in have if have.count(p) > 1})
+        raise ValueError(f"truth files of {n} sweep points: missing {missing}, repeated {repeated}")
+    labels = list(dict.fromkeys(lab for b in parts for lab in b["quantity"].values.tolist()))
+    aligned = [b.reindex(quantity=labels) for b in parts]
+    out = xr.concat(aligned, dim="point", data_vars="minimal", coords="minimal", compat="override", join="outer")
+    out = out.sortby("point")
+    out.attrs = {k: v for k, v in parts[0].attrs.items() if k in (*_TRUTH_ATTRS, "truth_impacts")}
+    return out
+
+
+#: The attributes a truth file carries from its study (:func:`_attrs`).
+_TRUTH_ATTRS = ("study_seed", "replicates_per_point", "sweep_parameter", "sweep_values")
 
 
 def truths_from_dataset(ds: xr.Dataset) -> list[dict]:

@@ -292,6 +292,7 @@ STUDIES = [s for s in ALL_STUDIES if not config["studies"][s].get("on_request", 
 wildcard_constraints:
     study="|".join(ALL_STUDIES) or "^$",
     batch=r"\d+",
+    point=r"\d+",
 
 
 def study_settings(name):
@@ -364,6 +365,18 @@ def study_batch_runtime(wildcards):
     return max(10, math.ceil(s.batch_size * 2 / 60) + 5)
 
 
+def get_study_truth_points(wildcards):
+    n = study_settings(wildcards.study).n_points
+    return [f"results/studies/{wildcards.study}/truth/point{p}.nc" for p in range(n)]
+
+
+def study_truth_runtime(wildcards):
+    """Minutes: a truth job reduces one large noise-free experiment (measured about 2 CPU minutes for
+    10000 impacts per ball and bat with rendered tracks), with room."""
+    s = study_settings(wildcards.study)
+    return max(30, math.ceil(4 * max(s.truth_impacts, 1000) / 10000) + 10)
+
+
 def study_targets(on_request=False):
     """Every product of every study (of `studies`, or with on_request those of `studies_on_request`), its truth
     and batches included (so that one deleted by hand is rebuilt: Snakemake does not rebuild a missing
@@ -376,7 +389,7 @@ def study_targets(on_request=False):
             targets += [f"results/studies/{name}/grid.png"]
         elif sweep:
             targets += [f"results/studies/{name}/design.{ext}" for ext in ("nc", "csv", "png")]
-        targets += [f"results/studies/{name}/truth.nc"]
+        targets += [f"results/studies/{name}/truth.nc"] + get_study_truth_points(Namespace(study=name))
         targets += get_study_batches(Namespace(study=name))
     return targets
 

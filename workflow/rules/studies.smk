@@ -29,32 +29,50 @@ rule study_batch:
         "../scripts/study_batch.py"
 
 
-rule study_truth:
-    """The design's truth of every quantity: the estimators on a large noise-free experiment per sweep point.
+rule study_truth_point:
+    """The design's truth of every quantity at one sweep point: the estimators on a large noise-free experiment.
 
-    Its own job, so that it runs beside the batches rather than after them.
+    A job per point, beside the batches (a grid's points in parallel, not one after the other).
     """
     input:
         balls=get_study_balls,
         bats=get_study_bats,
         code=code("study_truth.py"),
     output:
-        truth="results/studies/{study}/truth.nc",
+        truth="results/studies/{study}/truth/point{point}.nc",
     log:
-        "results/studies/{study}/logs/truth.log",
+        "results/studies/{study}/logs/truth_point{point}.log",
     benchmark:
-        "results/studies/{study}/benchmarks/truth.tsv"
+        "results/studies/{study}/benchmarks/truth_point{point}.tsv"
     conda:
         ENV
     threads: 1
     resources:
         mem_mb=study_truth_mem_mb,
-        runtime=30,
+        runtime=study_truth_runtime,
     params:
         study=get_study_config,
         sha256=study_hashes,
     script:
         "../scripts/study_truth.py"
+
+
+rule study_truth:
+    """The design's truth of every quantity at every sweep point (the points' files joined)."""
+    input:
+        points=get_study_truth_points,
+        code=code("study_truth_merge.py"),
+    output:
+        truth="results/studies/{study}/truth.nc",
+    log:
+        "results/studies/{study}/logs/truth.log",
+    conda:
+        ENV
+    threads: 1
+    resources:
+        runtime=10,
+    script:
+        "../scripts/study_truth_merge.py"
 
 
 rule study_aggregate:
