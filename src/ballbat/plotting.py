@@ -692,7 +692,7 @@ def grid_coverage_figure(cov: xr.Dataset, band: tuple[float, float] = (0.93, 0.9
         axes,
         (
             ("coverage_95", "statistical 95 % interval"),
-            ("coverage_95_combined", "combined 95 % interval (statistical and systematic in quadrature)"),
+            ("coverage_95_combined", "combined 95 % interval (stat. and syst. in quadrature)"),
         ),
         strict=True,
     ):
@@ -714,12 +714,12 @@ def grid_coverage_figure(cov: xr.Dataset, band: tuple[float, float] = (0.93, 0.9
         n = int(np.nanmax(cov["n_replicates"].values)) if cov["n_replicates"].size else 0
         ax.set_title(f"{title}; {n} replicates per point", fontsize=9)
     axes[1].set_xticks(np.arange(npt), cols, fontsize=6)
-    bar = fig.colorbar(image, ax=axes, shrink=0.6, label="95 % coverage")
+    bar = fig.colorbar(image, ax=axes, shrink=0.6, label="95 % coverage (below 85 %: darkest red)", extend="min")
     for b in band:
         bar.ax.axhline(b, color="k", lw=1.0)
     fig.suptitle(
-        f"Coverage over the grid (target {band[0]:.0%}-{band[1]:.0%}, lines on the colour bar): "
-        "x outside by more than 2 binomial errors, . outside within 2; grey: none",
+        f"95 % coverage over the grid; target {band[0]:.0%}-{band[1]:.0%} (lines on the colour bar)\n"
+        "x: outside it by more than 2 binomial errors; dot: outside within 2; grey: no value",
         fontsize=9,
     )
     return fig
