@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.ballbat-installed
 CORES ?= 2
 
-.PHONY: install run test test-slurm test-report test-citation validate-crate study report bench lint lock clean
+.PHONY: install run test test-slurm test-report test-citation validate-crate study study-robustness report bench lint lock clean
 
 # Create the virtual environment and install the pinned stack plus ballbat (editable).
 $(STAMP): pyproject.toml requirements.lock
@@ -41,6 +41,13 @@ test-slurm: $(SLURM_VENV)/.installed
 study: install
 	$(BIN)/snakemake -c$(CORES) all studies
 	$(BIN)/snakemake -c$(CORES) --report results/report.html all studies
+
+# The studies marked on_request (config `studies.robustness`: a grid over tracking noise, impacts
+# per bat and contact time with drawn calibration; hours on 2 cores, docs/studies.md), with
+# those of `make study`, then the report with every study's figures.
+study-robustness: install
+	$(BIN)/snakemake -c$(CORES) all studies studies_on_request
+	$(BIN)/snakemake -c$(CORES) --report results/report.html all studies studies_on_request
 
 # The last run's Provenance Run Crate (results/ro-crate-metadata.json) against roc-validator's
 # provenance-run-crate-0.5 profile, offline (its cache seeded from tests/data/jsonld/).

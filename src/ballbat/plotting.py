@@ -615,7 +615,100 @@ def coverage_figure(cov: xr.Dataset, point: int = 0) -> Figure:
     n = int(np.nanmax(c["n_replicates"].values)) if c["n_replicates"].size else 0
     setting = float(c["setting"])
     where = "" if not np.isfinite(setting) else f", {cov.attrs.get('sweep_parameter', '')} = {setting:g}"
+    if "grid_setting" in c:  # a grid: this point's settings (the whole grid: grid_coverage_figure)
+        vals = c["grid_setting"].values
+        names = c["parameter"].values
+        where = f", grid point {point + 1} of {cov.sizes['point']}: " + ", ".join(
+            f"{n} = {v:g}" for n, v in zip(names, vals, strict=True)
+        )
     fig.suptitle(f"Replicate study: {n} replicates{where} (grey: target)", fontsize=10)
+    return fig
+
+
+#: How a grid figure's axis names a swept setting's value.
+GRID_LABELS = {
+    "pixel_noise_px": "{v:g} px",
+    "impacts_per_bat": "n {v:g}",
+    "contact_ms": "tc {v:g} ms",
+    "swing_fps": "cam1 {v:g} fps",
+    "spin_fps": "cam2 {v:g} fps",
+    "noise_scale": "noise x{v:g}",
+    "e_x": "e_x {v:g}",
+}
+
+
+def grid_coverage_figure(cov: xr.Dataset, band: tuple[float, float] = (0.93, 0.97)) -> Figure:
+    """Draw a grid study's 95 % coverage at a glance: quantities x grid points, statistical and combined intervals.
+
+    Colour: the coverage (white at 95 %, blue above, red below). A cell whose coverage lies
+    outside ``band`` by more than two binomial errors is marked with a cross, one outside the
+    band but within two errors with a dot; a grey cell has no value (the combined interval of
+    a quantity without a systematic, or no replicate).
+
+    Parameters
+    ----------
+    cov : xarray.Dataset
+        ``results/studies/{name}/coverage.nc`` of a study whose sweep is a grid (or any sweep;
+        one-parameter sweeps give one row of labels).
+
+    Returns
+    -------
+    Figure
+    """
+    from matplotlib.colors import TwoSlopeNorm
+
+    labels = [
+        f"{q} {b} {t}".strip()
+        for q, b, t in zip(cov["quantity_name"].values, cov["ball"].values, cov["bat"].values, strict=True)
+    ]
+    if "grid_setting" in cov:
+        names = [str(n) for n in cov["parameter"].values]
+        table = cov["grid_setting"].values
+    else:
+        names = [str(cov.attrs.get("sweep_parameter") or "setting")]
+        table = cov["setting"].values[:, None]
+    fmt = [GRID_LABELS.get(n, n + " {v:g}") for n in names]
+    cols = ["\n".join(f.format(v=v) for f, v in zip(fmt, row, strict=True)) for row in table]
+    npt, nq = cov.sizes["point"], cov.sizes["quantity"]
+    fig = Figure(figsize=(max(8.0, 0.42 * npt + 3.5), 2 * (0.2 * nq + 1.0) + 1.2), dpi=DPI, layout="constrained")
+    axes = fig.subplots(2, 1, sharex=True)
+    norm = TwoSlopeNorm(vmin=0.85, vcenter=0.95, vmax=1.0)
+    cmap = matplotlib.colormaps["RdBu"].with_extremes(bad="0.8")
+    image = None
+    for ax, (var, title) in zip(
+        axes,
+        (
+            ("coverage_95", "statistical 95 % interval"),
+            ("coverage_95_combined", "combined 95 % interval (stat. and syst. in quadrature)"),
+        ),
+        strict=True,
+    ):
+        c = cov[var].values.T  # quantity x point
+        e = cov[f"{var}_err"].values.T
+        image = ax.imshow(np.ma.masked_invalid(c), cmap=cmap, norm=norm, aspect="auto", interpolation="nearest")
+        with np.errstate(invalid="ignore"):
+            far = (c + 2 * e < band[0]) | (c - 2 * e > band[1])
+            near = ((c < band[0]) | (c > band[1])) & ~far
+        yq, xp = np.nonzero(far)
+        ax.plot(xp, yq, "x", color="k", ms=5, mew=1.2, ls="none")
+        yq, xp = np.nonzero(near)
+        ax.plot(xp, yq, ".", color="k", ms=4, ls="none")
+        if len(names) > 1:  # the first setting varies slowest: separate its blocks
+            first = table[:, 0]
+            for k in np.flatnonzero(first[1:] != first[:-1]):
+                ax.axvline(k + 0.5, color="k", lw=0.8)
+        ax.set_yticks(np.arange(nq), labels, fontsize=6.5)
+        n = int(np.nanmax(cov["n_replicates"].values)) if cov["n_replicates"].size else 0
+        ax.set_title(f"{title}; {n} replicates per point", fontsize=9)
+    axes[1].set_xticks(np.arange(npt), cols, fontsize=6)
+    bar = fig.colorbar(image, ax=axes, shrink=0.6, label="95 % coverage (below 85 %: darkest red)", extend="min")
+    for b in band:
+        bar.ax.axhline(b, color="k", lw=1.0)
+    fig.suptitle(
+        f"95 % coverage over the grid; target {band[0]:.0%}-{band[1]:.0%} (lines on the colour bar)\n"
+        "x: outside it by more than 2 binomial errors; dot: outside within 2; grey: no value",
+        fontsize=9,
+    )
     return fig
 
 

@@ -28,7 +28,6 @@ of impacts per bat needed to tell two bats ``delta_e_x`` apart.
 
 from __future__ import annotations
 
-import copy
 import math
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
@@ -38,7 +37,7 @@ import xarray as xr
 
 from .pipeline.config import renders
 from .pipeline.products import Var, build_dataset
-from .sweeps import point_dataset
+from .sweeps import point_dataset, study_dataset, sweep_points
 
 if TYPE_CHECKING:
     from collections.abc import Callable, Iterable, Sequence
@@ -75,10 +74,12 @@ class StudySettings:
         The study's seed (every replicate's seeds derive from it).
     batch_size : int
         Replicates per batch job.
-    parameter : str or None
-        Swept setting (a key of :data:`ballbat.sweeps.SWEEP_PARAMETERS`), None for no sweep.
-    values : tuple of float
-        Its values (one point, NaN, without a sweep).
+    parameter : str, tuple of str or None
+        Swept setting (a key of :data:`ballbat.sweeps.SWEEP_PARAMETERS`), None for no sweep;
+        for a grid sweep the tuple of its settings.
+    values : tuple
+        Its values (one point, NaN, without a sweep); for a grid one tuple per point, every
+        combination of the settings' values (:func:`ballbat.sweeps.sweep_points`).
     v_ref_mph, mu_k_example : float
         The workflow's ``normalize.v_ref_mph`` and ``analysis.mu_k_example``.
     stronge : dict
@@ -114,13 +115,15 @@ class StudySettings:
         """Return the settings from a study's block of the validated config (:func:`study_block`; the rules' params)."""
         s = block["study"]
         sweep = s.get("sweep")  # optional, no default: None is no sweep
+        names, points = sweep_points(sweep)
+        grid = bool(sweep) and "grid" in sweep
         return cls(
-            dataset=copy.deepcopy(block["dataset"]),
+            dataset=study_dataset(block["dataset"], s),
             replicates=int(s["replicates"]),
             seed=int(s["seed"]),
             batch_size=int(s["batch_size"]),
-            parameter=sweep["parameter"] if sweep else None,
-            values=tuple(float(v) for v in sweep["values"]) if sweep else (math.nan,),
+            parameter=(names if grid else names[0]) if sweep else None,
+            values=(tuple(points) if grid else tuple(p[0] for p in points)) if sweep else (math.nan,),
             v_ref_mph=float(block["normalize"]["v_ref_mph"]),
             mu_k_example=float(block["analysis"]["mu_k_example"]),
             stronge={k: block["stronge"][k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")},
@@ -129,6 +132,22 @@ class StudySettings:
             confidence=float(s["confidence"]),
             power=float(s["power"]),
         )
+
+    @property
+    def parameters(self) -> tuple[str, ...]:
+        """Names of the swept settings (one for a one-parameter sweep, none without a sweep)."""
+        if self.parameter is None:
+            return ()
+        return (self.parameter,) if isinstance(self.parameter, str) else tuple(self.parameter)
+
+    @property
+    def is_grid(self) -> bool:
+        """Whether the sweep is a grid (several settings at once)."""
+        return self.parameter is not None and not isinstance(self.parameter, str)
+
+    def point_settings(self) -> np.ndarray:
+        """Return the settings at every point (point x setting; one column of NaN without a sweep)."""
+        return np.asarray([v if self.is_grid else (v,) for v in self.values], dtype=float).reshape(self.n_points, -1)
 
     @property
     def n_points(self) -> int:
@@ -179,13 +198,24 @@ def replicate_seeds(seed: int, replicate: int) -> tuple[int, int]:
 
 
 def _source(
-    dataset: dict, seeds: tuple[int, int], balls: dict[str, Ball], bats: dict[str, Bat], where: str = "render"
+    dataset: dict,
+    seeds: tuple[int, int],
+    balls: dict[str, Ball],
+    bats: dict[str, Bat],
+    where: str = "render",
+    check: bool = True,
 ) -> xr.Dataset:
     """Simulate one experiment and, when the dataset renders tracks, render, reduce and cross-check them.
 
     The same stages as the workflow's simulate, render_tracks and reduce rules
     (:mod:`ballbat.stages`), so every render and reduce setting is honoured alike; the tracks
-    stay in memory (the workflow's make a round trip through tracks.nc).
+    stay in memory (the workflow's make a round trip through tracks.nc). A dataset that draws
+    its calibration (``render.draw_calibration``) is reduced again at +-1 sigma of each stated
+    calibration uncertainty, as the workflow's reduce does, so that its replicates report the
+    calibration systematics. ``check=False`` skips the cross-checks of the settings
+    (:func:`ballbat.tracks.checks.cross_check`): for the truth job's large experiment, whose
+    truth needs no check, and where the checks' tight errors over some 70000 impacts flag a
+    small bias of the tip's arc at 5 px as a wrong rig (kappa 1.34 +- 0.006 against at most 1.23).
     """
     from .stages import reduce, render, simulate
     from .synthetic import SyntheticSettings
@@ -199,9 +229,12 @@ def _source(
 
     cfg = {**block, "seed": seeds[1]}
     tracks = render.render(settings_from_config(cfg), sim, balls)
-    return reduce.run(
-        reduce.ReduceSettings.from_config(camera_block(cfg), where, systematics=False), tracks, balls, bats
-    )
+    settings = reduce.ReduceSettings.from_config(camera_block(cfg), where, systematics=bool(cfg["draw_calibration"]))
+    if not check:
+        from .tracks.reduce import reduce_tracks
+
+        return reduce.reduction_dataset(reduce_tracks(tracks, settings.cameras, settings.rig, settings.options))
+    return reduce.run(settings, tracks, balls, bats)
 
 
 def _truth_source(src: xr.Dataset) -> xr.Dataset:
@@ -233,7 +266,12 @@ def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> t
 
 
 def run_replicate(
-    settings: StudySettings, dataset: dict, replicate: int, balls: dict[str, Ball], bats: dict[str, Bat]
+    settings: StudySettings,
+    dataset: dict,
+    replicate: int,
+    balls: dict[str, Ball],
+    bats: dict[str, Bat],
+    check: bool = True,
 ) -> list[dict]:
     """Run the chain on one replicate experiment; return one row per recorded quantity.
 
@@ -246,25 +284,36 @@ def run_replicate(
         Replicate number within the point (seeds: :func:`replicate_seeds`).
     balls, bats : dict
         Property tables.
+    check : bool
+        Cross-check the reduced tracks' settings (:func:`_source`; off for the truth job).
 
     Returns
     -------
     list of dict
-        ``quantity, ball, bat, value, uncertainty, truth, dof, units`` (SI, as fit_ex.nc holds them).
+        ``quantity, ball, bat, value, uncertainty, truth, dof, units, systematic`` (SI, as fit_ex.nc
+        holds them; systematic NaN where there is none).
     """
     from .stages import fit_ex, normalize, reconstruct
 
-    src = _source(dataset, replicate_seeds(settings.seed, replicate), balls, bats, f"render (replicate {replicate})")
+    src = _source(
+        dataset, replicate_seeds(settings.seed, replicate), balls, bats, f"render (replicate {replicate})", check
+    )
     norm = normalize.NormalizeSettings(v_ref_mph=settings.v_ref_mph)
     rec = reconstruct.run(reconstruct.ReconstructSettings(), normalize.run(norm, src), balls, bats)
-    # no study quantity is a systematic; every replicate's numbers are recorded as they come
-    fit = fit_ex.run(fit_ex.FitExSettings(settings.mu_k_example, systematic=False, check_physical=False), rec)
+    # the calibration systematics where the replicate draws its calibration (the combined interval's
+    # coverage); every replicate's numbers are recorded as they come
+    from .systematics import has_shifts
+
+    drawn = has_shifts(rec)
+    fit = fit_ex.run(fit_ex.FitExSettings(settings.mu_k_example, systematic=drawn, check_physical=False), rec)
     rows = fit_quantity_rows(fit)
     if "eta2" in STUDY_QUANTITIES:
         rec_truth = reconstruct.run(
             reconstruct.ReconstructSettings(), normalize.run(norm, _truth_source(src)), balls, bats
         )
-        for ball in fit["ball"].values.astype(str):
+        balls_fitted = fit["ball"].values.astype(str)
+        syst = _eta2_systematic(rec, balls_fitted, settings.stronge) if drawn else np.full(balls_fitted.size, np.nan)
+        for ball, sy in zip(balls_fitted, syst, strict=True):
             v, e, t, dof = _eta2(rec, rec_truth, ball, settings.stronge)
             rows.append(
                 {
@@ -276,9 +325,19 @@ def run_replicate(
                     "truth": t,
                     "dof": dof,
                     "units": "1",
+                    "systematic": float(sy) if math.isfinite(v) else math.nan,
                 }
             )
     return rows
+
+
+def _eta2_systematic(rec: xr.Dataset, balls: np.ndarray, stronge: dict) -> np.ndarray:
+    """eta^2's calibration systematic of each ball, every source in quadrature (as stronge.nc's ``eta2_syst``)."""
+    from .systematics import stronge_by_source
+
+    kw = {k: stronge[k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")}
+    with np.errstate(invalid="ignore"):
+        return np.sqrt(np.sum(stronge_by_source(rec, list(balls), ["eta2"], **kw)["eta2"] ** 2, axis=0))
 
 
 def _at(fit: xr.Dataset, var: str, ball: str, bat: str) -> float | None:
@@ -324,9 +383,23 @@ def fit_quantity_rows(fit: xr.Dataset) -> list[dict]:
                         "truth": _at(fit, f"truth_{q}", ball, bat),
                         "dof": dof,
                         "units": str(fit[q].attrs["units"]),
+                        "systematic": _systematic(fit, q, ball, bat),
                     }
                 )
     return rows
+
+
+def _systematic(fit: xr.Dataset, q: str, ball: str, bat: str) -> float:
+    """Return the systematic uncertainty of a quantity of ``fit_ex.nc`` (SI; NaN: none).
+
+    ``{q}_syst`` (every calibration source) or, in files without it, ``{q}_err_scale``
+    (:func:`ballbat.systematics.systematic_var`).
+    """
+    from .systematics import systematic_var
+
+    name = systematic_var(fit, q)
+    v = None if name is None else _at(fit, name, ball, bat)
+    return math.nan if v is None else float(v)
 
 
 # ---------------------------------------------------------------------------------------
@@ -349,6 +422,9 @@ BATCH_TABLE = {
         PER_QUANTITY_UNITS,
     ),
     "dof": Var(("replicate", "quantity"), "1", "degrees of freedom of the uncertainty (inf: normal)"),
+    "systematic": Var(
+        ("replicate", "quantity"), "1", "reported systematic uncertainty of the estimate (same unit; NaN: none)"
+    ),
     "point": Var(("replicate",), "1", "sweep point of the replicate (index into setting)"),
     "seed_replicate": Var(("replicate",), "1", "replicate number within its point (its seeds' spawn key)"),
 }
@@ -397,12 +473,12 @@ def run_batch(
             progress(done, len(indices))
     labels = list(table)
     nq = len(labels)
-    arrays = {k: np.full((len(records), nq), np.nan) for k in ("value", "uncertainty", "truth", "dof")}
+    arrays = {k: np.full((len(records), nq), np.nan) for k in ("value", "uncertainty", "truth", "dof", "systematic")}
     for i, (_, _, _, rows) in enumerate(records):
         for label, r in zip(_labels(rows), rows, strict=True):
             j = table[label]
             for k in arrays:
-                v = r[k]
+                v = r.get(k)
                 arrays[k][i, j] = np.nan if v is None else float(v)
     parts = [lab.split(":") for lab in labels]
     values = {
@@ -436,15 +512,46 @@ def display_unit(quantity: str) -> str:
 
 
 def _attrs(settings: StudySettings, batch: int | None = None) -> dict:
+    """Return the study's attributes: a grid's settings are comma-joined, its values flattened point by point."""
     attrs = {
         "study_seed": settings.seed,
         "replicates_per_point": settings.replicates,
-        "sweep_parameter": settings.parameter or "",
-        "sweep_values": np.asarray(settings.values, dtype=float),
+        "sweep_parameter": ",".join(settings.parameters),
+        "sweep_values": settings.point_settings().ravel(),
     }
     if batch is not None:
         attrs["batch"] = batch
     return attrs
+
+
+def sweep_table(attrs: dict) -> tuple[tuple[str, ...], np.ndarray]:
+    """Return the swept settings' names and their values at every point (point x setting) from a file's attrs.
+
+    Without a sweep: no name and one point of NaN.
+    """
+    names = tuple(n for n in str(attrs.get("sweep_parameter", "")).split(",") if n)
+    flat = np.atleast_1d(np.asarray(attrs["sweep_values"], dtype=float))
+    return names, flat.reshape(-1, max(1, len(names)))
+
+
+def _setting_column(names: tuple[str, ...], table: np.ndarray) -> np.ndarray:
+    """Return the ``setting`` of a file: the swept value at each point; NaN for a grid (see ``grid_setting``)."""
+    return table[:, 0] if len(names) <= 1 else np.full(table.shape[0], np.nan)
+
+
+def _grid_coords(names: tuple[str, ...], table: np.ndarray) -> dict:
+    """Return a grid's coordinates: ``parameter`` (its settings) and ``grid_setting`` (point x parameter), or none."""
+    if len(names) <= 1:
+        return {}
+    return {
+        "parameter": (Var(("parameter",), None, "swept setting of the grid"), np.array(names)),
+        "grid_setting": (Var(("point", "parameter"), "1", "value of each swept setting at each point"), table),
+    }
+
+
+def point_label(names: Sequence[str], values: Sequence[float]) -> str:
+    """``name = value, ...`` of a sweep point (empty without a sweep)."""
+    return ", ".join(f"{n} = {v:g}" for n, v in zip(names, values, strict=True) if np.isfinite(v))
 
 
 # ---------------------------------------------------------------------------------------
@@ -489,7 +596,7 @@ def _population_rows(settings: StudySettings, point: int, balls: dict[str, Ball]
     big = replace(
         settings, seed=int(np.random.SeedSequence(settings.seed, spawn_key=(2**31 - 1, point)).generate_state(1)[0])
     )
-    return run_replicate(big, ds, 0, balls, bats)
+    return run_replicate(big, ds, 0, balls, bats, check=False)
 
 
 #: The truth file of a study (``results/{study}/truth.nc``; dims point x quantity).
@@ -504,25 +611,61 @@ TRUTH_TABLE = {
 }
 
 
-def truth_dataset(settings: StudySettings, balls: dict[str, Ball], bats: dict[str, Bat]) -> xr.Dataset:
+def truth_dataset(
+    settings: StudySettings, balls: dict[str, Ball], bats: dict[str, Bat], points: Sequence[int] | None = None
+) -> xr.Dataset:
     """:func:`population_truth` of every sweep point, as a dataset (its own job: it runs beside the batches).
+
+    ``points``: only these sweep points (one job per point, :func:`merge_truths` joins them);
+    None: every point.
 
     Returns
     -------
     xarray.Dataset
         ``truth`` (point x quantity, labels as the batches'), ``setting``.
     """
-    points = [_population_rows(settings, p, balls, bats) for p in range(settings.n_points)]
-    truths = [dict(zip(_labels(rows), (r["truth"] for r in rows), strict=True)) for rows in points]
-    units = {lab: r["units"] for rows in points for lab, r in zip(_labels(rows), rows, strict=True)}
+    points = list(range(settings.n_points)) if points is None else [int(p) for p in points]
+    rows_of = [_population_rows(settings, p, balls, bats) for p in points]
+    truths = [dict(zip(_labels(rows), (r["truth"] for r in rows), strict=True)) for rows in rows_of]
+    units = {lab: r["units"] for rows in rows_of for lab, r in zip(_labels(rows), rows, strict=True)}
     labels = list(dict.fromkeys(lab for t in truths for lab in t))
+    names, table = sweep_table(_attrs(settings))
+    table = table[points]
     values = {
         "truth": np.array([[np.nan if t.get(lab) is None else float(t[lab]) for lab in labels] for t in truths]),
-        "setting": np.asarray(settings.values, dtype=float),
+        "setting": _setting_column(names, table),
     }
     coords = _coords(labels, [lab.split(":") for lab in labels], [units[lab] for lab in labels])
-    coords["point"] = (Var(("point",), "1", "sweep point"), np.arange(settings.n_points, dtype=np.int64))
+    coords["point"] = (Var(("point",), "1", "sweep point"), np.asarray(points, dtype=np.int64))
+    coords.update(_grid_coords(names, table))
     return build_dataset(TRUTH_TABLE, values, coords, {**_attrs(settings), "truth_impacts": settings.truth_impacts})
+
+
+def merge_truths(parts: Iterable[xr.Dataset]) -> xr.Dataset:
+    """Join the truth files of single sweep points (:func:`truth_dataset` with ``points``) into the study's.
+
+    Quantities are aligned by label (NaN where a point has none); every point of the study must
+    be there exactly once, or a :class:`ValueError` names the missing or repeated ones.
+    """
+    parts = list(parts)
+    if not parts:
+        raise ValueError("no truth files to merge")
+    n = int(np.asarray(parts[0].attrs["sweep_values"]).size // max(1, len(sweep_table(parts[0].attrs)[0])))
+    have = [int(p) for part in parts for p in part["point"].values]
+    if sorted(have) != list(range(n)):
+        missing = sorted(set(range(n)) - set(have))
+        repeated = sorted({p for p in have if have.count(p) > 1})
+        raise ValueError(f"truth files of {n} sweep points: missing {missing}, repeated {repeated}")
+    labels = list(dict.fromkeys(lab for b in parts for lab in b["quantity"].values.tolist()))
+    aligned = [b.reindex(quantity=labels) for b in parts]
+    out = xr.concat(aligned, dim="point", data_vars="minimal", coords="minimal", compat="override", join="outer")
+    out = out.sortby("point")
+    out.attrs = {k: v for k, v in parts[0].attrs.items() if k in (*_TRUTH_ATTRS, "truth_impacts")}
+    return out
+
+
+#: The attributes a truth file carries from its study (:func:`_attrs`).
+_TRUTH_ATTRS = ("study_seed", "replicates_per_point", "sweep_parameter", "sweep_values")
 
 
 def truths_from_dataset(ds: xr.Dataset) -> list[dict]:
@@ -576,7 +719,23 @@ COVERAGE_TABLE = {
     "mean_value": Var(("point", "quantity"), None, "mean estimate (SI: unit in units)", PER_QUANTITY_UNITS),
     "mean_truth": Var(("point", "quantity"), None, "mean truth (SI: unit in units)", PER_QUANTITY_UNITS),
     "mean_dof": Var(("point", "quantity"), "1", "mean degrees of freedom of the uncertainty"),
-    "setting": Var(("point",), "1", "value of the swept setting (NaN: no sweep)"),
+    "n_systematic": Var(("point", "quantity"), "1", "replicates of n_replicates with a systematic uncertainty"),
+    "mean_systematic": Var(("point", "quantity"), "1", "mean reported systematic uncertainty (unit of the quantity)"),
+    "coverage_68_combined": Var(
+        ("point", "quantity"),
+        "1",
+        "fraction of 68 % combined intervals (t quantile x sqrt(uncertainty^2 + systematic^2)) that cover the truth "
+        "(NaN: no systematic)",
+    ),
+    "coverage_68_combined_err": Var(("point", "quantity"), "1", "binomial standard error of coverage_68_combined"),
+    "coverage_95_combined": Var(
+        ("point", "quantity"),
+        "1",
+        "fraction of 95 % combined intervals (t quantile x sqrt(uncertainty^2 + systematic^2)) that cover the truth "
+        "(NaN: no systematic)",
+    ),
+    "coverage_95_combined_err": Var(("point", "quantity"), "1", "binomial standard error of coverage_95_combined"),
+    "setting": Var(("point",), "1", "value of the swept setting (NaN: no sweep, or a grid: grid_setting)"),
 }
 
 
@@ -610,13 +769,15 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
     has a usable estimate of any quantity raises :class:`EmptySweepPoint` naming it; a quantity
     with fewer than :data:`MIN_COVERAGE_REPLICATES` replicates gets a warning (``warning``).
     """
-    values = np.atleast_1d(np.asarray(rep.attrs["sweep_values"], dtype=float))
-    npt, nq = values.size, rep.sizes["quantity"]
+    swept, table = sweep_table(rep.attrs)
+    npt, nq = table.shape[0], rep.sizes["quantity"]
     out = {k: np.full((npt, nq), np.nan) for k in COVERAGE_TABLE if k != "setting"}
     point = rep["point"].values
+    syst_all = rep["systematic"].values if "systematic" in rep else np.full(rep["value"].shape, np.nan)
     for p in range(npt):
         sel = point == p
         v, e, t, dof = (rep[k].values[sel] for k in ("value", "uncertainty", "truth", "dof"))
+        syst = syst_all[sel]
         if truths is not None:
             labels = rep["quantity"].values.astype(str)
             names = rep["quantity_name"].values.astype(str)
@@ -626,7 +787,7 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
         ok = np.isfinite(v) & np.isfinite(e) & np.isfinite(t) & (e > 0)
         n = ok.sum(axis=0)
         if not n.any():
-            what = f"{rep.attrs.get('sweep_parameter') or 'setting'} = {values[p]:g}" if np.isfinite(values[p]) else ""
+            what = point_label(swept, table[p]) if swept else ""
             raise EmptySweepPoint(
                 f"sweep point {p}{f' ({what})' if what else ''}: none of its {int(sel.sum())} replicates gave a "
                 "usable estimate (value, uncertainty and truth) of any quantity; the setting is beyond what the "
@@ -650,12 +811,24 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
                 frac = hit.sum(axis=0) / n
                 out[f"coverage_{q}"][p] = frac
                 out[f"coverage_{q}_err"][p] = np.sqrt(frac * (1 - frac) / n)
+            # the combined interval (statistical and systematic in quadrature, the same t quantile), where a
+            # systematic is reported; a quantity without one gets NaN, not the statistical coverage again
+            oks = ok & np.isfinite(syst) & (syst >= 0)
+            ns = oks.sum(axis=0)
+            out["n_systematic"][p] = ns
+            out["mean_systematic"][p] = np.where(oks, syst, 0.0).sum(axis=0) / np.where(ns > 0, ns, np.nan)
+            for q in (68, 95):
+                half = _t(q / 100, dof) * np.hypot(e, np.where(oks, syst, 0.0))
+                frac = np.where(oks, np.abs(d) <= half, False).sum(axis=0) / np.where(ns > 0, ns, np.nan)
+                out[f"coverage_{q}_combined"][p] = frac
+                out[f"coverage_{q}_combined_err"][p] = np.sqrt(frac * (1 - frac) / ns)
             out["mean_value"][p] = np.nanmean(np.where(ok, v, np.nan), axis=0)
             out["mean_truth"][p] = np.nanmean(np.where(ok, t, np.nan), axis=0)
             out["mean_dof"][p] = np.nanmean(np.where(ok, dof, np.nan), axis=0)
-    out["setting"] = values
+    out["setting"] = _setting_column(swept, table)
     coords = {k: _copy_coord(rep, k) for k in ("quantity", "quantity_name", "ball", "bat", "units")}
     coords["point"] = (Var(("point",), "1", "sweep point"), np.arange(npt, dtype=np.int64))
+    coords.update(_grid_coords(swept, table))
     from .compare import STANDARD_ERROR, UNCERTAINTY_NOTES
 
     kinds = np.array([UNCERTAINTY_NOTES.get(str(q), STANDARD_ERROR) for q in rep["quantity_name"].values])
@@ -686,6 +859,11 @@ COVERAGE_COLUMNS = (
     "coverage_68_err",
     "coverage_95",
     "coverage_95_err",
+    "mean_systematic",
+    "coverage_68_combined",
+    "coverage_68_combined_err",
+    "coverage_95_combined",
+    "coverage_95_combined_err",
     "mean_uncertainty",
     "spread",
     "mean_dof",
@@ -733,9 +911,13 @@ def coverage_csv(cov: xr.Dataset) -> str:
                 f"coverage: quantity {cov['quantity'].values[j]} is in {si}, but the table has no unit for it"
             )
 
+    grid = [str(n) for n in cov["parameter"].values] if "grid_setting" in cov else []
+
     def row(p, j):
         for k in COVERAGE_COLUMNS:
-            if k == "setting":
+            if k == "setting" and grid:  # a grid: its settings in words, and in columns of their own at the end
+                yield " ".join(f"{n}={v:g}" for n, v in zip(grid, cov["grid_setting"].values[p], strict=True))
+            elif k == "setting":
                 yield cov["setting"].values[p]
             elif k == "warning":
                 yield str(cov["warning"].values[p, j])
@@ -747,9 +929,12 @@ def coverage_csv(cov: xr.Dataset) -> str:
                 yield from_si(float(cov[k].values[p, j]), shown[j])
             else:
                 yield cov[k].values[p, j]
+        if grid:
+            yield from cov["grid_setting"].values[p]
 
+    header = [*COVERAGE_COLUMNS, *grid]  # "setting,quantity,ball,bat,...": the header the guards know
     points, quantities = range(cov.sizes["point"]), range(cov.sizes["quantity"])
-    return _csv_text(COVERAGE_COLUMNS, (list(row(p, j)) for p in points for j in quantities))
+    return _csv_text(header, (list(row(p, j)) for p in points for j in quantities))
 
 
 # ---------------------------------------------------------------------------------------

@@ -1,18 +1,30 @@
 """Sweeps of a replicate study: what a sweep may vary and the dataset settings at each point.
 
-Plain dictionaries only (no xarray), so that the config check at every workflow start can use
-them without importing the analysis stack (:mod:`ballbat.studies` runs the studies).
+A sweep varies one setting (``parameter``, ``values``) or several at once over the product
+of their values (``grid``: setting -> values). Plain dictionaries only (no xarray), so that the
+config check at every workflow start can use them without importing the analysis stack
+(:mod:`ballbat.studies` runs the studies).
 """
 
 from __future__ import annotations
 
 import copy
+import itertools
+import math
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
-__all__ = ["SWEEP_PARAMETERS", "check_sweep", "point_dataset"]
+__all__ = [
+    "CONTACT_HALF_WIDTH_MS",
+    "SWEEP_PARAMETERS",
+    "check_study_sweep",
+    "check_sweep",
+    "point_dataset",
+    "study_dataset",
+    "sweep_points",
+]
 
 #: What a sweep may vary: name -> what it sets in the dataset's settings.
 SWEEP_PARAMETERS = {
@@ -22,33 +34,137 @@ SWEEP_PARAMETERS = {
     "spin_fps": "frame rate of the spin camera (datasets that render tracks)",
     "noise_scale": "factor on every direct measurement noise (datasets that do not render tracks)",
     "e_x": "true e_x of every bat and ball",
+    "contact_ms": "rendered contact time (ms): drawn uniformly within CONTACT_HALF_WIDTH_MS of the value",
 }
 
+#: A ``contact_ms`` sweep point c draws the renderer's contact times uniformly from
+#: [c - 0.05, c + 0.05] ms (``render.contact_ms``): a narrow range about c, not one value, so
+#: that the impacts of a point still differ a little, as real ones do.
+CONTACT_HALF_WIDTH_MS = 0.05
 
-def check_sweep(dataset: dict, parameter: str | None, values: Sequence[float], where: str) -> list[str]:
-    """Problems of a study's sweep against its validated dataset (empty when fine), each naming ``where``."""
+#: The renderer's contact times must lie in the reduction's prior (``contact_range`` of the schema).
+CONTACT_PRIOR_MS = (0.2, 2.0)
+
+#: Settings that need a dataset that renders camera tracks.
+RENDER_PARAMETERS = ("pixel_noise_px", "swing_fps", "spin_fps", "contact_ms")
+
+
+def sweep_points(sweep: dict | None) -> tuple[tuple[str, ...], list[tuple[float, ...]]]:
+    """Names of a sweep's settings and the settings at each of its points.
+
+    Parameters
+    ----------
+    sweep : dict or None
+        A study's ``sweep`` block: ``{parameter, values}`` or ``{grid: {name: values}}``.
+
+    Returns
+    -------
+    (names, points)
+        ``()`` and ``[]`` without a sweep; one name and one-element points for a one-parameter
+        sweep; for a grid the names in the config's order and every combination of their
+        values (the first name varies slowest).
+    """
+    if not sweep:
+        return (), []
+    if "grid" in sweep:
+        names = tuple(sweep["grid"])
+        return names, [tuple(float(v) for v in p) for p in itertools.product(*sweep["grid"].values())]
+    return (sweep["parameter"],), [(float(v),) for v in sweep["values"]]
+
+
+def _value_problem(parameter: str, v: float) -> str | None:
+    if not math.isfinite(v):
+        return f"{parameter} must be a finite number, not {v}"
+    if parameter == "impacts_per_bat" and (v != int(v) or v < 3):
+        return f"impacts per bat must be a whole number >= 3, not {v:g}"
+    if parameter in ("swing_fps", "spin_fps", "pixel_noise_px", "noise_scale") and v <= 0:
+        return f"{parameter} must be positive, not {v:g}"
+    if parameter == "e_x" and not -1.0 < v < 1.0:
+        return f"e_x must lie in (-1, 1), not {v:g}"
+    lo, hi = CONTACT_PRIOR_MS
+    h = CONTACT_HALF_WIDTH_MS
+    if parameter == "contact_ms" and not lo + h <= v <= hi - h:
+        return (
+            f"contact_ms must lie in [{lo + h:g}, {hi - h:g}] ms (its contacts are drawn within {h:g} ms of it, "
+            f"inside the reduction's prior {lo:g}-{hi:g} ms), not {v:g}"
+        )
+    return None
+
+
+def check_sweep(
+    dataset: dict, parameter: str | None, values: Sequence[float], where: str, at: str | None = None
+) -> list[str]:
+    """Problems of a one-parameter sweep against its validated dataset (empty when fine), each naming ``where``.
+
+    ``at`` is the config key of the values (default ``{where}.sweep.values``; a grid's
+    ``{where}.sweep.grid.{parameter}``).
+    """
     from .pipeline.config import renders as renders_tracks
 
     if parameter is None:
         return []
+    at = at or f"{where}.sweep.values"
+    name_at = f"{where}.sweep.parameter" if at.endswith(".values") else at
     problems = []
     renders = renders_tracks(dataset)
-    if parameter in ("pixel_noise_px", "swing_fps", "spin_fps") and not renders:
-        problems.append(f"{where}.sweep.parameter: {parameter} needs a dataset that renders camera tracks")
+    if parameter in RENDER_PARAMETERS and not renders:
+        problems.append(f"{name_at}: {parameter} needs a dataset that renders camera tracks")
     if parameter == "noise_scale" and renders:
-        problems.append(f"{where}.sweep.parameter: noise_scale scales the direct noise, but the dataset renders tracks")
+        problems.append(f"{name_at}: noise_scale scales the direct noise, but the dataset renders tracks")
     for i, v in enumerate(values):
-        if parameter == "impacts_per_bat" and (v != int(v) or v < 3):
-            problems.append(f"{where}.sweep.values[{i}]: impacts per bat must be a whole number >= 3, not {v:g}")
-        elif parameter in ("swing_fps", "spin_fps", "pixel_noise_px", "noise_scale") and v <= 0:
-            problems.append(f"{where}.sweep.values[{i}]: {parameter} must be positive, not {v:g}")
-        elif parameter == "e_x" and not -1.0 < v < 1.0:
-            problems.append(f"{where}.sweep.values[{i}]: e_x must lie in (-1, 1), not {v:g}")
+        why = _value_problem(parameter, float(v))
+        if why:
+            problems.append(f"{at}[{i}]: {why}")
     return problems
 
 
-def point_dataset(dataset: dict, parameter: str | None, value: float) -> dict:
-    """Return the dataset's config block with the swept setting at ``value`` (a copy)."""
+def check_study_sweep(dataset: dict, study: dict, where: str) -> list[str]:
+    """Problems of a study's sweep (one parameter or a grid) and of its ``draw_calibration``, each naming its key."""
+    sweep = study.get("sweep") or {}
+    problems = []
+    if "grid" in sweep:
+        for name, values in sweep["grid"].items():
+            problems += check_sweep(dataset, name, values, where, at=f"{where}.sweep.grid.{name}")
+            if len(set(map(float, values))) != len(values):
+                problems.append(f"{where}.sweep.grid.{name}: a value is repeated ({list(values)}); give each once")
+    else:
+        problems += check_sweep(dataset, sweep.get("parameter"), sweep.get("values", ()), where)
+    if study["draw_calibration"]:  # the validated study block (its defaults filled)
+        from .pipeline.config import renders
+
+        if not renders(dataset):
+            problems.append(f"{where}.draw_calibration: needs a dataset that renders camera tracks")
+        else:
+            render = dataset["render"]
+            blocks = [*render["cameras"].values(), render["rig"]]
+            stated = [k for b in blocks for k, v in b.items() if k.endswith(("_err", "_err_in")) and float(v) > 0]
+            if not stated:
+                problems.append(
+                    f"{where}.draw_calibration: the dataset states no calibration uncertainty "
+                    "(every m_per_px_err and fps_err of render.cameras and the rig's *_err_in are 0): "
+                    "there is nothing to draw"
+                )
+    return problems
+
+
+def study_dataset(dataset: dict, study: dict) -> dict:
+    """Return the dataset's config block as a study replicates it (a copy): ``draw_calibration`` set in ``render``."""
+    ds = copy.deepcopy(dataset)
+    if study["draw_calibration"]:
+        ds["render"]["draw_calibration"] = True
+    return ds
+
+
+def point_dataset(dataset: dict, parameter: str | Sequence[str] | None, value: float | Sequence[float]) -> dict:
+    """Return the dataset's config block with the swept setting at ``value`` (a copy).
+
+    A grid point gives the names and values as sequences (each set in turn).
+    """
+    if parameter is not None and not isinstance(parameter, str):
+        ds = copy.deepcopy(dataset)
+        for name, v in zip(parameter, value, strict=True):
+            ds = point_dataset(ds, name, v)
+        return ds
     ds = copy.deepcopy(dataset)
     if parameter is None:
         return ds
@@ -64,6 +180,8 @@ def point_dataset(dataset: dict, parameter: str | None, value: float) -> dict:
             cam["pixel_noise_px"] = float(value)
     elif parameter in ("swing_fps", "spin_fps"):
         ds["render"]["cameras"][parameter.split("_")[0]]["fps"] = float(value)
+    elif parameter == "contact_ms":
+        ds["render"]["contact_ms"] = [float(value) - CONTACT_HALF_WIDTH_MS, float(value) + CONTACT_HALF_WIDTH_MS]
     else:
         raise ValueError(f"unknown sweep parameter {parameter!r} (known: {', '.join(SWEEP_PARAMETERS)})")
     return ds

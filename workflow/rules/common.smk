@@ -284,13 +284,16 @@ def get_scenario_fit(wildcards):
     return {"fit": f"results/{name}/fit_ex.nc"} if name else {}
 
 
-# Replicate studies (studies.smk).
-STUDIES = sorted(config.get("studies") or {})
+# Replicate studies (studies.smk). STUDIES: those of `snakemake studies` (`make study`); the studies marked
+# on_request are built by `snakemake studies_on_request` only.
+ALL_STUDIES = sorted(config.get("studies") or {})
+STUDIES = [s for s in ALL_STUDIES if not config["studies"][s].get("on_request", False)]
 
 
 wildcard_constraints:
-    study="|".join(STUDIES) or "^$",
+    study="|".join(ALL_STUDIES) or "^$",
     batch=r"\d+",
+    point=r"\d+",
 
 
 def study_settings(name):
@@ -358,18 +361,34 @@ def study_batch_runtime(wildcards):
     return max(10, math.ceil(s.batch_size * 2 / 60) + 5)
 
 
-def study_targets():
-    """Every product of every study, its truth and batches included (so that one deleted by hand is rebuilt:
-    Snakemake does not rebuild a missing intermediate whose consumers are up to date)."""
+def get_study_truth_points(wildcards):
+    n = study_settings(wildcards.study).n_points
+    return [f"results/studies/{wildcards.study}/truth/point{p}.nc" for p in range(n)]
+
+
+def study_truth_runtime(wildcards):
+    """Minutes: a truth job reduces one large noise-free experiment (measured about 2 CPU minutes for
+    10000 impacts per ball and bat with rendered tracks), with room."""
+    s = study_settings(wildcards.study)
+    return max(30, math.ceil(4 * max(s.truth_impacts, 1000) / 10000) + 10)
+
+
+def study_targets(on_request=False):
+    """Every product of every study (of `studies`, or with on_request those of `studies_on_request`), its truth
+    and batches included (so that one deleted by hand is rebuilt: Snakemake does not rebuild a missing
+    intermediate whose consumers are up to date). A one-parameter sweep has a design, a grid its grid figure."""
     targets = []
-    for name in STUDIES:
+    for name in STUDIES if not on_request else sorted(set(ALL_STUDIES) - set(STUDIES)):
         targets += [f"results/studies/{name}/coverage.{ext}" for ext in ("nc", "csv", "png")]
-        if config["studies"][name].get("sweep"):
+        sweep = config["studies"][name].get("sweep") or {}
+        if "grid" in sweep:
+            targets += [f"results/studies/{name}/grid.png"]
+        elif sweep:
             targets += [f"results/studies/{name}/design.{ext}" for ext in ("nc", "csv", "png")]
-        targets += [f"results/studies/{name}/truth.nc"]
+        targets += [f"results/studies/{name}/truth.nc"] + get_study_truth_points(Namespace(study=name))
         targets += get_study_batches(Namespace(study=name))
     return targets
 
 
 # A damaged product is named, with the command that rebuilds it (nothing is removed here).
-report_damaged_products(final_targets() + study_targets())
+report_damaged_products(final_targets() + study_targets() + study_targets(on_request=True))

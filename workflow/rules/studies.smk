@@ -1,6 +1,7 @@
 # Replicate studies (docs/studies.md): the whole chain on many replicates of a synthetic
 # dataset, one job per batch of replicates, then the coverage of every uncertainty and, for a
-# sweep, the design table. Not part of `rule all`: `make study` (or `snakemake studies`).
+# sweep, the design table; a grid's coverage figure. Not part of `rule all`: `make study` (or `snakemake
+# studies`); the studies marked on_request: `make study-robustness` (`snakemake studies_on_request`).
 
 
 rule study_batch:
@@ -28,32 +29,50 @@ rule study_batch:
         "../scripts/study_batch.py"
 
 
-rule study_truth:
-    """The design's truth of every quantity: the estimators on a large noise-free experiment per sweep point.
+rule study_truth_point:
+    """The design's truth of every quantity at one sweep point: the estimators on a large noise-free experiment.
 
-    Its own job, so that it runs beside the batches rather than after them.
+    A job per point, beside the batches (a grid's points in parallel, not one after the other).
     """
     input:
         balls=get_study_balls,
         bats=get_study_bats,
         code=code("study_truth.py"),
     output:
-        truth="results/studies/{study}/truth.nc",
+        truth="results/studies/{study}/truth/point{point}.nc",
     log:
-        "results/studies/{study}/logs/truth.log",
+        "results/studies/{study}/logs/truth_point{point}.log",
     benchmark:
-        "results/studies/{study}/benchmarks/truth.tsv"
+        "results/studies/{study}/benchmarks/truth_point{point}.tsv"
     conda:
         ENV
     threads: 1
     resources:
         mem_mb=study_truth_mem_mb,
-        runtime=30,
+        runtime=study_truth_runtime,
     params:
         study=get_study_config,
         sha256=study_hashes,
     script:
         "../scripts/study_truth.py"
+
+
+rule study_truth:
+    """The design's truth of every quantity at every sweep point (the points' files joined)."""
+    input:
+        points=get_study_truth_points,
+        code=code("study_truth_merge.py"),
+    output:
+        truth="results/studies/{study}/truth.nc",
+    log:
+        "results/studies/{study}/logs/truth.log",
+    conda:
+        ENV
+    threads: 1
+    resources:
+        runtime=10,
+    script:
+        "../scripts/study_truth_merge.py"
 
 
 rule study_aggregate:
@@ -113,7 +132,34 @@ rule study_design:
         "../scripts/study_design.py"
 
 
+rule study_grid:
+    """A grid study's coverage at a glance: quantities x grid points, statistical and combined intervals."""
+    input:
+        coverage=rules.study_aggregate.output.coverage,
+        code=code("study_grid.py"),
+    output:
+        png=report(
+            "results/studies/{study}/grid.png",
+            caption="../report/study_grid.rst",
+            category="Studies",
+            subcategory="{study}",
+            labels={"figure": "grid", "shows": "95 % coverage at every grid point"},
+        ),
+    log:
+        "results/studies/{study}/logs/grid.log",
+    conda:
+        ENV
+    script:
+        "../scripts/study_grid.py"
+
+
 rule studies:
-    """Every study of the config (`make study`)."""
+    """Every study of the config but those on request (`make study`)."""
     input:
         study_targets() + (["results/studies/front.rst"] if STUDIES else []),
+
+
+rule studies_on_request:
+    """The studies marked on_request (`make study-robustness`): too long to run with the others."""
+    input:
+        study_targets(on_request=True),

@@ -1,4 +1,4 @@
-"""Rule study_truth: adapter around ballbat.studies.truth_dataset."""
+"""Rule study_truth_point: adapter around ballbat.studies.truth_dataset (one sweep point, or every point)."""
 
 from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
@@ -7,7 +7,10 @@ from ballbat.studies import StudySettings, truth_dataset
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     study = snakemake.wildcards.study
+    point = int(snakemake.wildcards.point) if "point" in snakemake.wildcards.keys() else None
     settings = StudySettings.from_block(snakemake.params.study)
-    log.info("%d sweep point(s), about %d impacts per ball and bat each", settings.n_points, settings.truth_impacts)
-    ds = truth_dataset(settings, load_balls(snakemake.input.balls), load_bats(snakemake.input.bats))
-    write_job_output(ds, snakemake, "truth", f"Study {study}: the design's truth of every quantity")
+    where = "every point" if point is None else f"point {point}"
+    log.info("%s of %d, about %d impacts per ball and bat", where, settings.n_points, settings.truth_impacts)
+    points = None if point is None else [point]
+    ds = truth_dataset(settings, load_balls(snakemake.input.balls), load_bats(snakemake.input.bats), points=points)
+    write_job_output(ds, snakemake, "truth", f"Study {study}, {where}: the design's truth")

@@ -63,12 +63,19 @@ STUDY_BYTES_PER_REPLICATE = 4_000
 MAX_STUDY_BATCHES = 10_000
 
 
-def study_impacts(dataset: dict, parameter: str | None, values: list, truth_impacts: int) -> tuple[int, int]:
-    """Impacts of a study's largest replicate, and of its noise-free design (the truth job), per sweep point."""
+def study_impacts(dataset: dict, parameter: str | tuple | None, values: list, truth_impacts: int) -> tuple[int, int]:
+    """Impacts of a study's largest replicate, and of its noise-free design (the truth job), per sweep point.
+
+    A grid gives ``parameter`` as a tuple of names and ``values`` as tuples (one per point).
+    """
     impacts = dataset["synthetic"]["impacts"]
     pairs = sum(len(v or {}) for v in impacts.values())
     most = max((int(n) for v in impacts.values() for n in (v or {}).values()), default=0)
-    counts = [int(v) for v in values] if parameter == "impacts_per_bat" else [most]
+    if isinstance(parameter, tuple):
+        j = parameter.index("impacts_per_bat") if "impacts_per_bat" in parameter else None
+        counts = [int(p[j]) for p in values] if j is not None else [most]
+    else:
+        counts = [int(v) for v in values] if parameter == "impacts_per_bat" else [most]
     return pairs * max(counts), pairs * max(int(truth_impacts), max(counts))
 
 
@@ -128,7 +135,7 @@ def _names(config: dict) -> list[str]:
 
 def _studies(config: dict) -> list[str]:
     """Check that each study names a synthetic dataset and that its sweep suits that dataset."""
-    from ..sweeps import check_sweep
+    from ..sweeps import check_study_sweep
 
     problems = []
     datasets = config.get("datasets") or {}
@@ -145,8 +152,7 @@ def _studies(config: dict) -> list[str]:
                 f"{where}.dataset: {study['dataset']!r} is not synthetic (a study replicates a synthetic experiment)"
             )
         else:
-            sweep = study.get("sweep") or {}
-            problems += check_sweep(ds, sweep.get("parameter"), sweep.get("values", ()), where)
+            problems += check_study_sweep(ds, study, where)
     return problems
 
 
@@ -250,12 +256,15 @@ def _sizes(config: dict, available: int) -> list[str]:
     for name, st in (config.get("studies") or {}).items():
         ds = datasets.get(st.get("dataset")) if isinstance(st, dict) else None
         if isinstance(ds, dict) and isinstance(ds.get("synthetic"), dict):
+            from ..sweeps import sweep_points
+
             sweep = st.get("sweep") or {}
-            values = sweep.get("values") or []
-            one, truth = study_impacts(ds, sweep.get("parameter"), values, st["truth_impacts"])
+            names, values = sweep_points(sweep)
+            one, truth = study_impacts(ds, names, values, st["truth_impacts"])
             where = f"studies.{name}"
-            if sweep.get("parameter") == "impacts_per_bat":
-                check(f"{where}.sweep.values", one, impact_bytes(ds), "impacts in one replicate")
+            if "impacts_per_bat" in names:
+                key = "sweep.grid.impacts_per_bat" if "grid" in sweep else "sweep.values"
+                check(f"{where}.{key}", one, impact_bytes(ds), "impacts in one replicate")
             check(f"{where}.truth_impacts", truth, impact_bytes(ds), "impacts")
             total = int(st["replicates"]) * max(len(values), 1)
             check(f"{where}.replicates", total, STUDY_BYTES_PER_REPLICATE, "replicates (all sweep points)")

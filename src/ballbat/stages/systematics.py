@@ -23,6 +23,7 @@ from ..systematics import (
     Shifts,
     has_shifts,
     shifted_impacts,
+    stronge_by_source,
 )
 
 if TYPE_CHECKING:
@@ -178,37 +179,12 @@ def stronge_systematics(
     """
     if not has_shifts(rec):
         return ds
-    from ..stronge.analysis import fit_ball, vtf_data
-
     names = ["eta2"] + (["e_y"] if vary_e_y else []) + (["mu"] if vary_mu else [])
-    balls = ds["ball"].values.astype(str)
-    rel = rec["systematic_rel_sigma"].values
-    out = {q: np.zeros((len(SOURCES), balls.size)) for q in names}
-    for q in names:
+    out = stronge_by_source(
+        rec, ds["ball"].values.astype(str), names, e_y=e_y, mu=mu, vary_e_y=vary_e_y, vary_mu=vary_mu
+    )
+    for q in names:  # no value, no systematic
         out[q][:, ~np.isfinite(ds[q].values)] = np.nan
-    usable = rec["flag"].values == 0
-    ball_of = rec["ball"].values.astype(str)
-    for i in range(len(SOURCES)):
-        if rel[i] == 0:
-            continue
-        fits = []
-        for j in range(len(SIDES)):
-            sh = shifted_impacts(rec, i, j)
-            fits.append(
-                [
-                    fit_ball(
-                        vtf_data(sh, usable & (ball_of == b)),
-                        e_y=e_y,
-                        mu=mu,
-                        vary_e_y=vary_e_y,
-                        vary_mu=vary_mu,
-                        interval=False,
-                    )
-                    for b in balls
-                ]
-            )
-        for q in names:
-            plus, minus = (np.array([getattr(f, q) for f in side]) for side in fits)
-            out[q][i] = 0.5 * np.abs(plus - minus)
+    rel = rec["systematic_rel_sigma"].values
     what = "the tracks reduced again, then normalize, reconstruct and the eta^2 fit"
     return _systematic_vars(ds, out, what, rel)

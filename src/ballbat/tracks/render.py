@@ -85,6 +85,46 @@ class RenderSettings:
     tilt: tuple[float, float]
 
 
+#: Calibrations a lab states with an uncertainty, which ``draw_calibration`` draws:
+#: (block, setting, its uncertainty's key, relative). A camera's ``m_per_px_err`` is relative
+#: (as the reduction reads it), ``fps_err`` too; the rig's ``*_err_in`` are absolute (inches, as
+#: their names say). An uncertainty of 0 (the schema's default) is not drawn.
+CALIBRATION_ERRORS = (
+    ("cameras", "m_per_px", "m_per_px_err", True),
+    ("cameras", "fps", "fps_err", True),
+    ("rig", "pivot_to_tip_in", "pivot_to_tip_err_in", False),
+    ("rig", "pivot_to_impact_in", "pivot_to_impact_err_in", False),
+)
+
+#: Spawn key of the calibration's draw under the render seed: a stream of its own, so that the
+#: impacts' draws (``numpy.random.default_rng(seed)``) are the same whether it is drawn or not.
+CALIBRATION_SPAWN_KEY = 0xCA1
+
+
+def drawn_calibration(cfg: dict) -> dict:
+    """Return the render block with its true calibration drawn from the stated uncertainties (a copy).
+
+    Every setting of :data:`CALIBRATION_ERRORS` whose uncertainty the block states (non-zero)
+    becomes ``value * (1 + err * z)`` (relative) or ``value + err * z`` (absolute), z standard
+    normal from ``numpy.random.SeedSequence(cfg["seed"], spawn_key=(CALIBRATION_SPAWN_KEY,))``,
+    in the order of the table, camera by camera (swing, spin): reproducible from the render seed.
+    The renderer draws the tracks with these; the reduction reads the declared block
+    (:func:`ballbat.tracks.data.camera_block` of the config), so the difference is the
+    calibration error a lab's declared uncertainty is meant to cover. The draw of a setting is
+    the same whether or not the others are stated (each takes its own normal).
+    """
+    rng = np.random.default_rng(np.random.SeedSequence(int(cfg["seed"]), spawn_key=(CALIBRATION_SPAWN_KEY,)))
+    out = {**cfg, "cameras": {n: dict(c) for n, c in cfg["cameras"].items()}, "rig": dict(cfg["rig"])}
+    blocks = {"cameras": [out["cameras"][n] for n in ("swing", "spin")], "rig": [out["rig"]]}
+    for block, key, err_key, relative in CALIBRATION_ERRORS:
+        for b in blocks[block]:
+            z = rng.standard_normal()
+            err = float(b[err_key])
+            if err > 0:
+                b[key] = float(b[key]) * (1.0 + err * z) if relative else float(b[key]) + err * z
+    return out
+
+
 def settings_from_config(cfg: dict) -> RenderSettings:
     """Render settings from a dataset's validated ``render`` config block (paper units: in, deg, ms, mm).
 
@@ -93,12 +133,16 @@ def settings_from_config(cfg: dict) -> RenderSettings:
     cfg : dict
         The block of the validated config, every default filled (the workflow's config;
         :func:`ballbat.pipeline.config.checked_block` for a block of one's own). A key
-        missing is a ``KeyError``: no default is restated here.
+        missing is a ``KeyError``: no default is restated here. With ``draw_calibration``
+        true the tracks are drawn with a true calibration drawn from the stated
+        uncertainties (:func:`drawn_calibration`).
 
     Returns
     -------
     RenderSettings
     """
+    if cfg["draw_calibration"]:
+        cfg = drawn_calibration(cfg)
     cams = {}
     for name, c in cfg["cameras"].items():
         cams[name] = RenderCamera(
