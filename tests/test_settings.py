@@ -220,6 +220,8 @@ def _render_value(s: RenderSettings, path: tuple) -> object:
         return list(cam.tee_px) if key == "tee_px" else getattr(cam, key)
     if path[0] == "rig":
         return getattr(s.rig, path[1].removesuffix("_in")) / INCH
+    if path == ("draw_calibration",):  # false: the settings hold the declared calibration (drawn: test_study_grid)
+        return settings_from_config(checked_block(MINIMAL_RENDER, "render")) != s
     if path[0] == "min_frames":
         return getattr(reduce_options(checked_block(MINIMAL_RENDER, "render")), f"min_{path[1]}_frames")
     field = {k[0]: f for f, (k, _) in SETTINGS[RenderSettings][1].items()}[path[0]]
@@ -266,7 +268,12 @@ def test_every_other_default_arrives(config):
     raw["studies"] = {"bare": {"dataset": "synthetic", "replicates": 5, "seed": 1}}
     study = StudySettings.from_config(validate_config(raw, SCHEMA), "bare")
     for (key,), default in _defaults("study").items():
-        assert getattr(study, key) == default, key
+        if key == "draw_calibration":  # carried into the replicates' render block (sweeps.study_dataset)
+            assert study.dataset["render"]["draw_calibration"] == default
+        elif key == "on_request":  # which target builds it (common.smk: STUDIES), no replicate's setting
+            assert validate_config(copy.deepcopy(raw), SCHEMA)["studies"]["bare"]["on_request"] == default
+        else:
+            assert getattr(study, key) == default, key
 
 
 def _schema_keys_with_defaults() -> set[str]:
@@ -351,6 +358,7 @@ RENDER_CHANGES = {
     ("axis_offset_mm",): 10.0,
     ("tilted_fraction",): 0.5,
     ("tilt_deg",): [20.0, 30.0],
+    ("draw_calibration",): True,
 }
 CAMERA_CHANGES = {
     "swing": {

@@ -423,7 +423,10 @@ BATCH_TABLE = {
     ),
     "dof": Var(("replicate", "quantity"), "1", "degrees of freedom of the uncertainty (inf: normal)"),
     "systematic": Var(
-        ("replicate", "quantity"), "1", "reported systematic uncertainty of the estimate (same unit; NaN: none)"
+        ("replicate", "quantity"),
+        None,
+        "reported systematic uncertainty of the estimate (same unit; NaN: none)",
+        PER_QUANTITY_UNITS,
     ),
     "point": Var(("replicate",), "1", "sweep point of the replicate (index into setting)"),
     "seed_replicate": Var(("replicate",), "1", "replicate number within its point (its seeds' spawn key)"),
@@ -720,7 +723,9 @@ COVERAGE_TABLE = {
     "mean_truth": Var(("point", "quantity"), None, "mean truth (SI: unit in units)", PER_QUANTITY_UNITS),
     "mean_dof": Var(("point", "quantity"), "1", "mean degrees of freedom of the uncertainty"),
     "n_systematic": Var(("point", "quantity"), "1", "replicates of n_replicates with a systematic uncertainty"),
-    "mean_systematic": Var(("point", "quantity"), "1", "mean reported systematic uncertainty (unit of the quantity)"),
+    "mean_systematic": Var(
+        ("point", "quantity"), None, "mean reported systematic uncertainty (SI: unit in units)", PER_QUANTITY_UNITS
+    ),
     "coverage_68_combined": Var(
         ("point", "quantity"),
         "1",
@@ -892,7 +897,7 @@ def _csv_text(header: Sequence[str], rows: Iterable[Sequence]) -> str:
 
 
 #: Columns of the coverage table in the unit of their quantity: SI in coverage.nc, the table's units in the CSV.
-COVERAGE_IN_UNITS = ("mean_uncertainty", "spread")
+COVERAGE_IN_UNITS = ("mean_uncertainty", "spread", "mean_systematic")
 
 
 def coverage_csv(cov: xr.Dataset) -> str:

@@ -287,7 +287,7 @@ def get_scenario_fit(wildcards):
 # Replicate studies (studies.smk). STUDIES: those of `snakemake studies` (`make study`); the studies marked
 # on_request are built by `snakemake studies_on_request` only.
 ALL_STUDIES = sorted(config.get("studies") or {})
-STUDIES = [s for s in ALL_STUDIES if not config["studies"][s].get("on_request", False)]
+STUDIES = [s for s in ALL_STUDIES if not config["studies"][s]["on_request"]]
 
 
 wildcard_constraints:
