@@ -105,14 +105,18 @@ def test_front_page_shows_e_x_and_eta2_before_the_configuration(page, report_roo
                 assert row.start() < config_at
                 assert _close(row[1], float(f["e_x"])), (ball, bat, row[0])
                 assert _close(row[2], float(f["e_x_err"])), (ball, bat, row[0])
-                if "e_x_err_scale" in f and float(f["e_x_err_scale"]) > 0:
-                    assert row[3] and _close(row[3], float(f["e_x_err_scale"])), (ball, bat, row[0])
+                if "e_x_syst" in f and float(f["e_x_syst"]) > 0:  # every calibration source, combined
+                    assert row[3] and _close(row[3], float(f["e_x_syst"])), (ball, bat, row[0])
                 checked += 1
             s = stronge.sel(ball=ball)
-            row = re.compile(rf"^{ball}\t{NUM} ± {NUM}\t{NUM} . {NUM}", re.MULTILINE).search(text, section)
+            row = re.compile(rf"^{ball}\t{NUM} ± {NUM}(?: ± {NUM} syst\.)?\t{NUM} . {NUM}", re.MULTILINE).search(
+                text, section
+            )
             assert row and row.start() < config_at, (name, ball)
             assert _close(row[1], float(s["eta2"])) and _close(row[2], float(s["eta2_err"])), row[0]
-            assert _close(row[3], float(s["eta2_ci_low"])) and _close(row[4], float(s["eta2_ci_high"])), row[0]
+            if "eta2_syst" in s and float(s["eta2_syst"]) > 0:  # tracked data: its calibration systematic shown
+                assert row[3] and _close(row[3], float(s["eta2_syst"])), row[0]
+            assert _close(row[4], float(s["eta2_ci_low"])) and _close(row[5], float(s["eta2_ci_high"])), row[0]
             checked += 1
     assert checked >= 9  # the default run: 7 bat x ball pairs and 2 balls' eta^2
     shot = page.screenshot(report_root / "results" / "report-front.png")

@@ -229,7 +229,7 @@ def test_study_rules_through_snakemake(tmp_path):
     assert sorted(p.name for p in (res / "calibration" / "batches").iterdir()) == ["batch0.nc", "batch1.nc"]
     cov = xr.open_dataset(res / "calibration" / "coverage.nc")
     assert cov.sizes == {"point": 1, "quantity": 21}
-    assert all("units" in cov[v].attrs for v in cov.data_vars)
+    assert all("units" in cov[v].attrs or cov[v].attrs.get("units_from") == "units" for v in cov.data_vars)
     assert cov.attrs["provenance_rule"] == "study_aggregate"
     truth = xr.open_dataset(res / "calibration" / "truth.nc")
     assert truth.attrs["provenance_rule"] == "study_truth" and truth.attrs["truth_impacts"] == 60

@@ -273,7 +273,16 @@ def test_workbook_in_the_fields_units(run_dir):
 
     res = run_dir / "results" / "small"
     book = openpyxl.load_workbook(res / "results.xlsx")
-    assert book.sheetnames == ["impacts", "e_x", "sec4", "eta2", "paper_comparison", "warnings", "provenance"]
+    assert book.sheetnames == [
+        "impacts",
+        "e_x",
+        "sec4",
+        "eta2",
+        "systematics",
+        "paper_comparison",
+        "warnings",
+        "provenance",
+    ]
     assert [c.value for c in book["impacts"][2]][3:5] == ["mph", "mph"]  # units in the second row
     rec = xr.open_dataset(res / "reconstruct.nc")
     fit = xr.open_dataset(res / "fit_ex.nc")

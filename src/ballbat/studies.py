@@ -333,7 +333,7 @@ def run_replicate(
 
 def _eta2_systematic(rec: xr.Dataset, balls: np.ndarray, stronge: dict) -> np.ndarray:
     """eta^2's calibration systematic of each ball, every source in quadrature (as stronge.nc's ``eta2_syst``)."""
-    from .systematics import stronge_by_source
+    from .stages.stronge import stronge_by_source
 
     kw = {k: stronge[k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")}
     with np.errstate(invalid="ignore"):

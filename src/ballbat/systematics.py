@@ -13,8 +13,8 @@ relative; ``pivot_to_tip_err_in`` and ``pivot_to_impact_err_in`` of the rig, inc
    shift of every measured quantity the later stages read (v_bat, v_ball, theta, omega and
    their standard uncertainties: ``<name>_shift`` in reduce.nc, dimensions ``systematic``,
    ``shift``, ``impact``; units of the quantity). The impacts' flags are the nominal ones.
-2. **Every reported quantity** (:func:`ballbat.stages.systematics.fit_systematics` for fit_ex.nc,
-   :func:`~ballbat.stages.systematics.stronge_systematics` for stronge.nc): the measured
+2. **Every reported quantity** (:func:`ballbat.stages.fit_ex.fit_systematics` for fit_ex.nc,
+   :func:`~ballbat.stages.stronge.stronge_systematics` for stronge.nc): the measured
    values shifted to +1 sigma and to -1 sigma of each source (:func:`shifted_impacts`) go
    through normalize and reconstruct again and through the same estimator; half the
    difference of the two estimates is that source's systematic (``<q>_syst_by_source``), the
@@ -36,8 +36,6 @@ import numpy as np
 import xarray as xr
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
-
     from .tracks.data import Camera, Rig, Tracks
     from .tracks.reduce import ReduceOptions, Reduction
 
@@ -173,35 +171,6 @@ def shifted_impacts(rec: xr.Dataset, source: int, side: int) -> xr.Dataset:
     # the normalize and reconstruct stages' steps, at the nominal reference speed and properties
     out = out.assign({k: ("impact", v) for k, v in normalize_values(out, float(rec.attrs["v_ref"])).items()})
     return out.assign({k: ("impact", v) for k, v in reconstruct_again_values(out).items()})
-
-
-def stronge_by_source(
-    rec: xr.Dataset, balls: Sequence[str], names: Sequence[str], *, e_y: float, mu: float, vary_e_y: bool, vary_mu: bool
-) -> dict[str, np.ndarray]:
-    """Systematic of eta^2 (and e_y, mu when fitted: ``names``) of each ball, per source (source x ball).
-
-    Each ball is fitted again (:func:`ballbat.stronge.analysis.fit_ball`, no interval) on its
-    usable impacts at +1 and at -1 sigma of each source (:func:`shifted_impacts`); half the
-    difference; 0 for a source without uncertainty. ``rec`` carries the shifts (:func:`has_shifts`).
-    """
-    from .stronge.analysis import fit_ball, vtf_data
-
-    rel = rec["systematic_rel_sigma"].values
-    out = {q: np.zeros((len(SOURCES), len(balls))) for q in names}
-    usable = rec["flag"].values == 0
-    ball_of = rec["ball"].values.astype(str)
-    kw = {"e_y": e_y, "mu": mu, "vary_e_y": vary_e_y, "vary_mu": vary_mu, "interval": False}
-    for i in range(len(SOURCES)):
-        if rel[i] == 0:
-            continue
-        fits = []
-        for j in range(len(SIDES)):
-            sh = shifted_impacts(rec, i, j)
-            fits.append([fit_ball(vtf_data(sh, usable & (ball_of == b)), **kw) for b in balls])
-        for q in names:
-            plus, minus = (np.array([getattr(f, q) for f in side]) for side in fits)
-            out[q][i] = 0.5 * np.abs(plus - minus)
-    return out
 
 
 @dataclass

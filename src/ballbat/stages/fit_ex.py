@@ -14,8 +14,8 @@ import numpy as np
 
 from ..fitting import FitGrid, FitStatus, ImplausibleFit, Sec4, analyze_impacts, check_physical, fit_status
 from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
-from ..systematics import has_shifts
-from .systematics import add_fit_systematics, fit_systematics, scale_entries
+from ..systematics import FIT_QUANTITIES, SIDES, SOURCES, FitSystematics, has_shifts, shifted_impacts
+from .systematics import systematic_vars
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -213,3 +213,52 @@ def fit_problems(ds: xr.Dataset, balls: dict, bats: dict) -> list[str]:
     except ImplausibleFit as exc:
         return [str(exc)]
     return []
+
+
+# ---------------------------------------------------------------------------------------
+# the calibration systematics of every quantity (ballbat.systematics)
+
+
+def fit_systematics(rec: xr.Dataset, res: Sec4) -> FitSystematics:
+    """Every quantity of fit_ex.nc at +-1 sigma of each source; half the differences.
+
+    Parameters
+    ----------
+    rec : xarray.Dataset
+        Reconstructed impacts carrying the shifts (:func:`has_shifts`).
+    res : Sec4
+        The nominal fits (labels, mu_k of the example).
+
+    Returns
+    -------
+    FitSystematics
+    """
+    nominal = results_dataset(res)
+    rel = rec["systematic_rel_sigma"].values
+    out = {q: np.zeros((len(SOURCES), *nominal[q].shape)) for q in FIT_QUANTITIES}
+    for q in FIT_QUANTITIES:  # no value, no systematic
+        out[q][:, ~np.isfinite(nominal[q].values)] = np.nan
+    for i in range(len(SOURCES)):
+        if rel[i] == 0:
+            continue
+        fits = [
+            results_dataset(analyze_impacts(shifted_impacts(rec, i, j), res.mu_k_example, systematic=False))
+            for j in range(len(SIDES))
+        ]
+        for q in FIT_QUANTITIES:
+            out[q][i] = 0.5 * np.abs(fits[0][q].values - fits[1][q].values)
+    return FitSystematics(out, rel)
+
+
+def scale_entries(fs: FitSystematics) -> dict[str, np.ndarray]:
+    """``e_x_err_scale`` and ``e_x_pooled_err_scale``: the swing camera's pixel-scale systematic of e_x."""
+    i = list(SOURCES).index("swing_m_per_px")
+    return {"e_x_err_scale": fs.by_source["e_x"][i], "e_x_pooled_err_scale": fs.by_source["e_x_pooled"][i]}
+
+
+def add_fit_systematics(ds: xr.Dataset, fs: FitSystematics | None) -> xr.Dataset:
+    """fit_ex.nc's dataset with the systematics of :func:`fit_systematics` (unchanged for None)."""
+    if fs is None:
+        return ds
+    what = "the tracks reduced again, then normalize, reconstruct and the fit"
+    return systematic_vars(ds, fs.by_source, what, fs.rel_sigma)

@@ -15,11 +15,22 @@ import numpy as np
 from ..linefit import MIN_FIT_IMPACTS
 from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 from ..published import STRONGE_E_Y, STRONGE_MU
-from ..stronge.analysis import HISTORY_VARIABLES, PUBLISHED_ETA2, ModelCurves, analyse_ball, time_history, vtf_data
+from ..stronge.analysis import (
+    HISTORY_VARIABLES,
+    PUBLISHED_ETA2,
+    ModelCurves,
+    analyse_ball,
+    fit_ball,
+    time_history,
+    vtf_data,
+)
 from ..stronge.regimes import Regime
-from .systematics import stronge_systematics
+from ..systematics import SIDES, SOURCES, has_shifts, shifted_impacts
+from .systematics import systematic_vars
 
 if TYPE_CHECKING:
+    from collections.abc import Sequence
+
     import xarray as xr
     from numpy.typing import NDArray
 
@@ -252,3 +263,56 @@ def run(settings: StrongeSettings, impacts: xr.Dataset) -> xr.Dataset:
         attrs=attrs,
     )
     return stronge_systematics(ds, rec, e_y=e_y, mu=mu, vary_e_y=vary_e_y, vary_mu=vary_mu)
+
+
+# ---------------------------------------------------------------------------------------
+# the calibration systematics of eta^2 (ballbat.systematics)
+
+
+def stronge_systematics(
+    ds: xr.Dataset, rec: xr.Dataset, *, e_y: float, mu: float, vary_e_y: bool, vary_mu: bool
+) -> xr.Dataset:
+    """stronge.nc's dataset with the systematics of eta^2 (and of e_y and mu when fitted).
+
+    Each ball of ``ds`` is fitted again (:func:`ballbat.stronge.analysis.fit_ball`, no interval)
+    on its usable impacts at +-1 sigma of each source. ``ds`` is returned unchanged when
+    ``rec`` carries no shifts (no camera tracks).
+    """
+    if not has_shifts(rec):
+        return ds
+    names = ["eta2"] + (["e_y"] if vary_e_y else []) + (["mu"] if vary_mu else [])
+    out = stronge_by_source(
+        rec, ds["ball"].values.astype(str), names, e_y=e_y, mu=mu, vary_e_y=vary_e_y, vary_mu=vary_mu
+    )
+    for q in names:  # no value, no systematic
+        out[q][:, ~np.isfinite(ds[q].values)] = np.nan
+    rel = rec["systematic_rel_sigma"].values
+    what = "the tracks reduced again, then normalize, reconstruct and the eta^2 fit"
+    return systematic_vars(ds, out, what, rel)
+
+
+def stronge_by_source(
+    rec: xr.Dataset, balls: Sequence[str], names: Sequence[str], *, e_y: float, mu: float, vary_e_y: bool, vary_mu: bool
+) -> dict[str, np.ndarray]:
+    """Systematic of eta^2 (and e_y, mu when fitted: ``names``) of each ball, per source (source x ball).
+
+    Each ball is fitted again (:func:`ballbat.stronge.analysis.fit_ball`, no interval) on its
+    usable impacts at +1 and at -1 sigma of each source (:func:`shifted_impacts`); half the
+    difference; 0 for a source without uncertainty. ``rec`` carries the shifts (:func:`has_shifts`).
+    """
+    rel = rec["systematic_rel_sigma"].values
+    out = {q: np.zeros((len(SOURCES), len(balls))) for q in names}
+    usable = rec["flag"].values == 0
+    ball_of = rec["ball"].values.astype(str)
+    kw = {"e_y": e_y, "mu": mu, "vary_e_y": vary_e_y, "vary_mu": vary_mu, "interval": False}
+    for i in range(len(SOURCES)):
+        if rel[i] == 0:
+            continue
+        fits = []
+        for j in range(len(SIDES)):
+            sh = shifted_impacts(rec, i, j)
+            fits.append([fit_ball(vtf_data(sh, usable & (ball_of == b)), **kw) for b in balls])
+        for q in names:
+            plus, minus = (np.array([getattr(f, q) for f in side]) for side in fits)
+            out[q][i] = 0.5 * np.abs(plus - minus)
+    return out
