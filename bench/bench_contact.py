@@ -2,7 +2,7 @@
 
 The default ``synthetic`` dataset (108 impacts rendered as camera tracks and reduced) with the
 renderer's contact time drawn from a chosen range, ``N`` replicates per range through the
-study's own in-memory functions (``ballbat.studies.run_batch``, the design's truth from
+study's own in-memory functions (``ballbat.stages.study_batch.run``, the design's truth from
 ``population_truth``, ``coverage``), in one process. Prints, per quantity (e_x per bat and
 pooled, the implied e_y), the bias over the standard error and the 95 % coverage, each with
 its binomial or standard error. Targets: |bias| <= 0.25 SE, coverage 93-97 %.
@@ -21,7 +21,8 @@ import time
 
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.studies import StudySettings, combine, coverage, population_truth, run_batch
+from ballbat.stages import study_batch
+from ballbat.studies import StudySettings, combine, coverage, population_truth
 
 QUANTITIES = ("e_x", "e_x_pooled", "e_y_implied")
 
@@ -36,7 +37,7 @@ def run(replicates: int, contact_ms: tuple[float, float], seed: int, truth_impac
     s = StudySettings.from_config(cfg, "calibration")
     balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
     t0 = time.perf_counter()
-    reps = combine([run_batch(s, 0, balls, bats)])
+    reps = combine([study_batch.run(s, 0, balls, bats)])
     cov = coverage(reps, [population_truth(s, 0, balls, bats)])
     dt = time.perf_counter() - t0
     rows = []

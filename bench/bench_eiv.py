@@ -2,7 +2,7 @@
 
 For each set-up (the shipped calibration; 5 px tracking noise at the paper's size; 3.5 px
 with 60 impacts per bat) it runs replicate experiments through the study's chain
-(:func:`ballbat.studies.run_batch`) twice on the same replicates: with the fits as they
+(:func:`ballbat.stages.study_batch.run`) twice on the same replicates: with the fits as they
 were (weighted least squares, which the abscissa's noise attenuates) and with the
 moment-corrected fits (``linefit.eiv_line``, ``fitting.implied_e_y``). Each replicate's
 experiment and tracks are simulated once and reused by the second pass. The design's truth
@@ -28,6 +28,7 @@ import numpy as np
 from ballbat import fitting, studies
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
+from ballbat.stages import study_batch
 
 #: name -> (replicates, [(sweep parameter, value), ...])
 SETUPS = {
@@ -110,9 +111,9 @@ def main() -> None:
                 t0 = time.perf_counter()
                 if label == "before":
                     with plain_fits():
-                        rep = studies.run_batch(s, 0, balls, bats)
+                        rep = study_batch.run(s, 0, balls, bats)
                 else:
-                    rep = studies.run_batch(s, 0, balls, bats)
+                    rep = study_batch.run(s, 0, balls, bats)
                 dt = time.perf_counter() - t0
                 cov = studies.coverage(rep, truth)
                 out += [*table(cov, label), f"  {label}: {dt:.0f} s"]

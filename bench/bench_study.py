@@ -29,15 +29,16 @@ CHILD = """
 import resource, sys, time
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.studies import StudySettings, run_batch
+from ballbat.stages import study_batch
+from ballbat.studies import StudySettings
 n = int(sys.argv[1])
 cfg = load_config()
 cfg["studies"]["calibration"]["batch_size"] = n
 s = StudySettings.from_config(cfg, "calibration")
 balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
-run_batch(s, 0, balls, bats)  # warm-up of the imports and caches: one batch
+study_batch.run(s, 0, balls, bats)  # warm-up of the imports and caches: one batch
 t0 = time.perf_counter()
-ds = run_batch(s, 1, balls, bats)
+ds = study_batch.run(s, 1, balls, bats)
 dt = time.perf_counter() - t0
 print(dt, resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, ds.sizes["replicate"])
 """

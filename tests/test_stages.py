@@ -246,6 +246,7 @@ SCRIPTS = {
     "fit_ex": "fit_ex",
     "fit_stronge": "stronge",
     "implications": "implications",
+    "study_batch": "study_batch",
 }
 
 

@@ -16,6 +16,7 @@ from scipy import stats
 from ballbat import studies
 from ballbat.pipeline.config import ConfigError, validate_config
 from ballbat.pipeline.ncio import read_table_csv
+from ballbat.stages import study_batch
 
 
 def settings(config, name="calibration", **over):
@@ -183,7 +184,7 @@ def test_replicates_cover_the_truth(config, balls, bats):
     `make study`, is the full check; its figures are in docs/studies.md and the issue notes.)
     """
     s = settings(config, replicates=40, batch_size=40, truth_impacts=400)
-    batch = studies.run_batch(s, 0, balls, bats)
+    batch = study_batch.run(s, 0, balls, bats)
     assert batch.sizes == {"replicate": 40, "quantity": 21}
     truths = [studies.population_truth(s, 0, balls, bats)]
     cov = studies.coverage(studies.combine([batch]), truths).isel(point=0)

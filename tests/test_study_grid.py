@@ -14,6 +14,7 @@ import yaml
 
 from ballbat import studies
 from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.stages import study_batch
 from ballbat.sweeps import CONTACT_HALF_WIDTH_MS, point_dataset, sweep_points
 from ballbat.tracks.data import camera_block
 from ballbat.tracks.render import drawn_calibration, settings_from_config
@@ -317,7 +318,7 @@ def test_a_grid_replicate_records_a_systematic(config, balls, bats):
     cfg["studies"]["robustness"].update(replicates=1, batch_size=1)
     cfg["studies"]["robustness"]["sweep"] = {"grid": {"pixel_noise_px": [3.0], "contact_ms": [0.9]}}
     s = studies.StudySettings.from_config(cfg, "robustness")
-    batch = studies.run_batch(s, 0, balls, bats)
+    batch = study_batch.run(s, 0, balls, bats)
     assert batch.attrs["sweep_parameter"] == "pixel_noise_px,contact_ms"
     names = batch.quantity_name.values
     syst = batch.systematic.values[0]

@@ -410,41 +410,20 @@ def _systematic(fit: xr.Dataset, q: str, ball: str, bat: str) -> float:
 #: names the coordinate, :func:`ballbat.pipeline.ncio.check_metadata`).
 PER_QUANTITY_UNITS = {"units_from": "units"}
 
-BATCH_TABLE = {
-    "value": Var(("replicate", "quantity"), None, "estimate (SI: unit of its quantity in units)", PER_QUANTITY_UNITS),
-    "uncertainty": Var(
-        ("replicate", "quantity"), None, "reported uncertainty of the estimate (same unit)", PER_QUANTITY_UNITS
-    ),
-    "truth": Var(
-        ("replicate", "quantity"),
-        None,
-        "the same estimator on the replicate's noise-free truth (same unit)",
-        PER_QUANTITY_UNITS,
-    ),
-    "dof": Var(("replicate", "quantity"), "1", "degrees of freedom of the uncertainty (inf: normal)"),
-    "systematic": Var(
-        ("replicate", "quantity"),
-        None,
-        "reported systematic uncertainty of the estimate (same unit; NaN: none)",
-        PER_QUANTITY_UNITS,
-    ),
-    "point": Var(("replicate",), "1", "sweep point of the replicate (index into setting)"),
-    "seed_replicate": Var(("replicate",), "1", "replicate number within its point (its seeds' spawn key)"),
-}
 
-
-def _labels(rows: list[dict]) -> list[str]:
+def row_labels(rows: list[dict]) -> list[str]:
+    """Return ``quantity:ball:bat`` of each row of :func:`run_replicate` (the batches' quantity labels)."""
     return [f"{r['quantity']}:{r['ball']}:{r['bat']}" for r in rows]
 
 
-def run_batch(
+def run_replicates(
     settings: StudySettings,
     batch: int,
     balls: dict[str, Ball],
     bats: dict[str, Bat],
     progress: Callable[[int, int], None] | None = None,
-) -> xr.Dataset:
-    """Run the replicates of batch ``batch``; return its dataset (dims replicate x quantity).
+) -> list[tuple[int, int, int, list[dict]]]:
+    """Run the replicates of batch ``batch`` (the file: :func:`ballbat.stages.study_batch.run`).
 
     Parameters
     ----------
@@ -458,46 +437,23 @@ def run_batch(
 
     Returns
     -------
-    xarray.Dataset
+    list of (int, int, int, list of dict)
+        Per replicate: its number over the whole study, its sweep point, its number within the
+        point and its rows (:func:`run_replicate`).
     """
     indices = settings.batch_range(batch)
-    table: dict[str, int] = {}
-    units: dict[str, str] = {}
     records = []
     for done, g in enumerate(indices, 1):
         point, rep = divmod(g, settings.replicates)
         dataset = point_dataset(settings.dataset, settings.parameter, settings.values[point])
-        rows = run_replicate(settings, dataset, rep, balls, bats)
-        for label, r in zip(_labels(rows), rows, strict=True):
-            table.setdefault(label, len(table))
-            units.setdefault(label, r["units"])
-        records.append((g, point, rep, rows))
+        records.append((g, point, rep, run_replicate(settings, dataset, rep, balls, bats)))
         if progress is not None:
             progress(done, len(indices))
-    labels = list(table)
-    nq = len(labels)
-    arrays = {k: np.full((len(records), nq), np.nan) for k in ("value", "uncertainty", "truth", "dof", "systematic")}
-    for i, (_, _, _, rows) in enumerate(records):
-        for label, r in zip(_labels(rows), rows, strict=True):
-            j = table[label]
-            for k in arrays:
-                v = r.get(k)
-                arrays[k][i, j] = np.nan if v is None else float(v)
-    parts = [lab.split(":") for lab in labels]
-    values = {
-        **arrays,
-        "point": np.array([p for _, p, _, _ in records], dtype=np.int64),
-        "seed_replicate": np.array([r for _, _, r, _ in records], dtype=np.int64),
-    }
-    coords = _coords(labels, parts, [units[lab] for lab in labels])
-    coords["replicate"] = (
-        Var(("replicate",), "1", "replicate number over the whole study"),
-        np.array([g for g, _, _, _ in records], dtype=np.int64),
-    )
-    return build_dataset(BATCH_TABLE, values, coords, _attrs(settings, batch))
+    return records
 
 
-def _coords(labels: list[str], parts: list[list[str]], units: list[str]) -> dict:
+def quantity_coords(labels: list[str], parts: list[list[str]], units: list[str]) -> dict:
+    """Return the ``quantity`` coordinate and its companions (name, ball, bat, SI unit) of a study's files."""
     return {
         "quantity": (Var(("quantity",), None, "quantity:ball:bat, as in paper_comparison.csv"), np.array(labels)),
         "quantity_name": (Var(("quantity",), None, "quantity"), np.array([p[0] for p in parts])),
@@ -514,7 +470,7 @@ def display_unit(quantity: str) -> str:
     return FIT_QUANTITIES[quantity][1] if quantity in FIT_QUANTITIES else "1"
 
 
-def _attrs(settings: StudySettings, batch: int | None = None) -> dict:
+def study_attrs(settings: StudySettings, batch: int | None = None) -> dict:
     """Return the study's attributes: a grid's settings are comma-joined, its values flattened point by point."""
     attrs = {
         "study_seed": settings.seed,
@@ -574,7 +530,7 @@ def population_truth(settings: StudySettings, point: int, balls: dict[str, Ball]
         ``quantity:ball:bat`` label -> truth.
     """
     rows = _population_rows(settings, point, balls, bats)
-    return dict(zip(_labels(rows), (r["truth"] for r in rows), strict=True))
+    return dict(zip(row_labels(rows), (r["truth"] for r in rows), strict=True))
 
 
 def _population_rows(settings: StudySettings, point: int, balls: dict[str, Ball], bats: dict[str, Bat]) -> list[dict]:
@@ -629,19 +585,21 @@ def truth_dataset(
     """
     points = list(range(settings.n_points)) if points is None else [int(p) for p in points]
     rows_of = [_population_rows(settings, p, balls, bats) for p in points]
-    truths = [dict(zip(_labels(rows), (r["truth"] for r in rows), strict=True)) for rows in rows_of]
-    units = {lab: r["units"] for rows in rows_of for lab, r in zip(_labels(rows), rows, strict=True)}
+    truths = [dict(zip(row_labels(rows), (r["truth"] for r in rows), strict=True)) for rows in rows_of]
+    units = {lab: r["units"] for rows in rows_of for lab, r in zip(row_labels(rows), rows, strict=True)}
     labels = list(dict.fromkeys(lab for t in truths for lab in t))
-    names, table = sweep_table(_attrs(settings))
+    names, table = sweep_table(study_attrs(settings))
     table = table[points]
     values = {
         "truth": np.array([[np.nan if t.get(lab) is None else float(t[lab]) for lab in labels] for t in truths]),
         "setting": _setting_column(names, table),
     }
-    coords = _coords(labels, [lab.split(":") for lab in labels], [units[lab] for lab in labels])
+    coords = quantity_coords(labels, [lab.split(":") for lab in labels], [units[lab] for lab in labels])
     coords["point"] = (Var(("point",), "1", "sweep point"), np.asarray(points, dtype=np.int64))
     coords.update(_grid_coords(names, table))
-    return build_dataset(TRUTH_TABLE, values, coords, {**_attrs(settings), "truth_impacts": settings.truth_impacts})
+    return build_dataset(
+        TRUTH_TABLE, values, coords, {**study_attrs(settings), "truth_impacts": settings.truth_impacts}
+    )
 
 
 def merge_truths(parts: Iterable[xr.Dataset]) -> xr.Dataset:

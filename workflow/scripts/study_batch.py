@@ -1,9 +1,10 @@
-"""Rule study_batch: adapter around ballbat.studies.run_batch."""
+"""Rule study_batch: adapter around ballbat.stages.study_batch.run."""
 
 from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
-from ballbat.studies import StudySettings, run_batch
+from ballbat.stages import study_batch
+from ballbat.studies import StudySettings
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     study, batch = snakemake.wildcards.study, int(snakemake.wildcards.batch)
@@ -15,5 +16,5 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         if done % step == 0 or done == n:
             log.info("%d of %d replicates", done, n)
 
-    ds = run_batch(settings, batch, load_balls(snakemake.input.balls), load_bats(snakemake.input.bats), progress)
+    ds = study_batch.run(settings, batch, load_balls(snakemake.input.balls), load_bats(snakemake.input.bats), progress)
     write_job_output(ds, snakemake, "batch", f"Study {study}, batch {batch}: replicate estimates, errors and truths")
