@@ -578,6 +578,12 @@ FIGURES = {
 }
 
 
+def _quantity_labels(cov: xr.Dataset) -> list[str]:
+    """``quantity ball bat`` of each quantity of a study's coverage file (the figures' row labels)."""
+    names = zip(cov["quantity_name"].values, cov["ball"].values, cov["bat"].values, strict=True)
+    return [f"{q} {b} {t}".strip() for q, b, t in names]
+
+
 def coverage_figure(cov: xr.Dataset, point: int = 0) -> Figure:
     """Coverage of a replicate study at one sweep point: 68 % and 95 % coverage and spread / SE per quantity.
 
@@ -592,10 +598,7 @@ def coverage_figure(cov: xr.Dataset, point: int = 0) -> Figure:
     -------
     Figure
     """
-    labels = [
-        f"{q} {b} {t}".strip()
-        for q, b, t in zip(cov["quantity_name"].values, cov["ball"].values, cov["bat"].values, strict=True)
-    ]
+    labels = _quantity_labels(cov)
     y = np.arange(len(labels))[::-1]
     fig = Figure(figsize=(10.0, 0.28 * len(labels) + 1.6), dpi=DPI, layout="constrained")
     axes = fig.subplots(1, 3, sharey=True)
@@ -657,10 +660,7 @@ def grid_coverage_figure(cov: xr.Dataset, band: tuple[float, float] = (0.93, 0.9
     """
     from matplotlib.colors import TwoSlopeNorm
 
-    labels = [
-        f"{q} {b} {t}".strip()
-        for q, b, t in zip(cov["quantity_name"].values, cov["ball"].values, cov["bat"].values, strict=True)
-    ]
+    labels = _quantity_labels(cov)
     if "grid_setting" in cov:
         names = [str(n) for n in cov["parameter"].values]
         table = cov["grid_setting"].values

@@ -40,7 +40,7 @@ from .pipeline.products import Var, build_dataset
 from .sweeps import point_dataset, study_dataset, sweep_points
 
 if TYPE_CHECKING:
-    from collections.abc import Callable, Iterable, Sequence
+    from collections.abc import Iterable, Iterator, Sequence
 
     from .properties import Ball, Bat
 
@@ -417,39 +417,17 @@ def row_labels(rows: list[dict]) -> list[str]:
 
 
 def run_replicates(
-    settings: StudySettings,
-    batch: int,
-    balls: dict[str, Ball],
-    bats: dict[str, Bat],
-    progress: Callable[[int, int], None] | None = None,
-) -> list[tuple[int, int, int, list[dict]]]:
-    """Run the replicates of batch ``batch`` (the file: :func:`ballbat.stages.study_batch.run`).
+    settings: StudySettings, batch: int, balls: dict[str, Ball], bats: dict[str, Bat]
+) -> Iterator[tuple[int, int, int, list[dict]]]:
+    """Run the replicates of batch ``batch`` one after the other (the file: :func:`ballbat.stages.study_batch.run`).
 
-    Parameters
-    ----------
-    settings : StudySettings
-    batch : int
-        Batch number (:meth:`StudySettings.batch_range`).
-    balls, bats : dict
-        Property tables.
-    progress : callable, optional
-        Called with (done, total) after each replicate (for the log).
-
-    Returns
-    -------
-    list of (int, int, int, list of dict)
-        Per replicate: its number over the whole study, its sweep point, its number within the
-        point and its rows (:func:`run_replicate`).
+    Yields, per replicate: its number over the whole study, its sweep point, its number within
+    the point (:meth:`StudySettings.batch_range`) and its rows (:func:`run_replicate`).
     """
-    indices = settings.batch_range(batch)
-    records = []
-    for done, g in enumerate(indices, 1):
+    for g in settings.batch_range(batch):
         point, rep = divmod(g, settings.replicates)
         dataset = point_dataset(settings.dataset, settings.parameter, settings.values[point])
-        records.append((g, point, rep, run_replicate(settings, dataset, rep, balls, bats)))
-        if progress is not None:
-            progress(done, len(indices))
-    return records
+        yield g, point, rep, run_replicate(settings, dataset, rep, balls, bats)
 
 
 def quantity_coords(labels: list[str], parts: list[list[str]], units: list[str]) -> dict:

@@ -68,7 +68,11 @@ def run(
     progress : callable, optional
         Called with (done, total) after each replicate (for the log).
     """
-    records = run_replicates(settings, batch, balls, bats, progress)
+    records = []
+    for record in run_replicates(settings, batch, balls, bats):
+        records.append(record)
+        if progress is not None:
+            progress(len(records), len(settings.batch_range(batch)))
     table: dict[str, int] = {}
     units: dict[str, str] = {}
     for _, _, _, rows in records:
