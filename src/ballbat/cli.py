@@ -567,8 +567,7 @@ def summary_lines(folder: Path) -> list[str]:
             ) from None
     rec, fit, st = read
     lines = [f"{folder.name}: {rec.sizes['impact']} impacts, {int((rec['flag'].values != 0).sum())} not used (flagged)"]
-    from .compare import format_measurement, total_uncertainty
-    from .systematics import SYSTEMATIC_NOTE, systematic_var
+    from .compare import SYSTEMATIC_NOTE, format_measurement, systematic_var, total_uncertainty
 
     scale = systematic_var(fit, "e_x") is not None
     head = f"{'ball':<10} {'bat':<20} {'e_x':>8} {'± stat':>8}"

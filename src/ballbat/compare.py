@@ -20,7 +20,6 @@ import numpy as np
 
 from .kinematics import offset_from_psi
 from .published import PUBLISHED, UNPUBLISHED
-from .systematics import SYSTEMATIC_NOTE, systematic_var
 from .units import from_si
 
 if TYPE_CHECKING:
@@ -30,6 +29,30 @@ if TYPE_CHECKING:
     import xarray as xr
 
     from .published import Published
+
+# The calibration systematics in the results (ballbat.systematics): how the tables, the summary
+# and the front page find and describe them.
+
+
+def systematic_var(ds: xr.Dataset, var: str) -> str | None:
+    """Return the name of the combined systematic of ``var`` in ``ds``, or None when it has none.
+
+    ``<var>_syst`` (every calibration source), else ``<var>_err_scale`` (the pixel-scale one
+    of e_x, in files made before the other sources were propagated).
+    """
+    for name in (f"{var}_syst", f"{var}_err_scale"):
+        if name in ds:
+            return name
+    return None
+
+
+#: What the combined systematic holds, in the tables' notes.
+SYSTEMATIC_NOTE = (
+    "every stated calibration uncertainty (pixel scale and frame rate of each camera, the rig's lengths), "
+    "each propagated by reducing the tracks again at ± one standard uncertainty, combined in quadrature; "
+    "shared by every impact, apart from the standard error"
+)
+
 
 COLUMNS = (
     "quantity",

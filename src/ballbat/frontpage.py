@@ -26,8 +26,8 @@ from urllib.parse import quote
 
 import numpy as np
 
+from .compare import SYSTEMATIC_NOTE, systematic_var
 from .published import PUBLISHED, per_ball
-from .systematics import SYSTEMATIC_NOTE, systematic_var
 
 if TYPE_CHECKING:
     import os

@@ -18,10 +18,9 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .compare import COLUMNS, format_measurement, read_csv, total_uncertainty
+from .compare import COLUMNS, SYSTEMATIC_NOTE, format_measurement, read_csv, systematic_var, total_uncertainty
 from .pipeline.ncio import atomic_write_text
 from .published import per_ball
-from .systematics import SYSTEMATIC_NOTE, systematic_var
 from .units import from_si
 
 if TYPE_CHECKING:

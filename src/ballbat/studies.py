@@ -393,9 +393,9 @@ def _systematic(fit: xr.Dataset, q: str, ball: str, bat: str) -> float:
     """Return the systematic uncertainty of a quantity of ``fit_ex.nc`` (SI; NaN: none).
 
     ``{q}_syst`` (every calibration source) or, in files without it, ``{q}_err_scale``
-    (:func:`ballbat.systematics.systematic_var`).
+    (:func:`ballbat.compare.systematic_var`).
     """
-    from .systematics import systematic_var
+    from .compare import systematic_var
 
     name = systematic_var(fit, q)
     v = None if name is None else _at(fit, name, ball, bat)

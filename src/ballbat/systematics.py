@@ -179,25 +179,3 @@ class FitSystematics:
 
     by_source: dict[str, np.ndarray]
     rel_sigma: np.ndarray
-
-
-# ---------------------------------------------------------------------------------------
-# readers of the results (tables, summary, front page)
-def systematic_var(ds: xr.Dataset, var: str) -> str | None:
-    """Return the name of the combined systematic of ``var`` in ``ds``, or None when it has none.
-
-    ``<var>_syst`` (every calibration source), else ``<var>_err_scale`` (the pixel-scale one
-    of e_x, in files made before the other sources were propagated).
-    """
-    for name in (f"{var}_syst", f"{var}_err_scale"):
-        if name in ds:
-            return name
-    return None
-
-
-#: What the combined systematic holds, in the tables' notes.
-SYSTEMATIC_NOTE = (
-    "every stated calibration uncertainty (pixel scale and frame rate of each camera, the rig's lengths), "
-    "each propagated by reducing the tracks again at ± one standard uncertainty, combined in quadrature; "
-    "shared by every impact, apart from the standard error"
-)

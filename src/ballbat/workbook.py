@@ -38,9 +38,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .compare import total_uncertainty
+from .compare import systematic_var, total_uncertainty
 from .pipeline.atomic import atomic_target
-from .systematics import systematic_var
 from .units import from_si
 
 if TYPE_CHECKING:
