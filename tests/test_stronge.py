@@ -440,6 +440,7 @@ def test_robust_fit_interval_and_dof(balls, bats):
         fit_eta2(psi, x, y, r_x, r_y, robust=True, strata=strata[:-1])
 
 
+@pytest.mark.slow  # seconds (quiet machine): more than a unit test may take
 def test_robust_error_describes_repeats_of_a_design_with_fixed_bats(balls, bats):
     """Three bats of constant e_x 0.10, 0.17, 0.24 (Table II-like; one eta^2 cannot describe
     them), 15 impacts each at random psi, repeated 60 times: the spread of eta2 over the
