@@ -33,9 +33,72 @@ def bats():
 
 @pytest.fixture(scope="session")
 def default_run(tmp_path_factory):
-    """A copy of the workflow run once with the default config (`snakemake -c2`), shared by the tests that read it."""
+    """A copy of the workflow run once with the default config (`snakemake -c2`), shared by the tests that read it.
+
+    The only build of the default workflow in the suite: a test that changes a run works on a
+    copy of this one (:func:`workflow_helpers.copy_run`), where Snakemake has nothing to redo.
+    """
     from workflow_helpers import make_workdir, snakemake
 
     work = make_workdir(tmp_path_factory.mktemp("default_run"))
     snakemake(work, "-c2")
+    return work
+
+
+@pytest.fixture(scope="session")
+def default_report(default_run, tmp_path_factory):
+    """A copy of the default run with its report (`snakemake --report results/report.html`)."""
+    from workflow_helpers import copy_run, snakemake
+
+    work = copy_run(default_run, tmp_path_factory.mktemp("default_report") / "run")
+    snakemake(work, "--report", "results/report.html")
+    return work
+
+
+@pytest.fixture(scope="session")
+def small_run(tmp_path_factory):
+    """One finished run of a small config, shared (through copies) by test_workflow and test_redteam_guards.
+
+    The package's source is copied too (tests edit it to see what reruns). Config: the
+    dataset ``small`` (36 impacts, direct noise), the paper scenario with 26 offsets and e_x
+    from ``small``, a ``flyballs`` scenario (2 exit speeds x 3 launch angles, 11 points), and a
+    2-replicate calibration study of ``small``; built with ``snakemake -c2 all studies``.
+    """
+    from workflow_helpers import SMALL_SYNTHETIC, make_workdir, snakemake, write_config
+
+    def edit(cfg):
+        cfg["datasets"] = {"small": {"synthetic": SMALL_SYNTHETIC}}
+        paper = cfg["implications"]["scenarios"]["paper"]
+        paper["sweep"]["D_in"]["num"] = 26
+        paper["e_x_from_dataset"] = "small"
+        cfg["implications"]["scenarios"]["flyballs"] = {
+            "ball": "baseball",
+            "launch": {"exit_speed_mph": [95, 105], "launch_deg": [15, 25, 35], "backspin_rpm": 2200},
+            "flight": {"n_points": 11},
+        }
+        cfg["studies"] = {
+            "calibration": {"dataset": "small", "seed": 1, "replicates": 2, "batch_size": 1, "truth_impacts": 40}
+        }
+
+    work = make_workdir(tmp_path_factory.mktemp("small_run"), copy_package=True)
+    write_config(work, edit)
+    snakemake(work, "-c2", "all", "studies")
+    return work
+
+
+@pytest.fixture(scope="session")
+def maple_run(tmp_path_factory):
+    """One finished run of the example measured dataset (config/examples/maple.yaml) beside the small
+    synthetic dataset ``tiny`` (no scenarios, no studies), shared through copies by test_byod and test_faults.
+    """
+    from workflow_helpers import TINY_SYNTHETIC, make_workdir, snakemake, write_config
+
+    def edit(cfg):
+        cfg["datasets"] = {"tiny": {"synthetic": TINY_SYNTHETIC}}
+        cfg["studies"] = {}
+        cfg["implications"]["scenarios"] = {}
+
+    work = make_workdir(tmp_path_factory.mktemp("maple_run"))
+    write_config(work, edit)
+    snakemake(work, "-c2", "--configfile", "config/examples/maple.yaml")
     return work

@@ -12,21 +12,11 @@ import xarray as xr
 import yaml
 
 from ballbat.compare import read_csv
-from workflow_helpers import make_workdir, planned_jobs, snakemake
+from workflow_helpers import copy_run, planned_jobs, snakemake
 
 pytestmark = pytest.mark.slow
 
 MAPLE = "config/examples/maple.yaml"
-TINY = {  # a small synthetic dataset beside the measured one
-    "tiny": {
-        "synthetic": {
-            "seed": 3,
-            "impacts": {"baseball": {"wood": 8}},
-            "e_x": {"baseball": {"wood": 0.464}},
-            "e_y": {"baseball": 0.45},
-        }
-    }
-}
 BAD_CSV = """impact_id,bat,ball,v_bat_mph,v_ball_mph,theta_deg,omega_rpm
 X1,maple,baseball,75,84,10,1900
 X2,ash,baseball,75,fast,10,1900
@@ -35,21 +25,23 @@ X3,maple,baseball,-75,84,95,1900
 
 
 @pytest.fixture(scope="module")
-def run(tmp_path_factory):
-    """One run: tiny (synthetic), maple (the example) and bad, with --keep-going."""
-    wd = make_workdir(tmp_path_factory.mktemp("byod"))
-    cfg = yaml.safe_load((wd / "config" / "config.yaml").read_text())
-    cfg["datasets"] = TINY
-    cfg["studies"] = {}
-    cfg["implications"]["scenarios"] = {}
-    (wd / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
+def run(maple_run, tmp_path_factory):
+    """A copy of the suite's run of tiny (synthetic) and maple (the example), then bad beside them with --keep-going."""
+    wd = copy_run(maple_run, tmp_path_factory.mktemp("byod") / "run")
     (wd / "bad.csv").write_text(BAD_CSV)
     (wd / "bad.yaml").write_text(
         yaml.safe_dump({"datasets": {"bad": {"impacts": "bad.csv", "bats": "config/examples/maple_bats.csv"}}})
     )
+    front = wd / "results" / "report" / "front.rst"
+    assert front.is_file()
+    front.unlink()  # so that the run with bad would have to make it
+    for name in ("tiny", "maple"):  # and the good datasets' fits and tables, which it must make all the same
+        for product in ("fit_ex.nc", "paper_comparison.csv"):
+            (wd / "results" / name / product).unlink()
     proc = snakemake(wd, "-c2", "--keep-going", "--configfile", MAPLE, "bad.yaml", check=False)
     # the report's front page covers every dataset of a config, so the failed run made none: the good
     # config's (tiny and maple) is its only job left
+    assert not front.exists()
     assert planned_jobs(wd, "--configfile", MAPLE) == {"report_front": 1}
     snakemake(wd, "-c2", "--configfile", MAPLE)
     return wd, proc
@@ -78,7 +70,7 @@ def test_example_dataset_end_to_end(run):
 def test_bad_dataset_stops_only_itself(run):
     wd, proc = run
     assert proc.returncode != 0
-    for name in ("tiny", "maple"):
+    for name in ("tiny", "maple"):  # remade by the run that failed on bad (the fixture removed them)
         assert (wd / "results" / name / "paper_comparison.csv").is_file(), name
     bad = wd / "results" / "bad"
     assert sorted(p.name for p in bad.iterdir() if p.is_file()) == []  # no partial files

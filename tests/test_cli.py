@@ -1,7 +1,11 @@
 """The `ballbat` command, run through its installed entry point (issue 13)."""
 
+import contextlib
 import csv
+import io
 import json
+import os
+import shlex
 import subprocess
 import sys
 from pathlib import Path
@@ -9,26 +13,108 @@ from pathlib import Path
 import pytest
 from conftest import ROOT
 
+from ballbat import __version__, cli
+
 BALLBAT = Path(sys.executable).parent / "ballbat"
 MAPLE = ROOT / "config" / "examples" / "maple_impacts.csv"
 MAPLE_BATS = ROOT / "config" / "examples" / "maple_bats.csv"
 
 
+def ballbat_process(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
+    """Run the installed `ballbat` command in a process of its own."""
+    env = {**os.environ, "COLUMNS": "200"}  # argparse wraps the help at the terminal's width
+    return subprocess.run([str(BALLBAT), *args], capture_output=True, text=True, timeout=120, cwd=cwd, env=env)
+
+
 def ballbat(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    """Run the installed `ballbat` command."""
-    return subprocess.run([str(BALLBAT), *args], capture_output=True, text=True, timeout=120, cwd=cwd)
+    """Run `ballbat` as its entry point does (:func:`ballbat.cli.main`), in this process (no start-up cost).
+
+    Its exit status, standard output and error come back as from :func:`ballbat_process`; the
+    entry point itself is tested through the installed command (test_entry_point_is_installed).
+    """
+    out, err = io.StringIO(), io.StringIO()
+    here = Path.cwd()
+    try:
+        if cwd is not None:
+            os.chdir(cwd)
+        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+            try:
+                status = cli.main(list(args))
+            except SystemExit as exc:  # argparse: --help, --version and bad arguments
+                status = exc.code if isinstance(exc.code, int) else 1
+    finally:
+        os.chdir(here)
+    return subprocess.CompletedProcess(["ballbat", *args], status, out.getvalue(), err.getvalue())
+
+
+COMMANDS = {
+    "check": "validate a measured impacts file",
+    "fly": "carry, hang time and apex of batted balls",
+    "import-tracks": "read Tracker or Kinovea files into ballbat's long tracks CSV",
+    "summary": "a dataset's headline numbers",
+}
 
 
 def test_entry_point_is_installed():
+    """`make install` installs the console script: it runs cli.main, with its exit status and streams."""
     assert BALLBAT.is_file(), "make install installs the console script"
-    out = ballbat("--help")
-    assert out.returncode == 0 and "check" in out.stdout and "fly" in out.stdout and "summary" in out.stdout
+    out = ballbat_process("--version")
+    assert out.returncode == 0 and out.stdout == f"ballbat {__version__}\n"
+    out = ballbat_process("--help")
+    assert out.returncode == 0, out.stderr
+    lines = out.stdout.splitlines()
+    assert lines[0] == "usage: ballbat [-h] [--version] {check,fly,import-tracks,summary} ..."
+    listed = dict(line.split(None, 1) for line in lines if line.startswith("    ") and not line.startswith("     "))
+    assert listed == COMMANDS  # every command, each with its one-line help
+    out = ballbat_process("fly", "--speed", "fast", "--angle", "20")
+    assert out.returncode == 2 and out.stdout == ""
+    assert out.stderr == "ballbat fly: error: argument --speed: 'fast' is not a number\n"
 
 
-@pytest.mark.parametrize("command", ["check", "fly", "summary"])
-def test_help_has_examples(command):
+@pytest.mark.parametrize("command", list(COMMANDS))
+def test_help_ends_with_its_examples(command):
     out = ballbat(command, "--help")
-    assert out.returncode == 0 and "examples:" in out.stdout and f"ballbat {command}" in out.stdout
+    assert out.returncode == 0 and out.stderr == ""
+    assert out.stdout.startswith(f"usage: ballbat {command} ")
+    assert out.stdout.endswith("\n\n" + cli.EXAMPLES[command] + "\n")
+
+
+def _examples() -> list[str]:
+    """The one-line examples of every command's help (a continued line or one with '...' is a sketch)."""
+    lines = [line.strip() for text in cli.EXAMPLES.values() for line in text.splitlines()]
+    return [line.split("  (")[0].strip() for line in lines if line.startswith("ballbat ") and "\\" not in line]
+
+
+#: What an example on the repository's own files prints (a line of its output).
+EXAMPLE_OUTPUT = {
+    "ballbat check config/examples/maple_impacts.csv --bats config/examples/maple_bats.csv": (
+        "config/examples/maple_impacts.csv: usable: 31 impacts, 1 excluded"
+    ),
+    "ballbat check config/examples/tracked_tracks.csv --kind tracks --impacts config/examples/tracked_impacts.csv": (
+        "read and validated: 12 impacts tracked by the cameras spin, swing"
+    ),
+    "ballbat check --kind tracks --config config/examples/tracked.yaml": "cross-check: ",
+    "ballbat fly --speed 103 --angle 27.5 --backspin 2500": "carry 422.6 ft, hang time 5.52 s, apex 92.1 ft",
+    "ballbat fly --speed 103 --angle 27.5 --backspin 2500 --method calculator --json": '"carry_ft": 421.48',
+}
+
+
+@pytest.mark.parametrize("example", _examples())
+def test_help_examples_run(example):
+    """Each example of the help runs as printed, from the repository: on its own files it succeeds
+    (with the output the docs quote); a placeholder file (data/mylab/...) is named as missing.
+    """
+    argv = shlex.split(example)[1:]
+    out = ballbat(*argv, cwd=ROOT)
+    paths = [a for i, a in enumerate(argv) if ("/" in a or "." in a) and argv[i - 1] not in ("-o", "--points")]
+    paths = [a for a in paths if not a.replace(".", "").replace(",", "").lstrip("-").isdigit()]
+    missing = [a for a in paths if not (ROOT / a).exists()]
+    if missing:
+        assert out.returncode != 0 and missing[0].rstrip("/") in out.stderr, (example, out.stderr)
+        assert "Traceback" not in out.stderr
+    else:
+        assert out.returncode == 0, (example, out.stdout, out.stderr)
+        assert EXAMPLE_OUTPUT.get(example, "") in out.stdout, (example, out.stdout)
 
 
 def test_fly_reproduces_the_calculator():

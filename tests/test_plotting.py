@@ -5,7 +5,6 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import xarray as xr
-from matplotlib.figure import Figure
 from PIL import Image
 
 from ballbat import plotting, reporting
@@ -114,15 +113,110 @@ def test_stick_period():
     assert reporting.stick_period(t, late) == (pytest.approx(0.3), pytest.approx(0.5))
 
 
-@pytest.mark.parametrize(
-    "func", [plotting.fig9a_stronge_fit, plotting.fig9b_stronge_extrapolation, plotting.fig10_time_history]
-)
-def test_stronge_figures_from_the_contract(func, tmp_path):
-    fig = func(fake_stronge())
-    assert isinstance(fig, Figure)
-    path = plotting.save_figure(fig, tmp_path / "f.png")
-    assert_not_blank(path)
-    assert fig.axes[0].get_legend() is not None or fig.legends
+def _lines(ax) -> dict:
+    """The labelled lines of ``ax`` by label."""
+    return {line.get_label(): line for line in ax.get_lines() if not line.get_label().startswith("_")}
+
+
+def _xy(line) -> tuple[np.ndarray, np.ndarray]:
+    return np.asarray(line.get_xdata(), dtype=float), np.asarray(line.get_ydata(), dtype=float)
+
+
+def test_fig9a_draws_the_files_curves_over_the_datas_range(tmp_path):
+    st = fake_stronge()
+    fig = plotting.fig9a_stronge_fit(st)
+    (ax,) = fig.axes
+    lines = _lines(ax)
+    assert set(lines) == {
+        "baseball fit: η² = 4.90 ± 0.20",
+        "baseball paper: η² = 4.75",
+        "softball fit: η² = 6.10 ± 0.30",
+        "softball paper: η² = 6.3",
+    }
+    for ball, fit, paper in (
+        ("baseball", "fit: η² = 4.90 ± 0.20", "paper: η² = 4.75"),
+        ("softball", "fit: η² = 6.10 ± 0.30", "paper: η² = 6.3"),
+    ):
+        s = st.sel(ball=ball)
+        xmax = 1.05 * st.data_vtf_x.values[st.data_ball.values == ball].max()
+        keep = s.vtf_x_model.values <= xmax  # the model over the data's range only
+        assert 0 < keep.sum() < keep.size
+        x, y = _xy(lines[f"{ball} {fit}"])
+        np.testing.assert_array_equal(x, s.vtf_x_model.values[keep])
+        np.testing.assert_array_equal(y, s.vtf_y_model.values[keep])
+        np.testing.assert_array_equal(_xy(lines[f"{ball} {paper}"])[1], s.vtf_y_published.values[keep])
+    # the data with their error bars, one set per ball
+    bars = {c.get_label(): c for c in ax.containers}
+    assert set(bars) == {"baseball data (n = 30)", "softball data (n = 25)"}
+    x, y = _xy(bars["softball data (n = 25)"].lines[0])
+    np.testing.assert_array_equal(x, st.data_vtf_x.values[30:])
+    np.testing.assert_array_equal(y, st.data_vtf_y.values[30:])
+    assert ax.get_xlim()[0] == 0 and ax.get_ylim()[0] == 0
+    assert_not_blank(plotting.save_figure(fig, tmp_path / "f.png"))
+
+
+def test_fig9b_extrapolates_and_marks_the_regime_boundaries(tmp_path):
+    st = fake_stronge()
+    fig = plotting.fig9b_stronge_extrapolation(st)
+    top, bottom = fig.axes
+    psi_deg = np.degrees(st.psi_grid.values)
+    lines = _lines(bottom)
+    for ball in BALLS:
+        s = st.sel(ball=ball)
+        x, y = _xy(lines[f"{ball} fit"])
+        np.testing.assert_allclose(x, psi_deg, rtol=1e-12)  # the whole grid, to 85 deg
+        np.testing.assert_array_equal(y, s.e_x_model.values)
+        np.testing.assert_array_equal(_xy(lines[f"{ball} paper"])[1], s.e_x_published.values)
+        np.testing.assert_array_equal(_xy(_lines(top)[f"{ball} fit η² = {float(s.eta2):.2f}"])[1], s.vtf_y_model.values)
+    # the boundaries: a vertical line at each and its name (stick 22 and 25 deg, gross slip 58 and 62 deg)
+    vertical = sorted(
+        round(float(line.get_xdata()[0]), 9)
+        for line in bottom.get_lines()
+        if line.get_label().startswith("_") and len(set(line.get_xdata())) == 1
+    )
+    assert vertical == [22.0, 25.0, 58.0, 62.0]
+    assert sorted((t.get_text(), round(t.get_position()[0], 9)) for t in bottom.texts) == [
+        (" gross slip (baseball)", 58.0),
+        (" gross slip (softball)", 62.0),
+        (" stick ends (baseball)", 22.0),
+        (" stick ends (softball)", 25.0),
+    ]
+    assert bottom.get_xlim() == (0.0, 90.0)
+    assert_not_blank(plotting.save_figure(fig, tmp_path / "f.png"))
+
+
+def test_fig10_draws_the_histories_and_the_stick_period(tmp_path):
+    st = fake_stronge()
+    fig = plotting.fig10_time_history(st)
+    ax, right = fig.axes
+    t = st.t_over_tc.values
+    lines, points = _lines(ax), _lines(right)
+    for ball in BALLS:
+        s = st.sel(ball=ball)
+        x, y = _xy(lines[f"{ball} N/N_max"])
+        np.testing.assert_array_equal(x, t)
+        np.testing.assert_array_equal(y, s.normal_force.values)
+        np.testing.assert_array_equal(_xy(lines[f"{ball} F/N_max"])[1], s.tangential_force.values)
+        x, y = _xy(points[f"{ball} tangential velocity"])
+        np.testing.assert_array_equal(x, t[::4])  # 171 samples: every 4th, about 40 points
+        np.testing.assert_array_equal(y, s.tangential_velocity.values[::4])
+    # the initial stick bar of each ball: from t/t_c = 0 to 1.4 (fake: stick until 1.4)
+    bars = [_xy(line) for line in ax.get_lines() if line.get_label().startswith("_")]
+    assert sorted((list(x), list(np.round(y, 9))) for x, y in bars) == [
+        ([0.0, pytest.approx(1.4)], [1.22, 1.22]),
+        ([0.0, pytest.approx(1.4)], [1.29, 1.29]),
+    ]
+    assert sorted(tx.get_text().strip() for tx in ax.texts) == ["initial stick (baseball)", "initial stick (softball)"]
+    assert ax.get_title() == "Fig. 10: time histories at ψ = 30° (fitted η²)"
+    assert [tx.get_text() for tx in fig.legends[0].get_texts()] == [
+        "baseball F/N_max",
+        "baseball N/N_max",
+        "softball F/N_max",
+        "softball N/N_max",
+        "baseball tangential velocity",
+        "softball tangential velocity",
+    ]
+    assert_not_blank(plotting.save_figure(fig, tmp_path / "f.png"))
 
 
 def test_draw_fig9_writes_pngs_and_caption_numbers(tmp_path):

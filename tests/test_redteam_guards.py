@@ -1,16 +1,15 @@
 """Red team, issue 19: nothing deleted, stale or half-checked behind the user's back.
 
 :data:`RED_TEAM` lists each case with its expected outcome and the tests that hold it (each
-fails on the code before issue 19 and passes now). The workflow is built once (``finished``: a
-small synthetic dataset, the paper scenario and a 2-replicate study); each workflow test works
-on its own copy of that finished folder.
+fails on the code before issue 19 and passes now). The workflow is built once for the suite
+(``conftest.small_run``: a small synthetic dataset, the paper scenario and a 2-replicate study);
+each workflow test works on its own copy of that finished folder.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
-import shutil
 import subprocess
 import sys
 from pathlib import Path
@@ -18,7 +17,6 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-import yaml
 
 from ballbat import compare, studies
 from ballbat.pipeline import guards
@@ -33,7 +31,7 @@ from ballbat.pipeline.checked import (
 )
 from ballbat.pipeline.ncio import read_dataset, write_dataset
 from ballbat.pipeline.runlog import logged
-from workflow_helpers import make_workdir, planned_jobs, snakemake
+from workflow_helpers import copy_run, planned_jobs, snakemake
 
 #: case -> (expected outcome, tests)
 RED_TEAM = {
@@ -81,14 +79,6 @@ def test_every_case_has_its_tests():
     names = {name for name, obj in globals().items() if name.startswith("test_") and callable(obj)}
     for case, (outcome, tests) in RED_TEAM.items():
         assert outcome and tests and set(tests) <= names, case
-
-
-SMALL = {
-    "seed": 7,
-    "impacts": {"baseball": {"wood": 12, "metal_rough": 12}, "softball": {"softball_composite": 12}},
-    "e_x": {"baseball": {"wood": 0.464, "metal_rough": 0.356}, "softball": {"softball_composite": 0.128}},
-    "e_y": {"baseball": 0.45, "softball": 0.32},
-}
 
 
 # --- unit tests of the guards ----------------------------------------------------------------
@@ -248,27 +238,15 @@ def test_a_job_removes_only_what_the_workflow_wrote(tmp_path, monkeypatch):
 
 
 @pytest.fixture(scope="session")
-def finished(tmp_path_factory):
-    """One finished run: a small synthetic dataset, the paper scenario, a 2-replicate study."""
-    wd = make_workdir(tmp_path_factory.mktemp("guards"), copy_package=True)
-    cfg = yaml.safe_load((wd / "config" / "config.yaml").read_text())
-    cfg["datasets"] = {"small": {"synthetic": SMALL}}
-    cfg["implications"]["scenarios"]["paper"]["sweep"]["D_in"]["num"] = 26
-    cfg["studies"] = {
-        "calibration": {"dataset": "small", "seed": 1, "replicates": 2, "batch_size": 1, "truth_impacts": 40}
-    }
-    (wd / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
-    snakemake(wd, "-c2", "all", "studies")
-    return wd
+def finished(small_run):
+    """One finished run: a small synthetic dataset, the paper scenario, a 2-replicate study (conftest.small_run)."""
+    return small_run
 
 
 @pytest.fixture
 def run(finished, tmp_path):
     """A copy of the finished run (timestamps kept) for one test to change."""
-    wd = tmp_path / "wd"
-    shutil.copytree(finished, wd, symlinks=True)
-    shutil.rmtree(wd / ".snakemake" / "locks", ignore_errors=True)
-    return wd
+    return copy_run(finished, tmp_path / "wd")
 
 
 def nc_state(wd):

@@ -2,7 +2,7 @@
 
 `make test-report` installs Debian's chromium, builds the default run's report and runs this
 file with BALLBAT_REPORT_ROOT set to the repository (its screenshot: results/report-front.png).
-Without that variable the tests build the default workflow's report in a temporary copy; they
+Without that variable the tests build the report of the suite's default run (conftest) in a copy; they
 are skipped when Chromium is not installed (failed instead when BALLBAT_REQUIRE_BROWSER is set).
 """
 
@@ -18,7 +18,7 @@ import pytest
 import xarray as xr
 from browser import Browser, chromium_path
 
-from workflow_helpers import assert_not_blank, make_workdir, snakemake
+from workflow_helpers import assert_not_blank
 
 pytestmark = pytest.mark.slow
 
@@ -27,7 +27,7 @@ WIDTH = 1400
 
 
 @pytest.fixture(scope="module")
-def report_root(tmp_path_factory) -> Path:
+def report_root(request) -> Path:
     given = os.environ.get("BALLBAT_REPORT_ROOT")
     if given:
         root = Path(given)
@@ -35,10 +35,7 @@ def report_root(tmp_path_factory) -> Path:
         return root
     if chromium_path() is None:
         pytest.skip("no chromium (make test-report installs Debian's)")
-    wd = make_workdir(tmp_path_factory.mktemp("report"))
-    snakemake(wd, "-c2")
-    snakemake(wd, "--report", "results/report.html")
-    return wd
+    return request.getfixturevalue("default_report")  # the suite's default run, its report built in a copy
 
 
 @pytest.fixture(scope="module")

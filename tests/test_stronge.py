@@ -457,6 +457,7 @@ def test_robust_fit_interval_and_dof(balls, bats):
         fit_eta2(psi, x, y, r_x, r_y, robust=True, strata=strata[:-1])
 
 
+@pytest.mark.slow  # seconds (quiet machine): more than a unit test may take
 def test_robust_error_describes_repeats_of_a_design_with_fixed_bats(balls, bats):
     """Three bats of constant e_x 0.10, 0.17, 0.24 (Table II-like; one eta^2 cannot describe
     them), 15 impacts each at random psi, repeated 60 times: the spread of eta2 over the
@@ -518,7 +519,31 @@ def test_fit_input_errors(balls, bats):
         fit_eta2(psi, x, y_bad, r_x, r_y)
     with pytest.raises(ValueError, match="need more than 3"):
         fit_eta2(psi[:3], x[:3], y[:3], r_x[:3], r_y[:3], vary_e_y=True, vary_mu=True)
-    assert issubclass(Eta2FitError, RuntimeError)
+
+
+@pytest.mark.parametrize(("success", "eta2"), [(False, 4.75), (True, np.nan)])
+def test_failed_fit_names_its_inputs(balls, bats, monkeypatch, success, eta2):
+    """A failure that lmfit reports, or a non-finite eta^2, is an Eta2FitError naming the fit's inputs."""
+    import lmfit
+
+    real = lmfit.minimize
+
+    def failing(*args, **kwargs):
+        res = real(*args, **kwargs)
+        res.success, res.message = success, "the fit wandered off"
+        res.params["eta2"].value = eta2
+        return res
+
+    monkeypatch.setattr(lmfit, "minimize", failing)
+    psi, x, y, r_x, r_y = _synthetic(balls, bats, np.random.default_rng(4), n=10)
+    lo, hi = np.degrees(psi.min()), np.degrees(psi.max())
+    with pytest.raises(Eta2FitError) as info:
+        fit_eta2(psi, x, y, r_x, r_y, e_y=0.4)
+    assert str(info.value) == (
+        f"fit_eta2: fit failed (the fit wandered off) (n=10 impacts, psi {lo:.3g}..{hi:.3g} deg,"
+        " e_y=0.4 (fixed), mu=0.5 (fixed))"
+    )
+    assert isinstance(info.value, RuntimeError)  # callers that catch a failed fit as a RuntimeError still do
 
 
 def test_import_is_light():

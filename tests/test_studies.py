@@ -176,6 +176,7 @@ def test_impacts_required_matches_the_normal_formula_for_many_impacts():
     assert studies.impacts_required(1.0, 20, 1e-6) == math.inf
 
 
+@pytest.mark.slow  # seconds (quiet machine): more than a unit test may take
 def test_replicates_cover_the_truth(config, balls, bats):
     """A fast coverage check of the whole chain: 40 replicates of the default experiment (raw tracks).
 

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import base64
 import json
 import subprocess
 import sys
@@ -10,45 +11,18 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
-import yaml
 
 from ballbat.compare import format_measurement, read_csv
 from ballbat.pipeline.provenance import sha256_file
-from workflow_helpers import ROOT, assert_cf, assert_not_blank, make_workdir, planned_jobs, snakemake
+from workflow_helpers import ROOT, assert_cf, assert_not_blank, copy_run, make_workdir, planned_jobs, snakemake
 
 pytestmark = pytest.mark.slow
 
-SMALL = {
-    "datasets": {
-        "small": {
-            "synthetic": {
-                "seed": 7,
-                "impacts": {"baseball": {"wood": 12, "metal_rough": 12}, "softball": {"softball_composite": 12}},
-                "e_x": {"baseball": {"wood": 0.464, "metal_rough": 0.356}, "softball": {"softball_composite": 0.128}},
-                "e_y": {"baseball": 0.45, "softball": 0.32},
-            }
-        }
-    }
-}
-
 
 @pytest.fixture(scope="module")
-def run_dir(tmp_path_factory):
-    wd = make_workdir(tmp_path_factory.mktemp("wf"), copy_package=True)
-    cfg = yaml.safe_load((wd / "config" / "config.yaml").read_text())
-    cfg["datasets"] = SMALL["datasets"]
-    cfg["studies"] = {}
-    paper = cfg["implications"]["scenarios"]["paper"]
-    paper["sweep"]["D_in"]["num"] = 26
-    paper["e_x_from_dataset"] = "small"
-    cfg["implications"]["scenarios"]["flyballs"] = {
-        "ball": "baseball",
-        "launch": {"exit_speed_mph": [95, 105], "launch_deg": [15, 25, 35], "backspin_rpm": 2200},
-        "flight": {"n_points": 11},
-    }
-    (wd / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
-    snakemake(wd, "-c2")
-    return wd
+def run_dir(small_run, tmp_path_factory):
+    """A copy of the suite's small run (conftest.small_run: dataset ``small``, scenarios paper and flyballs)."""
+    return copy_run(small_run, tmp_path_factory.mktemp("wf") / "run")
 
 
 def test_outputs_content(run_dir):
@@ -259,8 +233,8 @@ def test_jobs_import_only_what_they_use(script):
 
 def test_results_pass_the_cf_checker(run_dir):
     """Every NetCDF file of a run passes the IOOS compliance-checker's CF 1.10 suite (issue 9)."""
-    files = sorted(str(p) for p in (run_dir / "results").rglob("*.nc"))
-    assert len(files) >= 7  # small: simulate .. stronge; implications: paper, flyballs
+    files = sorted(str(p) for d in ("small", "implications") for p in (run_dir / "results" / d).rglob("*.nc"))
+    assert len(files) >= 7  # small: simulate .. stronge; implications: paper, flyballs (the study's: test_studies)
     assert_cf(files, run_dir / "cf.json")
 
 
@@ -361,17 +335,33 @@ def test_figures_drawn(run_dir):
     assert "<td>e_x_pooled</td>" in (run_dir / "results" / "small" / "paper_comparison.html").read_text()
 
 
+def _report_results(html: str) -> dict:
+    """The report's table of results: path -> entry (its labels, caption, MIME type and data URI)."""
+    at = html.index("results = {") + len("results = ")
+    return json.JSONDecoder().raw_decode(html, at)[0]
+
+
 def test_report_builds(run_dir):
-    """`snakemake --report` embeds every figure with its caption numbers and the comparison tables."""
+    """`snakemake --report` embeds every figure, table and workbook byte for byte, each figure with
+    its caption numbers, and the run's config.
+    """
     snakemake(run_dir, "--report", "results/report.html")
     html = (run_dir / "results" / "report.html").read_text()
-    assert len(html) > 100_000
-    for name in ("fig3.png", "fig6.png", "fig9b.png", "fig10.png", "paper_fig11a.png", "flyballs_launch.png"):
-        assert name in html, name
-    assert "paper_comparison.html" in html
-    assert "results.xlsx" in html  # the workbooks are linked from the report (issue 13)
+    results = _report_results(html)
+    products = sorted(str(p.relative_to(run_dir)) for p in run_dir.glob("results/*/figures/*.png"))
+    products += sorted(str(p.relative_to(run_dir)) for p in run_dir.glob("results/*/paper_comparison.html"))
+    products += sorted(str(p.relative_to(run_dir)) for p in run_dir.glob("results/*/results.xlsx"))
+    assert len(products) == 10 + 2 + 2  # small: 7 figures; implications: 3 figures; a table and a workbook each
+    assert sorted(results) == sorted(products)
+    for path in products:
+        head, data = results[path]["data_uri"].split(",", 1)
+        assert head.endswith(";base64"), path
+        assert base64.b64decode(data) == (run_dir / path).read_bytes(), path  # the file, whole
+    assert results["results/small/figures/fig3.png"]["mime_type"] == "image/png"
+    assert results["results/small/figures/fig3.png"]["labels"]["figure"] == "Fig. 3"
+    assert results["results/small/results.xlsx"]["labels"] == {"table": "results.xlsx"}  # issue 13
     e_x = float(xr.open_dataset(run_dir / "results" / "small" / "fit_ex.nc").e_x_pooled.sel(ball="baseball"))
-    assert f"e_x = {e_x:.3f}" in html  # a caption quoting the fitted number
+    assert f"e_x = {e_x:.3f}" in results["results/small/figures/fig5.png"]["caption"]  # the fitted number
     assert "v_ref_mph" in html  # the run's config
 
 
