@@ -81,6 +81,8 @@ def fit() -> xr.Dataset:
         "spin_theta_slope_err": [6.3 * RPM / DEGREE, 7.0 * RPM / DEGREE],
         "speed_theta_slope": [-0.25 * MPH / DEGREE, -0.3 * MPH / DEGREE],
         "speed_theta_slope_err": [0.012 * MPH / DEGREE, 0.02 * MPH / DEGREE],
+        "spin_theta_slope_intercept": [2100.0 * RPM, 1900.0 * RPM],
+        "speed_theta_slope_intercept": [95.0 * MPH, 85.0 * MPH],
         "gross_slip_psi": [np.radians(22.0), np.radians(30.0)],
         "gross_slip_theta": [np.radians(20.0), np.nan],
         "gross_slip_omega": [3000.0 * RPM, 2000.0 * RPM],
@@ -136,7 +138,16 @@ def formats(ws, row: int) -> list[str]:
 
 def test_sheets_and_header_rows(book):
     wb = openpyxl.load_workbook(book)
-    assert wb.sheetnames == ["impacts", "e_x", "sec4", "eta2", "paper_comparison", "warnings", "provenance"]
+    assert wb.sheetnames == [
+        "impacts",
+        "e_x",
+        "sec4",
+        "eta2",
+        "systematics",
+        "paper_comparison",
+        "warnings",
+        "provenance",
+    ]
     ws = wb["impacts"]
     names = [
         "impact",
@@ -200,7 +211,7 @@ def test_e_x_sheet_rounds_to_the_finer_error(book):
         "bat",
         "e_x",
         "e_x_err",
-        "e_x_err_scale",
+        "e_x_syst",  # the combined calibration systematic (here a file with the pixel scale's alone)
         "e_x_err_total",
         "e_x_ci_low",
         "e_x_ci_high",
