@@ -798,8 +798,35 @@ def reduce_tracks(
         The fits, the values (SI) and the flag and reason of every impact.
     """
     opt = options or ReduceOptions.schema_defaults()
-    n = tracks.n
     tracks, n_outliers = remove_glitches(tracks, cameras)
+    onset, flight, times, phys, contact, swing, spin = _fit_motions(tracks, cameras, rig)
+    values = _measured_values(flight["swing"], swing, spin, contact, cameras, rig)
+    flag, reason, agree = _exclusions(tracks.n, onset, flight, swing, spin, cameras, opt)
+    return Reduction(
+        tracks,
+        cameras,
+        rig,
+        onset,
+        flight,
+        swing,
+        spin,
+        times,
+        phys,
+        values,
+        flag,
+        reason.astype(str),
+        n_outliers,
+        agree,
+        contact,
+    )
+
+
+def _fit_motions(tracks: Tracks, cameras: dict[str, Camera], rig: Rig) -> tuple:
+    """Fit every impact: the ball's onset and free flight in each camera, the contact, the swing, the spin.
+
+    Returns ``onset, flight, times, phys, contact, swing, spin`` (:class:`Reduction`'s fields).
+    """
+    n = tracks.n
     onset, flight, times, phys = {}, {}, {}, {}
     for name in ("swing", "spin"):
         ct, cam = tracks.cameras[name], cameras[name]
@@ -832,8 +859,13 @@ def reduce_tracks(
         flight["spin"],
         cameras["spin"],
     )
+    return onset, flight, times, phys, contact, swing, spin
 
-    fs = flight["swing"]
+
+def _measured_values(
+    fs: Flight, swing: Swing, spin: Spin, contact: Contact, cameras: dict[str, Camera], rig: Rig
+) -> dict[str, np.ndarray]:
+    """v_bat, v_ball, theta, omega and the other measured values of every impact (SI), from the fits."""
     with np.errstate(all="ignore"):
         v_ball = np.hypot(fs.vx, fs.vy)
         v_ball_err = np.sqrt(fs.vx_var)  # same design for both components: isotropic
@@ -863,17 +895,37 @@ def reduce_tracks(
         "contact_time": contact.duration,
         "contact_time_err": contact.duration_err,
     }
+    return values
 
-    flag = np.zeros(n, dtype=np.int8)
-    reason = np.full(n, "ok", dtype=object)
-    fps_spin = cameras["spin"].fps
 
-    def mark(cond, code, texts):
-        new = cond & (flag == 0)
-        flag[new] = code
+class _Marks:
+    """The flag and reason of every impact: each impact keeps the first reason that applies."""
+
+    def __init__(self, n: int):
+        self.flag = np.zeros(n, dtype=np.int8)
+        self.reason = np.full(n, "ok", dtype=object)
+
+    def __call__(self, cond: np.ndarray, code: ReduceFlag, texts) -> None:
+        new = cond & (self.flag == 0)
+        self.flag[new] = code
         for i in np.flatnonzero(new):
-            reason[i] = f"{STAGE}: {texts(i)}"
+            self.reason[i] = f"{STAGE}: {texts(i)}"
 
+
+def _exclusions(
+    n: int, onset: dict, flight: dict, swing: Swing, spin: Spin, cameras: dict[str, Camera], opt: ReduceOptions
+) -> tuple[np.ndarray, np.ndarray, object]:
+    """Return the flag and reason of every impact (the first reason that applies), and the cameras' agreement."""
+    mark = _Marks(n)
+    agree = _motion_exclusions(mark, onset, flight, swing, cameras, opt)
+    _spin_exclusions(mark, flight, spin, cameras["spin"].fps, opt)
+    return mark.flag, mark.reason, agree
+
+
+def _motion_exclusions(
+    mark: _Marks, onset: dict, flight: dict, swing: Swing, cameras: dict[str, Camera], opt: ReduceOptions
+) -> object:
+    """Mark impacts without an impact, with too few frames or whose cameras disagree; return the agreement."""
     for name in ("swing", "spin"):
         mark(
             ~onset[name].found,
@@ -918,6 +970,11 @@ def reduce_tracks(
         ReduceFlag.TOO_FEW_FRAMES,
         lambda i: f"{swing.n[i]} pre-impact frame(s) of bat_tip in the swing camera, fewer than {opt.min_tip_frames}",
     )
+    return agree
+
+
+def _spin_exclusions(mark: _Marks, flight: dict, spin: Spin, fps_spin: float, opt: ReduceOptions) -> None:
+    """Mark impacts whose spin dots are too few, do not rotate about the ball's centre, or turn too fast."""
     for p in ("dot_a", "dot_b"):
         n_p = spin.mask[p].sum(axis=1)
         mark(
@@ -949,21 +1006,4 @@ def reduce_tracks(
             f"a dot turns up to {spin.max_step[i]:.2f} rad between frames (limit {UNWRAP_LIMIT:.2f}): "
             f"spin too fast for {fps_spin:g} fps to unwrap"
         ),
-    )
-    return Reduction(
-        tracks,
-        cameras,
-        rig,
-        onset,
-        flight,
-        swing,
-        spin,
-        times,
-        phys,
-        values,
-        flag,
-        reason.astype(str),
-        n_outliers,
-        agree,
-        contact,
     )

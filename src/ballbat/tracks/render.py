@@ -231,6 +231,50 @@ def _exit_time(v, launch, t_c, cam: RenderCamera):
     return 1.2 * t + t_c + 3.0 / cam.camera.fps
 
 
+def _dot_track(X, Y, r, rho, phi, frame) -> tuple[np.ndarray, np.ndarray]:
+    """Return a spin dot's position: at ``rho`` from the spin axis, turned to ``phi``; NaN behind the ball.
+
+    ``frame`` is the spin axis and two unit vectors across it (each 3 x impact); the camera
+    looks along -z, so a dot with z < 0 is hidden.
+    """
+    axis, e1, e2 = frame
+    gamma = np.arcsin(np.clip(rho / r, -1, 1))
+    c, sn = np.cos(phi), np.sin(phi)
+    comp = [
+        r[:, None]
+        * (
+            np.cos(gamma)[:, None] * axis[i][:, None]
+            + np.sin(gamma)[:, None] * (c * e1[i][:, None] + sn * e2[i][:, None])
+        )
+        for i in range(3)
+    ]
+    hidden = comp[2] < 0
+    return np.where(hidden, np.nan, X + comp[0]), np.where(hidden, np.nan, Y + comp[1])
+
+
+def _observed(pts: dict, points: tuple, cam, t: np.ndarray, rng) -> tuple[dict, dict]:
+    """Return the pixel tracks of ``points`` as the camera records them.
+
+    With its tracking noise, NaN outside the view, and ended when the ball leaves the view.
+    """
+    xs, ys = {}, {}
+    for p in points:
+        Xp, Yp = pts[p]
+        noise = rng.standard_normal((2, *Xp.shape)) * cam.pixel_noise_px
+        x, y = _to_pixels(Xp, Yp, cam, noise)
+        out = ~((x >= 0) & (x < cam.width_px) & (y >= 0) & (y < cam.height_px))
+        x[out] = np.nan
+        y[out] = np.nan
+        xs[p], ys[p] = x, y
+    # the track ends when the ball leaves the view (after impact)
+    gone = (t > 0) & np.isnan(xs["ball"])
+    ended = np.cumsum(gone, axis=1) > 0
+    for p in points:
+        xs[p][ended] = np.nan
+        ys[p][ended] = np.nan
+    return xs, ys
+
+
 def render_tracks(
     truth: dict[str, np.ndarray],
     ball_radius: np.ndarray,
@@ -305,35 +349,8 @@ def render_tracks(
         else:
             turn = omega[:, None] * s  # rotation angle (s is distance / speed: same clock)
             for p, (rho, phi0) in dots.items():
-                gamma = np.arcsin(np.clip(rho / r, -1, 1))
-                phi = phi0[:, None] + turn
-                c, sn = np.cos(phi), np.sin(phi)
-                comp = [
-                    r[:, None]
-                    * (
-                        np.cos(gamma)[:, None] * axis[i][:, None]
-                        + np.sin(gamma)[:, None] * (c * e1[i][:, None] + sn * e2[i][:, None])
-                    )
-                    for i in range(3)
-                ]
-                hidden = comp[2] < 0
-                pts[p] = (np.where(hidden, np.nan, X + comp[0]), np.where(hidden, np.nan, Y + comp[1]))
-        xs, ys = {}, {}
-        sd = cam.pixel_noise_px
-        for p in POINTS[name]:
-            Xp, Yp = pts[p]
-            noise = rng.standard_normal((2, *Xp.shape)) * sd
-            x, y = _to_pixels(Xp, Yp, cam, noise)
-            out = ~((x >= 0) & (x < cam.width_px) & (y >= 0) & (y < cam.height_px))
-            x[out] = np.nan
-            y[out] = np.nan
-            xs[p], ys[p] = x, y
-        # the track ends when the ball leaves the view (after impact)
-        gone = (t > 0) & np.isnan(xs["ball"])
-        ended = np.cumsum(gone, axis=1) > 0
-        for p in POINTS[name]:
-            xs[p][ended] = np.nan
-            ys[p][ended] = np.nan
+                pts[p] = _dot_track(X, Y, r, rho, phi0[:, None] + turn, (axis, e1, e2))
+        xs, ys = _observed(pts, POINTS[name], cam, t, rng)
         cams[name] = CameraTracks(frame0.astype(np.int64), xs, ys)
 
     keep = {f"truth_{k}": np.asarray(v) for k, v in truth.items()}
