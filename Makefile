@@ -19,8 +19,10 @@ install: $(STAMP)
 run: install
 	$(BIN)/snakemake -c$(CORES)
 
+# The suite on $(CORES) processes (pytest-xdist); the tests of each shared workflow run stay on one
+# process (tests/conftest.py), so each run is still built once. `pytest` alone runs them in one.
 test: install
-	$(BIN)/python -m pytest
+	$(BIN)/python -m pytest -n $(CORES) --dist loadgroup
 
 # The default workflow through a real single-node SLURM set up on this machine (Debian's
 # packages; root needed), compared byte for byte with a local run; the daemons are stopped after.

@@ -102,3 +102,17 @@ def maple_run(tmp_path_factory):
     write_config(work, edit)
     snakemake(work, "-c2", "--configfile", "config/examples/maple.yaml")
     return work
+
+
+#: The shared runs above: under pytest-xdist (`make test`: ``-n 2 --dist loadgroup``) every test
+#: that uses one goes to the same worker, so each run is still built once in the whole suite.
+SHARED_RUNS = {"default_run": "default_run", "default_report": "default_run", "small_run": "small_run"}
+SHARED_RUNS["maple_run"] = "maple_run"
+
+
+def pytest_collection_modifyitems(config, items):
+    """Group the tests of each shared run onto one xdist worker (a no-op without xdist)."""
+    for item in items:
+        groups = {SHARED_RUNS[f] for f in item.fixturenames if f in SHARED_RUNS}
+        if groups:
+            item.add_marker(pytest.mark.xdist_group("+".join(sorted(groups))))
