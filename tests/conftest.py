@@ -3,6 +3,7 @@
 from pathlib import Path
 
 import pytest
+import yaml
 
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
@@ -19,6 +20,18 @@ def root():
 def config():
     """The default config/config.yaml, validated, with the schema's defaults (as the workflow sees it)."""
     return load_config(ROOT / "config" / "config.yaml")
+
+
+@pytest.fixture
+def raw():
+    """The default config/config.yaml as written (not validated): a fresh copy for each test to edit."""
+    return yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+
+
+@pytest.fixture(scope="module")
+def schema():
+    """The config schema (workflow/schemas/config.schema.yaml)."""
+    return yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
 
 
 @pytest.fixture(scope="session")

@@ -8,11 +8,6 @@ import yaml
 from ballbat.pipeline.config import ConfigError, drop_nulls, validate_config
 
 
-@pytest.fixture(scope="module")
-def schema(root):
-    return yaml.safe_load((root / "workflow" / "schemas" / "config.schema.yaml").read_text())
-
-
 @pytest.fixture
 def base(root):
     return yaml.safe_load((root / "config" / "config.yaml").read_text())

@@ -125,11 +125,6 @@ CONFIG_CASES = [
 ]
 
 
-@pytest.fixture(scope="module")
-def schema():
-    return yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
-
-
 @pytest.fixture
 def base():
     return yaml.safe_load((ROOT / "config" / "config.yaml").read_text())

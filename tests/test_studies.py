@@ -58,16 +58,6 @@ def test_sweep_sets_the_dataset(config, parameter, value, check):
     assert base == before  # a copy: the config is untouched
 
 
-@pytest.fixture
-def raw(root):
-    return yaml.safe_load((root / "config" / "config.yaml").read_text())
-
-
-@pytest.fixture(scope="module")
-def schema(root):
-    return yaml.safe_load((root / "workflow" / "schemas" / "config.schema.yaml").read_text())
-
-
 @pytest.mark.parametrize(
     ("edit", "message"),
     [

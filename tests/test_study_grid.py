@@ -10,7 +10,6 @@ import itertools
 import numpy as np
 import pytest
 import xarray as xr
-import yaml
 
 from ballbat import studies
 from ballbat.pipeline.config import ConfigError, validate_config
@@ -18,17 +17,6 @@ from ballbat.stages import study_batch
 from ballbat.sweeps import CONTACT_HALF_WIDTH_MS, point_dataset, sweep_points
 from ballbat.tracks.data import camera_block
 from ballbat.tracks.render import drawn_calibration, settings_from_config
-
-
-@pytest.fixture
-def raw(root):
-    return yaml.safe_load((root / "config" / "config.yaml").read_text())
-
-
-@pytest.fixture(scope="module")
-def schema(root):
-    return yaml.safe_load((root / "workflow" / "schemas" / "config.schema.yaml").read_text())
-
 
 # ---------------------------------------------------------------------------------------
 # the grid

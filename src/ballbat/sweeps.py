@@ -42,9 +42,6 @@ SWEEP_PARAMETERS = {
 #: that the impacts of a point still differ a little, as real ones do.
 CONTACT_HALF_WIDTH_MS = 0.05
 
-#: The renderer's contact times must lie in the reduction's prior (``contact_range`` of the schema).
-CONTACT_PRIOR_MS = (0.2, 2.0)
-
 #: Settings that need a dataset that renders camera tracks.
 RENDER_PARAMETERS = ("pixel_noise_px", "swing_fps", "spin_fps", "contact_ms")
 
@@ -81,7 +78,9 @@ def _value_problem(parameter: str, v: float) -> str | None:
         return f"{parameter} must be positive, not {v:g}"
     if parameter == "e_x" and not -1.0 < v < 1.0:
         return f"e_x must lie in (-1, 1), not {v:g}"
-    lo, hi = CONTACT_PRIOR_MS
+    from .tracks.data import CONTACT_PRIOR  # the reduction's prior: the renderer's contacts must lie in it
+
+    lo, hi = (1e3 * v for v in CONTACT_PRIOR)
     h = CONTACT_HALF_WIDTH_MS
     if parameter == "contact_ms" and not lo + h <= v <= hi - h:
         return (

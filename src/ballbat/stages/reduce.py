@@ -13,11 +13,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..pipeline.products import Var, build_dataset, flag_attrs
-from ..systematics import reduce_shifts
-from ..tracks.checks import cross_check
 from ..tracks.io import cameras_from_config
-from ..tracks.reduce import FLAG_VAR, ReduceFlag, ReduceOptions, Reduction, reduce_tracks
-from ..tracks.stage import reduce_options
+from ..tracks.reduce import FLAG_VAR, ReduceFlag, ReduceOptions, Reduction
+from ..tracks.stage import reduce_and_check, reduce_options
 from .impacts import IMPACT_COORDS, QUANTITIES, measured, truth_var
 from .systematics import add_shifts
 
@@ -230,10 +228,9 @@ def run(
     ballbat.properties.InputError
         A cross-check that stops the dataset (:func:`ballbat.tracks.checks.cross_check`).
     """
-    red = reduce_tracks(tracks, settings.cameras, settings.rig, settings.options)
-    verdict = cross_check(red, balls, bats, settings.where)
-    if settings.systematics:
-        red.shifts = reduce_shifts(tracks, settings.cameras, settings.rig, settings.options, red)
+    red, verdict = reduce_and_check(
+        tracks, settings.cameras, settings.rig, settings.options, balls, bats, settings.where, settings.systematics
+    )
     ds = reduction_dataset(red)
     if source_file is not None:
         ds.attrs["source_file"] = str(source_file)

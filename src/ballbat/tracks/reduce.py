@@ -50,7 +50,7 @@ import numpy as np
 
 from ..units import G
 from .checks import IMPACT_Z, camera_agreement, glitch_mask
-from .data import POINTS, Camera, CameraTracks, Rig, Tracks
+from .data import CONTACT_PRIOR, POINTS, Camera, CameraTracks, Rig, Tracks
 from .render import contact_distance
 
 if TYPE_CHECKING:
@@ -63,10 +63,6 @@ THRESHOLD_FLOOR_PX = 3.0
 THRESHOLD_SIGMA = 8.0
 #: Longest contact (s): "under a millisecond" (Sec. II).
 CONTACT_MAX = 1.0e-3
-#: Prior range of a ball-on-bat contact time (s), uniform: generous bounds around the
-#: literature's 0.6-0.7 ms of a baseball on a bat and about 1 ms or more of a softball
-#: (docs/tracks.md, "The contact time"). Each impact's contact time is fitted within it.
-CONTACT_PRIOR = (0.2e-3, 2.0e-3)
 #: Grid points of the contact-time posterior (10 us steps over CONTACT_PRIOR).
 CONTACT_GRID = 181
 #: EM iterations of the contact times' (normal) distribution among the impacts of a ball type.

@@ -16,7 +16,7 @@ from .reduce import ReduceOptions, Reduction, reduce_tracks
 if TYPE_CHECKING:
     import os
 
-    from .data import Tracks
+    from .data import Camera, Rig, Tracks
 
 
 def reduce_options(cfg: dict) -> ReduceOptions:
@@ -58,12 +58,30 @@ def reduce_in_memory(
         A setting wrong or a cross-check that stops the dataset (:func:`.checks.cross_check`).
     """
     cameras, rig = cameras_from_config(cfg, where)
-    red = reduce_tracks(tracks, cameras, rig, reduce_options(cfg))
+    return reduce_and_check(tracks, cameras, rig, reduce_options(cfg), balls, bats, where, systematics)
+
+
+def reduce_and_check(
+    tracks: Tracks,
+    cameras: dict[str, Camera],
+    rig: Rig,
+    options: ReduceOptions,
+    balls: dict,
+    bats: dict,
+    where: str,
+    systematics: bool,
+) -> tuple[Reduction, Verdict]:
+    """Reduce and cross-check tracks with settings already built (:func:`reduce_in_memory`, the reduce stage).
+
+    ``systematics``: also reduce the tracks again at +-1 sigma of each stated calibration
+    uncertainty (:func:`ballbat.systematics.reduce_shifts`, kept as ``Reduction.shifts``).
+    """
+    red = reduce_tracks(tracks, cameras, rig, options)
     verdict = cross_check(red, balls, bats, where)
     if systematics:
         from ..systematics import reduce_shifts
 
-        red.shifts = reduce_shifts(tracks, cameras, rig, reduce_options(cfg), red)
+        red.shifts = reduce_shifts(tracks, cameras, rig, options, red)
     return red, verdict
 
 
@@ -85,4 +103,4 @@ def reduce_checked(
     balls, bats = load_balls(balls_path), load_bats(bats_path)
     cameras_from_config(cfg, where)  # the settings are checked before the files are read
     tracks = load_tracks(tracks_path, impacts_path, balls, bats)
-    return reduce_in_memory(tracks, cfg, balls, bats, where, systematics=True)
+    return reduce_in_memory(tracks, cfg, balls, bats, where)  # a check needs no calibration reruns
