@@ -19,10 +19,11 @@ install: $(STAMP)
 run: install
 	$(BIN)/snakemake -c$(CORES)
 
-# The suite on $(CORES) processes (pytest-xdist); the tests of each shared workflow run stay on one
-# process (tests/conftest.py), so each run is still built once. `pytest` alone runs them in one.
+# The suite on $(CORES) processes (pytest-xdist), each test module on one, in the order of
+# tests/conftest.py (FIRST); the two shared workflow runs are built once, by whichever process
+# needs them first. `pytest` alone runs the suite in one process.
 test: install
-	$(BIN)/python -m pytest -n $(CORES) --dist loadgroup
+	$(BIN)/python -m pytest -n $(CORES) --dist loadscope --no-loadscope-reorder
 
 # The default workflow through a real single-node SLURM set up on this machine (Debian's
 # packages; root needed), compared byte for byte with a local run; the daemons are stopped after.

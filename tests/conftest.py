@@ -1,5 +1,9 @@
-"""Shared fixtures: the repository's property tables (Tables I and II of the paper), and one default workflow run."""
+"""Shared fixtures: the repository's property tables (Tables I and II of the paper), and the suite's two
+workflow runs (the default, and a lab's datasets, scenarios and studies in one folder), each built once.
+"""
 
+import os
+import shutil
 from pathlib import Path
 
 import pytest
@@ -44,18 +48,53 @@ def bats():
     return load_bats(ROOT / "config" / "bats.csv")
 
 
+def _shared_run(tmp_path_factory, name: str, build) -> Path:
+    """A workflow run built once for the whole session, whichever pytest-xdist worker asks first.
+
+    The folder lives beside the workers' own temporary folders, and its build holds a lock:
+    a worker that needs it while another builds it waits, and a finished build is marked
+    (``.built``) so that no one builds it twice. A failed build is marked too, with its error,
+    so that the other worker fails at once instead of building it again.
+    """
+    import fcntl
+
+    base = tmp_path_factory.getbasetemp()
+    if os.environ.get("PYTEST_XDIST_WORKER"):
+        base = base.parent  # shared by the session's workers
+    work, done, failed = base / name, base / f"{name}.built", base / f"{name}.failed"
+    with open(base / f"{name}.lock", "w") as lock:
+        fcntl.flock(lock, fcntl.LOCK_EX)
+        try:
+            if failed.exists():
+                raise RuntimeError(f"the shared run {name} failed to build:\n{failed.read_text()}")
+            if not done.exists():
+                shutil.rmtree(work, ignore_errors=True)
+                work.mkdir()
+                try:
+                    build(work)
+                except BaseException as exc:
+                    failed.write_text(str(exc))
+                    raise
+                done.touch()
+        finally:
+            fcntl.flock(lock, fcntl.LOCK_UN)
+    return work
+
+
 @pytest.fixture(scope="session")
 def default_run(tmp_path_factory):
-    """A copy of the workflow run once with the default config (`snakemake -c2`), shared by the tests that read it.
+    """The workflow run once with the default config (`snakemake -c2`), shared by the tests that read it.
 
-    The only build of the default workflow in the suite: a test that changes a run works on a
-    copy of this one (:func:`workflow_helpers.copy_run`), where Snakemake has nothing to redo.
+    One of the two builds of the workflow in the suite (the other: :func:`lab_run`). Tests
+    only read it; a test that changes a run works on a copy (:func:`workflow_helpers.copy_run`).
     """
     from workflow_helpers import make_workdir, snakemake
 
-    work = make_workdir(tmp_path_factory.mktemp("default_run"))
-    snakemake(work, "-c2")
-    return work
+    def build(work):
+        make_workdir(work)
+        snakemake(work, "-c2")
+
+    return _shared_run(tmp_path_factory, "default_run", build)
 
 
 @pytest.fixture(scope="session")
@@ -63,24 +102,55 @@ def default_report(default_run, tmp_path_factory):
     """A copy of the default run with its report (`snakemake --report results/report.html`)."""
     from workflow_helpers import copy_run, snakemake
 
-    work = copy_run(default_run, tmp_path_factory.mktemp("default_report") / "run")
-    snakemake(work, "--report", "results/report.html")
-    return work
+    def build(work):
+        copy_run(default_run, work / "run")
+        snakemake(work / "run", "--report", "results/report.html")
+
+    return _shared_run(tmp_path_factory, "default_report", build) / "run"
+
+
+#: The lab run's tool-file datasets (``tools.yaml``; docs/tracks.md): the example tracks as a
+#: long CSV (``tracked``) and as a folder of Tracker projects (``trk``), reduced and fitted
+#: (--until fit_ex tracks_qa). The other formats give the same tracks as the .trk files
+#: (test_track_formats.test_every_format_imports_the_same_tracks).
+TOOL_CAMERAS = {"swing": {"fps": 3000.0, "m_per_px": 0.00074}, "spin": {"fps": 1000.0, "m_per_px": 0.00125}}
+
+
+def _tools_config(work: Path) -> dict:
+    from track_files import TOOL_NAMES, write_lab_folder
+
+    example = work / "config" / "examples"
+    write_lab_folder(work / "lab" / "trk", example / "tracked_tracks.csv", "trk", TOOL_CAMERAS)
+    tracked = yaml.safe_load((example / "tracked.yaml").read_text())["datasets"]["tracked"]["tracks"]
+    keep = ("mirror", "m_per_px_err")  # frame rates and pixel scales: from the files
+    cameras = {cam: {k: v for k, v in c.items() if k in keep} for cam, c in tracked["cameras"].items()}
+    lab = {"points": dict(TOOL_NAMES), "impacts": tracked["impacts"], "cameras": cameras, "rig": tracked["rig"]}
+    return {"tracked": {"tracks": tracked}, "trk": {"tracks": {**lab, "dir": "lab/trk"}}}
 
 
 @pytest.fixture(scope="session")
-def small_run(tmp_path_factory):
-    """One finished run of a small config, shared (through copies) by test_workflow and test_redteam_guards.
+def lab_run(tmp_path_factory):
+    """The other build of the workflow in the suite: what a lab runs beside the default, in one folder.
 
-    The package's source is copied too (tests edit it to see what reruns). Config: the
-    dataset ``small`` (36 impacts, direct noise), the paper scenario with 26 offsets and e_x
-    from ``small``, a ``flyballs`` scenario (2 exit speeds x 3 launch angles, 11 points), and a
-    2-replicate calibration study of ``small``; built with ``snakemake -c2 all studies``.
+    - dataset ``small``: 36 rendered impacts (3 ball x bat pairs, camera tracks as the default's);
+    - dataset ``maple``: the example measured dataset (config/examples/maple.yaml);
+    - scenarios: the paper's with 26 offsets and e_x from ``small``, and ``flyballs``
+      (2 exit speeds x 3 launch angles, 11 points);
+    - studies of ``small``: calibration (4 replicates in 2 batches), design (2 sizes) and,
+      on request, robustness (a grid of 2 points with drawn calibration);
+    - ``tools.yaml``: the tool-file datasets (:func:`_tools_config`), run --until fit_ex tracks_qa.
+
+    Built with ``snakemake -c2 all studies studies_on_request``, then the tool files'
+    datasets. The package's source is copied too (tests edit it to see what reruns). Tests
+    change copies of it (:func:`workflow_helpers.copy_run`), never the run itself.
     """
     from workflow_helpers import SMALL_SYNTHETIC, make_workdir, snakemake, write_config
 
     def edit(cfg):
-        cfg["datasets"] = {"small": {"synthetic": SMALL_SYNTHETIC}}
+        render = {**cfg["datasets"]["synthetic"]["render"], "tilted_fraction": 0.0}
+        small = {"synthetic": SMALL_SYNTHETIC, "render": render}
+        maple = yaml.safe_load((ROOT / "config" / "examples" / "maple.yaml").read_text())["datasets"]["maple"]
+        cfg["datasets"] = {"small": small, "maple": maple}
         paper = cfg["implications"]["scenarios"]["paper"]
         paper["sweep"]["D_in"]["num"] = 26
         paper["e_x_from_dataset"] = "small"
@@ -89,43 +159,62 @@ def small_run(tmp_path_factory):
             "launch": {"exit_speed_mph": [95, 105], "launch_deg": [15, 25, 35], "backspin_rpm": 2200},
             "flight": {"n_points": 11},
         }
-        cfg["studies"] = {
-            "calibration": {"dataset": "small", "seed": 1, "replicates": 2, "batch_size": 1, "truth_impacts": 40}
-        }
+        cfg["studies"] = LAB_STUDIES
 
-    work = make_workdir(tmp_path_factory.mktemp("small_run"), copy_package=True)
-    write_config(work, edit)
-    snakemake(work, "-c2", "all", "studies")
-    return work
+    def build(work):
+        make_workdir(work, copy_package=True)
+        write_config(work, edit)
+        snakemake(work, "-c2", "all", "studies", "studies_on_request")
+        (work / "tools.yaml").write_text(yaml.safe_dump({"datasets": _tools_config(work)}))
+        snakemake(work, "-c2", "--configfile", "tools.yaml", "--until", "fit_ex", "tracks_qa")
 
-
-@pytest.fixture(scope="session")
-def maple_run(tmp_path_factory):
-    """One finished run of the example measured dataset (config/examples/maple.yaml) beside the small
-    synthetic dataset ``tiny`` (no scenarios, no studies), shared through copies by test_byod and test_faults.
-    """
-    from workflow_helpers import TINY_SYNTHETIC, make_workdir, snakemake, write_config
-
-    def edit(cfg):
-        cfg["datasets"] = {"tiny": {"synthetic": TINY_SYNTHETIC}}
-        cfg["studies"] = {}
-        cfg["implications"]["scenarios"] = {}
-
-    work = make_workdir(tmp_path_factory.mktemp("maple_run"))
-    write_config(work, edit)
-    snakemake(work, "-c2", "--configfile", "config/examples/maple.yaml")
-    return work
+    return _shared_run(tmp_path_factory, "lab_run", build)
 
 
-#: The shared runs above: under pytest-xdist (`make test`: ``-n 2 --dist loadgroup``) every test
-#: that uses one goes to the same worker, so each run is still built once in the whole suite.
-SHARED_RUNS = {"default_run": "default_run", "default_report": "default_run", "small_run": "small_run"}
-SHARED_RUNS["maple_run"] = "maple_run"
+#: The lab run's studies (of dataset ``small``).
+LAB_STUDIES = {
+    "calibration": {"dataset": "small", "seed": 1, "replicates": 4, "batch_size": 3, "truth_impacts": 40},
+    "design": {
+        "dataset": "small",
+        "seed": 2,
+        "replicates": 2,
+        "batch_size": 4,
+        "truth_impacts": 40,
+        "sweep": {"parameter": "impacts_per_bat", "values": [5, 8]},
+    },
+    "robustness": {
+        "dataset": "small",
+        "seed": 3,
+        "on_request": True,
+        "replicates": 2,
+        "batch_size": 4,
+        "truth_impacts": 30,
+        "draw_calibration": True,
+        "sweep": {"grid": {"pixel_noise_px": [1.0, 5.0], "impacts_per_bat": [6], "contact_ms": [1.0]}},
+    },
+}
+
+
+#: The order of the test modules (``make test``: ``--dist loadscope --no-loadscope-reorder``, a
+#: module per pytest-xdist process, in this order), so that both processes stay busy and end
+#: together: the lab run's heaviest tests first (their process builds it), the default run's beside
+#: them, then unit tests while the lab run builds, then the rest of its tests.
+FIRST = (
+    "test_workflow.py",
+    "test_crate.py",
+    "test_faults.py",
+    "test_lab_numbers.py",
+    "test_settings.py",
+    "test_systematics.py",
+    "test_tracks.py",
+    "test_cli.py",
+    "test_redteam.py",
+    "test_redteam_guards.py",
+    "test_byod.py",
+)
 
 
 def pytest_collection_modifyitems(config, items):
-    """Group the tests of each shared run onto one xdist worker (a no-op without xdist)."""
-    for item in items:
-        groups = {SHARED_RUNS[f] for f in item.fixturenames if f in SHARED_RUNS}
-        if groups:
-            item.add_marker(pytest.mark.xdist_group("+".join(sorted(groups))))
+    """Order the modules: :data:`FIRST`, then the rest as collected (the same order in every process)."""
+    rank = {name: i for i, name in enumerate(FIRST)}
+    items.sort(key=lambda item: rank.get(item.path.name, len(FIRST)))

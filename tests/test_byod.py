@@ -12,11 +12,10 @@ import xarray as xr
 import yaml
 
 from ballbat.compare import read_csv
-from workflow_helpers import copy_run, planned_jobs, snakemake
+from workflow_helpers import copy_run, planned_jobs, planned_logs, snakemake
 
 pytestmark = pytest.mark.slow
 
-MAPLE = "config/examples/maple.yaml"
 BAD_CSV = """impact_id,bat,ball,v_bat_mph,v_ball_mph,theta_deg,omega_rpm
 X1,maple,baseball,75,84,10,1900
 X2,ash,baseball,75,fast,10,1900
@@ -25,9 +24,9 @@ X3,maple,baseball,-75,84,95,1900
 
 
 @pytest.fixture(scope="module")
-def run(maple_run, tmp_path_factory):
-    """A copy of the suite's run of tiny (synthetic) and maple (the example), then bad beside them with --keep-going."""
-    wd = copy_run(maple_run, tmp_path_factory.mktemp("byod") / "run")
+def run(lab_run, tmp_path_factory):
+    """A copy of the suite's lab run (small, synthetic; maple, the example), then bad beside them (--keep-going)."""
+    wd = copy_run(lab_run, tmp_path_factory.mktemp("byod") / "run")
     (wd / "bad.csv").write_text(BAD_CSV)
     (wd / "bad.yaml").write_text(
         yaml.safe_dump({"datasets": {"bad": {"impacts": "bad.csv", "bats": "config/examples/maple_bats.csv"}}})
@@ -35,15 +34,15 @@ def run(maple_run, tmp_path_factory):
     front = wd / "results" / "report" / "front.rst"
     assert front.is_file()
     front.unlink()  # so that the run with bad would have to make it
-    for name in ("tiny", "maple"):  # and the good datasets' fits and tables, which it must make all the same
-        for product in ("fit_ex.nc", "paper_comparison.csv"):
-            (wd / "results" / name / product).unlink()
-    proc = snakemake(wd, "-c2", "--keep-going", "--configfile", MAPLE, "bad.yaml", check=False)
+    (
+        wd / "results" / "maple" / "paper_comparison.csv"
+    ).unlink()  # and a good dataset's, which it must make all the same
+    proc = snakemake(wd, "-c2", "--keep-going", "--configfile", "bad.yaml", check=False)
     # the report's front page covers every dataset of a config, so the failed run made none: the good
-    # config's (tiny and maple) is its only job left
+    # config's (small and maple) is its only job left
     assert not front.exists()
-    assert planned_jobs(wd, "--configfile", MAPLE) == {"report_front": 1}
-    snakemake(wd, "-c2", "--configfile", MAPLE)
+    assert planned_jobs(wd) == {"report_front": 1}
+    snakemake(wd, "-c2")
     return wd, proc
 
 
@@ -70,8 +69,7 @@ def test_example_dataset_end_to_end(run):
 def test_bad_dataset_stops_only_itself(run):
     wd, proc = run
     assert proc.returncode != 0
-    for name in ("tiny", "maple"):  # remade by the run that failed on bad (the fixture removed them)
-        assert (wd / "results" / name / "paper_comparison.csv").is_file(), name
+    assert (wd / "results" / "maple" / "paper_comparison.csv").is_file()  # remade by the run that failed on bad
     bad = wd / "results" / "bad"
     assert sorted(p.name for p in bad.iterdir() if p.is_file()) == []  # no partial files
     assert not list(bad.rglob("*.nc")) and not list(bad.rglob("*.tmp"))
@@ -101,43 +99,50 @@ def _restoring(path, new_text):
     return Ctx()
 
 
-def _one_dataset(jobs):
-    """Every planned job once: the jobs of a single dataset."""
-    assert jobs and all(n == 1 for n in jobs.values()), jobs
-    return set(jobs)
+def _one_dataset(wd, name):
+    """The rules of the planned jobs, all of dataset ``name`` (or of what follows every dataset:
+    the scenarios that use its fits, the report's front page): no other dataset's job is planned.
+    """
+    logs = planned_logs(wd)
+    assert logs, "nothing planned"
+    others = {
+        log for log in logs if not log.startswith((f"results/{name}/", "results/implications/", "results/report/"))
+    }
+    assert not others, others
+    return {rule for log, rule in logs.items() if log.startswith(f"results/{name}/")}
 
 
 def test_replacing_a_file_reruns_only_its_dataset(run):
     wd, _ = run
-    assert planned_jobs(wd, "--configfile", MAPLE) == {}
+    assert planned_jobs(wd) == {}
     path = wd / "config" / "examples" / "maple_impacts.csv"
     text = path.read_text()
     with _restoring(path, text.replace("MP01,maple,baseball,68.7", "MP01,maple,baseball,68.9")):
-        jobs = _one_dataset(planned_jobs(wd, "--configfile", MAPLE))
+        jobs = _one_dataset(wd, "maple")
     assert {"ingest", "normalize", "reconstruct", "fit_ex", "compare"} <= jobs and "simulate" not in jobs
-    assert planned_jobs(wd, "--configfile", MAPLE) == {}
+    assert planned_jobs(wd) == {}
 
 
 def test_changing_a_bat_reruns_only_what_uses_its_table(run):
     wd, _ = run
     own = wd / "config" / "examples" / "maple_bats.csv"
     with _restoring(own, own.read_text().replace(",9.6,", ",9.9,")):
-        jobs = _one_dataset(planned_jobs(wd, "--configfile", MAPLE))
+        jobs = _one_dataset(wd, "maple")
     assert {"ingest", "reconstruct", "fit_ex"} <= jobs and "simulate" not in jobs
     shared = wd / "config" / "bats.csv"
     with _restoring(shared, shared.read_text().replace("wood,wood,29.41", "wood,wood,29.50")):
-        jobs = _one_dataset(planned_jobs(wd, "--configfile", MAPLE))
-    assert {"simulate", "reconstruct", "fit_ex"} <= jobs and "ingest" not in jobs  # maple has its own table
-    assert planned_jobs(wd, "--configfile", MAPLE) == {}
+        jobs = _one_dataset(wd, "small")  # maple has its own table
+    assert {"simulate", "reconstruct", "fit_ex"} <= jobs and "ingest" not in jobs
+    assert planned_jobs(wd) == {}
 
 
 def test_override_file_merges_and_null_drops(run):
     wd, _ = run
-    (wd / "drop.yaml").write_text("datasets:\n  tiny: null\n")
-    jobs = planned_jobs(wd, "--forceall", "--configfile", MAPLE, "drop.yaml")
-    assert "ingest" in jobs and "simulate" not in jobs
+    (wd / "drop.yaml").write_text("datasets:\n  maple: null\n")
+    jobs = planned_jobs(wd, "--forceall", "--configfile", "drop.yaml")
+    assert "simulate" in jobs and "ingest" not in jobs
     # --configfile merges mappings key by key: a dataset of the same name keeps its old keys
-    (wd / "clash.yaml").write_text("datasets:\n  tiny:\n    impacts: bad.csv\n")
+    (wd / "clash.yaml").write_text("datasets:\n  small:\n    impacts: bad.csv\n")
     out = snakemake(wd, "-n", "--configfile", "clash.yaml", check=False)
     assert out.returncode != 0
-    assert "datasets.tiny: give exactly one of synthetic, impacts, tracks, not several" in out.stdout + out.stderr
+    assert "datasets.small: give exactly one of synthetic, impacts, tracks, not several" in out.stdout + out.stderr

@@ -23,7 +23,6 @@ from workflow_helpers import copy_run, snakemake
 
 pytestmark = pytest.mark.slow
 
-MAPLE = "config/examples/maple.yaml"
 #: The targets of the reruns: the maple dataset's data files (its figures and the report's front
 #: page are not what these tests are about).
 DATA = [
@@ -48,15 +47,15 @@ def data_files(wd):
 
 
 @pytest.fixture(scope="module")
-def reference(maple_run):
-    """The maple example's files of a clean run (conftest.maple_run: maple beside a small synthetic dataset)."""
-    return data_files(maple_run)
+def reference(lab_run):
+    """The maple example's files of a clean run (conftest.lab_run: maple beside a rendered synthetic dataset)."""
+    return data_files(lab_run)
 
 
 @pytest.fixture
-def clean(maple_run, reference, tmp_path):
+def clean(lab_run, reference, tmp_path):
     """A copy of the clean run (timestamps kept) for one test to damage, with the clean run's files."""
-    wd = copy_run(maple_run, tmp_path / "wd")
+    wd = copy_run(lab_run, tmp_path / "wd")
     assert data_files(wd) == reference
     return wd, reference
 
@@ -65,7 +64,7 @@ def test_deleted_intermediate_is_rebuilt(clean):
     wd, reference = clean
     (wd / "results" / "maple" / "fit_ex.nc").unlink()
     (wd / "results" / "maple" / "normalize.nc").unlink()
-    snakemake(wd, "-c2", *DATA, "--configfile", MAPLE)
+    snakemake(wd, "-c2", *DATA)
     assert data_files(wd) == reference
 
 
@@ -76,11 +75,11 @@ def test_truncated_intermediate_is_named_and_rebuilt(clean):
     with open(path, "r+b") as fh:
         fh.truncate(path.stat().st_size // 2)
     size = path.stat().st_size
-    out = snakemake(wd, "-n", "--configfile", MAPLE)
+    out = snakemake(wd, "-n")
     assert "results/maple/reconstruct.nc: truncated" in out.stderr
     assert "rebuild it with: snakemake --forcerun results/maple/reconstruct.nc" in out.stderr
     assert path.stat().st_size == size  # a dry run removes nothing
-    snakemake(wd, "-c2", *DATA, "--configfile", MAPLE, "--forcerun", "results/maple/reconstruct.nc")
+    snakemake(wd, "-c2", *DATA, "--forcerun", "results/maple/reconstruct.nc")
     assert data_files(wd) == reference
 
 
@@ -94,7 +93,7 @@ def test_input_replaced_by_an_older_copy_reruns(clean):
         lines = original.decode().splitlines()
         src.write_text("\n".join(lines[:-1]) + "\n")  # one impact fewer
         os.utime(src, (old, old))
-        snakemake(wd, "-c2", *DATA, "--configfile", MAPLE)
+        snakemake(wd, "-c2", *DATA)
         changed = data_files(wd)
         assert changed["ingest.nc"] != reference["ingest.nc"]
         import xarray as xr
@@ -104,7 +103,7 @@ def test_input_replaced_by_an_older_copy_reruns(clean):
     finally:
         src.write_bytes(original)
         os.utime(src, (old, old))
-    snakemake(wd, "-c2", *DATA, "--configfile", MAPLE)
+    snakemake(wd, "-c2", *DATA)
     assert data_files(wd) == reference
 
 
@@ -115,7 +114,7 @@ def test_job_killed_while_writing(clean):
         p.unlink()
     env = dict(os.environ)
     proc = subprocess.Popen(
-        [sys.executable, "-m", "snakemake", "-c1", *DATA, "--configfile", MAPLE],
+        [sys.executable, "-m", "snakemake", "-c1", *DATA],
         cwd=wd,
         env=env,
         stdout=subprocess.DEVNULL,
@@ -133,7 +132,7 @@ def test_job_killed_while_writing(clean):
     stale = wd / "results" / "maple" / f".fit_ex.nc.{dead.pid}@{hostname()}.abc12345.tmp"  # its owner is dead
     stale.write_bytes(b"\x89HDF\r\n\x1a\n" + b"\0" * 4096)
     shutil.rmtree(wd / ".snakemake" / "locks", ignore_errors=True)  # the killed run's lock
-    out = snakemake(wd, "-c2", *DATA, "--configfile", MAPLE, "--rerun-incomplete")
+    out = snakemake(wd, "-c2", *DATA, "--rerun-incomplete")
     assert f"{stale}".split("/results/")[1] in out.stderr.replace(str(wd) + "/", "")
     assert not list((wd / "results").rglob("*.tmp"))
     assert data_files(wd) == reference
@@ -154,9 +153,9 @@ def test_missing_input_stops_only_its_dataset(clean, tmp_path):
             }
         )
     )
-    for product in ("fit_ex.nc", "paper_comparison.csv", "results.xlsx"):  # the good dataset has jobs to run
+    for product in ("paper_comparison.csv", "results.xlsx"):  # the good dataset has jobs to run
         (wd / "results" / "maple" / product).unlink()
-    out = snakemake(wd, "-c2", "--keep-going", "--configfile", MAPLE, "missing.yaml", check=False)
+    out = snakemake(wd, "-c2", "--keep-going", "--configfile", "missing.yaml", check=False)
     assert out.returncode != 0
     assert data_files(wd) == reference  # the good dataset is whole: its jobs ran beside the failing ones
     assert "nothere.csv: file not found" in (wd / "results" / "gone" / "logs" / "ingest.log").read_text()
@@ -176,7 +175,7 @@ def test_warnings_reach_every_product_and_the_end_of_the_run(clean, tmp_path):
     (wd / "warn.yaml").write_text(
         yaml.safe_dump({"datasets": {"warn": {"impacts": "warn.csv", "bats": "config/examples/maple_bats.csv"}}})
     )
-    out = snakemake(wd, "-c2", "--configfile", MAPLE, "warn.yaml")
+    out = snakemake(wd, "-c2", "--configfile", "warn.yaml")
     assert "warnings of this run" in out.stderr and "only v_bat_mph_err" in out.stderr
     import openpyxl
     import xarray as xr

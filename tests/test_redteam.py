@@ -478,30 +478,26 @@ def test_pip_install_outside_the_checkout(tmp_path):
 
 
 @pytest.mark.slow
-def test_missing_tracks_file_stops_only_its_dataset(tmp_path):
-    from workflow_helpers import make_workdir, snakemake
+def test_missing_tracks_file_stops_only_its_dataset(lab_run, tmp_path):
+    from workflow_helpers import copy_run, snakemake
 
-    wd = make_workdir(tmp_path)
-    cfg = yaml.safe_load((wd / "config" / "config.yaml").read_text())
-    cfg["datasets"] = {"synthetic": None}
-    cfg["implications"]["scenarios"] = {}
-    (wd / "config" / "config.yaml").write_text(yaml.safe_dump(cfg))
-    tracked = yaml.safe_load((ROOT / "config" / "examples" / "tracked.yaml").read_text())
-    tracked["datasets"]["tracked"]["tracks"]["file"] = "nothere_tracks.csv"
-    (wd / "gone.yaml").write_text(yaml.safe_dump(tracked))
-    dry = snakemake(wd, "-n", "--configfile", "config/examples/maple.yaml", "gone.yaml", check=False)
+    wd = copy_run(lab_run, tmp_path / "wd")
+    (wd / "results" / "maple" / "ingest.nc").unlink()  # the good dataset has a job to run
+    tracked = yaml.safe_load((ROOT / "config" / "examples" / "tracked.yaml").read_text())["datasets"]["tracked"]
+    tracked["tracks"]["file"] = "nothere_tracks.csv"
+    (wd / "gone.yaml").write_text(yaml.safe_dump({"datasets": {"gone": tracked}}))
+    dry = snakemake(wd, "-n", "--configfile", "gone.yaml", check=False)
     assert dry.returncode == 0 and "MissingInputException" not in dry.stderr, dry.stderr[-2000:]
     out = snakemake(
         wd,
         "-c1",
         "--keep-going",
-        "results/tracked/reduce.nc",
+        "results/gone/reduce.nc",
         "results/maple/ingest.nc",
         "--configfile",
-        "config/examples/maple.yaml",
         "gone.yaml",
         check=False,
     )
     assert out.returncode != 0
-    assert "nothere_tracks.csv: file not found" in (wd / "results" / "tracked" / "logs" / "reduce.log").read_text()
+    assert "nothere_tracks.csv: file not found" in (wd / "results" / "gone" / "logs" / "reduce.log").read_text()
     assert (wd / "results" / "maple" / "ingest.nc").is_file()  # the other dataset went on

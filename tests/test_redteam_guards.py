@@ -2,7 +2,7 @@
 
 :data:`RED_TEAM` lists each case with its expected outcome and the tests that hold it (each
 fails on the code before issue 19 and passes now). The workflow is built once for the suite
-(``conftest.small_run``: a small synthetic dataset, the paper scenario and a 2-replicate study);
+(``conftest.lab_run``: a small rendered dataset, the measured example, the scenarios and small studies);
 each workflow test works on its own copy of that finished folder.
 """
 
@@ -238,9 +238,9 @@ def test_a_job_removes_only_what_the_workflow_wrote(tmp_path, monkeypatch):
 
 
 @pytest.fixture(scope="session")
-def finished(small_run):
-    """One finished run: a small synthetic dataset, the paper scenario, a 2-replicate study (conftest.small_run)."""
-    return small_run
+def finished(lab_run):
+    """One finished run: datasets small and maple, the scenarios, small studies (conftest.lab_run)."""
+    return lab_run
 
 
 @pytest.fixture
@@ -378,7 +378,7 @@ def test_mid_file_corruption_is_found_and_rebuilt(run):
     assert "removed (this workflow wrote it): run again to rebuild it" in log
     assert "HDF" not in log
     assert not path.exists()
-    snakemake(run, "-c2")
+    snakemake(run, "-c2", "results/small/fit_ex.nc")
     assert_same_state(nc_state(run), before)
 
 

@@ -203,28 +203,22 @@ def test_replicates_cover_the_truth(config, balls, bats):
 
 
 @pytest.mark.slow
-def test_study_rules_through_snakemake(tmp_path):
-    """`snakemake studies`: batches, coverage and design files with units and provenance; `all` runs none."""
-    from workflow_helpers import assert_cf, assert_not_blank, make_workdir, planned_jobs, snakemake
+def test_study_rules_through_snakemake(lab_run, tmp_path):
+    """`snakemake studies` (the lab run's, conftest.LAB_STUDIES, of dataset small): batches, coverage and
+    design files with units and provenance; `all` runs none; the report holds every study's figures.
+    """
+    from workflow_helpers import assert_cf, assert_not_blank, copy_run, make_workdir, planned_jobs, snakemake
 
-    wd = make_workdir(tmp_path)
-    small = wd / "small.yaml"
-    small.write_text(
-        "studies:\n"
-        "  calibration: {replicates: 4, batch_size: 3, truth_impacts: 60}\n"
-        "  design: {replicates: 3, batch_size: 6, truth_impacts: 60,"
-        " sweep: {parameter: impacts_per_bat, values: [5, 8]}}\n"
-    )
-    assert not any(r.startswith("study") for r in planned_jobs(wd))  # a default run makes no study
-    snakemake(wd, "-c2", "studies", "--configfile", str(small))
-    res = wd / "results" / "studies"
+    assert not any(r.startswith("study") for r in planned_jobs(make_workdir(tmp_path)))  # a default run makes no study
+    res = lab_run / "results" / "studies"
     assert sorted(p.name for p in (res / "calibration" / "batches").iterdir()) == ["batch0.nc", "batch1.nc"]
     cov = xr.open_dataset(res / "calibration" / "coverage.nc")
-    assert cov.sizes == {"point": 1, "quantity": 21}
+    n_q = 3 + 2 * 7  # small: e_x of 3 bats; per ball, pooled e_x, 3 slopes, e_y, the mu_k bound, eta^2
+    assert cov.sizes == {"point": 1, "quantity": n_q}
     assert all("units" in cov[v].attrs or cov[v].attrs.get("units_from") == "units" for v in cov.data_vars)
     assert cov.attrs["provenance_rule"] == "study_aggregate"
     truth = xr.open_dataset(res / "calibration" / "truth.nc")
-    assert truth.attrs["provenance_rule"] == "study_truth" and truth.attrs["truth_impacts"] == 60
+    assert truth.attrs["provenance_rule"] == "study_truth" and truth.attrs["truth_impacts"] == 40
     assert set(truth.quantity.values) == set(cov.quantity.values)
     judged = cov.quantity.values[cov.quantity_name.values != "mu_k_lower_bound"]  # the others: the design's truth
     assert np.allclose(
@@ -232,25 +226,32 @@ def test_study_rules_through_snakemake(tmp_path):
     )
     assert int(cov.n_replicates.max()) == 4
     rows = list(csv.DictReader(io.StringIO(read_table_csv(res / "calibration" / "coverage.csv"))))
-    assert len(rows) == 21 and set(rows[0]) == set(studies.COVERAGE_COLUMNS)
+    assert len(rows) == n_q and set(rows[0]) == set(studies.COVERAGE_COLUMNS)
     design = list(csv.DictReader(io.StringIO(read_table_csv(res / "design" / "design.csv"))))
-    assert [r["setting"] for r in design] == ["5"] * 7 + ["8"] * 7
+    per_size = len(design) // 2
+    assert per_size >= 3 and [r["setting"] for r in design] == ["5"] * per_size + ["8"] * per_size
     assert all(float(r["impacts_required"]) >= 3 for r in design)
     for png in ("calibration/coverage.png", "design/coverage.png", "design/design.png"):
         assert_not_blank(res / png)
-    assert_cf(sorted(str(p) for p in res.rglob("*.nc")), tmp_path / "cf.json")
+    one_per_rule = ["calibration/truth/point0.nc", "calibration/truth.nc", "calibration/batches/batch0.nc"]
+    one_per_rule += ["calibration/coverage.nc", "design/design.nc", "robustness/coverage.nc"]  # a grid's columns
+    assert_cf([str(res / f) for f in one_per_rule], tmp_path / "cf.json")
     # the report's front page: one line per study (rule report_front_studies), shown when the report holds them
     front = (res / "front.rst").read_text()
-    assert "**calibration** (4 replicates per point, 21 quantities): 95 % intervals cover the truth in" in front
-    assert "**design** (3 replicates per point" in front and "impacts per bat to tell two bats" in front
-    snakemake(wd, "--report", "results/report.html", "studies", "--configfile", str(small))
+    assert f"**calibration** (4 replicates per point, {n_q} quantities): 95 % intervals cover the truth in" in front
+    assert "**design** (2 replicates per point" in front and "impacts per bat to tell two bats" in front
+    wd = copy_run(lab_run, tmp_path / "wd")
+    snakemake(wd, "--report", "results/report.html", "studies", "studies_on_request")
     html = (wd / "results" / "report.html").read_text()
-    assert "Replicate studies" in html and "What was run" not in html  # no dataset ran: no run's front page
-    # replicates are the same experiments whatever the batch size
-    b = xr.concat([xr.open_dataset(res / "calibration" / "batches" / f"batch{i}.nc") for i in (0, 1)], "replicate")
-    small.write_text(small.read_text().replace("batch_size: 3", "batch_size: 4"))
-    snakemake(wd, "-c2", "studies", "--configfile", str(small))
-    one = xr.open_dataset(res / "calibration" / "batches" / "batch0.nc")
+    assert "Replicate studies" in html and "What was run" not in html  # no dataset's target: no run's front page
+    assert "grid.png" in html and "Grid study" in html
+
+
+def test_replicates_do_not_depend_on_the_batch_size(config, balls, bats):
+    """Replicate k is the same experiment whether it runs in batch 0 of 4 or batch 1 of 3."""
+    three = settings(config, replicates=4, batch_size=3, truth_impacts=60)
+    b = xr.concat([study_batch.run(three, i, balls, bats) for i in (0, 1)], "replicate")
+    one = study_batch.run(settings(config, replicates=4, batch_size=4, truth_impacts=60), 0, balls, bats)
     np.testing.assert_array_equal(one.value.values, b.value.values)
 
 

@@ -399,57 +399,73 @@ def test_cli_import_tracks(tmp_path, rows):
 
 
 @pytest.mark.slow
-def test_tool_files_run_end_to_end_with_the_long_csvs_e_x(tmp_path):
-    """A Tracker project (.trk, and the same in .trz), a Kinovea file (.kva) and its CSV export, each a
-    folder of one file per impact and camera, run through snakemake and give the long CSV's e_x.
+def test_tool_files_run_end_to_end_with_the_long_csvs_e_x(lab_run):
+    """A folder of Tracker projects (.trk, one file per impact and camera) runs through snakemake (the
+    lab run's tools.yaml, conftest.lab_run) and gives the long CSV's e_x (every other format reads the
+    same tracks: :func:`test_every_format_imports_the_same_tracks`).
     """
     import xarray as xr
 
-    from workflow_helpers import make_workdir, snakemake
-
-    work = make_workdir(tmp_path)
-    for fmt in ("trk", "trz", "kva", "kinovea_csv"):
-        write_lab_folder(work / "lab" / fmt, EXAMPLE / "tracked_tracks.csv", fmt, CAMS)
-    rig = {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0}
-    impacts = "config/examples/tracked_impacts.csv"
-    mirrors = {"swing": {"mirror": False, "m_per_px_err": 0.005}, "spin": {"mirror": True}}
-    full = {c: {**mirrors[c], **CAMS[c]} for c in CAMS}
-    lab = {"points": POINTS, "impacts": impacts, "cameras": mirrors, "rig": rig}
-    datasets = {
-        "synthetic": None,
-        "ref": {
-            "tracks": {"file": "config/examples/tracked_tracks.csv", "impacts": impacts, "cameras": full, "rig": rig}
-        },
-        "trk": {"tracks": {**lab, "dir": "lab/trk"}},
-        "trz": {"tracks": {**lab, "dir": "lab/trz", "cameras": {**mirrors, "spin": {"mirror": True, "fps": 1000}}}},
-        "kva": {"tracks": {**lab, "dir": "lab/kva"}},
-        "kcsv": {
-            "tracks": {
-                **lab,
-                "dir": "lab/kinovea_csv",
-                "format": "kinovea_table",
-                "cameras": full,
-                "units": {"time": "ms", "length": "cm", "y": "up"},
-            }
-        },
-    }
-    (work / "lab.yaml").write_text(yaml.safe_dump({"datasets": datasets}))
-    snakemake(work, "-c2", "--configfile", "lab.yaml", "--until", "fit_ex", "tracks_qa")
-    ref = xr.open_dataset(work / "results" / "ref" / "fit_ex.nc")
-    ref_flags = xr.open_dataset(work / "results" / "ref" / "reduce.nc")["ingest_flag"].values
+    res = lab_run / "results"
+    ref = xr.open_dataset(res / "tracked" / "fit_ex.nc")
+    ref_flags = xr.open_dataset(res / "tracked" / "reduce.nc")["ingest_flag"].values
     assert np.isfinite(ref["e_x"].values).all()
-    for name, tol in (("trk", 1e-12), ("trz", 1e-12), ("kva", 1e-6), ("kcsv", 1e-6)):
-        got = xr.open_dataset(work / "results" / name / "fit_ex.nc")
+    for name, tol in (("trk", 1e-12),):
+        got = xr.open_dataset(res / name / "fit_ex.nc")
         np.testing.assert_allclose(got["e_x"].values, ref["e_x"].values, rtol=0, atol=tol, err_msg=name)
         np.testing.assert_allclose(got["e_x_err"].values, ref["e_x_err"].values, rtol=1e-6, err_msg=name)
-        flags = xr.open_dataset(work / "results" / name / "reduce.nc")["ingest_flag"].values
+        flags = xr.open_dataset(res / name / "reduce.nc")["ingest_flag"].values
         np.testing.assert_array_equal(flags, ref_flags)  # the same impact excluded (tilted spin axis)
-        assert (work / "results" / name / "figures" / "tracks_impacts.png").is_file()
-        found = yaml.safe_load((work / "results" / name / "imported_cameras.yaml").read_text())
+        assert (res / name / "figures" / "tracks_impacts.png").is_file()
+        found = yaml.safe_load((res / name / "imported_cameras.yaml").read_text())
         assert found["cameras"]["swing"]["fps"] == pytest.approx(3000.0)
         assert found["cameras"]["spin"]["m_per_px"] == pytest.approx(0.00125, rel=1e-6)
-        want = "config" if name == "kcsv" else "12 file(s)"  # a table holds no frame rate; the tools' files do
-        assert found["cameras"]["swing"]["fps_from"].startswith(want)
+        assert found["cameras"]["swing"]["fps_from"].startswith("12 file(s)")
+
+
+@pytest.mark.parametrize("fmt, tol", [("trz", 0.0), ("kva", 1e-6), ("kinovea_csv", 1e-6)])
+def test_every_format_imports_the_same_tracks(tmp_path, fmt, tol):
+    """A folder of each tool's files gives the tracks of the same folder of .trk files (the workflow's
+    import_tracks: :func:`import_block`), frames equal and pixels within the format's rounding.
+    """
+    from ballbat.tracks.data import to_long
+
+    def imported(f):
+        cfg = {
+            "dir": str(write_lab_folder(tmp_path / f, EXAMPLE / "tracked_tracks.csv", f, CAMS)),
+            "points": POINTS,
+            "impacts": str(EXAMPLE / "tracked_impacts.csv"),
+            "cameras": {"swing": {"mirror": False}, "spin": {"mirror": True}},
+            "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
+        }
+        if f == "kinovea_csv":
+            cfg.update(format="kinovea_table", cameras={c: {**cfg["cameras"][c], **CAMS[c]} for c in CAMS})
+            cfg["units"] = TABLE_UNITS
+        tracks, imp = import_block(checked_block(cfg, "tracks"), f"datasets.{f}.tracks")
+        found = imp.settings_yaml()["cameras"]["swing"]
+        assert found["fps"] == pytest.approx(3000.0)  # a table holds no frame rate; the tools' projects do
+        assert found["fps_from"].startswith("config" if f == "kinovea_csv" else "12 file(s)"), found
+        return to_long(tracks)
+
+    def relative(rows):
+        """Frames and pixels from each clip's first mark (a table's time and origin are its own)."""
+        clip = np.char.add(rows["impact_id"].astype(str), rows["camera"].astype(str))
+        out = {k: np.asarray(v) for k, v in rows.items()}
+        for c in np.unique(clip):
+            at = clip == c
+            first = np.flatnonzero(at)[np.argmin(out["frame"][at])]
+            for col in ("x_px", "y_px"):
+                out[col] = np.where(at, out[col] - out[col][first], out[col])
+            out["frame"] = np.where(at, out["frame"] - out["frame"][first], out["frame"])
+        return out
+
+    want, got = imported("trk"), imported(fmt)
+    if fmt == "kinovea_csv":
+        want, got = relative(want), relative(got)
+    for col in ("impact_id", "camera", "point", "frame"):
+        np.testing.assert_array_equal(got[col], want[col], err_msg=col)
+    for col in ("x_px", "y_px"):
+        np.testing.assert_allclose(got[col], want[col], rtol=0, atol=tol, err_msg=col)
 
 
 def test_check_tracks_reads_a_folder_of_tool_files_as_the_workflow_does(tmp_path):

@@ -22,20 +22,12 @@ def make_workdir(tmp: Path, copy_package: bool = False) -> Path:
     return tmp
 
 
-#: A small synthetic dataset (direct noise, no camera tracks): 36 impacts on three ball x bat pairs.
+#: A small synthetic experiment: 36 impacts on three ball x bat pairs (conftest.lab_run renders its tracks).
 SMALL_SYNTHETIC = {
     "seed": 7,
     "impacts": {"baseball": {"wood": 12, "metal_rough": 12}, "softball": {"softball_composite": 12}},
     "e_x": {"baseball": {"wood": 0.464, "metal_rough": 0.356}, "softball": {"softball_composite": 0.128}},
     "e_y": {"baseball": 0.45, "softball": 0.32},
-}
-
-#: A smaller one beside the example measured dataset (config/examples/maple.yaml).
-TINY_SYNTHETIC = {
-    "seed": 3,
-    "impacts": {"baseball": {"wood": 8}},
-    "e_x": {"baseball": {"wood": 0.464}},
-    "e_y": {"baseball": 0.45},
 }
 
 
@@ -46,7 +38,7 @@ def write_config(workdir: Path, edit) -> None:
     path = workdir / "config" / "config.yaml"
     cfg = yaml.safe_load(path.read_text())
     edit(cfg)
-    path.write_text(yaml.safe_dump(cfg))
+    path.write_text(yaml.safe_dump(cfg, sort_keys=False))
 
 
 def copy_run(finished: Path, dest: Path) -> Path:
@@ -89,8 +81,8 @@ def assert_not_blank(png, min_colors: int = 6) -> None:
     assert img.std() > 10, png
 
 
-def planned_jobs(workdir: Path, *args: str) -> dict[str, int]:
-    """Rule -> job count of what a run would do (empty when nothing is to be done).
+def planned_logs(workdir: Path, *args: str) -> dict[str, str]:
+    """Log file -> rule of every job a run would do (empty when nothing is to be done).
 
     Reads Snakemake's machine-readable ``--summary`` table (tab-separated: output file, date,
     rule, log file(s), status, plan): a job is one (rule, log file) pair with an output whose
@@ -100,12 +92,20 @@ def planned_jobs(workdir: Path, *args: str) -> dict[str, int]:
     lines = out.stdout.splitlines()
     header = lines[0].split("\t")
     col = {name: header.index(name) for name in ("rule", "log-file(s)", "plan")}
-    jobs: dict[str, set[str]] = {}
+    jobs: dict[str, str] = {}
     for line in lines[1:]:
         cells = line.split("\t")
         if len(cells) == len(header) and cells[col["plan"]] == "update pending":
-            jobs.setdefault(cells[col["rule"]], set()).add(cells[col["log-file(s)"]])
-    return {rule: len(logs) for rule, logs in jobs.items()}
+            jobs[cells[col["log-file(s)"]]] = cells[col["rule"]]
+    return jobs
+
+
+def planned_jobs(workdir: Path, *args: str) -> dict[str, int]:
+    """Rule -> job count of what a run would do (empty when nothing is to be done): :func:`planned_logs`."""
+    counts: dict[str, int] = {}
+    for rule in planned_logs(workdir, *args).values():
+        counts[rule] = counts.get(rule, 0) + 1
+    return counts
 
 
 def assert_cf(files: list[str], report: Path) -> None:

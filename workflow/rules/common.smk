@@ -297,14 +297,14 @@ wildcard_constraints:
 
 
 def study_settings(name):
-    from ballbat.studies import StudySettings
+    from ballbat.study_settings import StudySettings
 
     return StudySettings.from_config(config, name)
 
 
 def get_study_config(wildcards):
     """Everything a study's results depend on: its settings, its dataset's and the chain's (StudySettings.from_block)."""
-    from ballbat.studies import study_block
+    from ballbat.study_settings import study_block
 
     return study_block(config, wildcards.study)
 
