@@ -50,19 +50,65 @@ def copy_run(finished: Path, dest: Path) -> Path:
     return dest
 
 
+#: Snakemake's own modules, imported once per test process by a fork server: every run of
+#: :func:`snakemake` is a child forked from it (the real ``snakemake`` command line, ``main``),
+#: so that the suite's many short runs do not each pay the interpreter's start and Snakemake's
+#: imports. Nothing of ballbat is preloaded: each run imports it afresh (from ``workdir/src``
+#: when the run has its own copy), as ``python -m snakemake`` does.
+PRELOAD = ["snakemake.cli", "snakemake.api", "snakemake.workflow", "snakemake.persistence", "snakemake.dag"]
+_CONTEXT = None
+
+
+def _context():
+    global _CONTEXT
+    if _CONTEXT is None:
+        import multiprocessing
+
+        _CONTEXT = multiprocessing.get_context("forkserver")
+        _CONTEXT.set_forkserver_preload(PRELOAD)
+    return _CONTEXT
+
+
+def _snakemake_main(workdir: str, args: list[str], env: dict, out: str, err: str) -> None:
+    """The child: ``python -m snakemake ARGS`` in ``workdir`` with ``env``, its output in two files."""
+    os.chdir(workdir)
+    os.environ.clear()
+    os.environ.update(env)
+    sys.path[:0] = [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
+    for fd, path in ((1, out), (2, err)):
+        handle = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
+        os.dup2(handle, fd)
+        os.close(handle)
+    sys.stdout = open(1, "w", closefd=False)  # the child's own streams, left open for its exit
+    sys.stderr = open(2, "w", closefd=False)
+    sys.argv = ["snakemake", *args]
+    from snakemake.cli import main
+
+    main()
+
+
 def snakemake(workdir: Path, *args: str, check: bool = True, timeout: int = 600) -> subprocess.CompletedProcess:
-    """Run ``python -m snakemake`` in ``workdir`` (with workdir/src first on the path if present)."""
+    """Run ``python -m snakemake ARGS`` in ``workdir`` (with workdir/src first on the path if present).
+
+    The run is a child of a fork server that has Snakemake imported (:data:`PRELOAD`); its exit
+    status, standard output and standard error come back as those of a subprocess.
+    """
+    import tempfile
+
     env = dict(os.environ)
     if (workdir / "src").is_dir():
         env["PYTHONPATH"] = os.pathsep.join([str(workdir / "src"), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
-    proc = subprocess.run(
-        [sys.executable, "-m", "snakemake", *args],
-        cwd=workdir,
-        env=env,
-        capture_output=True,
-        text=True,
-        timeout=timeout,
-    )
+    with tempfile.TemporaryDirectory() as tmp:
+        out, err = os.path.join(tmp, "stdout"), os.path.join(tmp, "stderr")
+        child = _context().Process(target=_snakemake_main, args=(str(workdir), list(args), env, out, err))
+        child.start()
+        child.join(timeout)
+        if child.exitcode is None:
+            child.kill()
+            child.join()
+            raise subprocess.TimeoutExpired(["snakemake", *args], timeout)
+        with open(out) as fh_out, open(err) as fh_err:
+            proc = subprocess.CompletedProcess(["snakemake", *args], child.exitcode, fh_out.read(), fh_err.read())
     if check and proc.returncode != 0:
         raise AssertionError(f"snakemake {' '.join(args)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
     return proc
