@@ -62,22 +62,19 @@ def _shared_run(tmp_path_factory, name: str, build) -> Path:
     if os.environ.get("PYTEST_XDIST_WORKER"):
         base = base.parent  # shared by the session's workers
     work, done, failed = base / name, base / f"{name}.built", base / f"{name}.failed"
-    with open(base / f"{name}.lock", "w") as lock:
+    with open(base / f"{name}.lock", "w") as lock:  # closing the file releases the lock
         fcntl.flock(lock, fcntl.LOCK_EX)
-        try:
-            if failed.exists():
-                raise RuntimeError(f"the shared run {name} failed to build:\n{failed.read_text()}")
-            if not done.exists():
-                shutil.rmtree(work, ignore_errors=True)
-                work.mkdir()
-                try:
-                    build(work)
-                except BaseException as exc:
-                    failed.write_text(str(exc))
-                    raise
-                done.touch()
-        finally:
-            fcntl.flock(lock, fcntl.LOCK_UN)
+        if failed.exists():
+            raise RuntimeError(f"the shared run {name} failed to build:\n{failed.read_text()}")
+        if not done.exists():
+            shutil.rmtree(work, ignore_errors=True)
+            work.mkdir()
+            try:
+                build(work)
+            except BaseException as exc:
+                failed.write_text(str(exc))
+                raise
+            done.touch()
     return work
 
 

@@ -148,10 +148,9 @@ def planned_logs(workdir: Path, *args: str) -> dict[str, str]:
 
 def planned_jobs(workdir: Path, *args: str) -> dict[str, int]:
     """Rule -> job count of what a run would do (empty when nothing is to be done): :func:`planned_logs`."""
-    counts: dict[str, int] = {}
-    for rule in planned_logs(workdir, *args).values():
-        counts[rule] = counts.get(rule, 0) + 1
-    return counts
+    from collections import Counter
+
+    return dict(Counter(planned_logs(workdir, *args).values()))
 
 
 def assert_cf(files: list[str], report: Path) -> None:

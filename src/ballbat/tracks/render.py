@@ -259,7 +259,7 @@ def _observed(pts: dict, points: tuple, cam, t: np.ndarray, rng) -> tuple[dict, 
     Whether a point is in view is a matter of where it is, not of the tracking's error: a
     point is kept or lost by its true position. (Deciding on the noisy position kept, near
     the edge of the view, the frames whose error pointed inwards, and so slowed the ball's
-    and the tip's fitted speeds by about 0.1 of their standard error at 5 px.)
+    fitted speed by about 0.1 of its standard error at 5 px: docs/tracks.md.)
     """
     xs, ys = {}, {}
     for p in points:
