@@ -323,8 +323,13 @@ def test_a_replicate_and_the_workflow_reduce_alike(config, balls, bats, root, tm
     assert set(replicate.data_vars) == set(workflow.data_vars) - calibration
     for name in replicate.data_vars:
         a, b = replicate[name].values, workflow[name].values
-        if a.dtype.kind == "f":  # the workflow's tracks make a round trip through tracks.nc
-            np.testing.assert_allclose(a, b, rtol=1e-12, atol=0, err_msg=f"{edit}: {name}")
+        if a.dtype.kind == "f":
+            # the workflow's tracks make a round trip through tracks.nc, which keeps fewer empty
+            # columns: the sums' rounding differs in the last bit, and the contact prior's
+            # Nelder-Mead optimum (tolerance 1e-3 in its parameters) can carry it to about 1e-8
+            # (relative) in the contact time and 1e-11 in v_bat; a setting honoured differently
+            # moves them by far more
+            np.testing.assert_allclose(a, b, rtol=1e-7, atol=0, err_msg=f"{edit}: {name}")
         else:
             np.testing.assert_array_equal(a, b, err_msg=f"{edit}: {name}")
     usable = int((workflow["ingest_flag"].values == 0).sum())

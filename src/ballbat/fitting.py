@@ -47,6 +47,7 @@ from .systematics import has_shifts
 
 if TYPE_CHECKING:
     import xarray as xr
+    from numpy.typing import ArrayLike
 
 
 class FitStatus(enum.IntEnum):
@@ -308,6 +309,36 @@ def implied_e_y(
     return float(e_y), float((1.0 + e_y) * np.sqrt(var))
 
 
+#: Points of the grid on which :func:`largest_value` integrates the distribution of the largest value.
+LARGEST_GRID = 4001
+
+
+def largest_value(y: ArrayLike, sigma: ArrayLike) -> float:
+    """The largest of several true values from their measurements ``y +- sigma`` (independent, normal).
+
+    The largest measurement is biased high: among impacts whose values are close, the one
+    whose error happened to point up is the one picked (by +0.5 of its standard uncertainty
+    at 5 px and 60 impacts per bat). The bias is estimated as the parametric bootstrap
+    estimates it, exactly rather than by resampling: the largest of ``y_i + sigma_i z_i`` has
+    the distribution function prod_i Phi((m - y_i) / sigma_i), whose mean exceeds max(y) by
+    about what max(y) exceeds the largest true value. Returns max(y) minus that excess (NaN
+    measurements left out; max(y) where no uncertainty is finite).
+    """
+    from scipy.special import log_ndtr
+
+    y, sigma = np.asarray(y, dtype=float), np.asarray(sigma, dtype=float)
+    ok = np.isfinite(y) & np.isfinite(sigma) & (sigma > 0)
+    if not ok.any():
+        return float(np.nanmax(y)) if np.isfinite(y).any() else np.nan
+    y, sigma = y[ok], sigma[ok]
+    top = float(np.max(y))
+    m = np.linspace(top - 10 * sigma.max(), float(np.max(y + 10 * sigma)), LARGEST_GRID)
+    cdf = np.exp(np.sum(log_ndtr((m[:, None] - y[None, :]) / sigma[None, :]), axis=1))
+    # E[max] = m_0 + integral of (1 - F) from m_0 (F(m_0) = 0 to double precision)
+    mean = float(m[0] + np.trapezoid(1.0 - cdf, m))
+    return 2 * top - mean
+
+
 def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True) -> Sec4:
     """Sec. IV analysis of a normalised and reconstructed dataset (output of ``reconstruct``).
 
@@ -360,10 +391,14 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
         a = float(np.mean(alpha))
         e_y, e_y_err = implied_e_y(ds, in_ball, res, i, (x, y, jx, jy, sig), rfit)
         pb["e_y_implied"][i], pb["e_y_implied_err"][i] = e_y, e_y_err
-        # Eq. muk: the largest measured tan(psi - theta) bounds mu_k from below.
+        # Eq. muk: the largest true tan(psi - theta) bounds mu_k from below
         k = int(np.nanargmax(y))
-        pb["mu_k_lower_bound"][i] = float(y[k])
-        pb["mu_k_lower_bound_err"][i] = float(np.sqrt(np.sum(jy[k] ** 2 * sig[k] ** 2))) if sig is not None else np.nan
+        if sig is not None:
+            sy = np.sqrt(np.sum(jy**2 * sig**2, axis=1))
+            pb["mu_k_lower_bound"][i] = largest_value(y, sy)  # corrected for picking the largest
+            pb["mu_k_lower_bound_err"][i] = float(sy[k])
+        else:
+            pb["mu_k_lower_bound"][i] = float(y[k])
         pb["mu_k_lower_bound_impact"][i] = int(ds["impact"].values[in_ball][k])
         psi_g, theta_g, omega_g = gross_slip_onset(
             mu_k_example, rfit.slope, v_ref, exf.slope - 1.0, float(np.mean(r)), float(np.mean(r_x)), a
