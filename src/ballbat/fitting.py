@@ -314,7 +314,7 @@ LARGEST_GRID = 4001
 
 
 def largest_value(y: ArrayLike, sigma: ArrayLike) -> float:
-    """The largest of several true values from their measurements ``y +- sigma`` (independent, normal).
+    """Estimate the largest of several true values from their measurements ``y +- sigma`` (independent, normal).
 
     The largest measurement is biased high: among impacts whose values are close, the one
     whose error happened to point up is the one picked (by +0.5 of its standard uncertainty
