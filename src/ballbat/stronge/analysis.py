@@ -20,13 +20,14 @@ References
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 import xarray as xr
 from numpy.typing import NDArray
 
 from ..designs import Measured, measured_sigma, vtf_design
+from ..kinematics import psi_partials
 from ..linefit import effective_sigma, wls_slope
 from ..published import STRONGE_E_Y, STRONGE_MU, per_ball
 from .fit import Eta2Fit, fit_eta2
@@ -40,6 +41,7 @@ __all__ = [
     "History",
     "ModelCurves",
     "VtfData",
+    "VtfNoise",
     "analyse_ball",
     "boundaries",
     "fit_ball",
@@ -85,6 +87,21 @@ class VtfData:
     r_y: NDArray[np.float64]
     alpha: NDArray[np.float64]
     bat: NDArray[np.str_]
+    noise: VtfNoise | None = None
+
+
+@dataclass(frozen=True)
+class VtfNoise:
+    """How each impact's measurement noise enters the Eq. vtf data (the errors-in-variables correction).
+
+    ``jx``, ``jy``, ``dpsi``: derivatives of x, y and psi with respect to the measured
+    (v_bat, v_ball, theta, omega), each (n, 4); ``sigma``: their standard uncertainties (n, 4).
+    """
+
+    jx: NDArray[np.float64]
+    jy: NDArray[np.float64]
+    dpsi: NDArray[np.float64]
+    sigma: NDArray[np.float64]
 
 
 def vtf_data(rec: xr.Dataset, sel: NDArray[np.bool_]) -> VtfData:
@@ -105,10 +122,13 @@ def vtf_data(rec: xr.Dataset, sel: NDArray[np.bool_]) -> VtfData:
         data (the model's slope varies slowly with psi over the experiment's range).
     """
     r, r_x, r_y, alpha = (rec[k].values[sel] for k in ("r", "r_x", "r_y", "alpha"))
-    x, y, jx, jy = vtf_design(Measured.from_dataset(rec, sel), r, r_x, alpha)
+    m = Measured.from_dataset(rec, sel)
+    x, y, jx, jy = vtf_design(m, r, r_x, alpha)
     sig = measured_sigma(rec, sel)
     sigma = None if sig is None else effective_sigma(jx, jy, sig, wls_slope(x, y)[0])
-    return VtfData(rec["psi"].values[sel], x, y, sigma, r_x, r_y, alpha, rec["bat"].values[sel].astype(str))
+    noise = None if sig is None else VtfNoise(jx, jy, psi_partials(m[1], m[2], m[3], r, alpha)[1], sig)
+    bat = rec["bat"].values[sel].astype(str)
+    return VtfData(rec["psi"].values[sel], x, y, sigma, r_x, r_y, alpha, bat, noise)
 
 
 @dataclass(frozen=True)
@@ -266,6 +286,7 @@ def fit_ball(
     vary_mu: bool,
     sigma: NDArray[np.float64] | None = None,
     interval: bool = True,
+    errors_in_variables: bool = True,
 ) -> Eta2Fit:
     """Fit eta^2 to one ball's Eq. vtf data as the workflow does (the workflow and the replicate studies).
 
@@ -273,6 +294,8 @@ def fit_ball(
     freedom (:func:`ballbat.stronge.fit.fit_eta2` with ``robust=True``, ``strata`` the bats):
     a lab chooses its bats and the impacts per bat, so the misfit of one eta^2 to a bat's own
     e_x is the same in every repetition of the experiment; only the scatter within a bat is.
+    The fitted parameters are then corrected for the noise of the measured values, which
+    enter the abscissa x and psi as well as y (:func:`eiv_step`).
 
     Parameters
     ----------
@@ -286,19 +309,22 @@ def fit_ball(
         Weights' uncertainties in place of ``data.sigma`` (the truth of a replicate study
         is fitted with the measured data's weights).
     interval : compute the profile-likelihood interval (the truth of a study needs the value only).
+    errors_in_variables : correct for the measurement noise (needs ``data.noise``; off for
+        noise-free values, such as a study's truth).
 
     Returns
     -------
     Eta2Fit
     """
     d = data
-    return fit_eta2(
+    w = d.sigma if sigma is None else sigma
+    fit = fit_eta2(
         d.psi,
         d.x,
         d.y,
         d.r_x,
         d.r_y,
-        sigma=d.sigma if sigma is None else sigma,
+        sigma=w,
         e_y=e_y,
         mu=mu,
         alpha=d.alpha,
@@ -308,6 +334,59 @@ def fit_ball(
         strata=d.bat,
         interval=interval,
     )
+    if not errors_in_variables or d.noise is None or w is None:
+        return fit
+    names = ["eta2"] + (["e_y"] if vary_e_y else []) + (["mu"] if vary_mu else [])
+    step = eiv_step(d, np.asarray(w, dtype=float), {"eta2": fit.eta2, "e_y": fit.e_y, "mu": fit.mu}, names)
+    moved = dict(zip(names, step, strict=True))
+    de = moved["eta2"]
+    return replace(
+        fit,
+        eta2=fit.eta2 + de,
+        eta2_ci_low=fit.eta2_ci_low + de,
+        eta2_ci_high=fit.eta2_ci_high + de,
+        e_y=fit.e_y + moved.get("e_y", 0.0),
+        mu=fit.mu + moved.get("mu", 0.0),
+    )
+
+
+#: Relative steps of the central differences in :func:`eiv_step`: psi (rad) and each parameter.
+EIV_STEP_PSI = 1e-5
+EIV_STEP_PARAM = 1e-4
+
+
+def eiv_step(data: VtfData, w: NDArray[np.float64], at: dict[str, float], names: list[str]) -> NDArray[np.float64]:
+    """Return the corrected-score step of the fitted parameters for the noise of the measured values.
+
+    The least-squares fit solves sum_i r_i dr_i/dp = 0, r_i = (y_i - (1 + e_x(psi_i)) x_i) / w_i.
+    With x, y and psi all computed from the same noisy measurements, E[r_i dr_i/dp] at the
+    true parameters is not 0 but the covariance of r_i and dr_i/dp, sum_k (dr_i/dm_k)
+    (d^2 r_i/dp dm_k) sigma_ik^2 over the measured m = (v_bat, v_ball, theta, omega)
+    (independent errors, as in every design of :mod:`ballbat.designs`). Subtracting it gives
+    the corrected score (Nakamura 1990; the moment correction of the lines, Fuller 1987, is
+    its linear case); one Gauss-Newton step from the fit solves it:
+    dp = (J'J)^-1 sum_i c_i. Derivatives of e_x by central differences.
+    """
+    psi, x = data.psi, data.x
+    nz = data.noise
+
+    def ex(dpsi: float = 0.0, **shift: float) -> NDArray[np.float64]:
+        p = {k: at[k] + shift.get(k, 0.0) for k in ("eta2", "e_y", "mu")}
+        return stronge_ex(psi + dpsi, ContactParams(p["eta2"], p["e_y"], p["mu"], data.r_x, data.r_y, data.alpha))
+
+    hp = EIV_STEP_PSI
+    e_psi = (ex(hp) - ex(-hp)) / (2 * hp)
+    dr = (nz.jy - (1 + ex())[:, None] * nz.jx - (e_psi * x)[:, None] * nz.dpsi) / w[:, None]
+    J, c = [], []
+    for k in names:
+        h = EIV_STEP_PARAM * max(abs(at[k]), 1e-3)
+        e_k = (ex(**{k: h}) - ex(**{k: -h})) / (2 * h)
+        e_k_psi = (ex(hp, **{k: h}) - ex(-hp, **{k: h}) - ex(hp, **{k: -h}) + ex(-hp, **{k: -h})) / (4 * hp * h)
+        dr_k = -((e_k_psi * x)[:, None] * nz.dpsi + e_k[:, None] * nz.jx) / w[:, None]
+        J.append(-e_k * x / w)
+        c.append(np.sum(dr * dr_k * nz.sigma**2))
+    J = np.stack(J, axis=1)
+    return np.linalg.solve(J.T @ J, np.asarray(c))
 
 
 def analyse_ball(
