@@ -5,8 +5,8 @@
 #
 # Usage: bench/bench_robustness_slurm.sh [CONFIGFILE]
 #   CONFIGFILE: a --configfile for the study (default bench/robustness_slurm.yaml, 4 grid points).
-# Prints both wall times, the jobs submitted and the per-job time SLURM adds; the full study's
-# time through SLURM is its local time plus that overhead times its 135 jobs, over the cores.
+# Prints both wall times, the jobs submitted and the wall time SLURM adds per job; the full
+# study's time through SLURM is about its local time plus that times its 136 jobs.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 ROOT=$(pwd)
@@ -40,7 +40,7 @@ slurm_s=$(($(date +%s) - start))
 jobs=$(grep -c "SLURM jobid" "$WORK/slurm.log" || true)
 echo "robustness study ($(basename "$CONFIG")): local -c2 ${local_s} s, through SLURM ${slurm_s} s, ${jobs} cluster jobs"
 if [ "$jobs" -gt 0 ]; then
-    echo "SLURM adds $(((slurm_s - local_s) * 2 / jobs)) s of a core per job (2 cores)"
+    echo "SLURM adds $(((slurm_s - local_s) / jobs)) s of wall time per job (submission, the job step's start, squeue polling)"
 fi
 cmp "$WORK/local/$TARGET" "$WORK/slurm/$TARGET" && echo "coverage.csv byte-identical"
 rm -rf "$WORK"

@@ -632,7 +632,7 @@ def coverage_figure(cov: xr.Dataset, point: int = 0) -> Figure:
 GRID_LABELS = {
     "pixel_noise_px": "{v:g} px",
     "impacts_per_bat": "n {v:g}",
-    "contact_ms": "tc {v:g} ms",
+    "contact_ms": "{v:g} ms",  # the unit names it; short enough for 27 columns
     "swing_fps": "cam1 {v:g} fps",
     "spin_fps": "cam2 {v:g} fps",
     "noise_scale": "noise x{v:g}",
