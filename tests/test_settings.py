@@ -491,8 +491,12 @@ def _same_reduction(a, b, what: str) -> None:
     assert set(a.data_vars) - calibration == set(b.data_vars) - calibration, what
     for name in set(a.data_vars) - calibration:
         x, y = a[name].values, b[name].values
-        if x.dtype.kind == "f":  # the workflow's tracks make a round trip through tracks.nc: dense columns
-            np.testing.assert_allclose(x, y, rtol=1e-12, atol=0, err_msg=f"{what}: {name}")  # may start elsewhere
+        if x.dtype.kind == "f":
+            # the workflow's tracks make a round trip through tracks.nc (dense columns that may start
+            # elsewhere): the sums round differently in the last bit, and the contact prior's
+            # Nelder-Mead optimum can carry that to about 1e-8 (relative); a setting honoured
+            # differently moves the values by far more
+            np.testing.assert_allclose(x, y, rtol=1e-7, atol=0, err_msg=f"{what}: {name}")
         else:
             np.testing.assert_array_equal(x, y, err_msg=f"{what}: {name}")
 

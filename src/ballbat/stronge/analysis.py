@@ -338,15 +338,15 @@ def fit_ball(
         return fit
     names = ["eta2"] + (["e_y"] if vary_e_y else []) + (["mu"] if vary_mu else [])
     step = eiv_step(d, np.asarray(w, dtype=float), {"eta2": fit.eta2, "e_y": fit.e_y, "mu": fit.mu}, names)
-    moved = dict(zip(names, step, strict=True))
+    moved = {"e_y": 0.0, "mu": 0.0, **dict(zip(names, step, strict=True))}  # fixed parameters do not move
     de = moved["eta2"]
     return replace(
         fit,
         eta2=fit.eta2 + de,
         eta2_ci_low=fit.eta2_ci_low + de,
         eta2_ci_high=fit.eta2_ci_high + de,
-        e_y=fit.e_y + moved.get("e_y", 0.0),
-        mu=fit.mu + moved.get("mu", 0.0),
+        e_y=fit.e_y + moved["e_y"],
+        mu=fit.mu + moved["mu"],
     )
 
 
