@@ -152,9 +152,9 @@ def test_eta2_errors_in_variables_correction_removes_the_noise_bias(config, ball
 
     def data(m: Measured) -> VtfData:
         x, y, jx, jy = vtf_design(m, r, r_x, alpha)
-        psi, dpsi = psi_partials(m.v_ball, m.theta, m.omega, r, alpha)
+        psi = psi_partials(m.v_ball, m.theta, m.omega, r, alpha)[0]
         w = effective_sigma(jx, jy, sig, wls_slope(x, y)[0])
-        return VtfData(psi, x, y, w, r_x, r_y, alpha, bat, VtfNoise(jx, jy, dpsi, sig))
+        return VtfData(psi, x, y, w, r_x, r_y, alpha, bat, VtfNoise(jx, jy, sig))
 
     d0 = data(truth)
     fitted = fit_ball(d0, interval=False, **kw)  # fit_ball applies the step
@@ -164,7 +164,7 @@ def test_eta2_errors_in_variables_correction_removes_the_noise_bias(config, ball
     assert eiv_step(d0, d0.sigma, {"eta2": 5.0, "e_y": 0.5, "mu": 0.5}, ["eta2"]) != 0.0  # noise given: a step
     quiet = VtfData(
         *[getattr(d0, f) for f in ("psi", "x", "y", "sigma", "r_x", "r_y", "alpha", "bat")],
-        VtfNoise(d0.noise.jx, d0.noise.jy, d0.noise.dpsi, 0.0 * sig),
+        VtfNoise(d0.noise.jx, d0.noise.jy, 0.0 * sig),
     )
     assert eiv_step(quiet, d0.sigma, {"eta2": 5.0, "e_y": 0.5, "mu": 0.5}, ["eta2"])[0] == 0.0
     plain, corrected = [], []

@@ -647,9 +647,10 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
             oks = ok & np.isfinite(syst) & (syst >= 0)
             ns = oks.sum(axis=0)
             out["n_systematic"][p] = ns
-            out["mean_systematic"][p] = np.where(oks, syst, 0.0).sum(axis=0) / np.where(ns > 0, ns, np.nan)
-            combined = np.hypot(e, np.where(oks, syst, 0.0))
-            dof_combined = combined_dof(e, np.where(oks, syst, 0.0), dof)
+            s_used = np.where(oks, syst, 0.0)
+            out["mean_systematic"][p] = s_used.sum(axis=0) / np.where(ns > 0, ns, np.nan)
+            combined = np.hypot(e, s_used)
+            dof_combined = combined_dof(e, s_used, dof)
             for q in (68, 95):
                 half = _t(q / 100, dof_combined) * combined
                 frac = np.where(oks, np.abs(d) <= half, False).sum(axis=0) / np.where(ns > 0, ns, np.nan)

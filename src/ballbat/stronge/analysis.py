@@ -27,7 +27,6 @@ import xarray as xr
 from numpy.typing import NDArray
 
 from ..designs import Measured, measured_sigma, vtf_design
-from ..kinematics import psi_partials
 from ..linefit import effective_sigma, wls_slope
 from ..published import STRONGE_E_Y, STRONGE_MU, per_ball
 from .fit import Eta2Fit, fit_eta2
@@ -94,13 +93,13 @@ class VtfData:
 class VtfNoise:
     """How each impact's measurement noise enters the Eq. vtf data (the errors-in-variables correction).
 
-    ``jx``, ``jy``, ``dpsi``: derivatives of x, y and psi with respect to the measured
-    (v_bat, v_ball, theta, omega), each (n, 4); ``sigma``: their standard uncertainties (n, 4).
+    ``jx``, ``jy``: derivatives of x and y with respect to the measured (v_bat, v_ball, theta,
+    omega), each (n, 4) (:func:`ballbat.designs.vtf_design`; psi's are jx cos^2(psi) (1 + r_x),
+    as x = tan psi / (1 + r_x)); ``sigma``: their standard uncertainties (n, 4).
     """
 
     jx: NDArray[np.float64]
     jy: NDArray[np.float64]
-    dpsi: NDArray[np.float64]
     sigma: NDArray[np.float64]
 
 
@@ -122,11 +121,10 @@ def vtf_data(rec: xr.Dataset, sel: NDArray[np.bool_]) -> VtfData:
         data (the model's slope varies slowly with psi over the experiment's range).
     """
     r, r_x, r_y, alpha = (rec[k].values[sel] for k in ("r", "r_x", "r_y", "alpha"))
-    m = Measured.from_dataset(rec, sel)
-    x, y, jx, jy = vtf_design(m, r, r_x, alpha)
+    x, y, jx, jy = vtf_design(Measured.from_dataset(rec, sel), r, r_x, alpha)
     sig = measured_sigma(rec, sel)
     sigma = None if sig is None else effective_sigma(jx, jy, sig, wls_slope(x, y)[0])
-    noise = None if sig is None else VtfNoise(jx, jy, psi_partials(m[1], m[2], m[3], r, alpha)[1], sig)
+    noise = None if sig is None else VtfNoise(jx, jy, sig)
     bat = rec["bat"].values[sel].astype(str)
     return VtfData(rec["psi"].values[sel], x, y, sigma, r_x, r_y, alpha, bat, noise)
 
@@ -374,15 +372,16 @@ def eiv_step(data: VtfData, w: NDArray[np.float64], at: dict[str, float], names:
         p = {k: at[k] + shift.get(k, 0.0) for k in ("eta2", "e_y", "mu")}
         return stronge_ex(psi + dpsi, ContactParams(p["eta2"], p["e_y"], p["mu"], data.r_x, data.r_y, data.alpha))
 
+    dpsi = nz.jx * (np.cos(psi) ** 2 * (1.0 + data.r_x))[:, None]  # x = tan psi / (1 + r_x)
     hp = EIV_STEP_PSI
     e_psi = (ex(hp) - ex(-hp)) / (2 * hp)
-    dr = (nz.jy - (1 + ex())[:, None] * nz.jx - (e_psi * x)[:, None] * nz.dpsi) / w[:, None]
+    dr = (nz.jy - (1 + ex())[:, None] * nz.jx - (e_psi * x)[:, None] * dpsi) / w[:, None]
     J, c = [], []
     for k in names:
         h = EIV_STEP_PARAM * max(abs(at[k]), 1e-3)
         e_k = (ex(**{k: h}) - ex(**{k: -h})) / (2 * h)
         e_k_psi = (ex(hp, **{k: h}) - ex(-hp, **{k: h}) - ex(hp, **{k: -h}) + ex(-hp, **{k: -h})) / (4 * hp * h)
-        dr_k = -((e_k_psi * x)[:, None] * nz.dpsi + e_k[:, None] * nz.jx) / w[:, None]
+        dr_k = -((e_k_psi * x)[:, None] * dpsi + e_k[:, None] * nz.jx) / w[:, None]
         J.append(-e_k * x / w)
         c.append(np.sum(dr * dr_k * nz.sigma**2))
     J = np.stack(J, axis=1)
