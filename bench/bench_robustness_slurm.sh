@@ -15,14 +15,9 @@ HERE="$ROOT/tests/slurm"
 CONFIG=$(realpath "${1:-$ROOT/bench/robustness_slurm.yaml}")
 TARGET=results/studies/robustness/coverage.csv
 
-trap '"$HERE/cluster.sh" down' EXIT INT TERM
-"$HERE/cluster.sh" up
-
-WORK=$(mktemp -d /tmp/ballbat-robustness.XXXXXX)
-for side in local slurm; do
-    mkdir -p "$WORK/$side"
-    cp -r Snakefile workflow config README.md "$WORK/$side/"
-done
+# shellcheck source=tests/slurm/lib.sh
+. "$HERE/lib.sh"
+cluster_and_two_checkouts ballbat-robustness
 export PATH="$BIN:$PATH"
 start=$(date +%s)
 (cd "$WORK/local" && snakemake "$TARGET" -c2 --quiet all --configfile "$CONFIG") >"$WORK/local.log" 2>&1 || {

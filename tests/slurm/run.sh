@@ -8,14 +8,9 @@ ROOT=$(pwd)
 BIN="${BIN:-$ROOT/.venv-slurm/bin}"  # an environment with the executor plugin (make test-slurm)
 HERE="$ROOT/tests/slurm"
 
-trap '"$HERE/cluster.sh" down' EXIT INT TERM
-"$HERE/cluster.sh" up
-
-WORK=$(mktemp -d /tmp/ballbat-slurm.XXXXXX)
-for side in local slurm; do
-    mkdir -p "$WORK/$side"
-    cp -r Snakefile workflow config README.md "$WORK/$side/"
-done
+# shellcheck source=tests/slurm/lib.sh
+. "$HERE/lib.sh"
+cluster_and_two_checkouts ballbat-slurm
 
 export PATH="$BIN:$PATH"
 TARGETS=(all studies)
