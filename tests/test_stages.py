@@ -259,16 +259,18 @@ def test_rule_script_is_one_call_of_its_stage(script, stage):
 
 
 def test_a_replicate_is_the_stages_in_memory(config, balls, bats, monkeypatch):
-    """studies.run_replicate calls simulate, render, reduce, normalize, reconstruct and fit_ex's run, once each."""
+    """studies.run_replicate calls simulate, render, reduce, normalize, reconstruct and fit_ex's run, once each
+    (fit_ex's as :func:`fit_ex.fit`, its run with the signed systematics kept)."""
     calls = []
     for mod in (simulate, reduce, normalize, reconstruct, fit_ex):
-        orig = mod.run
+        entry = "fit" if mod is fit_ex else "run"
+        orig = getattr(mod, entry)
 
         def counted(*args, _orig=orig, _name=mod.__name__, **kw):
             calls.append(_name.rsplit(".", 1)[1])
             return _orig(*args, **kw)
 
-        monkeypatch.setattr(mod, "run", counted)
+        monkeypatch.setattr(mod, entry, counted)
     orig_render = render.render
     monkeypatch.setattr(render, "render", lambda *a, **k: calls.append("render") or orig_render(*a, **k))
     monkeypatch.setattr(studies, "STUDY_QUANTITIES", tuple(q for q in studies.STUDY_QUANTITIES if q != "eta2"))

@@ -16,7 +16,7 @@ from ballbat.pipeline.config import ConfigError, validate_config
 from ballbat.stages import study_batch
 from ballbat.sweeps import CONTACT_HALF_WIDTH_MS, point_dataset, sweep_points
 from ballbat.tracks.data import camera_block
-from ballbat.tracks.render import drawn_calibration, settings_from_config
+from ballbat.tracks.render import calibration_draws, drawn_calibration, settings_from_config
 
 # ---------------------------------------------------------------------------------------
 # the grid
@@ -368,3 +368,50 @@ def test_a_small_robustness_study_runs_through_snakemake(lab_run):
     )  # drawn calibration: e_x's pixel-scale systematic
     assert_not_blank(res / "grid.png")
     assert not (res / "design.csv").exists()  # a grid has no design table
+
+
+def test_the_calibration_effect_is_what_the_true_calibration_would_have_given(config, balls, bats):
+    """A replicate that draws its calibration reports, per quantity, the first-order change the draw made
+    (studies._calibration_effect). Reducing the same tracks with the drawn (true) calibration instead of
+    the declared one must give value + calibration_effect, up to second order: the study uses this to
+    take the draw's spread out of a bias and to judge the statistical interval where calibration is drawn.
+    """
+    from test_stages import SMALL
+
+    dataset = copy.deepcopy(config["datasets"]["synthetic"])
+    dataset["synthetic"]["impacts"] = SMALL
+    cams = dataset["render"]["cameras"]
+    cams["swing"].update(m_per_px_err=0.01, fps_err=0.003)
+    cams["spin"].update(m_per_px_err=0.01)
+    dataset["render"]["draw_calibration"] = True
+    settings = studies.StudySettings.from_config(
+        {**config, "studies": {"s": {**config["studies"]["calibration"], "dataset": "synthetic"}}}, "s"
+    )
+    replicate = 1
+    drawn = studies.run_replicate(settings, dataset, replicate, balls, bats)
+    # the lab that knows its true calibration: the drawn one declared, nothing drawn (same seeds: same tracks)
+    seeds = studies.replicate_seeds(settings.seed, replicate)
+    z = calibration_draws({**dataset["render"], "seed": seeds[1]})
+    assert np.all(np.abs(z[[0, 1, 2]]) > 0.2)  # swing and spin scale, swing frame rate: the draws this test needs
+    known = copy.deepcopy(dataset)
+    true_block = drawn_calibration({**dataset["render"], "seed": seeds[1]})
+    for name, cam in known["render"]["cameras"].items():
+        cam.update(m_per_px=true_block["cameras"][name]["m_per_px"], fps=true_block["cameras"][name]["fps"])
+    known["render"]["draw_calibration"] = False
+    plain = studies.run_replicate(settings, known, replicate, balls, bats)
+    exact = {studies.row_labels([r])[0]: r["value"] for r in plain}
+    moved, missed = [], []
+    for r in drawn:
+        label = studies.row_labels([r])[0]
+        if not np.isfinite(exact[label] - r["value"]):
+            continue
+        assert np.isfinite(r["calibration_effect"]), label
+        # in standard errors: how far the draw moved the value, and how far value + effect is from the true calibration's
+        moved.append((exact[label] - r["value"]) / r["uncertainty"])
+        missed.append((exact[label] - r["value"] - r["calibration_effect"]) / r["uncertainty"])
+        assert abs(missed[-1]) < 0.25, (label, moved[-1], missed[-1])
+    moved, missed = np.abs(moved), np.abs(missed)
+    assert len(moved) == 17 and (moved > 1).sum() >= 5 and moved.max() > 2.5  # the draw moved several by > 1 SE
+    assert missed.sum() < 0.15 * moved.sum()
+    # not drawn: no effect reported
+    assert all(np.isnan(r["calibration_effect"]) for r in plain)

@@ -163,30 +163,34 @@ def run_replicate(
     Returns
     -------
     list of dict
-        ``quantity, ball, bat, value, uncertainty, truth, dof, units, systematic`` (SI, as fit_ex.nc
-        holds them; systematic NaN where there is none).
+        ``quantity, ball, bat, value, uncertainty, truth, dof, units, systematic,
+        calibration_effect`` (SI, as fit_ex.nc holds them; systematic NaN where there is none;
+        calibration_effect, where the calibration is drawn, the first-order change the draw made:
+        :func:`_calibration_effect`).
     """
     from .stages import fit_ex, normalize, reconstruct
 
-    src = _source(
-        dataset, replicate_seeds(settings.seed, replicate), balls, bats, f"render (replicate {replicate})", check
-    )
+    seeds = replicate_seeds(settings.seed, replicate)
+    src = _source(dataset, seeds, balls, bats, f"render (replicate {replicate})", check)
     norm = normalize.NormalizeSettings(v_ref_mph=settings.v_ref_mph)
     rec = reconstruct.run(reconstruct.ReconstructSettings(), normalize.run(norm, src), balls, bats)
     # the calibration systematics where the replicate draws its calibration (the combined interval's
     # coverage); every replicate's numbers are recorded as they come
     from .systematics import has_shifts
+    from .tracks.render import calibration_draws
 
     drawn = has_shifts(rec)
-    fit = fit_ex.run(fit_ex.FitExSettings(settings.mu_k_example, systematic=drawn, check_physical=False), rec)
-    rows = fit_quantity_rows(fit)
+    fit, fs = fit_ex.fit(fit_ex.FitExSettings(settings.mu_k_example, systematic=drawn, check_physical=False), rec)
+    z = calibration_draws({**dataset["render"], "seed": seeds[1]}) if drawn else None
+    rows = fit_quantity_rows(fit, None if fs is None else _calibration_effect(fit, fs.signed, z))
     if "eta2" in STUDY_QUANTITIES:
         rec_truth = reconstruct.run(
             reconstruct.ReconstructSettings(), normalize.run(norm, _truth_source(src)), balls, bats
         )
         balls_fitted = fit["ball"].values.astype(str)
-        syst = _eta2_systematic(rec, balls_fitted, settings.stronge) if drawn else np.full(balls_fitted.size, np.nan)
-        for ball, sy in zip(balls_fitted, syst, strict=True):
+        nan = np.full(balls_fitted.size, np.nan)
+        syst, effect = _eta2_systematic(rec, balls_fitted, settings.stronge, z) if drawn else (nan, nan)
+        for ball, sy, ef in zip(balls_fitted, syst, effect, strict=True):
             v, e, t, dof = _eta2(rec, rec_truth, ball, settings.stronge)
             rows.append(
                 {
@@ -199,18 +203,34 @@ def run_replicate(
                     "dof": dof,
                     "units": "1",
                     "systematic": float(sy) if math.isfinite(v) else math.nan,
+                    "calibration_effect": float(ef) if math.isfinite(v) else math.nan,
                 }
             )
     return rows
 
 
-def _eta2_systematic(rec: xr.Dataset, balls: np.ndarray, stronge: dict) -> np.ndarray:
-    """eta^2's calibration systematic of each ball, every source in quadrature (as stronge.nc's ``eta2_syst``)."""
-    from .stages.stronge import stronge_by_source
+def _calibration_effect(fit: xr.Dataset, signed: dict[str, np.ndarray], z: np.ndarray) -> xr.Dataset:
+    """Each quantity's first-order change under the drawn calibration: sum over sources of z_k times its signed shift.
+
+    ``signed[q]``: half of (q at +1 sigma) - (q at -1 sigma) of each source (first axis, dims of
+    ``fit[q]`` after it); ``z``: the replicate's drawn calibration in stated uncertainties
+    (:func:`ballbat.tracks.render.calibration_draws`). The replicate's value plus this is, to
+    first order in the calibration errors, the value the chain gives with the true calibration.
+    """
+    return xr.Dataset({q: (fit[q].dims, np.tensordot(z, v, axes=1)) for q, v in signed.items()}, coords=fit.coords)
+
+
+def _eta2_systematic(
+    rec: xr.Dataset, balls: np.ndarray, stronge: dict, z: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
+    """eta^2's calibration systematic of each ball, every source in quadrature (as stronge.nc's ``eta2_syst``),
+    and its first-order change under the drawn calibration ``z`` (:func:`_calibration_effect`)."""
+    from .stages.stronge import stronge_shifts
 
     kw = {k: stronge[k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")}
+    signed = stronge_shifts(rec, list(balls), ["eta2"], **kw)["eta2"]
     with np.errstate(invalid="ignore"):
-        return np.sqrt(np.sum(stronge_by_source(rec, list(balls), ["eta2"], **kw)["eta2"] ** 2, axis=0))
+        return np.sqrt(np.sum(signed**2, axis=0)), np.tensordot(z, signed, axes=1)
 
 
 def _at(fit: xr.Dataset, var: str, ball: str, bat: str) -> float | None:
@@ -221,12 +241,13 @@ def _at(fit: xr.Dataset, var: str, ball: str, bat: str) -> float | None:
     return float((v.sel(bat=bat) if "bat" in v.dims else v).values)
 
 
-def fit_quantity_rows(fit: xr.Dataset) -> list[dict]:
+def fit_quantity_rows(fit: xr.Dataset, effect: xr.Dataset | None = None) -> list[dict]:
     """Return the study's quantities of ``fit_ex.nc`` (:func:`ballbat.fitting.results_dataset`), SI as it holds them.
 
     One row per quantity, ball and bat (a per-bat quantity of a pair without impacts is left
-    out, as in paper_comparison.csv): ``quantity, ball, bat, value, uncertainty, truth, dof``
-    and ``units`` (the file's units attribute of the quantity).
+    out, as in paper_comparison.csv): ``quantity, ball, bat, value, uncertainty, truth, dof``,
+    ``units`` (the file's units attribute of the quantity), ``systematic`` and
+    ``calibration_effect`` (from ``effect``, :func:`_calibration_effect`; NaN without it).
     """
     dof_of = {"spin_theta_slope": 2, "speed_theta_slope": 2}  # fitted parameters; others: 1
     balls = [str(b) for b in fit["ball"].values]
@@ -257,6 +278,7 @@ def fit_quantity_rows(fit: xr.Dataset) -> list[dict]:
                         "dof": dof,
                         "units": str(fit[q].attrs["units"]),
                         "systematic": _systematic(fit, q, ball, bat),
+                        "calibration_effect": math.nan if effect is None else _at(effect, q, ball, bat),
                     }
                 )
     return rows
@@ -566,6 +588,34 @@ COVERAGE_TABLE = {
         "(NaN: no systematic)",
     ),
     "coverage_95_combined_err": Var(("point", "quantity"), "1", "binomial standard error of coverage_95_combined"),
+    "n_calibrated": Var(("point", "quantity"), "1", "replicates of n_replicates with a drawn calibration's effect"),
+    "bias_over_se_calibrated": Var(
+        ("point", "quantity"),
+        "1",
+        "mean of (value + calibration_effect - truth) / uncertainty: the bias with the drawn calibration's "
+        "first-order effect taken out (NaN: calibration not drawn)",
+    ),
+    "bias_over_se_calibrated_err": Var(("point", "quantity"), "1", "standard error of bias_over_se_calibrated"),
+    "spread_over_se_calibrated": Var(
+        ("point", "quantity"),
+        "1",
+        "standard deviation of value + calibration_effect - truth / mean uncertainty (NaN: calibration not drawn)",
+    ),
+    "spread_over_se_calibrated_err": Var(("point", "quantity"), "1", "standard error of spread_over_se_calibrated"),
+    "coverage_68_calibrated": Var(
+        ("point", "quantity"),
+        "1",
+        "fraction of 68 % statistical intervals around value + calibration_effect that cover the truth "
+        "(NaN: calibration not drawn)",
+    ),
+    "coverage_68_calibrated_err": Var(("point", "quantity"), "1", "binomial standard error of coverage_68_calibrated"),
+    "coverage_95_calibrated": Var(
+        ("point", "quantity"),
+        "1",
+        "fraction of 95 % statistical intervals around value + calibration_effect that cover the truth "
+        "(NaN: calibration not drawn)",
+    ),
+    "coverage_95_calibrated_err": Var(("point", "quantity"), "1", "binomial standard error of coverage_95_calibrated"),
     "setting": Var(("point",), "1", "value of the swept setting (NaN: no sweep, or a grid: grid_setting)"),
 }
 
@@ -605,10 +655,11 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
     out = {k: np.full((npt, nq), np.nan) for k in COVERAGE_TABLE if k != "setting"}
     point = rep["point"].values
     syst_all = rep["systematic"].values if "systematic" in rep else np.full(rep["value"].shape, np.nan)
+    eff_all = rep["calibration_effect"].values if "calibration_effect" in rep else np.full(rep["value"].shape, np.nan)
     for p in range(npt):
         sel = point == p
         v, e, t, dof = (rep[k].values[sel] for k in ("value", "uncertainty", "truth", "dof"))
-        syst = syst_all[sel]
+        syst, eff = syst_all[sel], eff_all[sel]
         if truths is not None:
             labels = rep["quantity"].values.astype(str)
             names = rep["quantity_name"].values.astype(str)
@@ -656,6 +707,29 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
                 frac = np.where(oks, np.abs(d) <= half, False).sum(axis=0) / np.where(ns > 0, ns, np.nan)
                 out[f"coverage_{q}_combined"][p] = frac
                 out[f"coverage_{q}_combined_err"][p] = np.sqrt(frac * (1 - frac) / ns)
+            # the statistical interval where the calibration is drawn: around the value with the draw's
+            # first-order effect taken out (the value a lab with the true calibration would get), so that
+            # the draw's spread, which the statistical error does not claim, leaves the bias and the coverage
+            okc = ok & np.isfinite(eff)
+            nc = okc.sum(axis=0)
+            out["n_calibrated"][p] = nc
+            dc = np.where(okc, v + eff - t, 0.0)
+            zc = dc / np.where(okc, e, 1.0)
+            m = np.where(nc > 0, nc, np.nan)
+            bias_c = zc.sum(axis=0) / m
+            out["bias_over_se_calibrated"][p] = bias_c
+            sd_z = np.sqrt(np.where(okc, (zc - bias_c) ** 2, 0.0).sum(axis=0) / (m - 1))
+            out["bias_over_se_calibrated_err"][p] = sd_z / np.sqrt(m)
+            sd_d = np.sqrt(np.where(okc, (dc - dc.sum(axis=0) / m) ** 2, 0.0).sum(axis=0) / (m - 1))
+            spread_c = sd_d / (np.where(okc, e, 0.0).sum(axis=0) / m)
+            out["spread_over_se_calibrated"][p] = spread_c
+            out["spread_over_se_calibrated_err"][p] = spread_c / np.sqrt(2.0 * np.maximum(nc - 1, 1))
+            for q in (68, 95):
+                frac = np.where(okc, np.abs(dc) <= _t(q / 100, dof) * e, False).sum(axis=0) / np.where(
+                    nc > 0, nc, np.nan
+                )
+                out[f"coverage_{q}_calibrated"][p] = frac
+                out[f"coverage_{q}_calibrated_err"][p] = np.sqrt(frac * (1 - frac) / nc)
             out["mean_value"][p] = np.nanmean(np.where(ok, v, np.nan), axis=0)
             out["mean_truth"][p] = np.nanmean(np.where(ok, t, np.nan), axis=0)
             out["mean_dof"][p] = np.nanmean(np.where(ok, dof, np.nan), axis=0)
@@ -698,6 +772,14 @@ COVERAGE_COLUMNS = (
     "coverage_68_combined_err",
     "coverage_95_combined",
     "coverage_95_combined_err",
+    "bias_over_se_calibrated",
+    "bias_over_se_calibrated_err",
+    "spread_over_se_calibrated",
+    "spread_over_se_calibrated_err",
+    "coverage_68_calibrated",
+    "coverage_68_calibrated_err",
+    "coverage_95_calibrated",
+    "coverage_95_calibrated_err",
     "mean_uncertainty",
     "spread",
     "mean_dof",

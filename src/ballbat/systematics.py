@@ -179,3 +179,7 @@ class FitSystematics:
 
     by_source: dict[str, np.ndarray]
     rel_sigma: np.ndarray
+    #: The same with its sign: half of (the estimate at +1 sigma) - (the estimate at -1 sigma), so that
+    #: ``by_source == abs(signed)``; a quantity's first-order change when source k is off by z_k sigma
+    #: is sum_k z_k signed[k] (:func:`ballbat.studies.run_replicate`).
+    signed: dict[str, np.ndarray]

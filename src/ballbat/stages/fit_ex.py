@@ -168,6 +168,11 @@ def run(settings: FitExSettings, impacts: xr.Dataset) -> xr.Dataset:
     (an error for the dataset, not a note: such a number is always a mistake in the data;
     unless ``settings.check_physical`` is false).
     """
+    return fit(settings, impacts)[0]
+
+
+def fit(settings: FitExSettings, impacts: xr.Dataset) -> tuple[xr.Dataset, FitSystematics | None]:
+    """:func:`run`'s dataset and the calibration systematics it holds, with their signs (None: none fitted)."""
     res = analyze_impacts(impacts, settings.mu_k_example, systematic=settings.systematic)
     if settings.systematic and has_shifts(impacts):  # every calibration source, the tracks reduced again
         res.systematics = fit_systematics(impacts, res)
@@ -179,7 +184,7 @@ def run(settings: FitExSettings, impacts: xr.Dataset) -> xr.Dataset:
     ds.attrs["n_excluded"] = int((impacts["flag"].values != 0).sum())
     ds.attrs["v_ref"] = float(impacts.attrs["v_ref"])
     ds.attrs.update(carried_warnings(impacts))
-    return ds
+    return ds, res.systematics
 
 
 def not_fitted(ds: xr.Dataset) -> list[str]:
@@ -246,8 +251,8 @@ def fit_systematics(rec: xr.Dataset, res: Sec4) -> FitSystematics:
             for j in range(len(SIDES))
         ]
         for q in FIT_QUANTITIES:
-            out[q][i] = 0.5 * np.abs(fits[0][q].values - fits[1][q].values)
-    return FitSystematics(out, rel)
+            out[q][i] = 0.5 * (fits[0][q].values - fits[1][q].values)
+    return FitSystematics({q: np.abs(v) for q, v in out.items()}, rel, out)
 
 
 def scale_entries(fs: FitSystematics) -> dict[str, np.ndarray]:

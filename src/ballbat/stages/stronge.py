@@ -296,9 +296,20 @@ def stronge_by_source(
 ) -> dict[str, np.ndarray]:
     """Systematic of eta^2 (and e_y, mu when fitted: ``names``) of each ball, per source (source x ball).
 
+    The size of :func:`stronge_shifts`' signed changes.
+    """
+    kw = {"e_y": e_y, "mu": mu, "vary_e_y": vary_e_y, "vary_mu": vary_mu}
+    return {q: np.abs(v) for q, v in stronge_shifts(rec, balls, names, **kw).items()}
+
+
+def stronge_shifts(
+    rec: xr.Dataset, balls: Sequence[str], names: Sequence[str], *, e_y: float, mu: float, vary_e_y: bool, vary_mu: bool
+) -> dict[str, np.ndarray]:
+    """Half of (the fit at +1 sigma) - (the fit at -1 sigma) of each source and ball (source x ball).
+
     Each ball is fitted again (:func:`ballbat.stronge.analysis.fit_ball`, no interval) on its
-    usable impacts at +1 and at -1 sigma of each source (:func:`shifted_impacts`); half the
-    difference; 0 for a source without uncertainty. ``rec`` carries the shifts (:func:`has_shifts`).
+    usable impacts at +1 and at -1 sigma of each source (:func:`shifted_impacts`); 0 for a
+    source without uncertainty. ``rec`` carries the shifts (:func:`has_shifts`).
     """
     rel = rec["systematic_rel_sigma"].values
     out = {q: np.zeros((len(SOURCES), len(balls))) for q in names}
@@ -314,5 +325,5 @@ def stronge_by_source(
             fits.append([fit_ball(vtf_data(sh, usable & (ball_of == b)), **kw) for b in balls])
         for q in names:
             plus, minus = (np.array([getattr(f, q) for f in side]) for side in fits)
-            out[q][i] = 0.5 * np.abs(plus - minus)
+            out[q][i] = 0.5 * (plus - minus)
     return out

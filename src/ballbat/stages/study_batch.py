@@ -43,6 +43,14 @@ BATCH_TABLE = {
         "reported systematic uncertainty of the estimate (same unit; NaN: none)",
         PER_QUANTITY_UNITS,
     ),
+    "calibration_effect": Var(
+        ("replicate", "quantity"),
+        None,
+        "first-order change of the estimate under the replicate's drawn calibration: the sum over sources of "
+        "its drawn error in stated uncertainties times the estimate's signed change per +1 sigma "
+        "(same unit; NaN: calibration not drawn)",
+        PER_QUANTITY_UNITS,
+    ),
     "point": Var(("replicate",), "1", "sweep point of the replicate (index into setting)"),
     "seed_replicate": Var(("replicate",), "1", "replicate number within its point (its seeds' spawn key)"),
 }
@@ -81,7 +89,8 @@ def run(
             units.setdefault(label, r["units"])
     labels = list(table)
     arrays = {
-        k: np.full((len(records), len(labels)), np.nan) for k in ("value", "uncertainty", "truth", "dof", "systematic")
+        k: np.full((len(records), len(labels)), np.nan)
+        for k in ("value", "uncertainty", "truth", "dof", "systematic", "calibration_effect")
     }
     for i, (_, _, _, rows) in enumerate(records):
         for label, r in zip(row_labels(rows), rows, strict=True):

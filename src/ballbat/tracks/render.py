@@ -113,16 +113,34 @@ def drawn_calibration(cfg: dict) -> dict:
     calibration error a lab's declared uncertainty is meant to cover. The draw of a setting is
     the same whether or not the others are stated (each takes its own normal).
     """
-    rng = np.random.default_rng(np.random.SeedSequence(int(cfg["seed"]), spawn_key=(CALIBRATION_SPAWN_KEY,)))
     out = {**cfg, "cameras": {n: dict(c) for n, c in cfg["cameras"].items()}, "rig": dict(cfg["rig"])}
-    blocks = {"cameras": [out["cameras"][n] for n in ("swing", "spin")], "rig": [out["rig"]]}
-    for block, key, err_key, relative in CALIBRATION_ERRORS:
-        for b in blocks[block]:
-            z = rng.standard_normal()
-            err = float(b[err_key])
-            if err > 0:
-                b[key] = float(b[key]) * (1.0 + err * z) if relative else float(b[key]) + err * z
+    z = iter(calibration_draws(cfg))
+    for b, key, err_key, relative in _calibration_entries(out):
+        zk = next(z)
+        err = float(b[err_key])
+        if err > 0:
+            b[key] = float(b[key]) * (1.0 + err * zk) if relative else float(b[key]) + err * zk
     return out
+
+
+def _calibration_entries(cfg: dict) -> list[tuple[dict, str, str, bool]]:
+    """The drawn settings in the order of their draws: (block, setting, its uncertainty's key, relative)."""
+    blocks = {"cameras": [cfg["cameras"][n] for n in ("swing", "spin")], "rig": [cfg["rig"]]}
+    return [(b, key, err_key, rel) for block, key, err_key, rel in CALIBRATION_ERRORS for b in blocks[block]]
+
+
+def calibration_draws(cfg: dict) -> np.ndarray:
+    """Return the standard normals :func:`drawn_calibration` draws, one per calibration source.
+
+    In the order of :data:`ballbat.systematics.SOURCES` (swing and spin pixel scale, swing and
+    spin frame rate, pivot-to-tip, pivot-to-impact): the drawn true calibration of source k is
+    the declared one moved by ``z[k]`` of its stated uncertainty, so a quantity's change under
+    the draw is, to first order, the sum of ``z[k]`` times its change per +1 sigma of source k
+    (what a replicate study uses to take the draw's spread out of a bias,
+    :func:`ballbat.studies.run_replicate`). Drawn whether or not a source's uncertainty is stated.
+    """
+    rng = np.random.default_rng(np.random.SeedSequence(int(cfg["seed"]), spawn_key=(CALIBRATION_SPAWN_KEY,)))
+    return rng.standard_normal(len(_calibration_entries(cfg)))
 
 
 def settings_from_config(cfg: dict) -> RenderSettings:
