@@ -260,7 +260,8 @@ def test_rule_script_is_one_call_of_its_stage(script, stage):
 
 def test_a_replicate_is_the_stages_in_memory(config, balls, bats, monkeypatch):
     """studies.run_replicate calls simulate, render, reduce, normalize, reconstruct and fit_ex's run, once each
-    (fit_ex's as :func:`fit_ex.fit`, its run with the signed systematics kept)."""
+    (fit_ex's as :func:`fit_ex.fit`, its run with the signed systematics kept).
+    """
     calls = []
     for mod in (simulate, reduce, normalize, reconstruct, fit_ex):
         entry = "fit" if mod is fit_ex else "run"

@@ -406,7 +406,7 @@ def test_the_calibration_effect_is_what_the_true_calibration_would_have_given(co
         if not np.isfinite(exact[label] - r["value"]):
             continue
         assert np.isfinite(r["calibration_effect"]), label
-        # in standard errors: how far the draw moved the value, and how far value + effect is from the true calibration's
+        # in SE: how far the draw moved the value, and how far value + effect is from the true calibration's
         moved.append((exact[label] - r["value"]) / r["uncertainty"])
         missed.append((exact[label] - r["value"] - r["calibration_effect"]) / r["uncertainty"])
         assert abs(missed[-1]) < 0.25, (label, moved[-1], missed[-1])

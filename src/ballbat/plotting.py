@@ -643,7 +643,10 @@ GRID_LABELS = {
 def grid_coverage_figure(cov: xr.Dataset, band: tuple[float, float] = (0.93, 0.97)) -> Figure:
     """Draw a grid study's 95 % coverage at a glance: quantities x grid points, statistical and combined intervals.
 
-    Colour: the coverage (white at 95 %, blue above, red below). A cell whose coverage lies
+    The statistical interval is judged around the value with the drawn calibration's first-order
+    effect taken out, where the replicates draw their calibration (``coverage_95_calibrated``:
+    what the statistical error claims to cover), around the value otherwise; the combined one
+    around the value. Colour: the coverage (white at 95 %, blue above, red below). A cell whose coverage lies
     outside ``band`` by more than two binomial errors is marked with a cross, one outside the
     band but within two errors with a dot; a grey cell has no value (the combined interval of
     a quantity without a systematic, or no replicate).
@@ -678,13 +681,20 @@ def grid_coverage_figure(cov: xr.Dataset, band: tuple[float, float] = (0.93, 0.9
     for ax, (var, title) in zip(
         axes,
         (
-            ("coverage_95", "statistical 95 % interval"),
+            ("coverage_95", "statistical 95 % interval (drawn calibration's effect taken out)"),
             ("coverage_95_combined", "combined 95 % interval (stat. and syst. in quadrature)"),
         ),
         strict=True,
     ):
         c = cov[var].values.T  # quantity x point
         e = cov[f"{var}_err"].values.T
+        cal = f"{var}_calibrated"
+        if cal in cov:  # the statistical interval where the calibration is drawn
+            drawn = np.isfinite(cov[cal].values.T)
+            c = np.where(drawn, cov[cal].values.T, c)
+            e = np.where(drawn, cov[f"{cal}_err"].values.T, e)
+        if var == "coverage_95" and not (cal in cov and drawn.any()):
+            title = "statistical 95 % interval"
         image = ax.imshow(np.ma.masked_invalid(c), cmap=cmap, norm=norm, aspect="auto", interpolation="nearest")
         with np.errstate(invalid="ignore"):
             far = (c + 2 * e < band[0]) | (c - 2 * e > band[1])

@@ -220,11 +220,12 @@ def _calibration_effect(fit: xr.Dataset, signed: dict[str, np.ndarray], z: np.nd
     return xr.Dataset({q: (fit[q].dims, np.tensordot(z, v, axes=1)) for q, v in signed.items()}, coords=fit.coords)
 
 
-def _eta2_systematic(
-    rec: xr.Dataset, balls: np.ndarray, stronge: dict, z: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """eta^2's calibration systematic of each ball, every source in quadrature (as stronge.nc's ``eta2_syst``),
-    and its first-order change under the drawn calibration ``z`` (:func:`_calibration_effect`)."""
+def _eta2_systematic(rec: xr.Dataset, balls: np.ndarray, stronge: dict, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Return eta^2's calibration systematic of each ball and its change under the drawn calibration.
+
+    The systematic: every source in quadrature (as stronge.nc's ``eta2_syst``); the change: first
+    order, under the drawn calibration ``z`` (:func:`_calibration_effect`).
+    """
     from .stages.stronge import stronge_shifts
 
     kw = {k: stronge[k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")}

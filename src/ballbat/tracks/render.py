@@ -124,7 +124,7 @@ def drawn_calibration(cfg: dict) -> dict:
 
 
 def _calibration_entries(cfg: dict) -> list[tuple[dict, str, str, bool]]:
-    """The drawn settings in the order of their draws: (block, setting, its uncertainty's key, relative)."""
+    """Return the drawn settings in the order of their draws: (block, setting, its uncertainty's key, relative)."""
     blocks = {"cameras": [cfg["cameras"][n] for n in ("swing", "spin")], "rig": [cfg["rig"]]}
     return [(b, key, err_key, rel) for block, key, err_key, rel in CALIBRATION_ERRORS for b in blocks[block]]
 
