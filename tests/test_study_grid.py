@@ -251,6 +251,42 @@ def test_the_combined_interval_covers_what_the_statistical_one_misses():
     assert rows[1]["coverage_95_combined"] == "" and rows[0]["coverage_95_combined"] != ""
 
 
+def test_the_calibration_effect_takes_the_draw_out_of_bias_spread_and_statistical_coverage():
+    """value = truth + bias + statistical noise + the drawn calibration's shift (4x the SE, as at 1 px);
+    calibration_effect = minus that shift. Around value + effect the bias is measured to its statistical
+    precision (the raw bias is 4x less sharp), the spread is the statistical one and the statistical
+    interval covers 95 %; a replicate without an effect (not drawn) leaves the *_calibrated columns NaN.
+    """
+    from test_studies import fake_replicates
+
+    n, se, syst, bias = 4000, 0.01, 0.04, 0.3
+    rng = np.random.default_rng(7)
+    a = fake_replicates(n, se, se, seed=3)
+    shift = syst * rng.standard_normal((n, 1))
+    a["value"] = a["value"] + bias * se + shift
+    a["systematic"] = (("replicate", "quantity"), np.full((n, 1), syst))
+    a["calibration_effect"] = (("replicate", "quantity"), -shift)
+    c = studies.coverage(a).isel(point=0, quantity=0)
+    assert float(c.bias_over_se_calibrated) == pytest.approx(bias, abs=4 * float(c.bias_over_se_calibrated_err))
+    assert float(c.bias_over_se_calibrated_err) == pytest.approx(1 / np.sqrt(n), rel=0.1)
+    assert float(c.bias_over_se_err) > 3.5 * float(c.bias_over_se_calibrated_err)  # the draw's spread
+    assert float(c.spread_over_se_calibrated) == pytest.approx(1.0, abs=0.04)
+    assert float(c.spread_over_se) == pytest.approx(np.hypot(1, 4), rel=0.05)
+    # the statistical interval around value + effect, with the bias of 0.3 SE: 2 Phi(1.96 - 0.3) - 1 - ...
+    from scipy import stats
+
+    expected = stats.norm.cdf(1.96 - bias) - stats.norm.cdf(-1.96 - bias)
+    assert float(c.coverage_95_calibrated) == pytest.approx(expected, abs=4 * float(c.coverage_95_calibrated_err))
+    assert float(c.coverage_95) < 0.5  # the raw statistical interval does not cover the draw
+    assert int(c.n_calibrated) == n
+    plain = studies.coverage(fake_replicates(200, 0.01, 0.01)).isel(point=0, quantity=0)
+    assert int(plain.n_calibrated) == 0 and np.isnan(float(plain.bias_over_se_calibrated))
+    assert np.isnan(float(plain.coverage_95_calibrated))
+    text = studies.coverage_csv(studies.coverage(a))
+    header = text.splitlines()[0].split(",")
+    assert {"bias_over_se_calibrated", "coverage_95_calibrated", "spread_over_se_calibrated"} <= set(header)
+
+
 def test_batches_without_a_systematic_still_aggregate():
     from test_studies import fake_replicates
 
