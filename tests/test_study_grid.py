@@ -252,8 +252,8 @@ def test_the_combined_interval_covers_what_the_statistical_one_misses():
 
 
 def test_the_calibration_effect_takes_the_draw_out_of_bias_spread_and_statistical_coverage():
-    """value = truth + bias + statistical noise + the drawn calibration's shift (4x the SE, as at 1 px);
-    calibration_effect = minus that shift. Around value + effect the bias is measured to its statistical
+    """Each value is truth + bias + statistical noise + the drawn calibration's shift (4x the SE, as at
+    1 px); calibration_effect is minus that shift. Around value + effect the bias is measured to its statistical
     precision (the raw bias is 4x less sharp), the spread is the statistical one and the statistical
     interval covers 95 %; a replicate without an effect (not drawn) leaves the *_calibrated columns NaN.
     """
