@@ -643,6 +643,36 @@ class EmptySweepPoint(ValueError):
     """A sweep point at which no replicate gave a usable estimate of any quantity."""
 
 
+def _calibrated_columns(okc: np.ndarray, dc: np.ndarray, e: np.ndarray, dof: np.ndarray) -> dict[str, np.ndarray]:
+    """Return the ``*_calibrated`` columns of one sweep point (replicate x quantity in, a row per quantity out).
+
+    The statistical interval where the calibration is drawn: around the value with the draw's
+    first-order effect taken out (the value a lab with the true calibration would get), so that
+    the draw's spread, which the statistical error does not claim, leaves the bias and the
+    coverage. ``okc``: replicates with a value, an uncertainty, a truth and an effect; ``dc``:
+    value + calibration_effect - truth.
+    """
+    nc = okc.sum(axis=0)
+    col = {"n_calibrated": nc.astype(float)}
+    with np.errstate(all="ignore"):
+        dc = np.where(okc, dc, 0.0)
+        zc = dc / np.where(okc, e, 1.0)
+        m = np.where(nc > 0, nc, np.nan)
+        bias_c = zc.sum(axis=0) / m
+        col["bias_over_se_calibrated"] = bias_c
+        sd_z = np.sqrt(np.where(okc, (zc - bias_c) ** 2, 0.0).sum(axis=0) / (m - 1))
+        col["bias_over_se_calibrated_err"] = sd_z / np.sqrt(m)
+        sd_d = np.sqrt(np.where(okc, (dc - dc.sum(axis=0) / m) ** 2, 0.0).sum(axis=0) / (m - 1))
+        spread_c = sd_d / (np.where(okc, e, 0.0).sum(axis=0) / m)
+        col["spread_over_se_calibrated"] = spread_c
+        col["spread_over_se_calibrated_err"] = spread_c / np.sqrt(2.0 * np.maximum(nc - 1, 1))
+        for q in (68, 95):
+            frac = np.where(okc, np.abs(dc) <= _t(q / 100, dof) * e, False).sum(axis=0) / m
+            col[f"coverage_{q}_calibrated"] = frac
+            col[f"coverage_{q}_calibrated_err"] = np.sqrt(frac * (1 - frac) / nc)
+    return col
+
+
 def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Dataset:
     """Coverage of every quantity at every sweep point (from :func:`combine`'s replicates).
 
@@ -708,29 +738,8 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
                 frac = np.where(oks, np.abs(d) <= half, False).sum(axis=0) / np.where(ns > 0, ns, np.nan)
                 out[f"coverage_{q}_combined"][p] = frac
                 out[f"coverage_{q}_combined_err"][p] = np.sqrt(frac * (1 - frac) / ns)
-            # the statistical interval where the calibration is drawn: around the value with the draw's
-            # first-order effect taken out (the value a lab with the true calibration would get), so that
-            # the draw's spread, which the statistical error does not claim, leaves the bias and the coverage
-            okc = ok & np.isfinite(eff)
-            nc = okc.sum(axis=0)
-            out["n_calibrated"][p] = nc
-            dc = np.where(okc, v + eff - t, 0.0)
-            zc = dc / np.where(okc, e, 1.0)
-            m = np.where(nc > 0, nc, np.nan)
-            bias_c = zc.sum(axis=0) / m
-            out["bias_over_se_calibrated"][p] = bias_c
-            sd_z = np.sqrt(np.where(okc, (zc - bias_c) ** 2, 0.0).sum(axis=0) / (m - 1))
-            out["bias_over_se_calibrated_err"][p] = sd_z / np.sqrt(m)
-            sd_d = np.sqrt(np.where(okc, (dc - dc.sum(axis=0) / m) ** 2, 0.0).sum(axis=0) / (m - 1))
-            spread_c = sd_d / (np.where(okc, e, 0.0).sum(axis=0) / m)
-            out["spread_over_se_calibrated"][p] = spread_c
-            out["spread_over_se_calibrated_err"][p] = spread_c / np.sqrt(2.0 * np.maximum(nc - 1, 1))
-            for q in (68, 95):
-                frac = np.where(okc, np.abs(dc) <= _t(q / 100, dof) * e, False).sum(axis=0) / np.where(
-                    nc > 0, nc, np.nan
-                )
-                out[f"coverage_{q}_calibrated"][p] = frac
-                out[f"coverage_{q}_calibrated_err"][p] = np.sqrt(frac * (1 - frac) / nc)
+            for k, col in _calibrated_columns(ok & np.isfinite(eff), v + eff - t, e, dof).items():
+                out[k][p] = col
             out["mean_value"][p] = np.nanmean(np.where(ok, v, np.nan), axis=0)
             out["mean_truth"][p] = np.nanmean(np.where(ok, t, np.nan), axis=0)
             out["mean_dof"][p] = np.nanmean(np.where(ok, dof, np.nan), axis=0)
