@@ -360,3 +360,52 @@ def test_combined_interval_takes_welch_satterthwaite_degrees_of_freedom():
     held = np.mean(np.abs(d) <= _t(0.95, np.full(n, nu)) * total)
     assert abs(ws - 0.95) < 0.005, ws
     assert held > 0.97, held
+
+
+def _fake_rows(value: float) -> list[dict]:
+    row = {"quantity": "e_x", "ball": "baseball", "bat": "wood", "value": value, "uncertainty": 0.01, "truth": 0.35}
+    return [{**row, "dof": math.inf, "units": "1", "systematic": math.nan, "calibration_effect": math.nan}]
+
+
+def test_a_refused_replicate_is_counted_and_the_batch_goes_on(config, balls, bats, monkeypatch):
+    """A check's false alarm on one replicate (its data refused) must not stop a study of thousands: the
+    batch records why (``refusal``), gives it no estimates, and the coverage table counts it (``n_refused``)
+    apart from the replicates it judges.
+    """
+    from ballbat.properties import InputError
+
+    def fake(settings, dataset, replicate, balls, bats, check=True):
+        if replicate == 3:
+            raise InputError(["render (replicate 3).cameras.spin: g is negative: y points up"])
+        return _fake_rows(0.35 + 0.01 * (replicate - 5) / 5)
+
+    monkeypatch.setattr(studies, "run_replicate", fake)
+    s = settings(config, replicates=20, batch_size=20)
+    batch = study_batch.run(s, 0, balls, bats)
+    why = batch["refusal"].values.astype(str)
+    assert [i for i, w in enumerate(why) if w] == [3]
+    assert "replicate 3" in why[3] and "y points up" in why[3]
+    assert np.isnan(batch["value"].values[3]).all() and np.isfinite(batch["value"].values[:3]).all()
+    cov = studies.coverage(studies.combine([batch]))
+    assert int(cov["n_refused"].values[0, 0]) == 1 and int(cov["n_replicates"].values[0, 0]) == 19
+    header = studies.coverage_csv(cov).splitlines()[0].split(",")
+    assert header[header.index("n_replicates") + 1] == "n_refused"
+
+
+def test_a_batch_whose_data_are_refused_again_and_again_stops_with_the_first_reason(config, balls, bats, monkeypatch):
+    """More refusals than false alarms explain (over 5 % of a batch) are a wrong setting: the batch stops
+    at once with the first reason, instead of running on to a study of nothing.
+    """
+    from ballbat.properties import InputError
+
+    calls = []
+
+    def fake(settings, dataset, replicate, balls, bats, check=True):
+        calls.append(replicate)
+        raise InputError([f"tracks.cameras.swing: fps wrong (replicate {replicate})"])
+
+    monkeypatch.setattr(studies, "run_replicate", fake)
+    s = settings(config, replicates=40, batch_size=40)
+    with pytest.raises(studies.TooManyRefused, match=r"refused 3 of its first 3 replicates.*replicate 0\)"):
+        study_batch.run(s, 0, balls, bats)
+    assert len(calls) == 3  # 5 % of 40: two may be false alarms, the third stops it

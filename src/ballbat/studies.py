@@ -312,18 +312,49 @@ def row_labels(rows: list[dict]) -> list[str]:
     return [f"{r['quantity']}:{r['ball']}:{r['bat']}" for r in rows]
 
 
+#: Largest fraction of a batch's replicates whose data the chain may refuse before the batch stops.
+REFUSED_FRACTION_MAX = 0.05
+
+
+class TooManyRefused(ValueError):
+    """More of a batch's replicates were refused than a false alarm explains: a setting is wrong."""
+
+
 def run_replicates(
     settings: StudySettings, batch: int, balls: dict[str, Ball], bats: dict[str, Bat]
-) -> Iterator[tuple[int, int, int, list[dict]]]:
+) -> Iterator[tuple[int, int, int, list[dict], str]]:
     """Run the replicates of batch ``batch`` one after the other (the file: :func:`ballbat.stages.study_batch.run`).
 
     Yields, per replicate: its number over the whole study, its sweep point, its number within
-    the point (:meth:`StudySettings.batch_range`) and its rows (:func:`run_replicate`).
+    the point (:meth:`StudySettings.batch_range`), its rows (:func:`run_replicate`) and, when the
+    chain refused its data, why ("" otherwise; no rows then).
+
+    A check of the data (:func:`ballbat.tracks.checks.cross_check`) refuses a lab's dataset at
+    a false-alarm rate of about 1e-3 per test; over a study's thousands of replicates some are
+    refused by chance, and a lab whose data were refused would not report them either. They
+    are counted (``n_refused`` of the coverage table), not hidden. More than
+    :data:`REFUSED_FRACTION_MAX` of a batch (at least 2 replicates) is no false alarm but a
+    wrong setting: :class:`TooManyRefused`, with the first reason.
     """
-    for g in settings.batch_range(batch):
+    from .properties import InputError
+
+    todo = settings.batch_range(batch)
+    allowed = max(1, math.floor(REFUSED_FRACTION_MAX * len(todo)))
+    reasons = []
+    for g in todo:
         point, rep = divmod(g, settings.replicates)
         dataset = point_dataset(settings.dataset, settings.parameter, settings.values[point])
-        yield g, point, rep, run_replicate(settings, dataset, rep, balls, bats)
+        try:
+            rows, why = run_replicate(settings, dataset, rep, balls, bats), ""
+        except InputError as err:
+            rows, why = [], f"replicate {g} (point {point}, replicate {rep}): {err}"
+            reasons.append(why)
+            if len(reasons) > allowed:
+                raise TooManyRefused(
+                    f"batch {batch}: the chain refused {len(reasons)} of its first {g - todo[0] + 1} replicates "
+                    f"(at most {allowed} of {len(todo)} are put down to false alarms); the first: {reasons[0]}"
+                ) from err
+        yield g, point, rep, rows, why
 
 
 def quantity_coords(labels: list[str], parts: list[list[str]], units: list[str]) -> dict:
@@ -552,6 +583,11 @@ def _t(q: float, dof: np.ndarray) -> np.ndarray:
 #: The coverage table (dims point x quantity).
 COVERAGE_TABLE = {
     "n_replicates": Var(("point", "quantity"), "1", "replicates with a value, an uncertainty and a truth"),
+    "n_refused": Var(
+        ("point", "quantity"),
+        "1",
+        "replicates of the point whose data the chain refused (a check's false alarm; not in n_replicates)",
+    ),
     "bias_over_se": Var(("point", "quantity"), "1", "mean of (value - truth) / uncertainty"),
     "bias_over_se_err": Var(("point", "quantity"), "1", "standard error of bias_over_se"),
     "spread_over_se": Var(("point", "quantity"), "1", "standard deviation of (value - truth) / mean uncertainty"),
@@ -687,6 +723,7 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
     point = rep["point"].values
     syst_all = rep["systematic"].values if "systematic" in rep else np.full(rep["value"].shape, np.nan)
     eff_all = rep["calibration_effect"].values if "calibration_effect" in rep else np.full(rep["value"].shape, np.nan)
+    refused = rep["refusal"].values.astype(str) != "" if "refusal" in rep else np.zeros(point.size, dtype=bool)
     for p in range(npt):
         sel = point == p
         v, e, t, dof = (rep[k].values[sel] for k in ("value", "uncertainty", "truth", "dof"))
@@ -707,6 +744,7 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
                 "chain can fit: drop the point or change it"
             )
         out["n_replicates"][p] = n
+        out["n_refused"][p] = refused[sel].sum()
         with np.errstate(all="ignore"):
             d = np.where(ok, v - t, np.nan)
             z = d / np.where(ok, e, np.nan)
@@ -769,6 +807,7 @@ COVERAGE_COLUMNS = (
     "bat",
     "unit",
     "n_replicates",
+    "n_refused",
     "bias_over_se",
     "bias_over_se_err",
     "spread_over_se",

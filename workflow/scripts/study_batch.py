@@ -17,4 +17,7 @@ with logged(snakemake.log[0], snakemake.rule) as log:
             log.info("%d of %d replicates", done, n)
 
     ds = study_batch.run(settings, batch, load_balls(snakemake.input.balls), load_bats(snakemake.input.bats), progress)
+    for why in ds["refusal"].values.astype(str):
+        if why:
+            log.warning("data refused, counted in the coverage table's n_refused: %s", why)
     write_job_output(ds, snakemake, "batch", f"Study {study}, batch {batch}: replicate estimates, errors and truths")

@@ -53,6 +53,11 @@ BATCH_TABLE = {
     ),
     "point": Var(("replicate",), "1", "sweep point of the replicate (index into setting)"),
     "seed_replicate": Var(("replicate",), "1", "replicate number within its point (its seeds' spawn key)"),
+    "refusal": Var(
+        ("replicate",),
+        None,
+        "why the chain refused the replicate's data (empty: it did not; a refused replicate has no estimates)",
+    ),
 }
 
 
@@ -83,7 +88,7 @@ def run(
             progress(len(records), len(settings.batch_range(batch)))
     table: dict[str, int] = {}
     units: dict[str, str] = {}
-    for _, _, _, rows in records:
+    for _, _, _, rows, _ in records:
         for label, r in zip(row_labels(rows), rows, strict=True):
             table.setdefault(label, len(table))
             units.setdefault(label, r["units"])
@@ -92,19 +97,20 @@ def run(
         k: np.full((len(records), len(labels)), np.nan)
         for k in ("value", "uncertainty", "truth", "dof", "systematic", "calibration_effect")
     }
-    for i, (_, _, _, rows) in enumerate(records):
+    for i, (_, _, _, rows, _) in enumerate(records):
         for label, r in zip(row_labels(rows), rows, strict=True):
             for k in arrays:
                 v = r.get(k)
                 arrays[k][i, table[label]] = np.nan if v is None else float(v)
     values = {
         **arrays,
-        "point": np.array([p for _, p, _, _ in records], dtype=np.int64),
-        "seed_replicate": np.array([r for _, _, r, _ in records], dtype=np.int64),
+        "point": np.array([p for _, p, _, _, _ in records], dtype=np.int64),
+        "seed_replicate": np.array([r for _, _, r, _, _ in records], dtype=np.int64),
+        "refusal": np.array([why for *_, why in records], dtype=str),
     }
     coords = quantity_coords(labels, [lab.split(":") for lab in labels], [units[lab] for lab in labels])
     coords["replicate"] = (
         Var(("replicate",), "1", "replicate number over the whole study"),
-        np.array([g for g, _, _, _ in records], dtype=np.int64),
+        np.array([g for g, *_ in records], dtype=np.int64),
     )
     return build_dataset(BATCH_TABLE, values, coords, study_attrs(settings, batch))
