@@ -77,6 +77,9 @@ def main() -> None:
             f" {int(g['bias_fail'].sum())} of {len(g)} |"
         )
     n = len(d)
+    if "n_refused" in d:
+        refused = d.groupby(keys)["n_refused"].max()
+        print(f"\nreplicates refused by the data's checks: {int(refused.sum())} at {int((refused > 0).sum())} points")
     print(
         f"\n{n} entries at {d.groupby(keys).ngroups} points: {int(d['stat_fail'].sum())} statistical and"
         f" {int(d['comb_fail'].sum())} combined 95 % intervals outside 93-97 % by more than two binomial errors;"

@@ -43,7 +43,7 @@ from __future__ import annotations
 
 import enum
 import warnings
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -795,7 +795,48 @@ SPIN_GN_ITERATIONS = 4
 OFFSET_FALSE_ALARM = 1e-3
 
 
+#: Impacts per block of the joint spin fit (its design matrix is impacts x 6 columns x 9 parameters).
+SPIN_FIT_BLOCK = 2000
+
+
 def _spin_joint_fit(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept, radius, masks, s_dot):
+    """:func:`_spin_block` on blocks of :data:`SPIN_FIT_BLOCK` impacts (a bounded memory), joined."""
+    n = t.shape[0]
+    if n <= SPIN_FIT_BLOCK:
+        return _spin_block(ball, ct_x, ct_y, t, flight, omega, omega_err, intercept, radius, masks, s_dot)
+    parts = []
+    for lo in range(0, n, SPIN_FIT_BLOCK):
+        sl = slice(lo, lo + SPIN_FIT_BLOCK)
+
+        def cut(x, sl=sl):
+            return {k: v[sl] for k, v in x.items()} if isinstance(x, dict) else x[sl]
+
+        fl = replace(flight, **{f.name: getattr(flight, f.name)[sl] for f in fields(flight)})
+        parts.append(
+            _spin_block(
+                tuple(cut(b) for b in ball),
+                cut(ct_x),
+                cut(ct_y),
+                cut(t),
+                fl,
+                cut(omega),
+                cut(omega_err),
+                cut(intercept),
+                cut(radius),
+                cut(masks),
+                cut(s_dot),
+            )
+        )
+    joined = []
+    for k, first in enumerate(parts[0]):
+        if isinstance(first, dict):
+            joined.append({d: np.concatenate([p[k][d] for p in parts]) for d in first})
+        else:
+            joined.append(np.concatenate([p[k] for p in parts]))
+    return tuple(joined)
+
+
+def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept, radius, masks, s_dot):
     """Fit the spin, the dots' radii and phases and the ball's flight together, on positions.
 
     The angle of a dot about the flight's fitted centre is not linear in the centre's error
