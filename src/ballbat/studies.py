@@ -29,6 +29,7 @@ of impacts per bat needed to tell two bats ``delta_e_x`` apart.
 from __future__ import annotations
 
 import math
+import warnings
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
@@ -679,34 +680,31 @@ class EmptySweepPoint(ValueError):
     """A sweep point at which no replicate gave a usable estimate of any quantity."""
 
 
-def _calibrated_columns(okc: np.ndarray, dc: np.ndarray, e: np.ndarray, dof: np.ndarray) -> dict[str, np.ndarray]:
-    """Return the ``*_calibrated`` columns of one sweep point (replicate x quantity in, a row per quantity out).
+def _interval_columns(ok: np.ndarray, d: np.ndarray, e: np.ndarray, dof: np.ndarray, tag: str = "") -> dict:
+    """Return bias, spread and 68/95 % coverage of ``d`` (replicate x quantity in, a row per quantity out).
 
-    The statistical interval where the calibration is drawn: around the value with the draw's
-    first-order effect taken out (the value a lab with the true calibration would get), so that
-    the draw's spread, which the statistical error does not claim, leaves the bias and the
-    coverage. ``okc``: replicates with a value, an uncertainty, a truth and an effect; ``dc``:
-    value + calibration_effect - truth.
+    ``ok``: the replicates to judge; ``d``: estimate - truth; ``e``: the statistical
+    uncertainty, ``dof`` its degrees of freedom. ``tag`` goes into every column's name before
+    ``_err`` (``"_calibrated"``: the columns of value + calibration_effect, the value a lab
+    with the true calibration would get, so that the drawn calibration's spread, which the
+    statistical error does not claim, leaves the bias and the coverage).
     """
-    nc = okc.sum(axis=0)
-    col = {"n_calibrated": nc.astype(float)}
-    with np.errstate(all="ignore"):
-        dc = np.where(okc, dc, 0.0)
-        zc = dc / np.where(okc, e, 1.0)
-        m = np.where(nc > 0, nc, np.nan)
-        bias_c = zc.sum(axis=0) / m
-        col["bias_over_se_calibrated"] = bias_c
-        sd_z = np.sqrt(np.where(okc, (zc - bias_c) ** 2, 0.0).sum(axis=0) / (m - 1))
-        col["bias_over_se_calibrated_err"] = sd_z / np.sqrt(m)
-        sd_d = np.sqrt(np.where(okc, (dc - dc.sum(axis=0) / m) ** 2, 0.0).sum(axis=0) / (m - 1))
-        spread_c = sd_d / (np.where(okc, e, 0.0).sum(axis=0) / m)
-        col["spread_over_se_calibrated"] = spread_c
-        col["spread_over_se_calibrated_err"] = spread_c / np.sqrt(2.0 * np.maximum(nc - 1, 1))
+    n = ok.sum(axis=0)
+    col = {}
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # a quantity no replicate judged: NaN, said by n
+        d = np.where(ok, d, np.nan)
+        z = d / np.where(ok, e, np.nan)
+        col["bias_over_se"] = np.nanmean(z, axis=0)
+        col["bias_over_se_err"] = np.nanstd(z, axis=0, ddof=1) / np.sqrt(n)
+        ratio = np.nanstd(d, axis=0, ddof=1) / np.nanmean(np.where(ok, e, np.nan), axis=0)
+        col["spread_over_se"] = ratio
+        col["spread_over_se_err"] = ratio / np.sqrt(2.0 * np.maximum(n - 1, 1))
         for q in (68, 95):
-            frac = np.where(okc, np.abs(dc) <= _t(q / 100, dof) * e, False).sum(axis=0) / m
-            col[f"coverage_{q}_calibrated"] = frac
-            col[f"coverage_{q}_calibrated_err"] = np.sqrt(frac * (1 - frac) / nc)
-    return col
+            frac = np.where(ok, np.abs(d) <= _t(q / 100, dof) * e, False).sum(axis=0) / n
+            col[f"coverage_{q}"] = frac
+            col[f"coverage_{q}_err"] = np.sqrt(frac * (1 - frac) / n)
+    return {(k[:-4] + tag + "_err" if k.endswith("_err") else k + tag): v for k, v in col.items()}
 
 
 def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Dataset:
@@ -745,23 +743,17 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
             )
         out["n_replicates"][p] = n
         out["n_refused"][p] = refused[sel].sum()
+        okc = ok & np.isfinite(eff)
+        out["n_calibrated"][p] = okc.sum(axis=0)
+        for k, col in {
+            **_interval_columns(ok, v - t, e, dof),
+            **_interval_columns(okc, v + eff - t, e, dof, "_calibrated"),
+        }.items():
+            out[k][p] = col
         with np.errstate(all="ignore"):
             d = np.where(ok, v - t, np.nan)
-            z = d / np.where(ok, e, np.nan)
-            out["bias_over_se"][p] = np.nanmean(z, axis=0)
-            out["bias_over_se_err"][p] = np.nanstd(z, axis=0, ddof=1) / np.sqrt(n)
-            mean_e = np.nanmean(np.where(ok, e, np.nan), axis=0)
-            spread = np.nanstd(d, axis=0, ddof=1)
-            out["spread"][p] = spread
-            out["mean_uncertainty"][p] = mean_e
-            out["spread_over_se"][p] = spread / mean_e
-            out["spread_over_se_err"][p] = spread / mean_e / np.sqrt(2.0 * np.maximum(n - 1, 1))
-            for q in (68, 95):
-                half = _t(q / 100, dof) * e
-                hit = np.where(ok, np.abs(d) <= half, False)
-                frac = hit.sum(axis=0) / n
-                out[f"coverage_{q}"][p] = frac
-                out[f"coverage_{q}_err"][p] = np.sqrt(frac * (1 - frac) / n)
+            out["spread"][p] = np.nanstd(d, axis=0, ddof=1)
+            out["mean_uncertainty"][p] = np.nanmean(np.where(ok, e, np.nan), axis=0)
             # the combined interval (statistical and systematic in quadrature), where a systematic is
             # reported; a quantity without one gets NaN, not the statistical coverage again
             oks = ok & np.isfinite(syst) & (syst >= 0)
@@ -776,8 +768,6 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
                 frac = np.where(oks, np.abs(d) <= half, False).sum(axis=0) / np.where(ns > 0, ns, np.nan)
                 out[f"coverage_{q}_combined"][p] = frac
                 out[f"coverage_{q}_combined_err"][p] = np.sqrt(frac * (1 - frac) / ns)
-            for k, col in _calibrated_columns(ok & np.isfinite(eff), v + eff - t, e, dof).items():
-                out[k][p] = col
             out["mean_value"][p] = np.nanmean(np.where(ok, v, np.nan), axis=0)
             out["mean_truth"][p] = np.nanmean(np.where(ok, t, np.nan), axis=0)
             out["mean_dof"][p] = np.nanmean(np.where(ok, dof, np.nan), axis=0)
