@@ -841,8 +841,9 @@ def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept
 
     The angle of a dot about the flight's fitted centre is not linear in the centre's error
     (nor in the dot's own when the noise is a good part of the radius), so the slope of
-    those angles is low by a part in 10^3 at 5 px of noise, a twentieth of its error on
-    every impact, which a ball's 200 impacts add up to a third of eta^2's error. On the
+    those angles is low by a part in 10^3 at 5 px of noise, 0.03 of its error on every
+    impact, which a ball's 200 impacts add up to 0.13 of eta^2's error (softballs, 60 per
+    bat; docs/tracks.md). On the
     positions, where the noise is Gaussian, one least-squares fit of the ball's centre
     (:meth:`Flight.centre`'s model) and the dots turning about it at one spin has no such
     bias. Each coordinate of the ball is weighted by the flight fit's scatter, each of a
