@@ -154,6 +154,37 @@ def test_coverage_arithmetic():
     assert cov_t.coverage_95 == pytest.approx(0.95, abs=0.01)
 
 
+def test_the_truths_own_sampling_error_goes_into_the_bias_error():
+    """A design's truth comes from a finite experiment: its scatter, the replicates' own truths' over sqrt(scale).
+
+    Own noise-free estimates scatter by 0.01 about the population value; the truth's experiment
+    repeats the design 100 times, so the truth is known to 0.001, a tenth of the reported 0.01.
+    The bias's error is the replicates' 0.01 / sqrt(400) = 0.05 SE and that 0.1 in quadrature.
+    A conditional truth (each replicate's own) has none.
+    """
+    n = 400
+    a = fake_replicates(n, 0.01, 0.01, seed=3)
+    b = fake_replicates(n, 0.01, 0.01, seed=4)
+    b = b.assign_coords(quantity=["mu_k_lower_bound:baseball:"], quantity_name=("quantity", ["mu_k_lower_bound"]))
+    rep = xr.concat([a, b], dim="quantity", data_vars="minimal", coords="minimal", compat="override")
+    rng = np.random.default_rng(5)
+    own = 1.0 + 0.01 * rng.standard_normal((n, 2))
+    rep["truth"][:] = own
+    rep["value"][:] = own + 0.01 * rng.standard_normal((n, 2))
+    truths = [{"e_x:baseball:wood": 1.0, "mu_k_lower_bound:baseball:": 1.0}]
+    cov = studies.coverage(rep, truths, [100.0]).isel(point=0)
+    plain = studies.coverage(rep, truths).isel(point=0)
+    te = cov.truth_error_over_se.values
+    assert te[0] == pytest.approx(0.1, rel=0.1)
+    assert np.isnan(te[1]) and np.isnan(plain.truth_error_over_se.values).all()
+    stat = plain.bias_over_se_err.values
+    assert cov.bias_over_se_err.values[0] == pytest.approx(math.hypot(stat[0], te[0]), rel=1e-12)
+    assert cov.bias_over_se_err.values[1] == stat[1]
+    assert cov.bias_over_se.values == pytest.approx(plain.bias_over_se.values)
+    text = studies.coverage_csv(studies.coverage(rep, truths, [100.0]))
+    assert "truth_error_over_se" in text.splitlines()[0].split(",")
+
+
 def test_impacts_required_matches_the_normal_formula_for_many_impacts():
     # sigma with n_at impacts -> single-impact sigma s1; large n: n = 2 (z_a + z_b)^2 s1^2 / delta^2
     s1, delta = 0.1, 0.02

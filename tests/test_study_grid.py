@@ -377,6 +377,10 @@ def test_truth_files_of_single_points_merge_into_the_study_truth(config, balls, 
     assert list(merged.quantity.values) == list(whole.quantity.values)
     assert merged.attrs["truth_impacts"] == 30 and merged.attrs["sweep_parameter"] == "pixel_noise_px,impacts_per_bat"
     assert studies.truths_from_dataset(merged) == studies.truths_from_dataset(whole)
+    # the truth's experiment repeats the design ceil(30 / 6) = 5 and ceil(30 / 9) = 4 times
+    np.testing.assert_array_equal(studies.truth_scales_from_dataset(merged), [5.0, 4.0])
+    with pytest.raises(ValueError, match="no truth_scale variable"):
+        studies.truth_scales_from_dataset(merged.drop_vars("truth_scale"))
     with pytest.raises(ValueError, match=r"missing \[0\], repeated \[1\]"):
         studies.merge_truths([parts[0], parts[0]])
 

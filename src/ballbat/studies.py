@@ -454,6 +454,19 @@ def population_truth(settings: StudySettings, point: int, balls: dict[str, Ball]
     return dict(zip(row_labels(rows), (r["truth"] for r in rows), strict=True))
 
 
+def truth_scale(settings: StudySettings, point: int) -> int:
+    """How many times the truth job's experiment repeats a replicate's design at sweep point ``point``.
+
+    Every pair's impacts are multiplied by the same whole number, so that the pair with the
+    fewest has about ``settings.truth_impacts`` (:func:`_population_rows`). The truth's own
+    sampling error is then about that of a replicate's noise-free estimate over the square root
+    of this number (:func:`coverage`).
+    """
+    ds = point_dataset(settings.dataset, settings.parameter, settings.values[point])
+    counts = [n for per_bat in ds["synthetic"]["impacts"].values() for n in per_bat.values() if n > 0]
+    return max(1, math.ceil(settings.truth_impacts / min(counts)))
+
+
 def _population_rows(settings: StudySettings, point: int, balls: dict[str, Ball], bats: dict[str, Bat]) -> list[dict]:
     """Return the rows of the design's large noise-free experiment at sweep point ``point`` (:func:`run_replicate`'s).
 
@@ -468,8 +481,7 @@ def _population_rows(settings: StudySettings, point: int, balls: dict[str, Ball]
     is the same either way (the model is exact); :data:`CONDITIONAL_TRUTH` keep their own.
     """
     ds = point_dataset(settings.dataset, settings.parameter, settings.values[point])
-    counts = [n for per_bat in ds["synthetic"]["impacts"].values() for n in per_bat.values() if n > 0]
-    k = max(1, math.ceil(settings.truth_impacts / min(counts)))
+    k = truth_scale(settings, point)
     ds["synthetic"]["impacts"] = {
         b: {t: int(n) * k for t, n in per.items()} for b, per in ds["synthetic"]["impacts"].items()
     }
@@ -488,6 +500,9 @@ TRUTH_TABLE = {
         PER_QUANTITY_UNITS,
     ),
     "setting": Var(("point",), "1", "value of the swept setting (NaN: no sweep)"),
+    "truth_scale": Var(
+        ("point",), "1", "how many times the truth's experiment repeats a replicate's design (truth_scale())"
+    ),
 }
 
 
@@ -514,6 +529,7 @@ def truth_dataset(
     values = {
         "truth": np.array([[np.nan if t.get(lab) is None else float(t[lab]) for lab in labels] for t in truths]),
         "setting": _setting_column(names, table),
+        "truth_scale": np.array([truth_scale(settings, p) for p in points], dtype=float),
     }
     coords = quantity_coords(labels, [lab.split(":") for lab in labels], [units[lab] for lab in labels])
     coords["point"] = (Var(("point",), "1", "sweep point"), np.asarray(points, dtype=np.int64))
@@ -556,6 +572,22 @@ def truths_from_dataset(ds: xr.Dataset) -> list[dict]:
     return [dict(zip(labels, map(float, row), strict=True)) for row in ds["truth"].values]
 
 
+def truth_scales_from_dataset(ds: xr.Dataset) -> np.ndarray:
+    """Return the per-point ``truth_scale`` of :func:`truth_dataset` (what :func:`coverage` takes as ``truth_scale``).
+
+    Raises
+    ------
+    ValueError
+        A truth file without it (written before it was recorded): run its truth jobs again.
+    """
+    if "truth_scale" not in ds:
+        raise ValueError(
+            f"{ds.encoding.get('source', 'the truth file')}: no truth_scale variable (written by an older ballbat); "
+            "delete the study's truth files and run its truth jobs again"
+        )
+    return ds["truth_scale"].values.astype(float)
+
+
 # ---------------------------------------------------------------------------------------
 # aggregation
 
@@ -590,7 +622,18 @@ COVERAGE_TABLE = {
         "replicates of the point whose data the chain refused (a check's false alarm; not in n_replicates)",
     ),
     "bias_over_se": Var(("point", "quantity"), "1", "mean of (value - truth) / uncertainty"),
-    "bias_over_se_err": Var(("point", "quantity"), "1", "standard error of bias_over_se"),
+    "bias_over_se_err": Var(
+        ("point", "quantity"),
+        "1",
+        "standard error of bias_over_se: the replicates' scatter and the truth's own sampling error "
+        "(truth_error_over_se) in quadrature",
+    ),
+    "truth_error_over_se": Var(
+        ("point", "quantity"),
+        "1",
+        "sampling error of the design's truth (its large noise-free experiment) over the mean uncertainty "
+        "(NaN: judged against each replicate's own truth, or no truth_scale)",
+    ),
     "spread_over_se": Var(("point", "quantity"), "1", "standard deviation of (value - truth) / mean uncertainty"),
     "spread_over_se_err": Var(("point", "quantity"), "1", "standard error of spread_over_se"),
     "coverage_68": Var(("point", "quantity"), "1", "fraction of 68 % intervals (t quantile) that cover the truth"),
@@ -633,7 +676,9 @@ COVERAGE_TABLE = {
         "mean of (value + calibration_effect - truth) / uncertainty: the bias with the drawn calibration's "
         "first-order effect taken out (NaN: calibration not drawn)",
     ),
-    "bias_over_se_calibrated_err": Var(("point", "quantity"), "1", "standard error of bias_over_se_calibrated"),
+    "bias_over_se_calibrated_err": Var(
+        ("point", "quantity"), "1", "standard error of bias_over_se_calibrated (as bias_over_se_err)"
+    ),
     "spread_over_se_calibrated": Var(
         ("point", "quantity"),
         "1",
@@ -707,11 +752,22 @@ def _interval_columns(ok: np.ndarray, d: np.ndarray, e: np.ndarray, dof: np.ndar
     return {(k[:-4] + tag + "_err" if k.endswith("_err") else k + tag): v for k, v in col.items()}
 
 
-def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Dataset:
+def coverage(
+    rep: xr.Dataset, truths: Sequence[dict] | None = None, truth_scale: Sequence[float] | None = None
+) -> xr.Dataset:
     """Coverage of every quantity at every sweep point (from :func:`combine`'s replicates).
 
     ``truths``: per sweep point, the design's truth of each quantity (:func:`population_truth`);
-    None judges every estimate against its own replicate's truth. A point at which no replicate
+    None judges every estimate against its own replicate's truth. ``truth_scale``: per sweep
+    point, how many times the truth's experiment repeats a replicate's design
+    (:func:`truth_scale`). The design's truth is itself an estimate from a finite experiment:
+    its sampling error is about the spread of the replicates' own noise-free estimates (their
+    ``truth``) over the square root of that number. It is not negligible against a bias of a
+    tenth of a standard error (up to 0.05-0.08 standard errors at 30-60 impacts per bat and
+    10000 per truth, where the noise-free estimate scatters as much as the noisy one), so it
+    goes into the bias's standard error (``truth_error_over_se``).
+
+    A point at which no replicate
     has a usable estimate of any quantity raises :class:`EmptySweepPoint` naming it; a quantity
     with fewer than :data:`MIN_COVERAGE_REPLICATES` replicates gets a warning (``warning``).
     """
@@ -726,6 +782,8 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
         sel = point == p
         v, e, t, dof = (rep[k].values[sel] for k in ("value", "uncertainty", "truth", "dof"))
         syst, eff = syst_all[sel], eff_all[sel]
+        own = t
+        use = np.zeros(t.shape[1], dtype=bool)
         if truths is not None:
             labels = rep["quantity"].values.astype(str)
             names = rep["quantity_name"].values.astype(str)
@@ -750,6 +808,11 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
             **_interval_columns(okc, v + eff - t, e, dof, "_calibrated"),
         }.items():
             out[k][p] = col
+        if truth_scale is not None:
+            te = _truth_error_over_se(ok & use[None, :], own, e, float(truth_scale[p]))
+            out["truth_error_over_se"][p] = te
+            for k in ("bias_over_se_err", "bias_over_se_calibrated_err"):
+                out[k][p] = np.hypot(out[k][p], np.where(np.isfinite(te), te, 0.0))
         with np.errstate(all="ignore"):
             d = np.where(ok, v - t, np.nan)
             out["spread"][p] = np.nanstd(d, axis=0, ddof=1)
@@ -785,6 +848,20 @@ def coverage(rep: xr.Dataset, truths: Sequence[dict] | None = None) -> xr.Datase
     return build_dataset(COVERAGE_TABLE, out, coords, attrs)
 
 
+def _truth_error_over_se(ok: np.ndarray, own: np.ndarray, e: np.ndarray, scale: float) -> np.ndarray:
+    """Return the sampling error of a design's truth over the mean uncertainty (per quantity; NaN where ``ok`` has < 2).
+
+    ``own``: each replicate's own noise-free estimate; the truth's experiment is ``scale`` times
+    a replicate's, so its estimate scatters about sqrt(scale) times less.
+    """
+    with np.errstate(all="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)
+        good = ok & np.isfinite(own)
+        spread = np.nanstd(np.where(good, own, np.nan), axis=0, ddof=1)
+        mean_e = np.nanmean(np.where(good, e, np.nan), axis=0)
+        return spread / math.sqrt(scale) / mean_e
+
+
 def _copy_coord(ds: xr.Dataset, name: str) -> tuple:
     v = ds[name]
     return (Var(("quantity",), None, v.attrs.get("long_name", name)), v.values.astype(str))
@@ -800,6 +877,7 @@ COVERAGE_COLUMNS = (
     "n_refused",
     "bias_over_se",
     "bias_over_se_err",
+    "truth_error_over_se",
     "spread_over_se",
     "spread_over_se_err",
     "coverage_68",

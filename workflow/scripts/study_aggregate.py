@@ -4,12 +4,13 @@ from ballbat.pipeline.ncio import atomic_write_text, read_dataset, write_job_out
 from ballbat.pipeline.provenance import job_provenance, png_text
 from ballbat.pipeline.runlog import logged
 from ballbat.plotting import coverage_figure, save_figure
-from ballbat.studies import combine, coverage, coverage_csv, truths_from_dataset
+from ballbat.studies import combine, coverage, coverage_csv, truth_scales_from_dataset, truths_from_dataset
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     study = snakemake.wildcards.study
     reps = combine(read_dataset(p) for p in snakemake.input.batches)
-    cov = coverage(reps, truths_from_dataset(read_dataset(snakemake.input.truth)))
+    truth = read_dataset(snakemake.input.truth)
+    cov = coverage(reps, truths_from_dataset(truth), truth_scales_from_dataset(truth))
     for line in coverage_csv(cov).splitlines()[1:]:
         log.info("%s", line)
     write_job_output(cov, snakemake, "coverage", f"Study {study}: coverage of every reported uncertainty")
