@@ -412,10 +412,13 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
 
         v_bat, _, theta, _ = Measured.from_dataset(ds, in_ball)
         tv = Measured.from_dataset(ds, in_ball, "truth_") if has_truth else None
+        bats_in_ball = ds["bat"].values[in_ball].astype(str)  # the sandwich's strata (fit_line)
         for grid, which in ((res.spin_theta_slope, "omega"), (res.speed_theta_slope, "v_ball")):
             y_norm = ds[f"{which}_norm"].values[in_ball].astype(float)
             x, y, jx, jy = normalized_theta_design(v_bat, y_norm, theta, which, v_ref)
-            fit = fit_line(x, y, jx, jy, sig, through_origin=False, robust=True, errors_in_variables=True)
+            fit = fit_line(
+                x, y, jx, jy, sig, through_origin=False, robust=True, errors_in_variables=True, strata=bats_in_ball
+            )
             grid.fits[i] = fit
             if has_truth:
                 yt_norm = normalize_to_bat_speed(tv[MEASURED.index(which)], tv[0], v_ref)

@@ -70,6 +70,7 @@ def fit_line(
     iterations: int = 3,
     robust: bool = False,
     errors_in_variables: bool = False,
+    strata: ArrayLike | None = None,
 ) -> LineFit:
     """Fit y = slope x (+ intercept) with lmfit, weighting by the effective variance.
 
@@ -88,10 +89,14 @@ def fit_line(
         (:func:`eiv_line`): the weighted least-squares slope is attenuated by the abscissa's
         measurement noise, and the moment-corrected estimator is not. Needs the
         uncertainties; without them the fit is the plain one.
+    strata : with ``robust``, a label per point (its bat): the sandwich is centred within them
+        (:func:`sandwich_cov`). A line pooled over bats chosen by the lab (Figs. 3-4) misses
+        each bat's own line by the same amount in every repetition of the experiment; that
+        misfit is not scatter, only the spread within a bat is.
     """
     weighted = sigma is not None and np.all(np.isfinite(sigma)) and np.any(np.asarray(sigma) > 0)
     if errors_in_variables and weighted:
-        return eiv_line(x, y, jx, jy, sigma, through_origin, iterations, robust)
+        return eiv_line(x, y, jx, jy, sigma, through_origin, iterations, robust, strata)
     import lmfit
     from scipy import stats
 
@@ -135,7 +140,7 @@ def fit_line(
     if robust:
         X = x[:, None] if through_origin else np.stack([x, np.ones_like(x)], axis=1)
         w = np.ones(n) if weights is None else np.asarray(weights, dtype=float)
-        cov = sandwich_cov(X * w[:, None], (y - slope * x - icpt) * w)
+        cov = sandwich_cov(X * w[:, None], (y - slope * x - icpt) * w, strata)
         err = float(np.sqrt(cov[0, 0]))
         icpt_err = 0.0 if through_origin else float(np.sqrt(cov[1, 1]))
     return LineFit(
@@ -160,6 +165,7 @@ def eiv_line(
     through_origin: bool = True,
     iterations: int = 3,
     robust: bool = False,
+    strata: ArrayLike | None = None,
 ) -> LineFit:
     """Straight line through data whose abscissa is measured: the moment-corrected weighted fit.
 
@@ -182,7 +188,8 @@ def eiv_line(
     Standard errors: the covariance of the weighted fit with the residuals at beta, carried
     through (X'WX - N)^-1 (the delta method; the term of order sigma_x^4 is left out): the
     reduced-chi-square-scaled covariance, or with ``robust`` the HC3 sandwich
-    (:func:`sandwich_cov`). 95 % intervals use Student's t with n - p degrees of freedom.
+    (:func:`sandwich_cov`, centred within ``strata`` when given). 95 % intervals use
+    Student's t with n - p degrees of freedom.
     A corrected spread of x that is not positive (noise as large as the spread of the
     abscissa) gives a fit not made (NaN).
     """
@@ -216,7 +223,7 @@ def eiv_line(
     w = np.sqrt(W)
     redchi = float(np.sum(W * r**2) / (n - p))
     if robust:
-        inner = xwx @ sandwich_cov(X * w[:, None], r * w) @ xwx
+        inner = xwx @ sandwich_cov(X * w[:, None], r * w, strata) @ xwx
     else:
         inner = redchi * xwx
     Ainv = np.linalg.inv(A)
