@@ -133,7 +133,14 @@ def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> t
     d = vtf_data(rec, sel)
     try:
         fit = fit_ball(d, **kw)
-        truth = fit_ball(vtf_data(rec_truth, sel), sigma=d.sigma, interval=False, errors_in_variables=False, **kw).eta2
+        truth = fit_ball(
+            vtf_data(rec_truth, sel),
+            sigma=d.sigma,
+            interval=False,
+            errors_in_variables=False,
+            finite_sample=False,
+            **kw,
+        ).eta2
     except (ValueError, RuntimeError):
         return math.nan, math.nan, math.nan, 0
     return fit.eta2, fit.eta2_err, truth, fit.dof
