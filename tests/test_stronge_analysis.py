@@ -215,3 +215,55 @@ def test_finite_sample_bias_predicts_and_removes_the_skew_of_eta2():
     assert abs(corrected.mean() - 12.0) < 1.0 * err  # and removed
     free = {**kw, "vary_e_y": True}
     assert fit_ball(d, **free).eta2 == fit_ball(d, finite_sample=False, **free).eta2
+
+
+def test_finite_sample_bias_pools_bats_of_a_single_impact_as_the_sandwich_does():
+    """Bats of one impact cannot be centred; they are pooled (linefit.strata_blocks), not dropped.
+
+    A design with one impact per bat is then one stratum: the same bias as if every impact
+    shared one bat, and not zero (which centring each lone impact on itself would give).
+    """
+    from ballbat.stronge.analysis import VtfData, finite_sample_bias
+    from ballbat.stronge.model import ContactParams, stronge_ex
+
+    rng = np.random.default_rng(3)
+    n = 24
+    psi = np.radians(rng.uniform(5.0, 45.0, n))
+    r_x, r_y, alpha = np.full(n, 0.3), np.full(n, 1.5), np.full(n, 0.4)
+    x = np.tan(psi) / (1 + r_x)
+    y = (1 + stronge_ex(psi, ContactParams(12.0, 0.5, 0.5, r_x, r_y, alpha))) * x + 0.15 * rng.standard_normal(n)
+    at = {"eta2": 12.0, "e_y": 0.5, "mu": 0.5}
+
+    def bias(bat: np.ndarray) -> float:
+        return finite_sample_bias(VtfData(psi, x, y, np.full(n, 0.15), r_x, r_y, alpha, bat), None, at)
+
+    one_each = bias(np.array([f"b{i}" for i in range(n)]))
+    assert one_each != 0.0
+    assert one_each == pytest.approx(bias(np.full(n, "all")), rel=1e-12)
+    # a lone impact beside full bats joins no other bat's mean: it is its own (uncentred) stratum
+    pairs = np.repeat(["a", "b", "c"], 8)
+    lone = pairs.copy()
+    lone[-1] = "d"
+    assert bias(lone) != bias(pairs)
+
+
+def test_finite_sample_bias_does_not_depend_on_its_difference_step(monkeypatch):
+    """FINITE_SAMPLE_STEP is a numerical choice: a hundredfold change of it leaves the bias in place."""
+    from ballbat.stronge import analysis
+    from ballbat.stronge.model import ContactParams, stronge_ex
+
+    rng = np.random.default_rng(4)
+    n = 40
+    psi = np.radians(rng.uniform(2.0, 50.0, n))
+    r_x, r_y, alpha = rng.uniform(0.2, 0.4, n), rng.uniform(1.0, 2.0, n), np.full(n, 0.4)
+    x = np.tan(psi) / (1 + r_x)
+    y = (1 + stronge_ex(psi, ContactParams(5.0, 0.5, 0.5, r_x, r_y, alpha))) * x + 0.1 * rng.standard_normal(n)
+    d = analysis.VtfData(psi, x, y, np.full(n, 0.1), r_x, r_y, alpha, np.repeat(["a", "b", "c", "d"], 10))
+    at = {"eta2": 5.0, "e_y": 0.5, "mu": 0.5}
+    values = []
+    for step in (1e-2, 1e-3, 1e-4):
+        monkeypatch.setattr(analysis, "FINITE_SAMPLE_STEP", step)
+        values.append(analysis.finite_sample_bias(d, None, at))
+    assert values[1] != 0.0
+    assert values[0] == pytest.approx(values[1], rel=1e-3)
+    assert values[2] == pytest.approx(values[1], rel=1e-3)

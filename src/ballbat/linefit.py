@@ -243,7 +243,7 @@ def eiv_line(
     )
 
 
-def _strata_blocks(n: int, strata: ArrayLike | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def strata_blocks(n: int, strata: ArrayLike | None) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Stratum index of each row, and per stratum its size n_b, the factor f_b and the centering switch c_b.
 
     Without strata every row is one uncentred block (f = 1, c = 0): the plain sandwich. With
@@ -301,7 +301,7 @@ def sandwich_cov(J: ArrayLike, r: ArrayLike, strata: ArrayLike | None = None) ->
         u = r / (1.0 - h)
         return A @ (J.T @ (u[:, None] ** 2 * J)) @ A
     u = J * (r / (1.0 - h))[:, None]
-    idx, nb, f, c = _strata_blocks(J.shape[0], strata)
+    idx, nb, f, c = strata_blocks(J.shape[0], strata)
     mean = np.zeros((f.size, u.shape[1]))
     np.add.at(mean, idx, u)
     u = u - (c / nb)[idx, None] * mean[idx]
@@ -334,7 +334,7 @@ def sandwich_dof(J: ArrayLike, strata: ArrayLike | None = None, column: int = 0)
     n = J.shape[0]
     A, h = _hc3_parts(J)
     a = (J @ A[:, column]) / (1.0 - h)  # the diagonal of D: the parameter's score weights
-    idx, nb, f, c = _strata_blocks(n, strata)
+    idx, nb, f, c = strata_blocks(n, strata)
     K = J @ A  # the projection onto the model is P = K J'
 
     def apply_b(X: np.ndarray) -> np.ndarray:
