@@ -235,11 +235,12 @@ def _eta2_systematic(rec: xr.Dataset, balls: np.ndarray, stronge: dict, z: np.nd
     order, under the drawn calibration ``z`` (:func:`_calibration_effect`).
     """
     from .stages.stronge import stronge_shifts
+    from .stages.systematics import combine_sources
 
     kw = {k: stronge[k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")}
     signed = stronge_shifts(rec, list(balls), ["eta2"], **kw)["eta2"]
     with np.errstate(invalid="ignore"):
-        return np.sqrt(np.sum(signed**2, axis=0)), np.tensordot(z, signed, axes=1)
+        return combine_sources(signed), np.tensordot(z, signed, axes=1)
 
 
 def _at(fit: xr.Dataset, var: str, ball: str, bat: str) -> float | None:

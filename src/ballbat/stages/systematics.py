@@ -72,7 +72,8 @@ def add_shifts(ds: xr.Dataset, shifts: Shifts | None) -> xr.Dataset:
     return out
 
 
-def _combine(by_source: np.ndarray) -> np.ndarray:
+def combine_sources(by_source: np.ndarray) -> np.ndarray:
+    """Return the systematic error from each source's (first axis) signed shift: every source in quadrature."""
     return np.sqrt(np.sum(by_source**2, axis=0))
 
 
@@ -83,7 +84,7 @@ def systematic_vars(ds: xr.Dataset, by_source: dict[str, np.ndarray], what: str,
     for q, per in by_source.items():
         dims, attrs = ds[q].dims, ds[q].attrs
         units = {"units": attrs["units"]} if "units" in attrs else {}
-        syst = _combine(per)
+        syst = combine_sources(per)
         out[f"{q}_syst_by_source"] = (
             ("systematic", *dims),
             per,
