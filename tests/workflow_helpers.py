@@ -12,13 +12,18 @@ ROOT = Path(__file__).resolve().parents[1]
 
 
 def make_workdir(tmp: Path, copy_package: bool = False) -> Path:
-    """Copy Snakefile, workflow/ and config/ (and optionally src/) into ``tmp``."""
+    """Copy Snakefile, workflow/ and config/ (and optionally src/) into ``tmp``.
+
+    src/ comes with its bytecode (``make test`` compiles it): the copies keep the sources' times,
+    so it stays valid, and the runs' jobs do not compile the package again (an edited module
+    is compiled anew, as always).
+    """
     shutil.copy(ROOT / "Snakefile", tmp / "Snakefile")
     shutil.copytree(ROOT / "workflow", tmp / "workflow", ignore=shutil.ignore_patterns("__pycache__"))
     shutil.copytree(ROOT / "config", tmp / "config")
     (tmp / "README.md").write_text("copy\n")
     if copy_package:
-        shutil.copytree(ROOT / "src", tmp / "src", ignore=shutil.ignore_patterns("__pycache__", "*.egg-info"))
+        shutil.copytree(ROOT / "src", tmp / "src", ignore=shutil.ignore_patterns("*.egg-info"))
     return tmp
 
 
