@@ -78,6 +78,7 @@ def test_recovery_default_config(default_settings, balls, bats):
     assert int(fit.e_x_n.sel(ball="baseball", bat="softball_composite")) == 0  # no baseball on it
 
 
+@pytest.mark.slow  # about 2 s: 60 experiments
 def test_standard_errors_are_honest(default_settings, balls, bats):
     """Coverage: over 60 seeds the pooled e_x lies within 2 SE of the truth ~95 % of the time."""
     hits, pulls = 0, []

@@ -123,6 +123,7 @@ def test_comparison_rows(products):
     assert not any("psi30" in q for q in other)
 
 
+@pytest.mark.slow  # about 5 s: 200 noisy replicates fitted twice
 def test_eta2_errors_in_variables_correction_removes_the_noise_bias(config, balls, bats):
     """x, y and psi of Eq. vtf all come from the same noisy measurements, so least squares is biased.
 

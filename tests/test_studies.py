@@ -278,6 +278,7 @@ def test_study_rules_through_snakemake(lab_run, tmp_path):
     assert "grid.png" in html and "Grid study" in html
 
 
+@pytest.mark.slow  # about 3 s: 8 replicates in two batchings
 def test_replicates_do_not_depend_on_the_batch_size(config, balls, bats):
     """Replicate k is the same experiment whether it runs in batch 0 of 4 or batch 1 of 3."""
     three = settings(config, replicates=4, batch_size=3, truth_impacts=60)

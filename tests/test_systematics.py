@@ -154,6 +154,7 @@ def test_no_shifts_no_systematics():
         assert not [v for v in ds.data_vars if "syst" in v or "err_scale" in v]
 
 
+@pytest.mark.slow  # about 2 s: a whole chain reduced again at +-1 sigma
 def test_fitted_e_y_gets_a_systematic():
     """With e_y fitted beside eta^2, e_y gets its systematic too."""
     _, _, st = chain(swing=(("fps_err", 0.002),), vary_e_y=True)

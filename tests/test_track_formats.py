@@ -348,6 +348,7 @@ def test_schema_takes_a_folder_and_still_wants_settings_of_a_long_file():
 BALLBAT = Path(sys.executable).parent / "ballbat"
 
 
+@pytest.mark.slow  # about 3 s: the installed command on a folder of Tracker files
 def test_cli_import_tracks(tmp_path, rows):
     """The command import-tracks writes the long CSV (the example's rows) and prints the settings found as YAML."""
     lab = write_lab_folder(tmp_path / "lab", EXAMPLE / "tracked_tracks.csv", "trk", CAMS)
@@ -467,6 +468,7 @@ def test_every_format_imports_the_same_tracks(tmp_path, fmt, tol):
         np.testing.assert_allclose(got[col], want[col], rtol=0, atol=tol, err_msg=col)
 
 
+@pytest.mark.slow  # about 3 s: ballbat check imports and reduces a folder of tool files
 def test_check_tracks_reads_a_folder_of_tool_files_as_the_workflow_does(tmp_path):
     """``ballbat check --kind tracks --config`` on a dataset naming a folder (``dir``) imports the files
     as the import_tracks rule does and then reduces them: the same verdict per impact as the long CSV.

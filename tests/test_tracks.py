@@ -299,6 +299,7 @@ def test_bat_slows_only_pre_impact_frames_used(swing_fps):
     assert abs(np.mean(z)) < 0.6
 
 
+@pytest.mark.slow  # about 3 s: render, reduce and draw the QA figures
 def test_qa_figures_draw_the_fits(tmp_path):
     """The QA figure shows usable and excluded impacts with fitted lines through the tracked points."""
     from ballbat.plotting_tracks import impacts_figure, pick_impacts, save_figure, summary_figure
