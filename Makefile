@@ -21,7 +21,7 @@ install: $(STAMP)
 # set (as on this machine and in many containers), so every Snakemake job compiled the package
 # again (about 0.3 s a job; make test 290 -> 272 s).
 bytecode: install
-	$(BIN)/python -m compileall -q src > /dev/null
+	$(BIN)/python -m compileall -q src
 
 run: bytecode
 	$(BIN)/snakemake -c$(CORES)

@@ -376,8 +376,9 @@ def finite_sample_bias(data: VtfData, w: NDArray[np.float64] | None, at: dict[st
     whose counts the lab fixes, so the moments are those within bats: centred on each bat's
     mean, with the bats of a single impact pooled, as in the standard error's sandwich
     (:func:`ballbat.linefit.strata_blocks`). They are summed with the divisor n_b, without the
-    sandwich's n_b/(n_b - 1), which would change b by a term of order 1/n^2. Plugged in at the fit. The bias is positive
-    here: e_x falls ever more slowly as eta^2 grows, so eta^2's scatter is skewed high.
+    sandwich's n_b/(n_b - 1), which would change b by a term of order 1/n^2. Plugged in at
+    the fit. The bias is positive here: e_x falls ever more slowly as eta^2 grows, so eta^2's
+    scatter is skewed high.
     Measured on subsamples of one large noise-free experiment (1 px, 12 impacts per bat), the
     formula predicts the bias the subsamples show (docs/studies.md).
     """
