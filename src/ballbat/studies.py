@@ -465,14 +465,11 @@ def population_truth(settings: StudySettings, point: int, balls: dict[str, Ball]
 def truth_scale(settings: StudySettings, point: int) -> int:
     """How many times the truth job's experiment repeats a replicate's design at sweep point ``point``.
 
-    Every pair's impacts are multiplied by the same whole number, so that the pair with the
-    fewest has about ``settings.truth_impacts`` (:func:`_population_rows`). The truth's own
-    sampling error is then about that of a replicate's noise-free estimate over the square root
-    of this number (:func:`coverage`).
+    :meth:`StudySettings.truth_counts` (one rule for the truth's size). The truth's own
+    sampling error is about that of a replicate's noise-free estimate over the square root of
+    this number, for every pair alike (:func:`coverage`).
     """
-    ds = point_dataset(settings.dataset, settings.parameter, settings.values[point])
-    counts = [n for per_bat in ds["synthetic"]["impacts"].values() for n in per_bat.values() if n > 0]
-    return max(1, math.ceil(settings.truth_impacts / min(counts)))
+    return settings.truth_counts(point)[0]
 
 
 def _population_rows(settings: StudySettings, point: int, balls: dict[str, Ball], bats: dict[str, Bat]) -> list[dict]:
@@ -484,15 +481,13 @@ def _population_rows(settings: StudySettings, point: int, balls: dict[str, Ball]
     over bats of different e_x, a straight line through curved data), the impacts a replicate
     happens to draw move the estimate as much as the noise does, and the standard error from
     the scatter accounts for both. The truth is therefore the estimator on a large noise-free
-    experiment of the same design (about ``settings.truth_impacts`` impacts per ball and bat,
-    in the design's proportions), the same for every replicate of the point. e_x of one bat
-    is the same either way (the model is exact); :data:`CONDITIONAL_TRUTH` keep their own.
+    experiment of the same design (about ``settings.truth_impacts`` impacts per ball and bat on
+    average, in the design's proportions: :meth:`StudySettings.truth_counts`), the same for
+    every replicate of the point. e_x of one bat is the same either way (the model is exact);
+    :data:`CONDITIONAL_TRUTH` keep their own.
     """
-    ds = point_dataset(settings.dataset, settings.parameter, settings.values[point])
-    k = truth_scale(settings, point)
-    ds["synthetic"]["impacts"] = {
-        b: {t: int(n) * k for t, n in per.items()} for b, per in ds["synthetic"]["impacts"].items()
-    }
+    ds = settings.point_dataset(point)
+    ds["synthetic"]["impacts"] = settings.truth_counts(point)[1]
     big = replace(
         settings, seed=int(np.random.SeedSequence(settings.seed, spawn_key=(2**31 - 1, point)).generate_state(1)[0])
     )

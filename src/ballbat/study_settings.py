@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .sweeps import study_dataset, sweep_points
+from .sweeps import point_dataset, study_dataset, sweep_points, truth_counts
 
 
 @dataclass(frozen=True)
@@ -42,8 +42,8 @@ class StudySettings:
     stronge : dict
         The workflow's ``stronge`` section (``e_y``, ``mu``, ``vary_e_y``, ``vary_mu``).
     truth_impacts : int
-        Impacts per ball and bat of the large noise-free experiment that gives the design's
-        truth (:func:`population_truth`).
+        Impacts per ball and bat, on average over the pairs, of the large noise-free experiment
+        that gives the design's truth (:meth:`truth_counts`).
     delta_e_x, confidence, power : float
         The design table's difference in e_x to detect and its test's confidence and power.
     """
@@ -120,6 +120,34 @@ class StudySettings:
     def n_batches(self) -> int:
         """Batch jobs."""
         return -(-self.total // self.batch_size)
+
+    def point_dataset(self, point: int) -> dict:
+        """Return the dataset's block with the swept setting at sweep point ``point`` (a copy)."""
+        return point_dataset(self.dataset, self.parameter, self.values[point])
+
+    def truth_counts(self, point: int) -> tuple[int, dict[str, dict[str, int]]]:
+        """Return the truth job's scale and impacts per ball and bat at sweep point ``point``.
+
+        The one rule for the truth's size: :func:`ballbat.sweeps.truth_counts`.
+        """
+        return truth_counts(self.point_dataset(point), self.truth_impacts)
+
+    def truth_size(self, point: int) -> int:
+        """Return the impacts of the truth job's experiment at sweep point ``point`` (its plans scale with it)."""
+        return sum(n for bats in self.truth_counts(point)[1].values() for n in bats.values())
+
+    def truth_mem_mb(self, point: int) -> int:
+        """Return the truth job's memory plan at sweep point ``point`` (MB): 500 MB and the chain's per impact."""
+        from .pipeline.config import impact_bytes
+
+        return 500 + math.ceil(self.truth_size(point) * impact_bytes(self.dataset) / 1e6)
+
+    def truth_runtime_min(self, point: int) -> int:
+        """Return the truth job's run-time plan at sweep point ``point`` (minutes).
+
+        Measured about 2 CPU minutes for the calibration study's 70 000 rendered impacts; with room.
+        """
+        return max(30, math.ceil(4 * self.truth_size(point) / 70_000) + 10)
 
     def batch_range(self, batch: int) -> range:
         """Global replicate indices of batch ``batch`` (point = index // replicates)."""

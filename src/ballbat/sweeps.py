@@ -24,6 +24,7 @@ __all__ = [
     "point_dataset",
     "study_dataset",
     "sweep_points",
+    "truth_counts",
 ]
 
 #: What a sweep may vary: name -> what it sets in the dataset's settings.
@@ -184,3 +185,37 @@ def point_dataset(dataset: dict, parameter: str | Sequence[str] | None, value: f
     else:
         raise ValueError(f"unknown sweep parameter {parameter!r} (known: {', '.join(SWEEP_PARAMETERS)})")
     return ds
+
+
+def truth_counts(dataset: dict, truth_impacts: int) -> tuple[int, dict[str, dict[str, int]]]:
+    """Return the impacts per ball and bat of a study's truth job, for the dataset at one sweep point.
+
+    The one rule for the truth's size: the truth job runs it, and the memory plan, the run-time
+    plan and the size guard read it. The truth repeats the point's design ``k`` times (every
+    pair ``k`` times its own count), so that pooled quantities keep the design's proportions of
+    bats, and ``k = ceil(P T / N)`` for ``P`` pairs of ``N`` impacts in all and ``T =
+    truth_impacts``: the truth holds about ``T`` impacts per pair on average, whatever the
+    balance of the design (``P T`` in all). The truth's sampling error relative to a replicate's
+    standard error is the same for every pair, about the replicates' noise-free spread over their
+    error divided by sqrt(k), since a pair of ``n`` impacts in a replicate has ``k n`` in the truth
+    (``truth_error_over_se`` of the coverage table reports it).
+
+    Parameters
+    ----------
+    dataset : dict
+        The validated synthetic dataset's block at the sweep point (:func:`point_dataset`).
+    truth_impacts : int
+        The study's ``truth_impacts``.
+
+    Returns
+    -------
+    (k, counts)
+        The scale and ball -> bat -> impacts (a pair of no impacts keeps 0).
+    """
+    impacts = dataset["synthetic"]["impacts"]
+    design = {b: {t: int(n) for t, n in (bats or {}).items()} for b, bats in impacts.items()}
+    counts = [n for bats in design.values() for n in bats.values() if n > 0]
+    if not counts:
+        raise ValueError("the study's dataset has no impacts (every count is 0): nothing to take the truth of")
+    k = max(1, math.ceil(len(counts) * int(truth_impacts) / sum(counts)))
+    return k, {b: {t: n * k for t, n in bats.items()} for b, bats in design.items()}

@@ -343,10 +343,8 @@ def study_batch_mem_mb(wildcards):
 
 
 def study_truth_mem_mb(wildcards):
-    """The truth job holds the design's large noise-free experiment (truth_impacts per ball and bat:
-    measured 1.8 GB for the calibration study's 70000 rendered impacts)."""
-    s = study_settings(wildcards.study)
-    return 500 + math.ceil(_study_impacts(s)[1] * impact_bytes(s.dataset) / 1e6)
+    """The truth job of one sweep point holds the design's large noise-free experiment (StudySettings.truth_mem_mb)."""
+    return study_settings(wildcards.study).truth_mem_mb(int(wildcards.point))
 
 
 def study_aggregate_mem_mb(wildcards):
@@ -367,10 +365,8 @@ def get_study_truth_points(wildcards):
 
 
 def study_truth_runtime(wildcards):
-    """Minutes: a truth job reduces one large noise-free experiment (measured about 2 CPU minutes for
-    10000 impacts per ball and bat with rendered tracks), with room."""
-    s = study_settings(wildcards.study)
-    return max(30, math.ceil(4 * max(s.truth_impacts, 1000) / 10000) + 10)
+    """Minutes (StudySettings.truth_runtime_min)."""
+    return study_settings(wildcards.study).truth_runtime_min(int(wildcards.point))
 
 
 def study_targets(on_request=False):

@@ -64,19 +64,23 @@ MAX_STUDY_BATCHES = 10_000
 
 
 def study_impacts(dataset: dict, parameter: str | tuple | None, values: list, truth_impacts: int) -> tuple[int, int]:
-    """Impacts of a study's largest replicate, and of its noise-free design (the truth job), per sweep point.
+    """Impacts of a study's largest replicate, and of its largest truth job, over its sweep points.
 
-    A grid gives ``parameter`` as a tuple of names and ``values`` as tuples (one per point).
+    A grid gives ``parameter`` as a tuple of names and ``values`` as tuples (one per point);
+    no sweep gives no values. The truth job's size is :func:`ballbat.sweeps.truth_counts`, the
+    rule the truth job runs.
     """
-    impacts = dataset["synthetic"]["impacts"]
-    pairs = sum(len(v or {}) for v in impacts.values())
-    most = max((int(n) for v in impacts.values() for n in (v or {}).values()), default=0)
-    if isinstance(parameter, tuple):
-        j = parameter.index("impacts_per_bat") if "impacts_per_bat" in parameter else None
-        counts = [int(p[j]) for p in values] if j is not None else [most]
-    else:
-        counts = [int(v) for v in values] if parameter == "impacts_per_bat" else [most]
-    return pairs * max(counts), pairs * max(int(truth_impacts), max(counts))
+    from ..sweeps import point_dataset, truth_counts
+
+    one = truth = 0
+    for value in values if parameter else [None]:
+        ds = point_dataset(dataset, parameter or None, value)
+        counts = [int(n) for v in ds["synthetic"]["impacts"].values() for n in (v or {}).values()]
+        if sum(counts) == 0:
+            continue
+        one = max(one, sum(counts))
+        truth = max(truth, sum(n for v in truth_counts(ds, truth_impacts)[1].values() for n in v.values()))
+    return one, truth
 
 
 def drop_nulls(config: dict) -> dict:

@@ -1,0 +1,89 @@
+"""A study's truth job: one rule for its size, shared by the job, its plans and the size guard (issue 40)."""
+
+from __future__ import annotations
+
+import copy
+import math
+
+import pytest
+
+from ballbat import studies, sweeps
+from ballbat.pipeline.config import MEMORY_SHARE, ConfigError, impact_bytes, study_impacts, validate_config
+
+#: The unbalanced design of issue 40: 6 impacts on some bats and 60 on others, the softball bat
+#: swung with softballs only (102 of the 204 impacts on three pairs of 60).
+UNBALANCED = {
+    "baseball": {"wood": 6, "metal_rough": 60, "metal_smooth": 6},
+    "softball": {"wood": 60, "metal_rough": 6, "metal_smooth": 60, "softball_composite": 6},
+}
+
+
+def unbalanced(config, **over):
+    cfg = copy.deepcopy(config)
+    cfg["datasets"]["synthetic"]["synthetic"]["impacts"] = copy.deepcopy(UNBALANCED)
+    cfg["studies"]["calibration"].update(over)
+    return cfg
+
+
+def test_the_truth_keeps_the_designs_proportions_at_about_truth_impacts_a_pair(config):
+    s = studies.StudySettings.from_config(unbalanced(config), "calibration")
+    k, counts = s.truth_counts(0)
+    assert k == math.ceil(7 * 10_000 / 204) == 344
+    assert counts == {b: {t: n * k for t, n in bats.items()} for b, bats in UNBALANCED.items()}
+    # about truth_impacts a pair on average: the old rule (10000 / 6 = 1667 times) held 340 068
+    assert s.truth_size(0) == 204 * 344 == 70_176
+    assert 7 * 10_000 <= s.truth_size(0) < 7 * 10_000 + 204
+
+
+def test_a_balanced_design_keeps_the_old_scale(config):
+    # every pair alike: ceil(P T / N) = ceil(T / n), the scale before issue 40 (the design and
+    # robustness studies' truths are unchanged)
+    s = studies.StudySettings.from_config(config, "design")
+    for p, n in enumerate(s.values):
+        assert s.truth_counts(p)[0] == math.ceil(10_000 / n)
+
+
+def test_a_pair_of_no_impacts_stays_empty(config):
+    ds = copy.deepcopy(config["datasets"]["synthetic"])
+    ds["synthetic"]["impacts"]["baseball"]["wood"] = 0
+    k, counts = sweeps.truth_counts(ds, 1000)
+    assert counts["baseball"]["wood"] == 0 and k == math.ceil(6 * 1000 / 88)
+    ds["synthetic"]["impacts"] = {"baseball": {"wood": 0}}
+    with pytest.raises(ValueError, match="no impacts"):
+        sweeps.truth_counts(ds, 1000)
+
+
+def test_the_truth_job_runs_the_size_its_plans_use(config, monkeypatch):
+    """The truth job simulates exactly StudySettings.truth_counts: what the memory plan and the guard read."""
+    seen = {}
+
+    def fake_run_replicate(settings, ds, index, balls, bats, check):
+        seen["impacts"] = ds["synthetic"]["impacts"]
+        return []
+
+    monkeypatch.setattr(studies, "run_replicate", fake_run_replicate)
+    cfg = unbalanced(config)
+    s = studies.StudySettings.from_config(cfg, "calibration")
+    studies.population_truth(s, 0, {}, {})
+    assert seen["impacts"] == s.truth_counts(0)[1]
+    total = sum(n for bats in seen["impacts"].values() for n in bats.values())
+    ds = cfg["datasets"]["synthetic"]
+    assert study_impacts(ds, None, [], 10_000) == (204, total)
+    assert s.truth_mem_mb(0) == 500 + math.ceil(total * impact_bytes(ds) / 1e6)
+
+
+def test_the_unbalanced_design_runs_within_its_plan_on_this_machines_size(raw, schema):
+    """At the default truth_impacts the 6-to-60 design is accepted on a 24 GiB machine (its plan: 4.0 GB)."""
+    raw["datasets"]["synthetic"]["synthetic"]["impacts"] = copy.deepcopy(UNBALANCED)
+    cfg = validate_config(raw, schema, available=23 * 2**30)
+    s = studies.StudySettings.from_config(cfg, "calibration")
+    assert s.truth_mem_mb(0) * 1e6 <= MEMORY_SHARE * 23 * 2**30
+    assert s.truth_mem_mb(0) == 500 + math.ceil(70_176 * 50_000 / 1e6)
+
+
+def test_a_truth_the_machine_cannot_hold_is_refused_with_its_size(raw, schema):
+    """The guard reads the same size: on a 6 GiB machine the 6-to-60 design's truth (70 176 impacts) is refused."""
+    raw["datasets"]["synthetic"]["synthetic"]["impacts"] = copy.deepcopy(UNBALANCED)
+    with pytest.raises(ConfigError) as err:
+        validate_config(raw, schema, available=6 * 2**30)
+    assert "studies.calibration.truth_impacts: 70,176 impacts need about 3.3 GiB" in str(err.value)
