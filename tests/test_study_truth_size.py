@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import copy
 import math
+import re
 
 import pytest
 
@@ -87,3 +88,30 @@ def test_a_truth_the_machine_cannot_hold_is_refused_with_its_size(raw, schema):
     with pytest.raises(ConfigError) as err:
         validate_config(raw, schema, available=6 * 2**30)
     assert "studies.calibration.truth_impacts: 70,176 impacts need about 3.3 GiB" in str(err.value)
+
+
+def test_the_workflow_schedules_each_truth_job_at_its_plan(tmp_path):
+    """A dry run of the unbalanced design: every truth job is scheduled with StudySettings.truth_mem_mb of its point."""
+    from ballbat.pipeline.config import load_config
+    from workflow_helpers import make_workdir, snakemake, write_config
+
+    wd = make_workdir(tmp_path)
+
+    def edit(cfg):
+        cfg["datasets"]["synthetic"]["synthetic"]["impacts"] = copy.deepcopy(UNBALANCED)
+        cfg["studies"]["design"]["sweep"]["values"] = [6, 60]
+
+    write_config(wd, edit)
+    out = snakemake(wd, "-n", "results/studies/calibration/truth.nc", "results/studies/design/truth.nc")
+    jobs = re.findall(
+        r"rule study_truth_point:.*?wildcards: study=(\w+), point=(\d+)\n.*?mem_mb=(\d+)", out.stdout, re.S
+    )
+    planned = {(study, int(point)): int(mem) for study, point, mem in jobs}
+    cfg = load_config(wd / "config" / "config.yaml")
+    expect = {
+        (name, p): studies.StudySettings.from_config(cfg, name).truth_mem_mb(p)
+        for name, p in [("calibration", 0), ("design", 0), ("design", 1)]
+    }
+    assert planned == expect
+    assert expect["calibration", 0] == 500 + math.ceil(70_176 * 50_000 / 1e6)  # 344 x 204 impacts
+    assert expect["design", 0] == 500 + math.ceil(1667 * 42 * 50_000 / 1e6)  # balanced: ceil(T / n) x 7 n
