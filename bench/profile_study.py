@@ -1,0 +1,106 @@
+"""Profile of a replicate study: where one replicate's time goes, by stage and by function (issue 39).
+
+Runs ``N`` replicates (default 10) of a shipped study (default ``calibration``) in this
+process, exactly as its batch job does (``ballbat.stages.study_batch.run``), after one warm-up
+replicate, and prints:
+
+1. CPU time per replicate of each stage of the chain (simulate, render, reduce with its
+   cross-checks, normalize, reconstruct, fit_ex, the eta^2 fits, the assembly of the batch's
+   Dataset), measured by timing the stage functions themselves;
+2. the top functions by their own time and by cumulative time (cProfile).
+
+Run: ``.venv/bin/python bench/profile_study.py [N] [study]`` (about N x 0.3 s). Read the
+stage table as shares when the machine is busy.
+"""
+
+from __future__ import annotations
+
+import cProfile
+import functools
+import io
+import pstats
+import sys
+import time
+from collections import defaultdict
+
+from ballbat import studies
+from ballbat.pipeline.config import load_config
+from ballbat.properties import load_balls, load_bats
+from ballbat.stages import fit_ex, normalize, reconstruct, reduce, render, simulate, study_batch
+from ballbat.tracks import stage as tracks_stage
+
+#: (module, function name, label): the stage functions a replicate calls, timed where they are looked up.
+STAGES = [
+    (simulate, "run", "simulate"),
+    (render, "render", "render tracks"),
+    (reduce, "run", "reduce (with cross-checks)"),
+    (tracks_stage, "reduce_tracks", "  of which: the track fits"),
+    (tracks_stage, "cross_check", "  of which: the cross-checks"),
+    (normalize, "run", "normalize"),
+    (reconstruct, "run", "reconstruct (x2: measured, truth)"),
+    (fit_ex, "fit", "fit_ex (Sec. IV fits)"),
+    (studies, "_eta2", "eta^2 fits (value and truth)"),
+    (studies, "_eta2_systematic", "eta^2 systematics"),
+]
+
+SPENT: dict[str, float] = defaultdict(float)
+
+
+def _timed(fn, label):
+    @functools.wraps(fn)
+    def wrapper(*args, **kwargs):
+        t0 = time.process_time()
+        try:
+            return fn(*args, **kwargs)
+        finally:
+            SPENT[label] += time.process_time() - t0
+
+    return wrapper
+
+
+def instrument() -> None:
+    """Wrap every stage function of :data:`STAGES` with a CPU timer (in its own module)."""
+    for module, name, label in STAGES:
+        if hasattr(module, name):
+            setattr(module, name, _timed(getattr(module, name), label))
+
+
+def main(n: int = 10, study: str = "calibration") -> None:
+    """Profile ``n`` replicates of ``study``; print the stage table and the top functions."""
+    cfg = load_config()
+    cfg["studies"][study]["batch_size"] = n
+    s = studies.StudySettings.from_config(cfg, study)
+    balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
+    warm = studies.StudySettings.from_config(
+        {**cfg, "studies": {**cfg["studies"], study: {**cfg["studies"][study], "batch_size": 1}}}, study
+    )
+    study_batch.run(warm, 0, balls, bats)  # imports and caches
+    instrument()
+    prof = cProfile.Profile()
+    t0, c0 = time.perf_counter(), time.process_time()
+    prof.enable()
+    ds = study_batch.run(s, 1, balls, bats)
+    prof.disable()
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    reps = ds.sizes["replicate"]
+    print(
+        f"{reps} replicates of study {study!r}: {cpu / reps * 1e3:.0f} ms CPU, "
+        f"{wall / reps * 1e3:.0f} ms wall per replicate (under cProfile)"
+    )
+    print(f"\n{'stage':<36} {'ms / replicate':>15} {'share':>7}")
+    for _, _, label in STAGES:
+        print(f"{label:<36} {SPENT[label] / reps * 1e3:>15.1f} {SPENT[label] / cpu:>7.1%}")
+    top = [label for _, _, label in STAGES if not label.startswith(" ")]
+    rest = cpu - sum(SPENT[label] for label in top)
+    print(f"{'everything else (rows, Dataset)':<36} {rest / reps * 1e3:>15.1f} {rest / cpu:>7.1%}")
+    for key, title in (("tottime", "own time"), ("cumulative", "cumulative time")):
+        out = io.StringIO()
+        pstats.Stats(prof, stream=out).sort_stats(key).print_stats(15)
+        lines = out.getvalue().splitlines()
+        start = next(i for i, line in enumerate(lines) if line.strip().startswith("ncalls"))
+        print(f"\nTop 15 functions by {title} (seconds over {reps} replicates):")
+        print("\n".join(lines[start : start + 16]))
+
+
+if __name__ == "__main__":
+    main(int(sys.argv[1]) if len(sys.argv) > 1 else 10, sys.argv[2] if len(sys.argv) > 2 else "calibration")
