@@ -31,6 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..batched import gram, tdot
 from ..units import INCH, G
 
 if TYPE_CHECKING:
@@ -265,16 +266,16 @@ def free_fall(
     u = np.where(flight.mask, t - flight.t_ref[:, None], 0.0)
     n = w.sum(axis=1)
     P = np.stack([np.ones_like(u), u, u**2], axis=-1) * w[..., None]
-    A = np.einsum("ikp,ikq->ipq", P, P)
+    A = gram(P)
     bad = n < 4
     A[bad] = np.eye(3)
     Ainv = np.linalg.inv(A)
     Xz, Yz = np.where(flight.mask, X, 0.0), np.where(flight.mask, Y, 0.0)
-    cx = np.einsum("ipq,iq->ip", Ainv, np.einsum("ikp,ik->ip", P, Xz))
-    cy = np.einsum("ipq,iq->ip", Ainv, np.einsum("ikp,ik->ip", P, Yz))
+    cx = (Ainv @ tdot(P, Xz)[..., None])[..., 0]
+    cy = (Ainv @ tdot(P, Yz)[..., None])[..., 0]
     with np.errstate(all="ignore"):
-        rx = np.where(flight.mask, X - np.einsum("ikp,ip->ik", P, cx), 0.0)
-        ry = np.where(flight.mask, Y - np.einsum("ikp,ip->ik", P, cy), 0.0)
+        rx = np.where(flight.mask, X - (P @ cx[..., None])[..., 0], 0.0)
+        ry = np.where(flight.mask, Y - (P @ cy[..., None])[..., 0], 0.0)
         s2 = (np.sum(rx**2, axis=1) + np.sum(ry**2, axis=1)) / (2 * n - 6)
         ax, ay = 2 * cx[:, 2], 2 * cy[:, 2]
         var_a = 4 * s2 * Ainv[:, 2, 2]
@@ -327,19 +328,21 @@ def tip_arc(
     fact = [math.factorial(2 * k + 1) for k in range(5)]
 
     def model(a, V, tau, w):
+        # the series in x = V s: f = sum_k c_k x^(2k+1), c_k = (-w)^k / (2k+1)!; its derivatives
+        # by V and s share sum_k c_k (2k+1) x^(2k), by w sum_k k (-1)^k w^(k-1) x^(2k+1) / (2k+1)!
         s = np.where(mask, t - tau[:, None], 0.0)
-        f = np.zeros_like(s)
-        dV = np.zeros_like(s)
-        ds = np.zeros_like(s)
-        dw = np.zeros_like(s)
+        x = V[:, None] * s
+        x2 = x * x
+        x2k = np.ones_like(s)  # x^(2k)
+        f, dx, dw = np.zeros_like(s), np.zeros_like(s), np.zeros_like(s)
         for k in range(5):
-            c = (-w[:, None]) ** k / fact[k]
-            f = f + c * V[:, None] ** (2 * k + 1) * s ** (2 * k + 1)
-            dV = dV + c * (2 * k + 1) * V[:, None] ** (2 * k) * s ** (2 * k + 1)
-            ds = ds + c * (2 * k + 1) * V[:, None] ** (2 * k + 1) * s ** (2 * k)
+            term = (-w[:, None]) ** k / fact[k] * x2k
+            f = f + term * x
+            dx = dx + (2 * k + 1) * term
             if k:
-                dw = dw + k * (-1) ** k * w[:, None] ** (k - 1) / fact[k] * V[:, None] ** (2 * k + 1) * s ** (2 * k + 1)
-        J = np.stack([np.ones_like(s), dV, -ds, dw], axis=-1)
+                dw = dw + k * (-1) ** k * w[:, None] ** (k - 1) / fact[k] * x2k * x
+            x2k = x2k * x2
+        J = np.stack([np.ones_like(s), s * dx, -V[:, None] * dx, dw], axis=-1)
         return a[:, None] + f, np.where(mask[..., None], J, 0.0)
 
     ok = (n >= 6) & np.isfinite(V) & np.isfinite(tau) & np.isfinite(a)
@@ -350,8 +353,8 @@ def tip_arc(
             f, J = model(a, V, tau, w)
             r = np.where(mask, along - f, 0.0)
             s2 = np.sum(r**2, axis=1) / np.maximum(n - 4, 1)
-            A = np.einsum("ikp,ikq->ipq", J, J)
-            b = np.einsum("ikp,ik->ip", J, r)
+            A = gram(J)
+            b = tdot(J, r)
             prior = s2 / sigma_tau**2
             A[:, 2, 2] += prior
             b[:, 2] += prior * (tau0 - tau)
@@ -362,7 +365,7 @@ def tip_arc(
         f, J = model(a, V, tau, w)
         r = np.where(mask, along - f, 0.0)
         s2 = np.sum(r**2, axis=1) / np.maximum(n - 4, 1)
-        A = np.einsum("ikp,ikq->ipq", J, J)
+        A = gram(J)
         A[:, 2, 2] += s2 / sigma_tau**2
         A[~ok] = np.eye(4)
         cov = np.linalg.inv(A) * s2[:, None, None]

@@ -48,6 +48,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from ..batched import full_rank, gram, tdot
 from ..units import G
 from .checks import IMPACT_Z, camera_agreement, glitch_mask
 from .data import CONTACT_PRIOR, POINTS, Camera, CameraTracks, Rig, Tracks
@@ -584,8 +585,8 @@ def fit_swing(
             J = np.stack([np.ones_like(t), L * (t - tau[:, None]) * c, -L * om[:, None] * c], axis=-1)
             J = np.where(mask[..., None], J, 0.0)
             r = np.where(mask, r, 0.0)
-            A = np.einsum("ikp,ikq->ipq", J, J)
-            b = np.einsum("ikp,ik->ip", J, r)
+            A = gram(J)
+            b = tdot(J, r)
             A[:, 2, 2] += prior
             b[:, 2] += prior * (tau0 - tau)
             ok = n >= 4
@@ -603,7 +604,7 @@ def fit_swing(
         c = np.cos(arg)
         J = np.stack([np.ones_like(t), L * (t - tau[:, None]) * c, -L * om[:, None] * c], axis=-1)
         J = np.where(mask[..., None], J, 0.0)
-        A = np.einsum("ikp,ikq->ipq", J, J)
+        A = gram(J)
         A[:, 2, 2] += s2 / sigma_tau**2
         A[~(n >= 4)] = np.eye(3)
         cov = np.linalg.inv(A) * s2[:, None, None]
@@ -902,10 +903,10 @@ def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept
                 jac += [np.stack(jx, axis=-1) * wd[..., None], np.stack(jy, axis=-1) * wd[..., None]]
             r = np.concatenate(rows, axis=1)
             J = np.concatenate(jac, axis=1)
-            A = np.einsum("ikp,ikq->ipq", J, J)
-            b = np.einsum("ikp,ik->ip", J, r)
+            A = gram(J)
+            b = tdot(J, r)
             ok = np.all(np.isfinite(A), axis=(1, 2)) & np.all(np.isfinite(b), axis=1)
-            ok &= np.linalg.matrix_rank(np.where(ok[:, None, None], A, np.eye(9))) == 9
+            ok &= full_rank(np.where(ok[:, None, None], A, np.eye(9)))
             A[~ok] = np.eye(9)
             b[~ok] = 0.0
             p = p - np.linalg.solve(A, b[..., None])[..., 0]
@@ -922,12 +923,12 @@ def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept
             k = nb + 2 * j * u.shape[1]
             Jo[:, k : k + u.shape[1], 0] = -wd
             Jo[:, k + u.shape[1] : k + 2 * u.shape[1], 1] = -wd
-        B = np.einsum("ikp,ikq->ipq", J, Jo)
-        V = np.einsum("ikp,ikq->ipq", Jo, Jo) - np.einsum("ipa,ipq,iqb->iab", B, cov, B)
-        g = np.einsum("ikp,ik->ip", Jo, r)
+        B = gram(J, Jo)
+        V = gram(Jo) - gram(B, cov @ B)
+        g = tdot(Jo, r)
         V[~ok] = np.eye(2)
         step = -np.linalg.solve(V, g[..., None])[..., 0]
-        offset_chi2 = np.einsum("ip,ip->i", g, -step) / chi2
+        offset_chi2 = np.sum(g * -step, axis=1) / chi2
     good = ok & np.isfinite(p[:, 4]) & np.isfinite(err)
     new_omega = np.where(good, p[:, 4], omega)
     new_err = np.where(good, err, omega_err)
