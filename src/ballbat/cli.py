@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
 from . import __version__
+from .writer import OutputFailed, OutputRefused
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -328,9 +329,10 @@ def cmd_import_tracks(args: argparse.Namespace) -> int:
     import numpy as np
     import yaml
 
-    from .pipeline.ncio import atomic_write_text
+    from .pipeline.checked import sealed_csv
     from .tracks.formats import FormatError
     from .tracks.formats.layout import DEFAULT_PATTERN, import_files
+    from .writer import STDOUT, write_output
 
     points = _pairs(args.points, "--points")
     units = _pairs(args.units, "--units") if args.units else None
@@ -364,10 +366,11 @@ def cmd_import_tracks(args: argparse.Namespace) -> int:
         f"{c['impact_id'][i]},{c['camera'][i]},{c['point'][i]},{int(c['frame'][i])},{float(c['x_px'][i])!r},{float(c['y_px'][i])!r}"
         for i in order
     ]
-    atomic_write_text(args.output, "\n".join(lines) + "\n")
+    # the check line marks the file as ballbat's: only such a file is ever replaced (ballbat.writer)
+    where = write_output(args.output, sealed_csv("\n".join(lines) + "\n"), args.paths, parents=args.parents)
     found = imp.settings_yaml()
-    found["written"] = str(args.output)
-    print(yaml.safe_dump(found, sort_keys=False), end="")
+    found["written"] = where
+    print(yaml.safe_dump(found, sort_keys=False), end="", file=sys.stderr if args.output == STDOUT else sys.stdout)
     return 0
 
 
@@ -739,7 +742,13 @@ def parser() -> argparse.ArgumentParser:
     )
     p.add_argument("paths", nargs="+", metavar="FILE_OR_DIR", help="tool files, or folders of them")
     p.add_argument("--points", required=True, help="ballbat point=the tool's track name, e.g. ball=ball,bat_tip=tip")
-    p.add_argument("-o", "--output", required=True, help="long tracks CSV to write")
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="long tracks CSV to write ('-': standard output); an existing file is replaced only if ballbat wrote it",
+    )
+    p.add_argument("--parents", action="store_true", help="create the output's folder if it does not exist")
     p.add_argument("--pattern", help="file names (default {impact_id}_{camera}.{ext})")
     p.add_argument(
         "--format",
@@ -767,9 +776,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         status = args.func(args)
         sys.stdout.flush()
-    except UsageError as exc:
+    except (UsageError, OutputRefused) as exc:
         print(f"ballbat {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        return 1 if isinstance(exc, OutputFailed) else 2
     except BrokenPipeError:  # the reader left (`ballbat summary ... | head`): stop quietly, as cat does
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # nothing left to flush at exit

@@ -56,9 +56,11 @@ class Imported:
 
 def pattern_regex(pattern: str, exts: Iterable[str]) -> re.Pattern:
     """Return the regular expression of a file-name pattern (``{impact_id}``, ``{camera}``, ``{ext}``)."""
-    for key in ("{impact_id}", "{camera}"):
-        if key not in pattern:
+    for key in ("{impact_id}", "{camera}", "{ext}"):
+        if key != "{ext}" and key not in pattern:
             raise ValueError(f"pattern {pattern!r} lacks {key}")
+        if pattern.count(key) > 1:
+            raise ValueError(f"pattern {pattern!r} has {key} {pattern.count(key)} times (each field once)")
     out = re.escape(pattern)
     out = out.replace(re.escape("{impact_id}"), r"(?P<impact_id>.+?)")
     out = out.replace(re.escape("{camera}"), "(?P<camera>" + "|".join(CAMERAS) + ")")
