@@ -114,8 +114,8 @@ def _without_check_line(path: Path, text: str) -> str:
     if problem:
         raise InputError(
             [
-                f"{path}: ends in ballbat's check line, but {problem}: cut short, or edited after ballbat "
-                "wrote it (if you edited it on purpose, delete its last line '# ballbat table: ...')"
+                f"{path}: ends in ballbat's check line, which does not hold ({problem}): cut short, or "
+                "edited after ballbat wrote it (if you edited it on purpose, delete its last line '# ballbat table: ...')"
             ]
         )
     return body

@@ -100,6 +100,17 @@ def drop_nulls(config: dict) -> dict:
     return config
 
 
+def _render_without_synthetic(config: dict) -> list[str]:
+    """A ``render`` block renders a synthetic experiment's truth: a measured dataset has none to render."""
+    datasets = config.get("datasets")
+    return [
+        f"datasets.{name}.render: only a synthetic dataset renders camera tracks (this one is measured: "
+        f"{next(k for k in ('impacts', 'tracks') if k in ds)}); remove its render block"
+        for name, ds in (datasets.items() if isinstance(datasets, dict) else ())
+        if isinstance(ds, dict) and "render" in ds and "synthetic" not in ds and ("impacts" in ds or "tracks" in ds)
+    ]
+
+
 def _names(config: dict) -> list[str]:
     problems = []
     groups = (
@@ -379,7 +390,7 @@ def validate_config(config: dict, schema: dict, source: str = "config", availabl
 
     validator = jsonschema.Draft202012Validator(schema)
     errors = sorted(validator.iter_errors(config), key=lambda e: (list(map(str, e.absolute_path)), e.message))
-    lines = [_message(e) for e in errors] + _names(config) + _finite(config)
+    lines = [_message(e) for e in errors] + _names(config) + _finite(config) + _render_without_synthetic(config)
     if not lines:
         lines = _synthetic_keys(config) + _offsets(config)
     if not lines:
