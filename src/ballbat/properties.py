@@ -115,7 +115,8 @@ def _without_check_line(path: Path, text: str) -> str:
         raise InputError(
             [
                 f"{path}: ends in ballbat's check line, which does not hold ({problem}): cut short, or "
-                "edited after ballbat wrote it (if you edited it on purpose, delete its last line '# ballbat table: ...')"
+                "edited after ballbat wrote it (if you edited it on purpose, delete its last line "
+                "'# ballbat table: ...')"
             ]
         )
     return body

@@ -92,9 +92,7 @@ def output_problem(path: str | os.PathLike[str], inputs: Iterable[str | os.PathL
     return None
 
 
-def write_output(
-    path: str, text: str, inputs: Iterable[str | os.PathLike[str]] = (), *, parents: bool = False
-) -> str:
+def write_output(path: str, text: str, inputs: Iterable[str | os.PathLike[str]] = (), *, parents: bool = False) -> str:
     """Write ``text`` to ``path`` (``-``: standard output) as described above; return where it went.
 
     Raises :class:`OutputRefused` (one line) when the path is refused, :class:`OutputFailed` when

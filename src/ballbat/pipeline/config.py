@@ -101,7 +101,7 @@ def drop_nulls(config: dict) -> dict:
 
 
 def _render_without_synthetic(config: dict) -> list[str]:
-    """A ``render`` block renders a synthetic experiment's truth: a measured dataset has none to render."""
+    """Name each measured dataset with a ``render`` block (it renders a synthetic truth; a measured one has none)."""
     datasets = config.get("datasets")
     return [
         f"datasets.{name}.render: only a synthetic dataset renders camera tracks (this one is measured: "

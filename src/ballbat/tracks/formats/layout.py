@@ -143,6 +143,22 @@ def _read(path: Path, fmt: str, units: dict | None, cam: dict) -> FileTracks:
     return reader(path, units, float(cam["fps"]), float(cam["m_per_px"]))
 
 
+def _far_frames(ft: FileTracks, iid: str, cam: str, frames: dict[str, np.ndarray]) -> list[str]:
+    """Name the marks of a file's tracks (name -> frames) far outside the file's run of frames.
+
+    Named before any array is sized by them (:func:`ballbat.tracks.checks.check_frame_runs`: a
+    frame 999999999 is a typo).
+    """
+    from ..checks import check_frame_runs
+
+    have = [(n, f) for n, f in frames.items() if f.size]
+    if not have:
+        return []
+    fr = np.concatenate([f for _, f in have])
+    labels = np.concatenate([np.full(f.size, f"track {n!r}") for n, f in have])
+    return check_frame_runs(ft.path, np.full(fr.size, iid), np.full(fr.size, cam), fr, labels, column="")
+
+
 def import_files(
     paths: Iterable[str | os.PathLike[str]],
     points: dict,
@@ -238,6 +254,8 @@ def import_files(
             cols["frame"].append(fr)
             cols["x_px"].append(x * factor if factor != 1.0 else x)
             cols["y_px"].append(y * factor if factor != 1.0 else y)
+        names = [str(points[p]) for p in POINTS[cam] if p in points and str(points[p]) in ft.tracks]
+        problems += _far_frames(ft, iid, cam, {n: ft.tracks[n][0] for n in names})
     if problems:
         raise FormatError(problems)
     out = {k: np.concatenate(v) if v else np.array([]) for k, v in cols.items()}
