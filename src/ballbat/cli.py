@@ -184,10 +184,21 @@ def _tracks_dataset(args: argparse.Namespace, defaults: dict) -> tuple[str, dict
     cfg_path = Path(args.config)
     if not cfg_path.is_file():
         raise UsageError(f"argument --config: {cfg_path}: no such file")
+    from .pipeline.config import alias_problem
+
     try:
-        cfg = yaml.safe_load(cfg_path.read_text()) or {}
+        cfg = yaml.safe_load(cfg_path.read_text(encoding="utf-8")) or {}
+    except UnicodeDecodeError as exc:
+        raise UsageError(
+            f"argument --config: {cfg_path}: not UTF-8 text (byte {exc.start}): a binary file, not a YAML config?"
+        ) from None
     except yaml.YAMLError as exc:
-        raise UsageError(f"argument --config: {cfg_path}: not YAML ({exc})") from None
+        raise UsageError(f"argument --config: {cfg_path}: not YAML ({' '.join(str(exc).split())})") from None
+    bomb = alias_problem(cfg, str(cfg_path))
+    if bomb:
+        raise UsageError(f"argument --config: {bomb}")
+    if not isinstance(cfg, dict):
+        raise UsageError(f"argument --config: {cfg_path}: not a config (a YAML mapping of datasets, ...)")
     datasets = {k: v for k, v in (cfg.get("datasets") or {}).items() if isinstance(v, dict) and "tracks" in v}
     if args.dataset is None:
         if len(datasets) != 1:

@@ -353,4 +353,4 @@ def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | 
             )
     if problems:
         raise InputError(problems)
-    return _assemble(imp.columns, irows, None), imp
+    return _assemble(imp.columns, irows, None, str(cfg["dir"])), imp
