@@ -343,8 +343,12 @@ def cmd_import_tracks(args: argparse.Namespace) -> int:
     from .pipeline.checked import sealed_csv
     from .tracks.formats import FormatError
     from .tracks.formats.layout import DEFAULT_PATTERN, import_files
-    from .writer import STDOUT, write_output
+    from .writer import STDOUT, output_problem, write_output
 
+    if args.output != STDOUT:  # refused before any file is read (write_output checks again)
+        problem = output_problem(args.output, args.paths, args.parents)
+        if problem:
+            raise OutputRefused(problem)
     points = _pairs(args.points, "--points")
     units = _pairs(args.units, "--units") if args.units else None
     cameras: dict[str, dict] = {}
