@@ -14,6 +14,7 @@ import os
 import re
 import resource
 import shutil
+import stat
 import subprocess
 import sys
 import zipfile
@@ -33,7 +34,8 @@ from ballbat.pipeline.config import ConfigError, validate_config
 from ballbat.pipeline.ncio import read_dataset, write_dataset
 from ballbat.pipeline.provenance import sha256_file
 from ballbat.pipeline.runlog import logged
-from ballbat.tracks.formats import MAX_FILE_BYTES, FormatError
+from ballbat.tracks import formats
+from ballbat.tracks.formats import FormatError
 from ballbat.tracks.formats.tracker import read_trz
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -163,12 +165,32 @@ def lab(tmp_path, template):
 
 # --- 1. the writer ------------------------------------------------------------------------------
 
+
+def _device(work: Path, name: str, minor: int) -> Path:
+    """A memory device of the test's own (char 1:minor, as /dev/null and /dev/full) when run as root.
+
+    Run as root, the code before issue 34 replaced the device node it was given by a CSV file: the
+    test never gives it the system's. Without root, /dev/NAME itself (which cannot be replaced).
+    """
+    if os.geteuid() != 0:
+        return Path("/dev") / name
+    path = work / name
+    os.mknod(path, 0o666 | stat.S_IFCHR, os.makedev(1, minor))
+    return path
+
+
+def _fifo(work: Path) -> Path:
+    os.mkfifo(work / "pipe")
+    return work / "pipe"
+
+
 #: (case, -o target given the work folder w, text of the one line); the target must be unchanged.
 REFUSED = [
     ("a file of the input folder", lambda w: w / "trk" / "W01_swing.trk", "is inside the input folder"),
     ("a file named as input", lambda w: w / "W01_swing.trk", "is an input of this command"),
-    ("/dev/null", lambda w: Path("/dev/null"), "is a device"),
-    ("/dev/full", lambda w: Path("/dev/full"), "is a device"),
+    ("/dev/null", lambda w: _device(w, "null", 3), "is a device"),
+    ("/dev/full", lambda w: _device(w, "full", 7), "is a device"),
+    ("a named pipe", lambda w: _fifo(w), "not a regular file (a pipe or socket"),
     ("a folder", lambda w: w / "out", "is a folder"),
     ("a missing folder", lambda w: w / "nonexistent" / "dir" / "x.csv", "does not exist (give --parents"),
     ("a lab's own file", lambda w: w / "mine.csv", "exists and was not written by ballbat"),
@@ -189,6 +211,8 @@ def test_output_refused(tmp_path, lab, case, target, text):
     assert f"{path}:" in out.stderr
     if before is not None:
         assert sha256_file(path) == before
+    if case.startswith("/dev/"):
+        assert path.is_char_device()
     assert not (tmp_path / "nonexistent").exists()
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == []
 
@@ -326,7 +350,7 @@ def _big_kva(lab: Path) -> str:
     path = lab / "W05_swing.kva"
     path.write_text(kva_text(tracks, 3000.0, 0.00074))
     size = path.stat().st_size / 2**20
-    return f"W05_swing.kva: {size:.0f} MiB, more than the {MAX_FILE_BYTES // 2**20} MiB a tool file may hold"
+    return f"W05_swing.kva: {size:.0f} MiB, more than the {formats.MAX_FILE_BYTES // 2**20} MiB a tool file may hold"
 
 
 def _bomb_trz(lab: Path) -> str:

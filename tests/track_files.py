@@ -27,10 +27,10 @@ MEDIA = "org.opensourcephysics.media.core"
 
 def read_long_csv(path: Path) -> dict[tuple[str, str], dict[str, tuple]]:
     """A long tracks CSV -> {(impact_id, camera): {tool track name: (frames, x, y)}}."""
-    from ballbat.pipeline.checked import read_sealed_csv, split_check_line
+    from ballbat.pipeline.checked import read_sealed_csv
 
     text = Path(path).read_text()
-    if split_check_line(text)[1] is not None:  # ballbat import-tracks ends its CSV in the check line
+    if "\n# ballbat table: " in text:  # ballbat import-tracks ends its CSV in the check line
         text = read_sealed_csv(path)
     rows: dict[tuple[str, str], dict[str, list]] = {}
     for r in csv.DictReader(text.splitlines()):
