@@ -124,8 +124,9 @@ def main() -> None:
         bomb = ["a0: &a0 [x, x, x, x, x, x, x, x, x]"]
         bomb += [f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 9)}]" for i in range(1, 12)]
         bomb += ["datasets: {lab: {tracks: *a11}}"]
-        (tmp / "bomb.yaml").write_text("\n".join(bomb) + "\n")
-        show("a YAML alias bomb (3e11 values)", "check", run("check", "--kind", "tracks", "--config", tmp / "bomb.yaml"))
+        path = tmp / "bomb.yaml"
+        path.write_text("\n".join(bomb) + "\n")
+        show("a YAML alias bomb (3e11 values)", "check", run("check", "--kind", "tracks", "--config", path))
 
 
 if __name__ == "__main__":
