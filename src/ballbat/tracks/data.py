@@ -149,7 +149,9 @@ MAX_TRACK_FRAMES = 20_000
 MAX_DENSE_BYTES = 2 * 2**30
 
 
-def dense_problems(ids: np.ndarray, impact_index: np.ndarray, camera: np.ndarray, frame: np.ndarray, source: str):
+def dense_problems(
+    ids: np.ndarray, impact_index: np.ndarray, camera: np.ndarray, frame: np.ndarray, source: str
+) -> list[str]:
     """Name what would make the padded arrays of :func:`to_dense` too large, before they are sized.
 
     The longest track of each camera (impact id, frames spanned) against :data:`MAX_TRACK_FRAMES`,

@@ -143,15 +143,16 @@ def _read(path: Path, fmt: str, units: dict | None, cam: dict) -> FileTracks:
     return reader(path, units, float(cam["fps"]), float(cam["m_per_px"]))
 
 
-def _far_frames(ft: FileTracks, iid: str, cam: str, frames: dict[str, np.ndarray]) -> list[str]:
-    """Name the marks of a file's tracks (name -> frames) far outside the file's run of frames.
+def _far_frames(ft: FileTracks, iid: str, cam: str, points: dict) -> list[str]:
+    """Name the marks of a file's tracks of ``points`` far outside the file's run of frames.
 
     Named before any array is sized by them (:func:`ballbat.tracks.checks.check_frame_runs`: a
     frame 999999999 is a typo).
     """
     from ..checks import check_frame_runs
 
-    have = [(n, f) for n, f in frames.items() if f.size]
+    names = [str(points[p]) for p in POINTS[cam] if p in points and str(points[p]) in ft.tracks]
+    have = [(n, ft.tracks[n][0]) for n in names if ft.tracks[n][0].size]
     if not have:
         return []
     fr = np.concatenate([f for _, f in have])
@@ -254,8 +255,7 @@ def import_files(
             cols["frame"].append(fr)
             cols["x_px"].append(x * factor if factor != 1.0 else x)
             cols["y_px"].append(y * factor if factor != 1.0 else y)
-        names = [str(points[p]) for p in POINTS[cam] if p in points and str(points[p]) in ft.tracks]
-        problems += _far_frames(ft, iid, cam, {n: ft.tracks[n][0] for n in names})
+        problems += _far_frames(ft, iid, cam, points)
     if problems:
         raise FormatError(problems)
     out = {k: np.concatenate(v) if v else np.array([]) for k, v in cols.items()}
