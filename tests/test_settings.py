@@ -464,12 +464,12 @@ def _workflow(ds: dict, tmp_path: Path, balls, bats, seed: bool = True):
     With the study's seeds (the dataset's synthetic.seed and render.seed set to them; ``seed``
     false: the dataset's own render.seed).
     """
-    from ballbat.pipeline.ncio import read_dataset
+    from ballbat.pipeline.ncio import read_dataset, write_dataset
     from ballbat.stages import reduce, render, simulate
     from ballbat.tracks.io import load_tracks
 
     sim = simulate.run(SyntheticSettings(**{**ds["synthetic"], "seed": SEEDS[0]}), balls, bats)
-    sim.to_netcdf(tmp_path / "simulate.nc")
+    write_dataset(sim, tmp_path / "simulate.nc", title="simulate", rule="simulate", inputs={}, config={})
     block = {**ds["render"], "seed": SEEDS[1]} if seed else ds["render"]  # common.smk: get_render_settings
     tracks = render.run(settings_from_config(block), read_dataset(tmp_path / "simulate.nc"), balls)
     tracks.to_netcdf(tmp_path / "tracks.nc")

@@ -27,15 +27,19 @@ MEDIA = "org.opensourcephysics.media.core"
 
 def read_long_csv(path: Path) -> dict[tuple[str, str], dict[str, tuple]]:
     """A long tracks CSV -> {(impact_id, camera): {tool track name: (frames, x, y)}}."""
+    from ballbat.pipeline.checked import read_sealed_csv
+
+    text = Path(path).read_text()
+    if "\n# ballbat table: " in text:  # ballbat import-tracks ends its CSV in the check line
+        text = read_sealed_csv(path)
     rows: dict[tuple[str, str], dict[str, list]] = {}
-    with open(path, newline="") as fh:
-        for r in csv.DictReader(fh):
-            key = (r["impact_id"], r["camera"])
-            name = TOOL_NAMES[r["point"]]
-            d = rows.setdefault(key, {}).setdefault(name, ([], [], []))
-            d[0].append(int(r["frame"]))
-            d[1].append(float(r["x_px"]))
-            d[2].append(float(r["y_px"]))
+    for r in csv.DictReader(text.splitlines()):
+        key = (r["impact_id"], r["camera"])
+        name = TOOL_NAMES[r["point"]]
+        d = rows.setdefault(key, {}).setdefault(name, ([], [], []))
+        d[0].append(int(r["frame"]))
+        d[1].append(float(r["x_px"]))
+        d[2].append(float(r["y_px"]))
     return {k: {n: tuple(np.array(a) for a in v) for n, v in t.items()} for k, t in rows.items()}
 
 

@@ -27,9 +27,10 @@ from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
 from . import __version__
+from .writer import OutputFailed, OutputRefused
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Iterable, Sequence
 
 #: The config schema and the default property tables, shipped with the package (``data/`` links
 #: to ``workflow/schemas/`` and ``config/`` of the checkout, so there is one copy of each).
@@ -183,10 +184,21 @@ def _tracks_dataset(args: argparse.Namespace, defaults: dict) -> tuple[str, dict
     cfg_path = Path(args.config)
     if not cfg_path.is_file():
         raise UsageError(f"argument --config: {cfg_path}: no such file")
+    from .pipeline.config import alias_problem
+
     try:
-        cfg = yaml.safe_load(cfg_path.read_text()) or {}
+        cfg = yaml.safe_load(cfg_path.read_text(encoding="utf-8")) or {}
+    except UnicodeDecodeError as exc:
+        raise UsageError(
+            f"argument --config: {cfg_path}: not UTF-8 text (byte {exc.start}): a binary file, not a YAML config?"
+        ) from None
     except yaml.YAMLError as exc:
-        raise UsageError(f"argument --config: {cfg_path}: not YAML ({exc})") from None
+        raise UsageError(f"argument --config: {cfg_path}: not YAML ({' '.join(str(exc).split())})") from None
+    bomb = alias_problem(cfg, str(cfg_path))
+    if bomb:
+        raise UsageError(f"argument --config: {bomb}")
+    if not isinstance(cfg, dict):
+        raise UsageError(f"argument --config: {cfg_path}: not a config (a YAML mapping of datasets, ...)")
     datasets = {k: v for k, v in (cfg.get("datasets") or {}).items() if isinstance(v, dict) and "tracks" in v}
     if args.dataset is None:
         if len(datasets) != 1:
@@ -328,10 +340,15 @@ def cmd_import_tracks(args: argparse.Namespace) -> int:
     import numpy as np
     import yaml
 
-    from .pipeline.ncio import atomic_write_text
+    from .pipeline.checked import sealed_csv
     from .tracks.formats import FormatError
     from .tracks.formats.layout import DEFAULT_PATTERN, import_files
+    from .writer import STDOUT, output_problem, write_output
 
+    if args.output != STDOUT:  # refused before any file is read (write_output checks again)
+        problem = output_problem(args.output, args.paths, args.parents)
+        if problem:
+            raise OutputRefused(problem)
     points = _pairs(args.points, "--points")
     units = _pairs(args.units, "--units") if args.units else None
     cameras: dict[str, dict] = {}
@@ -364,10 +381,11 @@ def cmd_import_tracks(args: argparse.Namespace) -> int:
         f"{c['impact_id'][i]},{c['camera'][i]},{c['point'][i]},{int(c['frame'][i])},{float(c['x_px'][i])!r},{float(c['y_px'][i])!r}"
         for i in order
     ]
-    atomic_write_text(args.output, "\n".join(lines) + "\n")
+    # the check line marks the file as ballbat's: only such a file is ever replaced (ballbat.writer)
+    where = write_output(args.output, sealed_csv("\n".join(lines) + "\n"), args.paths, parents=args.parents)
     found = imp.settings_yaml()
-    found["written"] = str(args.output)
-    print(yaml.safe_dump(found, sort_keys=False), end="")
+    found["written"] = where
+    print(yaml.safe_dump(found, sort_keys=False), end="", file=sys.stderr if args.output == STDOUT else sys.stdout)
     return 0
 
 
@@ -546,6 +564,21 @@ def cmd_fly(args: argparse.Namespace) -> int:
 # summary
 
 
+def _verify_results(paths: Iterable[Path]) -> None:
+    """Raise a UsageError naming the first of ``paths`` that is damaged (truncated, not NetCDF)."""
+    from .pipeline.checked import verify_netcdf
+
+    for path in paths:
+        try:
+            verify_netcdf(path)
+        except Exception as exc:  # any damage gets the same answer
+            why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+            raise UsageError(
+                f"argument folder: {path} cannot be read ({why}): damaged or cut short; "
+                "rerun the workflow to rebuild it"
+            ) from None
+
+
 def summary_lines(folder: Path) -> list[str]:
     """Return the headline numbers of a dataset's results folder as lines of a terminal table."""
     from .analysis import impact_labels
@@ -555,16 +588,13 @@ def summary_lines(folder: Path) -> list[str]:
     missing = [str(p) for p in need.values() if not p.is_file()]
     if missing:
         raise UsageError(f"argument folder: {folder} lacks {', '.join(missing)} (run the workflow first)")
-    read = []
-    for path in need.values():
-        try:
-            read.append(read_dataset(path))
-        except Exception as exc:  # any damage (truncated, not NetCDF) gets the same answer
-            why = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-            raise UsageError(
-                f"argument folder: {path} cannot be read ({why}): damaged or cut short; "
-                "rerun the workflow to rebuild it"
-            ) from None
+    from .pipeline.checked import DamagedFileError
+
+    _verify_results(need.values())  # a damaged file is named first, before any file's identity
+    try:
+        read = [read_dataset(path) for path in need.values()]
+    except DamagedFileError as exc:  # whole, but not the workflow's (no provenance record)
+        raise UsageError(f"argument folder: {exc}") from None
     rec, fit, st = read
     lines = [f"{folder.name}: {rec.sizes['impact']} impacts, {int((rec['flag'].values != 0).sum())} not used (flagged)"]
     from .compare import SYSTEMATIC_NOTE, format_measurement, systematic_var, total_uncertainty
@@ -674,6 +704,39 @@ def cmd_summary(args: argparse.Namespace) -> int:
 # --------------------------------------------------------------------------------------
 
 
+def _import_tracks_parser(sub: argparse._SubParsersAction, fmt: type) -> None:
+    """Add the ``import-tracks`` command to the subcommands ``sub``."""
+    p = sub.add_parser(
+        "import-tracks",
+        help="read Tracker or Kinovea files into ballbat's long tracks CSV",
+        epilog=EXAMPLES["import-tracks"],
+        formatter_class=fmt,
+    )
+    p.add_argument("paths", nargs="+", metavar="FILE_OR_DIR", help="tool files, or folders of them")
+    p.add_argument("--points", required=True, help="ballbat point=the tool's track name, e.g. ball=ball,bat_tip=tip")
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="long tracks CSV to write ('-': standard output); an existing file is replaced only if ballbat wrote it",
+    )
+    p.add_argument("--parents", action="store_true", help="create the output's folder if it does not exist")
+    p.add_argument("--pattern", help="file names (default {impact_id}_{camera}.{ext})")
+    p.add_argument(
+        "--format",
+        choices=("tracker", "kinovea", "tracker_table", "kinovea_table"),
+        help="format of the files (default: from the extension, .trk/.trz/.kva; tables need it)",
+    )
+    p.add_argument("--units", help="tables only: time=s|ms|us|frames,length=m|cm|mm|in|ft|px,y=up|down")
+    p.add_argument(
+        "--camera",
+        action="append",
+        metavar="CAMERA:fps=..,m_per_px=..",
+        help="a camera's settings the files lack (tables), or to check against theirs; repeat per camera",
+    )
+    p.set_defaults(func=cmd_import_tracks)
+
+
 def parser() -> argparse.ArgumentParser:
     """Return the ``ballbat`` argument parser (defaults from the config schema)."""
     d = _schema_defaults()
@@ -731,29 +794,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("--json", action="store_true", help="print JSON")
     p.set_defaults(func=cmd_fly)
 
-    p = sub.add_parser(
-        "import-tracks",
-        help="read Tracker or Kinovea files into ballbat's long tracks CSV",
-        epilog=EXAMPLES["import-tracks"],
-        formatter_class=fmt,
-    )
-    p.add_argument("paths", nargs="+", metavar="FILE_OR_DIR", help="tool files, or folders of them")
-    p.add_argument("--points", required=True, help="ballbat point=the tool's track name, e.g. ball=ball,bat_tip=tip")
-    p.add_argument("-o", "--output", required=True, help="long tracks CSV to write")
-    p.add_argument("--pattern", help="file names (default {impact_id}_{camera}.{ext})")
-    p.add_argument(
-        "--format",
-        choices=("tracker", "kinovea", "tracker_table", "kinovea_table"),
-        help="format of the files (default: from the extension, .trk/.trz/.kva; tables need it)",
-    )
-    p.add_argument("--units", help="tables only: time=s|ms|us|frames,length=m|cm|mm|in|ft|px,y=up|down")
-    p.add_argument(
-        "--camera",
-        action="append",
-        metavar="CAMERA:fps=..,m_per_px=..",
-        help="a camera's settings the files lack (tables), or to check against theirs; repeat per camera",
-    )
-    p.set_defaults(func=cmd_import_tracks)
+    _import_tracks_parser(sub, fmt)
 
     p = sub.add_parser("summary", help="a dataset's headline numbers", epilog=EXAMPLES["summary"], formatter_class=fmt)
     p.add_argument("folder", help="a results folder, e.g. results/synthetic")
@@ -767,9 +808,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         status = args.func(args)
         sys.stdout.flush()
-    except UsageError as exc:
+    except (UsageError, OutputRefused) as exc:
         print(f"ballbat {args.command}: error: {exc}", file=sys.stderr)
-        return 2
+        return 1 if isinstance(exc, OutputFailed) else 2
     except BrokenPipeError:  # the reader left (`ballbat summary ... | head`): stop quietly, as cat does
         devnull = os.open(os.devnull, os.O_WRONLY)
         os.dup2(devnull, sys.stdout.fileno())  # nothing left to flush at exit

@@ -99,6 +99,29 @@ BAT_COLUMNS = {
 _DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$")
 
 
+def _without_check_line(path: Path, text: str) -> str:
+    """``text`` without ballbat's check line at its end (``ballbat import-tracks`` writes one), verified.
+
+    A table that ends in the check line but no longer matches it was cut short or edited after
+    ballbat wrote it: refused, naming the file (an edit on purpose: delete the last line).
+    """
+    from .pipeline.checked import csv_problem, split_check_line
+
+    body, trailer = split_check_line(text)
+    if trailer is None:
+        return text
+    problem = csv_problem(path)
+    if problem:
+        raise InputError(
+            [
+                f"{path}: ends in ballbat's check line, which does not hold ({problem}): cut short, or "
+                "edited after ballbat wrote it (if you edited it on purpose, delete its last line "
+                "'# ballbat table: ...')"
+            ]
+        )
+    return body
+
+
 def read_csv_rows(path: str | os.PathLike[str]) -> tuple[list[str], list[tuple[int, list[str]]]]:
     """Return the header and the non-blank rows (line number, cells) of a CSV file as labs make them.
 
@@ -124,7 +147,7 @@ def read_csv_rows(path: str | os.PathLike[str]) -> tuple[list[str], list[tuple[i
                 "(a Latin-1 or Windows export?); save the file as 'CSV UTF-8'"
             ]
         ) from None
-    lines = text.splitlines()
+    lines = _without_check_line(path, text).splitlines()
     first = next((ln for ln in lines if ln.strip()), "")
     semicolon = first.count(";") > first.count(",")
     reader = csv.reader(lines, delimiter=";" if semicolon else ",")

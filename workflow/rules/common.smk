@@ -217,6 +217,13 @@ def get_tool_files(wildcards):
     return {"files": found, "impacts": existing(t["impacts"])}
 
 
+def tool_file_hashes(wildcards):
+    """The sha256 of every tool file of a `tracks.dir` folder and of the dataset's tables (:func:`file_hashes`):
+    a tool file replaced by other content reruns the import, whatever its timestamp."""
+    files = {Path(f).name: f for f in get_tool_files(wildcards)["files"]}
+    return {**data_hashes(wildcards), **file_hashes(files)}
+
+
 def get_import_settings(wildcards):
     return dataset_config(wildcards)["tracks"]
 

@@ -53,6 +53,7 @@ rule import_tracks:
     params:
         settings=get_import_settings,
         where=get_reduce_where,
+        sha256=tool_file_hashes,
     script:
         "../scripts/import_tracks.py"
 

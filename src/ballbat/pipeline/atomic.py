@@ -3,7 +3,8 @@
 The content is written to a temporary file in the target's directory, given the usual
 permissions (0666 less the umask: ``mkstemp`` alone would make it private), and renamed
 into place only when complete. On any error the temporary file is removed and whatever
-was at the target before is left untouched.
+was at the target before is left untouched. A write that fails on a full disk (netCDF says only
+"NetCDF: HDF error") is reported as ``disk full``, naming the target (:func:`disk_full_error`).
 
 The temporary file's name says who owns it: ``.<name>.<pid>@<host>.<random><suffix>``.
 A job killed outright (SIGKILL, a lost node) cannot remove it; :func:`temporary_owner` reads
@@ -13,6 +14,7 @@ the owner back, so that only the temporaries of dead processes on this host are 
 
 from __future__ import annotations
 
+import errno
 import os
 import re
 import socket
@@ -51,6 +53,37 @@ def atomic_target(path: str | os.PathLike[str], suffix: str = ".tmp") -> Iterato
         os.umask(umask)
         os.chmod(tmp, 0o666 & ~umask)
         os.replace(tmp, path)
-    except BaseException:
+    except BaseException as exc:
+        full = disk_full_error(path, exc)  # judged before the temporary's space is freed
         Path(tmp).unlink(missing_ok=True)
+        if full is not None:
+            raise full from None
         raise
+
+
+#: Free space (bytes) below which a failed write is put down to a full disk.
+FULL_DISK_BYTES = 1 << 20
+
+
+def disk_full_error(path: Path, exc: BaseException) -> OSError | None:
+    """Return an error that says "disk full" and names ``path`` when ``exc`` met a full disk; None otherwise.
+
+    netCDF/HDF5 report a full disk as "NetCDF: HDF error" (a RuntimeError or an OSError without
+    errno): the free space of the target's folder tells.
+    """
+    if not isinstance(exc, (OSError, RuntimeError)):
+        return None
+    code = getattr(exc, "errno", None)
+    if code not in (errno.ENOSPC, errno.EDQUOT):
+        try:
+            st = os.statvfs(path.parent)
+        except OSError:
+            return None
+        if st.f_bavail * st.f_frsize >= FULL_DISK_BYTES:
+            return None
+    said = str(exc).splitlines()[0] if str(exc) else ""
+    return OSError(
+        errno.ENOSPC,
+        f"disk full: {path} could not be written ({type(exc).__name__}: {said}); "
+        "what was there is unchanged: free some space and run again",
+    )

@@ -51,7 +51,11 @@ def sealed_csv(text: str) -> str:
 
 
 def _split(data: bytes) -> tuple[str, str | None]:
-    text = data.decode("utf-8", errors="replace")
+    return split_check_line(data.decode("utf-8", errors="replace"))
+
+
+def split_check_line(text: str) -> tuple[str, str | None]:
+    """Split ``text`` into the table and its check line (None when it has none)."""
     cut = text.rfind("# ballbat table: ", 0, len(text))
     if cut < 0 or (cut > 0 and text[cut - 1] != "\n"):
         return text, None

@@ -104,6 +104,17 @@ def drop_nulls(config: dict) -> dict:
     return config
 
 
+def _render_without_synthetic(config: dict) -> list[str]:
+    """Name each measured dataset with a ``render`` block (it renders a synthetic truth; a measured one has none)."""
+    datasets = config.get("datasets")
+    return [
+        f"datasets.{name}.render: only a synthetic dataset renders camera tracks (this one is measured: "
+        f"{next(k for k in ('impacts', 'tracks') if k in ds)}); remove its render block"
+        for name, ds in (datasets.items() if isinstance(datasets, dict) else ())
+        if isinstance(ds, dict) and "render" in ds and "synthetic" not in ds and ("impacts" in ds or "tracks" in ds)
+    ]
+
+
 def _names(config: dict) -> list[str]:
     problems = []
     groups = (
@@ -196,6 +207,47 @@ def _synthetic_keys(config: dict) -> list[str]:
             if ball not in (syn.get("e_y") or {}):
                 problems.append(f"{where}.e_y: no entry for ball {ball} (it has impacts); give its true e_y")
     return problems
+
+
+#: The most values a config may hold once YAML's aliases (``&anchor`` ... ``*anchor``) are expanded, and
+#: its deepest nesting: a few aliases of aliases (a "billion laughs" file) would otherwise hold
+#: billions of values, and every check that walks the config would never end.
+MAX_CONFIG_VALUES = 100_000
+MAX_CONFIG_DEPTH = 40
+
+
+def alias_problem(config: object, source: str = "config") -> str | None:
+    """Return why ``config`` is too large or deep once its aliases are expanded (None when it is not).
+
+    Counts each shared mapping or list once per use without walking it again, so the count of a
+    bomb is found in the time of its few distinct nodes; a mapping that contains itself is named.
+    """
+    sizes: dict[int, int] = {}
+
+    def size(node: object, depth: int, stack: set[int]) -> int:
+        if not isinstance(node, (dict, list)):
+            return 1
+        if id(node) in stack:
+            raise ValueError(f"{source}: a YAML alias makes the config contain itself")
+        if depth > MAX_CONFIG_DEPTH:
+            raise ValueError(f"{source}: nested deeper than {MAX_CONFIG_DEPTH} levels")
+        if id(node) not in sizes:
+            stack.add(id(node))
+            items = node.values() if isinstance(node, dict) else node
+            sizes[id(node)] = 1 + sum(size(v, depth + 1, stack) for v in items)
+            stack.discard(id(node))
+        return sizes[id(node)]
+
+    try:
+        total = size(config, 0, set())
+    except ValueError as exc:
+        return str(exc)
+    if total > MAX_CONFIG_VALUES:
+        return (
+            f"{source}: holds {total} values once its YAML aliases (*name) are expanded, more than "
+            f"{MAX_CONFIG_VALUES}: aliases of aliases (a file built to blow up when read?)"
+        )
+    return None
 
 
 def _finite(node: object, where: str = "") -> list[str]:
@@ -381,9 +433,12 @@ def validate_config(config: dict, schema: dict, source: str = "config", availabl
     """
     import jsonschema
 
+    bomb = alias_problem(config, source)
+    if bomb:
+        raise ConfigError(f"{source} is not valid:\n  {bomb}")
     validator = jsonschema.Draft202012Validator(schema)
     errors = sorted(validator.iter_errors(config), key=lambda e: (list(map(str, e.absolute_path)), e.message))
-    lines = [_message(e) for e in errors] + _names(config) + _finite(config)
+    lines = [_message(e) for e in errors] + _names(config) + _finite(config) + _render_without_synthetic(config)
     if not lines:
         lines = _synthetic_keys(config) + _offsets(config)
     if not lines:

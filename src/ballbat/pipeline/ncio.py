@@ -18,7 +18,7 @@ import xarray as xr
 
 from .. import __version__
 from .atomic import atomic_target
-from .checked import CHECKSUM_ATTR, read_sealed_csv, seal_netcdf, verify_netcdf
+from .checked import CHECKSUM_ATTR, DamagedFileError, read_sealed_csv, seal_netcdf, verify_netcdf
 from .provenance import data_inputs, provenance_attrs
 
 if TYPE_CHECKING:
@@ -123,11 +123,18 @@ def read_dataset(path: str | os.PathLike[str], require: tuple[str, ...] = ()) ->
     """Load a results file fully into memory and check the variables ``require`` names.
 
     The file is verified whole first (:func:`~ballbat.pipeline.checked.verify_netcdf`): a damaged
-    file raises :class:`~ballbat.pipeline.checked.DamagedFileError` naming it.
+    file, or one without the workflow's provenance record (a user's own NetCDF at a results
+    path), raises :class:`~ballbat.pipeline.checked.DamagedFileError` naming it.
     """
     verify_netcdf(path)
     with xr.open_dataset(path, engine="netcdf4") as ds:
         ds = ds.load()
+    if "provenance_rule" not in ds.attrs:  # a NetCDF of someone else's at a path the workflow writes
+        raise DamagedFileError(
+            path,
+            "lacks the workflow's provenance record, so none of its rules wrote it: "
+            "a NetCDF of your own where the workflow keeps its results?",
+        )
     ds.attrs.pop(CHECKSUM_ATTR, None)  # of the file, not of the data: a file written from ds gets its own
     missing = [v for v in require if v not in ds.variables]
     if missing:

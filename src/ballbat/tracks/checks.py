@@ -79,6 +79,7 @@ def check_frame_runs(
     camera: np.ndarray,
     frame: np.ndarray,
     labels: Sequence[str],
+    column: str = ", column frame",
 ) -> list[str]:
     """Rows whose frame lies far outside the run of its impact and camera.
 
@@ -94,7 +95,9 @@ def check_frame_runs(
     impact_id, camera : array of str
     frame : array of int
     labels : array of str
-        Each row's label (``row 5``).
+        Each row's label (``row 5``; a tool file's ``track 'ball'``).
+    column : str
+        What follows the label in a message (a tool file has no column ``frame``).
 
     Returns
     -------
@@ -125,12 +128,12 @@ def check_frame_runs(
         lo, hi = uniq[bounds[main]], uniq[bounds[main + 1] - 1]
         out = (ff < lo) | (ff > hi)
         rows = order[s:e][out]
-        iid, cam = impact_id[rows[0]], camera[rows[0]]
+        iid, cam = str(impact_id[rows[0]]), str(camera[rows[0]])
         for r in rows[:5]:
             d = frame[r] - hi if frame[r] > hi else lo - frame[r]
             side = "after" if frame[r] > hi else "before"
             problems.append(
-                f"{path}: {labels[r]}, column frame: frame {frame[r]} of impact {iid!r} in the {cam} camera is "
+                f"{path}: {labels[r]}{column}: frame {frame[r]} of impact {iid!r} in the {cam} camera is "
                 f"{d} frames {side} the rest of its run (frames {lo}-{hi}, {uniq.size} tracked): a typo?"
             )
         if rows.size > 5:

@@ -141,6 +141,49 @@ def to_long(tracks: Tracks) -> dict[str, np.ndarray]:
     return {k: v[order] for k, v in out.items()}
 
 
+#: The most frames one impact's track may span in one camera (first to last tracked frame): every
+#: impact's tracks are stored padded to the longest (one array per camera), so a track of 1e6 rest
+#: frames would make every impact that long. 20 000 frames are 6.7 s at 3000 frames per second.
+MAX_TRACK_FRAMES = 20_000
+#: The most bytes the padded tracks of one camera may take (impacts x frames x points x 2 x 8 bytes).
+MAX_DENSE_BYTES = 2 * 2**30
+
+
+def dense_problems(
+    ids: np.ndarray, impact_index: np.ndarray, camera: np.ndarray, frame: np.ndarray, source: str
+) -> list[str]:
+    """Name what would make the padded arrays of :func:`to_dense` too large, before they are sized.
+
+    The longest track of each camera (impact id, frames spanned) against :data:`MAX_TRACK_FRAMES`,
+    and the padded size against :data:`MAX_DENSE_BYTES`. ``ids``: the impact ids by index.
+    """
+    problems = []
+    for cam, points in POINTS.items():
+        sel = camera == cam
+        if not sel.any():
+            continue
+        ii, ff = impact_index[sel], frame[sel].astype(np.int64)
+        lo = np.full(ids.size, np.iinfo(np.int64).max, dtype=np.int64)
+        hi = np.full(ids.size, np.iinfo(np.int64).min, dtype=np.int64)
+        np.minimum.at(lo, ii, ff)
+        np.maximum.at(hi, ii, ff)
+        span = np.where(hi >= lo, hi - lo + 1, 0)
+        k = int(np.argmax(span))
+        size = ids.size * int(span[k]) * len(points) * 2 * 8
+        what = f"{source}: impact {str(ids[k])!r} spans {int(span[k])} frames in the {cam} camera ({lo[k]}-{hi[k]})"
+        if span[k] > MAX_TRACK_FRAMES:
+            problems.append(
+                f"{what}, more than the {MAX_TRACK_FRAMES} one impact's track may span: track only the "
+                "frames around the impact (a rest position held for long, or a wrong frame number?)"
+            )
+        elif size > MAX_DENSE_BYTES:
+            problems.append(
+                f"{what}: {ids.size} impacts padded to it would take {size / 2**30:.1f} GiB, more than "
+                f"{MAX_DENSE_BYTES // 2**30} GiB; track fewer frames per impact, or split the dataset"
+            )
+    return problems
+
+
 def to_dense(
     impact_index: np.ndarray,
     camera: np.ndarray,

@@ -19,7 +19,7 @@ import xarray as xr
 
 from ..properties import InputError, cell_text, read_csv_table
 from .checks import check_frame_runs
-from .data import POINTS, Camera, Rig, Tracks, to_dense
+from .data import POINTS, Camera, Rig, Tracks, dense_problems, to_dense
 from .validate import (
     IMPACT_COLUMNS,
     TRACK_COLUMNS,
@@ -169,7 +169,7 @@ def load_tracks(
             runs = check_frame_runs(tracks_path, fast["impact_id"], fast["camera"], fast["frame"], labels)
             if runs:
                 raise InputError(runs)
-            return _assemble(fast, irows, ipath if impacts_path is None else None)
+            return _assemble(fast, irows, ipath if impacts_path is None else None, str(tracks_path))
     try:
         header, rows = read_table(tracks_path, TRACK_COLUMNS, "row")
     except InputError as exc:
@@ -184,7 +184,8 @@ def load_tracks(
         problems += check_frame_runs(tracks_path, cols["impact_id"], cols["camera"], cols["frame"], cols["label"])
     if problems:
         raise InputError(problems)
-    return _assemble({k: np.asarray(cols[k]) for k in TRACK_COLUMNS}, irows, ipath if impacts_path is None else None)
+    cols = {k: np.asarray(cols[k]) for k in TRACK_COLUMNS}
+    return _assemble(cols, irows, ipath if impacts_path is None else None, str(tracks_path))
 
 
 def _fast_nc(path: Path, impacts: dict) -> dict | None:
@@ -221,16 +222,22 @@ def _fast_nc(path: Path, impacts: dict) -> dict | None:
     }
 
 
-def _assemble(cols: dict, irows, truth_path) -> Tracks:
+def _assemble(cols: dict, irows, truth_path, source: str = "tracks") -> Tracks:
+    """Lay checked long rows out as dense tracks; too large a layout is named first (``source``: the file)."""
     ids = [row["impact_id"] for _, row in irows]
     index = {iid: i for i, iid in enumerate(ids)}
     n = len(ids)
     uniq, inv = np.unique(np.asarray(cols["impact_id"]).astype(str), return_inverse=True)
+    impact_index = np.array([index[u] for u in uniq], dtype=np.int64)[inv]
+    camera, frame = np.asarray(cols["camera"]).astype(str), np.asarray(cols["frame"], dtype=np.int64)
+    too_large = dense_problems(np.array(ids, dtype=str), impact_index, camera, frame, source)
+    if too_large:
+        raise InputError(too_large)
     cams = to_dense(
-        np.array([index[u] for u in uniq], dtype=np.int64)[inv],
-        np.asarray(cols["camera"]).astype(str),
+        impact_index,
+        camera,
         np.asarray(cols["point"]).astype(str),
-        np.asarray(cols["frame"], dtype=np.int64),
+        frame,
         np.asarray(cols["x_px"], dtype=float),
         np.asarray(cols["y_px"], dtype=float),
         n,

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
+from pathlib import Path
 
 import numpy as np
 
@@ -42,12 +43,45 @@ LENGTH_UNITS = {
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6}
 
 
+#: The largest tool file (or ``.trz`` archive member) read, in bytes: checked before reading it.
+#: 32 MiB holds some 200 000 marks (a lab's file of one impact and camera holds a few thousand).
+MAX_FILE_BYTES = 32 * 2**20
+#: The largest compression ratio of a ``.trz`` member (uncompressed / compressed size): Tracker's XML
+#: compresses some 10 times; far more is an archive built to blow up when read.
+MAX_COMPRESSION_RATIO = 200
+
+
 class FormatError(Exception):
     """Problems of one file (each naming the file, the track or row, and what is wrong)."""
 
     def __init__(self, problems: list[str]):
         super().__init__("\n".join(problems))
         self.problems = list(problems)
+
+
+def size_problem(name: str, size: int) -> str | None:
+    """Why a file (or archive member) of ``size`` bytes is not read (None: small enough)."""
+    if size <= MAX_FILE_BYTES:
+        return None
+    return (
+        f"{name}: {size / 2**20:.0f} MiB, more than the {MAX_FILE_BYTES // 2**20} MiB a tool file may hold "
+        "(one impact and one camera per file); not read"
+    )
+
+
+def read_limited(path: Path) -> bytes:
+    """Return the bytes of a tool file, refused (named) when it is larger than :data:`MAX_FILE_BYTES`."""
+    try:
+        problem = size_problem(str(path), path.stat().st_size)
+        if problem:
+            raise FormatError([problem])
+        with open(path, "rb") as fh:
+            data = fh.read(MAX_FILE_BYTES + 1)
+    except OSError as exc:
+        raise FormatError([f"{path}: cannot be read ({exc})"]) from None
+    if len(data) > MAX_FILE_BYTES:  # a file that grew, or a device: never more than the limit in memory
+        raise FormatError([size_problem(str(path), len(data)) or f"{path}: too large"])
+    return data
 
 
 @dataclass

@@ -25,7 +25,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from . import FileTracks, FormatError, finite_number, length_to_m, whole_frames
+from . import FileTracks, FormatError, finite_number, length_to_m, read_limited, whole_frames
 
 if TYPE_CHECKING:
     import os
@@ -59,10 +59,9 @@ def _point(text: str | None, what: str, problems: list[str]) -> tuple[float, flo
 def read_kva(path: str | os.PathLike[str]) -> FileTracks:
     """Read a Kinovea ``.kva`` file."""
     path = Path(path)
+    data = read_limited(path)
     try:
-        root = ET.fromstring(path.read_bytes())
-    except OSError as exc:
-        raise FormatError([f"{path}: cannot be read ({exc})"]) from None
+        root = ET.fromstring(data)
     except ET.ParseError as exc:
         raise FormatError([f"{path}: not a Kinovea file (XML does not parse: {exc})"]) from None
     if root.tag != "KinoveaVideoAnalysis":

@@ -56,9 +56,11 @@ class Imported:
 
 def pattern_regex(pattern: str, exts: Iterable[str]) -> re.Pattern:
     """Return the regular expression of a file-name pattern (``{impact_id}``, ``{camera}``, ``{ext}``)."""
-    for key in ("{impact_id}", "{camera}"):
-        if key not in pattern:
+    for key in ("{impact_id}", "{camera}", "{ext}"):
+        if key != "{ext}" and key not in pattern:
             raise ValueError(f"pattern {pattern!r} lacks {key}")
+        if pattern.count(key) > 1:
+            raise ValueError(f"pattern {pattern!r} has {key} {pattern.count(key)} times (each field once)")
     out = re.escape(pattern)
     out = out.replace(re.escape("{impact_id}"), r"(?P<impact_id>.+?)")
     out = out.replace(re.escape("{camera}"), "(?P<camera>" + "|".join(CAMERAS) + ")")
@@ -139,6 +141,23 @@ def _read(path: Path, fmt: str, units: dict | None, cam: dict) -> FileTracks:
         return read_kva(path)
     reader = read_tracker_table if fmt == "tracker_table" else read_kinovea_table
     return reader(path, units, float(cam["fps"]), float(cam["m_per_px"]))
+
+
+def _far_frames(ft: FileTracks, iid: str, cam: str, points: dict) -> list[str]:
+    """Name the marks of a file's tracks of ``points`` far outside the file's run of frames.
+
+    Named before any array is sized by them (:func:`ballbat.tracks.checks.check_frame_runs`: a
+    frame 999999999 is a typo).
+    """
+    from ..checks import check_frame_runs
+
+    names = [str(points[p]) for p in POINTS[cam] if p in points and str(points[p]) in ft.tracks]
+    have = [(n, ft.tracks[n][0]) for n in names if ft.tracks[n][0].size]
+    if not have:
+        return []
+    fr = np.concatenate([f for _, f in have])
+    labels = np.concatenate([np.full(f.size, f"track {n!r}") for n, f in have])
+    return check_frame_runs(ft.path, np.full(fr.size, iid), np.full(fr.size, cam), fr, labels, column="")
 
 
 def import_files(
@@ -236,6 +255,7 @@ def import_files(
             cols["frame"].append(fr)
             cols["x_px"].append(x * factor if factor != 1.0 else x)
             cols["y_px"].append(y * factor if factor != 1.0 else y)
+        problems += _far_frames(ft, iid, cam, points)
     if problems:
         raise FormatError(problems)
     out = {k: np.concatenate(v) if v else np.array([]) for k, v in cols.items()}
@@ -333,4 +353,4 @@ def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | 
             )
     if problems:
         raise InputError(problems)
-    return _assemble(imp.columns, irows, None), imp
+    return _assemble(imp.columns, irows, None, str(cfg["dir"])), imp

@@ -25,7 +25,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from . import TIME_UNITS, FileTracks, FormatError, length_to_m, whole_frames
+from . import TIME_UNITS, FileTracks, FormatError, length_to_m, read_limited, whole_frames
 
 if TYPE_CHECKING:
     import os
@@ -56,10 +56,7 @@ def check_units(units: object, where: str) -> list[str]:
 
 
 def _read_text(path: Path) -> str:
-    try:
-        raw = path.read_bytes()
-    except OSError as exc:
-        raise FormatError([f"{path}: cannot be read ({exc})"]) from None
+    raw = read_limited(path)
     for enc in ("utf-8-sig", "cp1252"):
         try:
             return raw.decode(enc)

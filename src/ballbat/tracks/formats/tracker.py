@@ -29,7 +29,16 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from . import FileTracks, FormatError, finite_number, length_to_m
+from . import (
+    MAX_COMPRESSION_RATIO,
+    MAX_FILE_BYTES,
+    FileTracks,
+    FormatError,
+    finite_number,
+    length_to_m,
+    read_limited,
+    size_problem,
+)
 
 if TYPE_CHECKING:
     import os
@@ -220,10 +229,7 @@ def _to_axes(px, py, xo, yo, angle_deg, ratio):
 def read_trk(path: str | os.PathLike[str]) -> FileTracks:
     """Read a ``.trk`` file."""
     path = Path(path)
-    try:
-        return read_trk_text(path.read_bytes(), str(path))
-    except OSError as exc:
-        raise FormatError([f"{path}: cannot be read ({exc})"]) from None
+    return read_trk_text(read_limited(path), str(path))
 
 
 def read_trz(path: str | os.PathLike[str]) -> FileTracks:
@@ -235,6 +241,26 @@ def read_trz(path: str | os.PathLike[str]) -> FileTracks:
             if len(names) != 1:
                 found = ", ".join(names) if names else "none"
                 raise FormatError([f"{path}: a .trz must hold exactly one .trk project (found: {found})"])
-            return read_trk_text(z.read(names[0]), f"{path}:{names[0]}")
-    except (OSError, zipfile.BadZipFile) as exc:
+            return read_trk_text(_read_member(z, z.getinfo(names[0]), f"{path}:{names[0]}"), f"{path}:{names[0]}")
+    except (OSError, zipfile.BadZipFile, EOFError, RuntimeError, NotImplementedError) as exc:
         raise FormatError([f"{path}: not a Tracker archive (.trz is a zip file: {exc})"]) from None
+
+
+def _read_member(z: zipfile.ZipFile, info: zipfile.ZipInfo, name: str) -> bytes:
+    """Return an archive member's bytes, checked before reading: not encrypted, within the size and ratio limits."""
+    if info.flag_bits & 0x1:
+        raise FormatError([f"{name}: the member is encrypted (password-protected); save the project unencrypted"])
+    problem = size_problem(name, info.file_size)
+    ratio = info.file_size / max(info.compress_size, 1)
+    if problem is None and ratio > MAX_COMPRESSION_RATIO:
+        problem = (
+            f"{name}: compressed {ratio:.0f} times, more than the {MAX_COMPRESSION_RATIO} a Tracker project "
+            "compresses (an archive built to blow up when read?); not read"
+        )
+    if problem:
+        raise FormatError([problem])
+    with z.open(info) as fh:
+        data = fh.read(MAX_FILE_BYTES + 1)  # the sizes in the header may lie: never more than the limit
+    if len(data) > MAX_FILE_BYTES:
+        raise FormatError([size_problem(name, len(data)) or f"{name}: too large"])
+    return data
