@@ -766,11 +766,15 @@ def parser() -> argparse.ArgumentParser:
     p = sub.add_parser("summary", help="a dataset's headline numbers", epilog=EXAMPLES["summary"], formatter_class=fmt)
     p.add_argument("folder", help="a results folder, e.g. results/synthetic")
     p.set_defaults(func=cmd_summary)
-
-    from .batcli import register  # ballbat bat (its own module)
-
-    register(sub, _finite, Path(d["tables"]["balls"]), EXAMPLES["bat"])
+    _add_bat(sub, Path(d["tables"]["balls"]))
     return top
+
+
+def _add_bat(sub: argparse._SubParsersAction, balls: Path) -> None:
+    """Add ``ballbat bat`` (:mod:`ballbat.batcli`, imported only here: it needs numpy)."""
+    from .batcli import register
+
+    register(sub, _finite, balls, EXAMPLES["bat"])
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -544,7 +544,7 @@ def _max_z(m: Measured, groups, sigma: dict | None, coarse) -> np.ndarray:
     return np.nan_to_num(np.abs(np.array(list(z.values()))), nan=0.0).max(axis=0)
 
 
-def row_unit_hints(m: Measured, groups, coarse, why: np.ndarray) -> dict[int, str]:
+def row_unit_hints(m: Measured, groups: ArrayLike, coarse: ArrayLike | None, why: np.ndarray) -> dict[int, str]:
     """Per impact whose values fit another unit far better than the file's: which (SI inputs).
 
     Rows excluded as implausible (``why`` not empty, :func:`implausible_rows`) and kept rows at
