@@ -79,6 +79,8 @@ def test_grams_as_ounces_and_b_outside_any_bat(tmp_path):
         ("h,h,lab,34,32,23,6,11200,28,2.6,11", "column impact_from_tip_in", "measured from the knob?"),
         ("h,h,lab,34,32,23,6,1952,6,2.6,11", "column moi_oz_in2", "about the centre of mass given as about the pivot"),
         ("h,h,lab,34,32,23,6,11200,6,1.3,11", "column diameter_in", "the radius given as the diameter"),
+        ("h,h,lab,34,32,23,6,17000,6,2.6,11", "column moi_oz_in2", "an MOI about the knob end"),
+        ("h,h,lab,34,32,23,6,9700,6,2.6,11", "column moi_oz_in2", "given as about the pivot"),
         ("h,h,lab,34,32,23,6,11200,6,2.6,110", "column Iz_oz_in2", "radius of gyration about the long axis"),
     ],
 )

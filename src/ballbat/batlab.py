@@ -234,6 +234,12 @@ def _cm_moi_problems(at: str, col: str, i0: float, m: float, length: float | Non
         )
     elif not lab and lo <= k0 / CM_PER_IN <= hi:
         hint = f": oz cm^2 typed as oz in^2? (sqrt(I0/M) would be {k0 / CM_PER_IN:.1f} in)"
+    elif lab:
+        hint = (
+            ": an MOI about the knob end (not the pivot_in one), or in oz cm^2?"
+            if k > hi
+            else ": an MOI about the centre of mass given as about the pivot, or the balance point or pivot wrong?"
+        )
     rng = f"{lo:g}-{hi:g}" + ("" if length else " in")
     return [
         f"{at}, column {col}: {about}the radius of gyration about the centre of mass sqrt(I0/M) is {where}, "
