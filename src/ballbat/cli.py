@@ -4,7 +4,8 @@
 rule does (the same function, :func:`ballbat.stages.ingest.run`); ``ballbat fly`` flies batted
 balls with Nathan's trajectory model (:func:`ballbat.flight.fly`), one from options or many
 from a CSV file; ``ballbat summary results/{dataset}`` prints a dataset's headline numbers; ``ballbat import-tracks``
-reads Tracker or Kinovea files into the long tracks CSV (:mod:`ballbat.tracks.formats`).
+reads Tracker or Kinovea files into the long tracks CSV (:mod:`ballbat.tracks.formats`); ``ballbat
+bat`` turns a lab's bat measurements into a bat-table row (:mod:`ballbat.batcli`).
 Defaults (air, spin decay, integrator, property tables) are the config schema's, the one
 place the workflow's defaults live. Errors are one line naming the bad argument (exit 2);
 ``check`` exits 1 when the file is not usable.
@@ -41,6 +42,7 @@ EXAMPLES = {
   ballbat check data/mylab/impacts.csv
   ballbat check data/mylab/impacts.csv --bats data/mylab/bats.csv
   ballbat check config/examples/maple_impacts.csv --bats config/examples/maple_bats.csv
+  ballbat check config/examples/hickory_impacts.csv --bats config/examples/hickory_bats.csv
   ballbat check config/examples/tracked_tracks.csv --kind tracks --impacts config/examples/tracked_impacts.csv
   ballbat check --kind tracks --config config/examples/tracked.yaml   (as the reduce rule: reduce, cross-check)""",
     "fly": """examples:
@@ -55,6 +57,12 @@ EXAMPLES = {
       --camera swing:fps=3000,m_per_px=0.00074 --camera spin:fps=1000,m_per_px=0.00125 --points ... -o tracks.csv
 Files are named {impact_id}_{camera}.{ext} (camera: swing or spin; --pattern to change it).
 Prints the camera settings found in the files as YAML; exits 1 when a file cannot be read.""",
+    "bat": """examples:
+  ballbat bat --length 34 --weight 32 --balance-point 23.0 --moi-6in 11200 --impact-from-tip 6 --diameter 2.6 --iz 11
+  ballbat bat --length 34 --weight 32 --balance-point 23.0 --period 1.72 --pivot 6 --impact-from-knob 28 \\
+      --diameter 2.6 --iz 11 --name hickory
+Prints the bat in the paper's convention and the lab's, its centre of percussion and what each
+measured value's uncertainty does to e_x; exits 1 when the values fail a bat row's checks.""",
     "summary": """examples:
   ballbat summary results/synthetic
   ballbat summary results/maple""",
@@ -799,7 +807,15 @@ def parser() -> argparse.ArgumentParser:
     p = sub.add_parser("summary", help="a dataset's headline numbers", epilog=EXAMPLES["summary"], formatter_class=fmt)
     p.add_argument("folder", help="a results folder, e.g. results/synthetic")
     p.set_defaults(func=cmd_summary)
+    _add_bat(sub, Path(d["tables"]["balls"]))
     return top
+
+
+def _add_bat(sub: argparse._SubParsersAction, balls: Path) -> None:
+    """Add ``ballbat bat`` (:mod:`ballbat.batcli`, imported only here: it needs numpy)."""
+    from .batcli import register
+
+    register(sub, _finite, balls, EXAMPLES["bat"])
 
 
 def main(argv: Sequence[str] | None = None) -> int:

@@ -113,6 +113,15 @@ PSI_MIN_FOR_E_X = 10.0 * DEGREE
 UNIT_WARN_FRACTION = 0.5
 #: ... and a suspected mistake is named when correcting it leaves at most this fraction.
 UNIT_FIX_FRACTION = 0.2
+#: A kept row this many robust standard deviations off its group's line is checked for a unit
+#: mistake of its own (:func:`row_unit_hints`) ...
+UNIT_ROW_Z = 3.0
+#: ... and named when a correction brings it within this many (and a third of its distance).
+UNIT_ROW_FIT_Z = 1.5
+#: Most rows checked one by one for a unit mistake (more: a file-wide mistake, :func:`unit_warnings`).
+UNIT_ROW_MAX = 50
+#: 1 mph in km/h (exact: 1.609344 km per mile).
+KMH_PER_MPH = 1.609344
 
 
 # ---------------------------------------------------------------------------------------
@@ -421,6 +430,15 @@ def _group_outliers(m: Measured, c: _Checks, groups, sigma: dict | None, coarse)
 
     Returns plane name -> boolean per impact, for the planes where any group could be judged.
     """
+    return {k: np.isfinite(z) & (z > OUTLIER_Z) for k, z in _group_z(m, c, groups, sigma, coarse).items()}
+
+
+def _group_z(m: Measured, c: _Checks, groups, sigma: dict | None, coarse) -> dict[str, np.ndarray]:
+    """Per plane, each impact's distance from its group's line in robust standard deviations (NaN: not judged).
+
+    The standard deviation is the impact's own (from the stated uncertainties) or the file's
+    robust spread (:func:`implausible_rows`, last bullet).
+    """
     v_bat, theta, omega = (np.asarray(a, dtype=float) for a in (m.v_bat, m.theta, m.omega))
     ok, use_ex = c.ok, c.use_ex
     # Group outliers on the spin residual of Eq. omega, omega - (1 + e_x) x with x its bracket:
@@ -462,10 +480,9 @@ def _group_outliers(m: Measured, c: _Checks, groups, sigma: dict | None, coarse)
         if not np.isfinite(dev).any():
             continue
         if name in own:
-            off[name] = np.isfinite(dev) & (dev > OUTLIER_Z)
+            off[name] = dev
         else:  # one spread for the file: a MAD of a dozen impacts is too uncertain
-            spread = 1.4826 * np.median(dev[np.isfinite(dev)])
-            off[name] = np.isfinite(dev) & (dev > OUTLIER_Z * max(spread, 1e-12))
+            off[name] = dev / max(1.4826 * np.median(dev[np.isfinite(dev)]), 1e-12)
     return off
 
 
@@ -495,6 +512,75 @@ _MISTAKES = (
     # last: on a tie the mistakes above are the likelier
     ("omega_rpm", "spin with the opposite sign (omega > 0 is backspin, Fig. 2)", lambda m: replace(m, omega=-m.omega)),
 )
+
+
+#: Per-row unit mistakes (:func:`row_unit_hints`): the file-wide ones and the other units labs use.
+_ROW_MISTAKES = (
+    *_MISTAKES[:-1],
+    ("omega_rpm", "spin in rev/s, not rpm", lambda m: replace(m, omega=m.omega * 60.0)),
+    ("v_bat_mph", "bat speed in km/h, not mph", lambda m: replace(m, v_bat=m.v_bat / KMH_PER_MPH)),
+    ("v_ball_mph", "exit speed in km/h, not mph", lambda m: replace(m, v_ball=m.v_ball / KMH_PER_MPH)),
+    _MISTAKES[-1],
+)
+
+
+def _with_row(m: Measured, i: int, fixed: Measured) -> Measured:
+    """Return ``m`` with impact ``i`` taken from ``fixed`` (scalars stay as they are)."""
+    values = {}
+    for f in fields(m):
+        a = np.asarray(getattr(m, f.name))
+        if a.ndim:
+            a = a.astype(float, copy=True)
+            a[i] = np.asarray(getattr(fixed, f.name))[i]
+        values[f.name] = a
+    return Measured(**values)
+
+
+def _max_z(m: Measured, groups, sigma: dict | None, coarse) -> np.ndarray:
+    """Per impact, its largest distance from its group's line over the planes (:func:`_group_z`; 0: not judged)."""
+    z = _group_z(m, _collision_checks(m), groups, sigma, coarse)
+    if not z:
+        return np.zeros(np.shape(m.v_bat))
+    return np.nan_to_num(np.abs(np.array(list(z.values()))), nan=0.0).max(axis=0)
+
+
+def row_unit_hints(m: Measured, groups: ArrayLike, coarse: ArrayLike | None, why: np.ndarray) -> dict[int, str]:
+    """Per impact whose values fit another unit far better than the file's: which (SI inputs).
+
+    Rows excluded as implausible (``why`` not empty, :func:`implausible_rows`) and kept rows at
+    least :data:`UNIT_ROW_Z` from their group's line are undone in turn for each mistake of
+    :data:`_ROW_MISTAKES` (that row alone). An excluded row is named when a correction makes it
+    plausible; a kept one when a correction brings it within :data:`UNIT_ROW_FIT_Z` and a third of
+    its distance. More than :data:`UNIT_ROW_MAX` such rows is a file-wide mistake
+    (:func:`unit_warnings`): none is named. Judged against the file's robust spread, not the
+    row's stated uncertainties (which share the row's unit mistake when they were converted alike).
+    """
+    z0 = _max_z(m, groups, None, coarse)
+    rows = np.flatnonzero((why != "") | (z0 > UNIT_ROW_Z))
+    hints: dict[int, str] = {}
+    for i in rows[: UNIT_ROW_MAX if rows.size <= UNIT_ROW_MAX else 0]:
+        fits = []  # (distance corrected, order, columns, mistake) of each correction that fits
+        for k, (cols, what, fix) in enumerate(_ROW_MISTAKES):
+            m1 = _with_row(m, int(i), fix(m))
+            if not _collision_checks(m1).ok[i]:
+                continue
+            z1 = _max_z(m1, groups, None, coarse)[i]
+            if why[i]:
+                good = implausible_rows(m1, groups, coarse=coarse)[i] == ""
+            else:
+                good = z1 < UNIT_ROW_FIT_Z and z1 < z0[i] / 3.0
+            if good:
+                fits.append((z1, k, cols, what))
+        if fits:  # the best first; the others fit too, and the data cannot tell them apart
+            fits.sort()
+            z1, _, cols, what = fits[0]
+            also = "".join(f" (or column {c}: {w})" for _, _, c, w in fits[1:])
+            hints[int(i)] = f"column {cols}: the row fits {what} far better{also}" + (
+                " (corrected for that, it passes every check)"
+                if why[i]
+                else f" (off its group's line by {z0[i]:.1f} robust sd; corrected, {z1:.1f})"
+            )
+    return hints
 
 
 def swapped_speeds(path: str | os.PathLike[str], m: Measured, usable: np.ndarray, groups: np.ndarray) -> list[str]:
@@ -597,8 +683,8 @@ def read_measured(
     cols, balls, bats = _read_checked(impacts_path, balls_path, bats_path)
     ball_ids, bat_ids = cols["ball"].astype(str), cols["bat"].astype(str)
     m = _measured(cols, ball_ids, bat_ids, balls, bats)
-    flag, reason = _flags(impacts_path, cols, m, ball_ids, bat_ids)
-    warnings = _dataset_checks(impacts_path, cols, m, flag, ball_ids, bat_ids)
+    flag, reason, notes = _flags(impacts_path, cols, m, ball_ids, bat_ids)
+    warnings = notes + _dataset_checks(impacts_path, cols, m, flag, ball_ids, bat_ids)
     return Ingested(cols, m, flag, reason, ball_ids, bat_ids, warnings)
 
 
@@ -641,16 +727,28 @@ def _measured(cols: dict, ball_ids, bat_ids, balls: dict[str, Ball], bats: dict[
     return Measured(si["v_bat"], si["v_ball"], si["theta"], si["omega"], r, alpha, r_x, r_y)
 
 
-def _flags(impacts_path, cols: dict, m: Measured, ball_ids, bat_ids) -> tuple[np.ndarray, np.ndarray]:
-    """Per impact: ``(ingest_flag, reason)`` from :func:`exclusions` and :func:`implausible_rows`.
+def _flags(impacts_path, cols: dict, m: Measured, ball_ids, bat_ids) -> tuple[np.ndarray, np.ndarray, list[str]]:
+    """Per impact: ``(ingest_flag, reason)`` from :func:`exclusions` and :func:`implausible_rows`, and warnings.
+
+    An excluded row whose values fit another unit far better says so in its reason; a kept one
+    is a warning (:func:`row_unit_hints`).
 
     A file with more than :data:`IMPLAUSIBLE_MAX_FRACTION` implausible impacts is an
     :class:`~ballbat.properties.InputError` (its units are likely wrong).
     """
     flag, reason = exclusions(m.v_ball, m.theta, m.omega, m.r, m.alpha)
     sigma = {si: cols[f"{c}_err"] * factor for c, (si, factor) in MEASURED_COLUMNS.items() if f"{c}_err" in cols}
-    why = implausible_rows(m, np.char.add(ball_ids, bat_ids), sigma=sigma, coarse=ball_ids)
+    groups = np.char.add(ball_ids, bat_ids)
+    why = implausible_rows(m, groups, sigma=sigma, coarse=ball_ids)
+    hints = row_unit_hints(m, groups, ball_ids, why)
     bad = why != ""
+    notes = [
+        f"{impacts_path}: {cols['label'][i]}: {h}: a unit mistake in this row? It is kept and fitted; correct it "
+        "or delete the row"
+        for i, h in sorted(hints.items())
+        if not bad[i]
+    ]
+    why = np.array([f"{w}; likely a unit mistake: {hints[i]}" if w and i in hints else w for i, w in enumerate(why)])
     flag = np.where(bad, ImpactFlag.IMPLAUSIBLE, flag).astype(np.int8)
     reason = np.where(bad, np.char.add("implausible: ", why.astype(str)), reason)
     if bad.sum() > IMPLAUSIBLE_MAX_FRACTION * bad.size:
@@ -663,7 +761,7 @@ def _flags(impacts_path, cols: dict, m: Measured, ball_ids, bat_ids) -> tuple[np
                 *listing,
             ]
         )
-    return flag, reason
+    return flag, reason, notes
 
 
 def _dataset_checks(impacts_path, cols: dict, m: Measured, flag: np.ndarray, ball_ids, bat_ids) -> list[str]:

@@ -14,6 +14,7 @@ References
 from __future__ import annotations
 
 import csv
+import json
 import math
 import re
 from dataclasses import dataclass
@@ -22,6 +23,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from . import batlab
 from .units import INCH, OUNCE, OZ_IN2
 
 if TYPE_CHECKING:
@@ -68,6 +70,8 @@ class Bat:
     Iz: float  # kg m^2, about the long axis
     b: float  # m, impact location from the centre of mass
     R: float  # m, bat radius at the impact location
+    convention: str = "paper"  # the table's convention (ballbat.batlab.CONVENTIONS)
+    given: str = ""  # JSON of the row's cells as given in its table (empty: not from a table)
 
 
 #: Columns of the ball table: name -> (unit factor to SI, required, must be positive).
@@ -81,17 +85,6 @@ BALL_COLUMNS = {
     "alpha": (1.0, False, True),
     "psi_max_deg": (math.pi / 180, False, True),
     "D_max_in": (INCH, False, True),
-}
-
-#: Columns of the bat table: name -> (unit factor to SI, required, must be positive).
-BAT_COLUMNS = {
-    "bat": (None, True, False),
-    "name": (None, False, False),
-    "M_oz": (OUNCE, True, True),
-    "I0_oz_in2": (OZ_IN2, True, True),
-    "Iz_oz_in2": (OZ_IN2, True, True),
-    "b_in": (INCH, True, False),
-    "R_in": (INCH, True, True),
 }
 
 
@@ -283,12 +276,18 @@ def cell_text(v: object) -> str:
     return repr(float(v))
 
 
+#: Keys of a row's line label and its cells as given in :func:`_read_table`'s records.
+ROW, GIVEN = "\0row", "\0given"
+
+
 def _read_table(path: Path, columns: dict, key: str) -> list[dict]:
-    """Read a property CSV, checking every row; raise one InputError listing all problems."""
+    """Read a property CSV, checking every row; raise one InputError listing all problems.
+
+    Each record also holds its line label under :data:`ROW` and its cells as given under :data:`GIVEN`.
+    """
     path = Path(path)
     problems: list[str] = []
     header, lines = read_csv_rows(path)
-    rows = [dict(zip(header, cells, strict=False)) for _, cells in lines]
     missing = [c for c, (_, req, _) in columns.items() if req and c not in header]
     unknown = [c for c in header if c not in columns]
     if missing:
@@ -298,41 +297,44 @@ def _read_table(path: Path, columns: dict, key: str) -> list[dict]:
     if missing:
         raise InputError(problems)
     out, seen = [], {}
-    for i, row in enumerate(rows, start=2):  # row 1 is the header
-        rec = {}
+    for i, cells in lines:
+        row = dict(zip(header, cells, strict=False))
+        rec = {ROW: f"row {i}", GIVEN: {c: row.get(c, "") for c in header}}
         for col, (factor, req, positive) in columns.items():
-            raw = row.get(col, "")
-            if factor is None:
-                if req and not raw:
-                    problems.append(f"{path}: row {i}, column {col}: empty")
-                rec[col] = raw
-                continue
-            if raw == "":
-                if req:
-                    problems.append(f"{path}: row {i}, column {col}: empty")
-                rec[col] = None
-                continue
-            try:
-                val = float(raw)
-            except ValueError:
-                problems.append(f"{path}: row {i}, column {col}: {raw!r} is not a number")
-                continue
-            if not math.isfinite(val):
-                problems.append(f"{path}: row {i}, column {col}: {raw!r} is not finite")
-            elif positive and val <= 0:
-                problems.append(f"{path}: row {i}, column {col}: {raw} must be positive")
-            rec[col] = val * factor
+            rec[col] = _cell(row.get(col, ""), f"{path}: row {i}, column {col}", factor, req, positive, problems)
         k = rec.get(key)
         if k:
             if k in seen:
                 problems.append(f"{path}: row {i}, column {key}: {k!r} duplicates row {seen[k]}")
             seen[k] = i
         out.append(rec)
-    if not rows:
+    if not lines:
         problems.append(f"{path}: no rows")
     if problems:
         raise InputError(problems)
     return out
+
+
+def _cell(raw: str, at: str, factor: float | None, req: bool, positive: bool, problems: list[str]) -> object:
+    """Return a property cell: text (``factor`` None), None (empty, optional) or the number times ``factor``."""
+    if factor is None:
+        if req and not raw:
+            problems.append(f"{at}: empty")
+        return raw
+    if raw == "":
+        if req:
+            problems.append(f"{at}: empty")
+        return None
+    try:
+        val = float(raw)
+    except ValueError:
+        problems.append(f"{at}: {raw!r} is not a number")
+        return None
+    if not math.isfinite(val):
+        problems.append(f"{at}: {raw!r} is not finite")
+    elif positive and val <= 0:
+        problems.append(f"{at}: {raw} must be positive")
+    return val * factor
 
 
 def load_balls(path: str | os.PathLike[str]) -> dict[str, Ball]:
@@ -351,20 +353,82 @@ def load_balls(path: str | os.PathLike[str]) -> dict[str, Ball]:
     return balls
 
 
+def _bat_columns(path: Path, header: list[str], lines: list) -> tuple[str, dict]:
+    """Return a bat table's convention and its columns (name -> (factor, required, positive), tables' units).
+
+    The convention is the ``convention`` column's (one for the whole table), else ``paper`` for a
+    table with Table II's columns (as before the lab convention existed). A lab table must
+    state it; a table whose columns fit neither convention, or mix them, is an InputError naming them.
+    """
+    conv_at = header.index("convention") if "convention" in header else None
+    stated = {cells[conv_at] for _, cells in lines if conv_at is not None and conv_at < len(cells)}
+    convention, problems = batlab.header_convention(path, header, stated)
+    if problems:
+        raise InputError(problems)
+    text = {"bat": (None, True, False), "name": (None, False, False), "convention": (None, False, False)}
+    if convention == "paper":
+        return convention, {**text, **{c: (1.0, True, c != "b_in") for c in batlab.PAPER}}
+    chosen = [c for pair in batlab.LAB_EITHER for c in pair if c in header]
+    cols = {c: (1.0, True, c != "pivot_in") for c in (*batlab.LAB_REQUIRED, *chosen)}
+    return convention, {**text, **cols, **{c: (1.0, False, True) for c in batlab.LAB_OPTIONAL}}
+
+
 def load_bats(path: str | os.PathLike[str]) -> dict[str, Bat]:
-    """Read a bat table (Table II layout, paper units) into SI :class:`Bat` records."""
-    return {
-        rec["bat"]: Bat(
+    """Read a bat table in the paper's convention (Table II) or a lab's (ASTM F2398) into SI :class:`Bat` records.
+
+    Every row is checked against what real bats are (:func:`ballbat.batlab.row_problems`); a lab
+    row is converted to the paper's convention (:func:`ballbat.batlab.paper_row`). Each record
+    keeps its convention, its cells as given and the values used (:func:`bat_record`).
+    """
+    path = Path(path)
+    header, lines = read_csv_rows(path)
+    convention, columns = _bat_columns(path, header, lines)
+    problems: list[str] = []
+    bats = {}
+    for rec in _read_table(path, columns, "bat"):
+        nums = {c: v for c, v in rec.items() if isinstance(v, float)}
+        found = batlab.row_problems(f"{path}: {rec[ROW]}", nums, convention)
+        problems += found
+        if found:
+            continue
+        used = batlab.paper_row(nums) if convention == "lab" else {c: nums[c] for c in batlab.PAPER}
+        given = {c: v for c, v in rec[GIVEN].items() if c not in ("bat", "name")}
+        bats[rec["bat"]] = Bat(
             bat=rec["bat"],
             name=rec["name"] or rec["bat"],
-            M=rec["M_oz"],
-            I0=rec["I0_oz_in2"],
-            Iz=rec["Iz_oz_in2"],
-            b=rec["b_in"],
-            R=rec["R_in"],
+            M=used["M_oz"] * OUNCE,
+            I0=used["I0_oz_in2"] * OZ_IN2,
+            Iz=used["Iz_oz_in2"] * OZ_IN2,
+            b=used["b_in"] * INCH,
+            R=used["R_in"] * INCH,
+            convention=convention,
+            given=json.dumps(given),
         )
-        for rec in _read_table(path, BAT_COLUMNS, "bat")
+    if problems:
+        raise InputError(problems)
+    return bats
+
+
+def bat_record(bats: dict[str, Bat]) -> str:
+    """Return JSON of the bats: per bat its convention, its cells as given and the paper-convention values used."""
+    used = {
+        "M_oz": lambda t: t.M / OUNCE,
+        "I0_oz_in2": lambda t: t.I0 / OZ_IN2,
+        "Iz_oz_in2": lambda t: t.Iz / OZ_IN2,
+        "b_in": lambda t: t.b / INCH,
+        "R_in": lambda t: t.R / INCH,
     }
+    return json.dumps(
+        {
+            k: {
+                "convention": t.convention,
+                "as_given": json.loads(t.given) if t.given else {},
+                "used": {c: round(f(t), 6) for c, f in used.items()},
+            }
+            for k, t in sorted(bats.items())
+        },
+        sort_keys=True,
+    )
 
 
 def recoil_normal(m: ArrayLike, M: ArrayLike, I0: ArrayLike, b: ArrayLike) -> np.ndarray:

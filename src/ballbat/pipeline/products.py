@@ -144,10 +144,12 @@ def add_variables(ds: xr.Dataset, table: Mapping[str, Var], values: Mapping[str,
     return out
 
 
-#: Attributes that carry a measured dataset's warnings from ingest.nc to every later file.
-WARNING_ATTRS = ("ingest_warnings", "n_warnings")
+#: Attributes carried from a dataset's first files to every later file: a measured dataset's
+#: warnings (ingest.nc) and its bats as given and as used (``bat_properties``, reconstruct.nc;
+#: :func:`ballbat.properties.bat_record`).
+WARNING_ATTRS = ("ingest_warnings", "n_warnings", "bat_properties")
 
 
 def carried_warnings(source: xr.Dataset) -> dict[str, Any]:
-    """Return the warning attributes of ``source`` (ingest.nc or a file made from it) to carry on."""
+    """Return the carried attributes of ``source`` (:data:`WARNING_ATTRS`) to pass on."""
     return {k: source.attrs[k] for k in WARNING_ATTRS if k in source.attrs}

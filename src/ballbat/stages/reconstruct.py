@@ -11,6 +11,7 @@ from typing import TYPE_CHECKING
 from ..analysis import reconstruct_values
 from ..kinematics import ImpactFlag
 from ..pipeline.products import Var, add_variables, flag_attrs
+from ..properties import bat_record
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -59,6 +60,11 @@ def run(settings: ReconstructSettings, impacts: xr.Dataset, balls: dict[str, Bal
     Adds the ball and bat properties used (r, alpha, R, r_x, r_y), psi (Eq. angmom), the
     flag and its reason, D (Eq. D), v_n and v_t, and the bracket terms of Eq. omega
     (``spin_bracket``) and Eq. vtf (``vtf_x``, with the left side ``vtf_y``), plus
-    tan(psi - theta) of Eq. ratio.
+    tan(psi - theta) of Eq. ratio. The attribute ``bat_properties`` records the dataset's bats:
+    each one's table convention, its cells as given and the paper-convention values used
+    (:func:`ballbat.properties.bat_record`).
     """
-    return add_variables(impacts, RECONSTRUCT_TABLE, reconstruct_values(impacts, balls, bats))
+    out = add_variables(impacts, RECONSTRUCT_TABLE, reconstruct_values(impacts, balls, bats))
+    used = sorted(set(impacts["bat"].values.astype(str)))
+    out.attrs["bat_properties"] = bat_record({k: bats[k] for k in used})
+    return out
