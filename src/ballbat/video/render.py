@@ -28,7 +28,7 @@ from scipy import ndimage
 
 from .scene import ClipTruth
 
-_LIGHT = np.array([-0.45, -0.55, 0.70]) / np.linalg.norm([-0.45, -0.55, 0.70])
+_LIGHT = np.array([-0.3, -0.35, 0.89]) / np.linalg.norm([-0.3, -0.35, 0.89])
 
 
 @dataclass(frozen=True)
@@ -116,7 +116,7 @@ def _ball_layer(gx, gy, c, r, dots, dot_r):
     cov = _coverage(rho - r)
     q = np.clip(rho / r, 0, 1)
     nz = np.sqrt(1 - q * q)
-    shade = 0.22 + 0.78 * np.clip((dx * _LIGHT[0] + dy * _LIGHT[1]) / r + nz * _LIGHT[2], 0, None)
+    shade = 0.35 + 0.65 * np.clip((dx * _LIGHT[0] + dy * _LIGHT[1]) / r + nz * _LIGHT[2], 0, None)
     albedo = np.full(gx.shape, 0.78)
     for d in dots:
         if not np.isfinite(d).all():
