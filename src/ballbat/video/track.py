@@ -1,0 +1,325 @@
+"""Find the ball, its two dots and the bat's tip marker in each frame of a clip, and link them (docs/video.md).
+
+Streamed: one frame at a time, each searched near where the previous frames predict (a
+region of interest), the whole frame (at half or quarter resolution) only until a point is
+found. Per point:
+
+* **ball** -- a bright disc of about the expected radius. Its edge is found on 48 rays from
+  the rough centre, each at the peak of the intensity gradient (sub-pixel, parabolic); a
+  circle is fitted to the edge points by least squares, rays more than 3 robust standard
+  deviations off rejected (the barrel in front, a dot on the limb), twice. Quality: the RMS
+  residual of the edge (px) and the contrast of the edge. Left out: fewer than half of the
+  rays kept (occluded), the disc touching the frame's border, no such disc, or two.
+* **dot_a, dot_b** -- dark spots inside the disc: the ball's own shading (a grey closing,
+  which removes spots smaller than it) minus the frame, thresholded at 5 noise sigma; each
+  spot's centroid weighted by its darkness. Left out: a spot beyond 0.8 of the radius (on
+  the limb: foreshortened, partly hidden), or not two spots. The labels a and b are
+  arbitrary but kept from frame to frame (nearest to the last positions relative to the ball).
+* **bat_tip** -- a small bright disc (the marker) inside a dark surround (the end cap):
+  its centroid weighted by brightness above the surround.
+
+Nothing is guessed: a point that fails a test is left out, with the reason.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy import ndimage
+
+from .io import Clip
+
+_N_RAYS = 48
+_ANGLES = np.linspace(0, 2 * np.pi, _N_RAYS, endpoint=False)
+_COS, _SIN = np.cos(_ANGLES), np.sin(_ANGLES)
+
+
+@dataclass(frozen=True)
+class TrackOptions:
+    """What the tracker expects (pixels): the ball's radius (e.g. Table I's diameter / 2 / m_per_px), dots and marker.
+
+    ``points``: which points to find (``ball`` always).
+    """
+
+    ball_radius_px: float
+    points: tuple[str, ...] = ("ball",)
+    dot_radius_px: float = 3.0
+    marker_radius_px: float = 8.0
+    radius_tolerance: float = 0.3
+
+
+@dataclass
+class Found:
+    """Rows of the long tracks table with their quality, and the points left out with their reason."""
+
+    rows: dict[str, list] = field(
+        default_factory=lambda: {k: [] for k in ("point", "frame", "x_px", "y_px", "residual_px", "contrast")}
+    )
+    left_out: list[tuple[str, int, str]] = field(default_factory=list)
+
+    def add(self, point: str, frame: int, x: float, y: float, residual: float, contrast: float) -> None:
+        """Add a found point."""
+        for k, v in zip(self.rows, (point, frame, x, y, residual, contrast), strict=True):
+            self.rows[k].append(v)
+
+    def leave_out(self, point: str, frame: int, reason: str) -> None:
+        """Note a point not given, and why."""
+        self.left_out.append((point, frame, reason))
+
+
+def _noise_sigma(img: np.ndarray) -> float:
+    """Robust pixel noise from the differences of neighbouring pixels (MAD)."""
+    d = np.diff(img[::4, :].astype(np.float32), axis=1)
+    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2)) + 1e-6
+
+
+def find_balls(img: np.ndarray, radius: float, tol: float) -> list[tuple[float, float]]:
+    """Rough centres of every bright disc of about ``radius`` in the frame (quarter resolution)."""
+    s = 4 if radius >= 12 else 2
+    h, w = (img.shape[0] // s) * s, (img.shape[1] // s) * s
+    small = img[:h, :w].reshape(h // s, s, w // s, s).mean(axis=(1, 3))
+    med, top = np.median(small), np.percentile(small, 99.9)
+    lab, n = ndimage.label(small > med + 0.6 * (top - med))
+    if n == 0:
+        return []
+    idx = np.arange(1, n + 1)
+    area = ndimage.sum_labels(np.ones_like(small), lab, idx) * s * s
+    expect = np.pi * radius**2
+    ok = (area > (1 - tol) ** 2 * expect * 0.5) & (area < (1 + tol) ** 2 * expect)
+    for j, sl in enumerate(ndimage.find_objects(lab)):  # round: a box about as wide as high, at most 2r
+        bh, bw = (sl[0].stop - sl[0].start) * s, (sl[1].stop - sl[1].start) * s
+        ok[j] &= max(bh, bw) <= 2 * radius * (1 + tol) + 2 * s and min(bh, bw) >= 0.5 * max(bh, bw)
+    return [((c[1] + 0.5) * s - 0.5, (c[0] + 0.5) * s - 0.5) for c in ndimage.center_of_mass(small, lab, idx[ok])]
+
+
+def _circle_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
+    """Least-squares circle (Kasa): centre and radius."""
+    a = np.column_stack([x, y, np.ones_like(x)])
+    sol = np.linalg.lstsq(a, x * x + y * y, rcond=None)[0]
+    cx, cy = sol[0] / 2, sol[1] / 2
+    return cx, cy, float(np.sqrt(max(sol[2] + cx * cx + cy * cy, 0)))
+
+
+def fit_ball(img: np.ndarray, cx: float, cy: float, r: float, sigma: float) -> tuple[tuple, str | None]:
+    """Sub-pixel centre and radius of the ball near (cx, cy): ((x, y, r, rms, contrast), reason left out or None)."""
+    h, w = img.shape
+    reason = None
+    for it in range(3):
+        rad = np.arange(-10.0, 10.01, 0.5) if it == 0 else np.arange(-5.0, 5.01, 0.5)
+        if cx - r - 11 < 0 or cy - r - 11 < 0 or cx + r + 11 > w - 1 or cy + r + 11 > h - 1:
+            return (), "ball touches the frame's border"
+        rr = r + rad[None, :]
+        xs, ys = cx + _COS[:, None] * rr, cy + _SIN[:, None] * rr
+        prof = ndimage.map_coordinates(
+            img, [ys.ravel(), xs.ravel()], output=np.float32, order=1, prefilter=False
+        ).reshape(xs.shape)
+        inner, outer = prof[:, :4].mean(axis=1), prof[:, -4:].mean(axis=1)
+        # the edge: the peak of the (signed, slightly smoothed) radial gradient, parabolic between samples
+        g = -np.gradient(prof, axis=1) * np.sign(inner - outer)[:, None]
+        g = ndimage.convolve1d(g, [0.25, 0.5, 0.25], axis=1, mode="nearest")
+        k = np.clip(np.argmax(g[:, 1:-1], axis=1) + 1, 1, rad.size - 2)
+        i = np.arange(_N_RAYS)
+        g0, g1, g2 = g[i, k - 1], g[i, k], g[i, k + 1]
+        den = g0 - 2 * g1 + g2
+        off = np.clip(0.5 * (g0 - g2) / np.where(den < 0, den, -np.inf), -0.5, 0.5)
+        edge = r + rad[k] + off * 0.5
+        step = np.abs(inner - outer)
+        keep = step > 6 * sigma
+        px, py = cx + _COS * edge, cy + _SIN * edge
+        for _ in range(2):
+            if keep.sum() < _N_RAYS // 2:
+                return (), f"ball edge seen on {int(keep.sum())} of {_N_RAYS} rays (occluded or blurred)"
+            fx, fy, fr = _circle_fit(px[keep], py[keep])
+            res = np.hypot(px - fx, py - fy) - fr
+            mad = 1.4826 * np.median(np.abs(res[keep] - np.median(res[keep]))) + 0.02
+            keep &= np.abs(res) < 3 * mad
+        cx, cy, r = fx, fy, fr
+    if keep.sum() < _N_RAYS // 2:
+        return (), f"ball edge seen on {int(keep.sum())} of {_N_RAYS} rays (occluded or blurred)"
+    rms = float(np.sqrt(np.mean(res[keep] ** 2)))
+    return (cx, cy, r, rms, float(np.median(step[keep]))), reason
+
+
+def _roi(img: np.ndarray, cx: float, cy: float, half: float) -> tuple[np.ndarray, int, int]:
+    """Return the square of half-side ``half`` about (cx, cy), clipped to the frame, and its origin."""
+    x0, y0 = max(int(cx - half), 0), max(int(cy - half), 0)
+    return img[y0 : int(cy + half) + 1, x0 : int(cx + half) + 1], x0, y0
+
+
+def find_dots(img: np.ndarray, ball: tuple, dot_r: float, sigma: float) -> tuple[list, str | None]:
+    """Dark spots inside the ball: [(x, y, contrast)], or the reason they are left out."""
+    cx, cy, r = ball[:3]
+    sub, x0, y0 = _roi(img.astype(np.float32), cx, cy, r + 2)
+    size = int(2 * np.ceil(2 * dot_r) + 1)
+    dark = ndimage.grey_closing(sub, size=(size, size)) - sub
+    yy, xx = np.mgrid[0 : sub.shape[0], 0 : sub.shape[1]]
+    inside = np.hypot(xx + x0 - cx, yy + y0 - cy) < r - 2
+    lab, n = ndimage.label((dark > 5 * sigma) & inside)
+    if n == 0:
+        return [], "no dot seen on the ball"
+    idx = np.arange(1, n + 1)
+    area = ndimage.sum_labels(np.ones_like(dark), lab, idx)
+    big = idx[area >= max(0.25 * np.pi * dot_r**2, 3)]
+    out = []
+    for j in big:
+        m = lab == j
+        m = ndimage.binary_dilation(m, iterations=2) & inside
+        wgt = np.where(m, np.clip(dark, 0, None), 0)
+        tot = wgt.sum()
+        x, y = (wgt * xx).sum() / tot + x0, (wgt * yy).sum() / tot + y0
+        out.append((float(x), float(y), float(dark[lab == j].max()), float(np.hypot(x - cx, y - cy) / r)))
+    return out, None
+
+
+def find_marker(img: np.ndarray, cx: float, cy: float, half: float, mr: float, sigma: float) -> tuple | None:
+    """Return the tip marker (a bright disc of radius ``mr`` in a dark surround) nearest (cx, cy): (x, y, contrast)."""
+    sub, x0, y0 = _roi(img.astype(np.float32), cx, cy, half)
+    if min(sub.shape) < 2 * mr:
+        return None
+    local = ndimage.uniform_filter(sub, size=int(4 * mr + 1))
+    lab, n = ndimage.label(sub - local > 8 * sigma)
+    if n == 0:
+        return None
+    idx = np.arange(1, n + 1)
+    area = ndimage.sum_labels(np.ones_like(sub), lab, idx)
+    ok = idx[(area > 0.3 * np.pi * mr**2) & (area < 2.0 * np.pi * mr**2)]
+    best = None
+    for j in ok:
+        yy, xx = np.nonzero(lab == j)
+        ring = ndimage.binary_dilation(lab == j, iterations=int(mr)) & (lab != j)
+        level = float(np.median(sub[ring]))
+        core = ndimage.binary_dilation(lab == j, iterations=2)
+        wy, wx = np.nonzero(core)
+        wgt = np.clip(sub[wy, wx] - level, 0, None)
+        x, y = (wgt * wx).sum() / wgt.sum() + x0, (wgt * wy).sum() / wgt.sum() + y0
+        contrast = float(sub[yy, xx].mean() - level)
+        if contrast > 0.3 * (float(sub.max()) - level) and (best is None or np.hypot(x - cx, y - cy) < best[3]):
+            best = (float(x), float(y), contrast, float(np.hypot(x - cx, y - cy)))
+    return best[:3] if best else None
+
+
+@dataclass
+class _Trail:
+    """Last two positions of a point (frame, x, y), for the prediction of the next."""
+
+    last: list = field(default_factory=list)
+
+    def push(self, k: int, x: float, y: float) -> None:
+        """Add a position."""
+        self.last = [*self.last[-1:], (k, x, y)]
+
+    def predict(self, k: int) -> tuple[float, float] | None:
+        """Return the position expected at frame ``k`` (constant velocity), None when lost for over 3 frames."""
+        if not self.last or k - self.last[-1][0] > 3:
+            return None
+        k1, x1, y1 = self.last[-1]
+        if len(self.last) < 2:
+            return x1, y1
+        k0, x0, y0 = self.last[0]
+        f = (k - k1) / (k1 - k0)
+        return x1 + f * (x1 - x0), y1 + f * (y1 - y0)
+
+
+def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found):
+    r = opt.ball_radius_px
+    guess = trail.predict(k)
+    if guess is not None:
+        sub, x0, y0 = _roi(img, guess[0], guess[1], 4 * r)
+        cands = [(x + x0, y + y0) for x, y in find_balls(sub, r, opt.radius_tolerance)]
+    else:
+        cands = find_balls(img, r, opt.radius_tolerance)
+    if len(cands) != 1:
+        found.leave_out("ball", k, "no ball found" if not cands else f"{len(cands)} balls found")
+        return None
+    fit, reason = fit_ball(img, *cands[0], r, sigma)
+    if reason is None and abs(fit[2] / r - 1) > opt.radius_tolerance:
+        reason = f"fitted radius {fit[2]:.1f} px, expected {r:.1f} px"
+    if reason:
+        found.leave_out("ball", k, reason)
+        return None
+    trail.push(k, fit[0], fit[1])
+    found.add("ball", k, fit[0], fit[1], fit[3], fit[4])
+    return fit
+
+
+def _dots(img, k, ball, opt: TrackOptions, sigma, rel_prev: dict, found: Found) -> None:
+    spots, reason = find_dots(img, ball, opt.dot_radius_px, sigma)
+    for s in [s for s in spots if s[3] > 0.8]:
+        found.leave_out("dot", k, f"spot at {s[0]:.1f}, {s[1]:.1f} on the limb ({s[3]:.2f} of the radius)")
+    spots = [s for s in spots if s[3] <= 0.8]
+    if reason or len(spots) > 2 or (not rel_prev and len(spots) != 2):
+        why = reason or f"{len(spots)} dark spots inside the ball (two expected)"
+        for p in ("dot_a", "dot_b"):
+            found.leave_out(p, k, why)
+        return
+    rel = [(s[0] - ball[0], s[1] - ball[1]) for s in spots]
+    if not rel_prev:
+        order = sorted(range(2), key=lambda j: np.arctan2(rel[j][1], rel[j][0]))
+        labels = dict(zip(("dot_a", "dot_b"), order, strict=True))
+    else:
+        labels = {}
+        for j, q in enumerate(rel):
+            near = min(rel_prev, key=lambda p: np.hypot(q[0] - rel_prev[p][0], q[1] - rel_prev[p][1]))
+            labels.setdefault(near, j)
+    for p in ("dot_a", "dot_b"):
+        if p not in labels:
+            found.leave_out(p, k, "not seen inside the ball (hidden or on the limb)")
+            continue
+        s = spots[labels[p]]
+        rel_prev[p] = rel[labels[p]]
+        found.add(p, k, s[0], s[1], np.nan, s[2])
+
+
+def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -> None:
+    guess = trail.predict(k)
+    if guess is None:
+        h, w = img.shape
+        m = find_marker(img, w / 2, h / 2, max(h, w), opt.marker_radius_px, sigma)
+    else:
+        m = find_marker(img, guess[0], guess[1], 4 * opt.marker_radius_px + 20, opt.marker_radius_px, sigma)
+    if m is None:
+        found.leave_out("bat_tip", k, "no tip marker found")
+        return
+    trail.push(k, m[0], m[1])
+    found.add("bat_tip", k, m[0], m[1], np.nan, m[2])
+
+
+def _check_time(clip: Clip, k: int, t: float | None, t0: list) -> None:
+    """Refuse a timestamp off the frame rate's grid by more than a quarter frame: a dropped frame or a jump."""
+    fps = clip.info.fps
+    if t is None or fps is None:
+        return
+    if not t0:
+        t0.append(t - k / fps)
+    lag = (t - t0[0]) * fps - k
+    if abs(lag) > 0.25:
+        from .io import VideoError
+
+        raise VideoError(
+            f"{clip.info.path}: frame {k}: timestamp {t:.6g} s is {lag:+.2f} frames off {fps:g} fps "
+            "(a frame dropped or the clock jumped)"
+        )
+
+
+def track_clip(clip: Clip, opt: TrackOptions) -> Found:
+    """Track one clip, streamed; frames numbered by the file's frame numbers where it has them, else from 0."""
+    found = Found()
+    trails = {"ball": _Trail(), "bat_tip": _Trail()}
+    rel_prev: dict = {}
+    numbers = clip.info.frame_numbers
+    t0: list = []
+    sigma = None
+    for k, t, img in clip.frames():
+        _check_time(clip, k, t, t0)
+        f = int(numbers[k]) if numbers is not None and k < numbers.size else k
+        sigma = _noise_sigma(img) if sigma is None else sigma
+        ball = _ball(img, f, opt, trails["ball"], sigma, found)
+        if ball is not None and "dot_a" in opt.points:
+            _dots(img, f, ball, opt, sigma, rel_prev, found)
+        elif "dot_a" in opt.points:
+            for p in ("dot_a", "dot_b"):
+                found.leave_out(p, f, "no ball")
+        if "bat_tip" in opt.points:
+            _tip(img, f, opt, trails["bat_tip"], sigma, found)
+    return found
