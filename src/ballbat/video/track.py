@@ -23,6 +23,7 @@ Nothing is guessed: a point that fails a test is left out, with the reason.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -101,44 +102,115 @@ def _circle_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
     return cx, cy, float(np.sqrt(max(sol[2] + cx * cx + cy * cy, 0)))
 
 
+#: Radial samples of a ray about the current edge (px) and the edge positions tried among them.
+_SAMPLES = np.arange(-5.0, 5.01, 0.5)
+_CAND = np.arange(-3.0, 3.0001, 0.1)
+
+
+@functools.lru_cache(maxsize=4)
+def _edge_projectors() -> np.ndarray:
+    """For each tried edge position e, I - P_e: the residual maker of the ray model with its edge at e.
+
+    The model of a ray's profile, linear in its four coefficients: the background (a constant
+    and a slope outside), the ball's limb (a constant inside) and its shading towards the limb,
+    which for a sphere goes as sqrt(e - rho) (the normal's component towards the camera). Each
+    is smoothed as the pixels sample it (a 1-px box, then the bilinear interpolation of the
+    rays: a triangle of half-width 1 px).
+    """
+    fine = np.arange(-9.0, 9.0, 0.02)
+    box = np.ones(50) / 50
+    tri = np.convolve(box, box)
+    kern = np.convolve(box, tri)
+    kern /= kern.sum()
+    out = np.empty((_CAND.size, _SAMPLES.size, _SAMPLES.size))
+    for j, e in enumerate(_CAND):
+        inside = fine < e
+        basis = [
+            np.ones_like(fine),
+            np.where(inside, 0.0, fine - e),
+            inside * 1.0,
+            np.sqrt(np.clip(e - fine, 0, None)),
+            np.clip(e - fine, 0, None),
+        ]
+        cols = [np.interp(_SAMPLES, fine, np.convolve(b, kern, mode="same")) for b in basis]
+        d = np.column_stack(cols)
+        out[j] = np.eye(_SAMPLES.size) - d @ np.linalg.pinv(d)
+    return out
+
+
+def _profiles(img, cx, cy, r, rad):
+    rr = r + rad[None, :]
+    xs, ys = cx + _COS[:, None] * rr, cy + _SIN[:, None] * rr
+    return ndimage.map_coordinates(img, [ys.ravel(), xs.ravel()], output=np.float32, order=1, prefilter=False).reshape(
+        xs.shape
+    )
+
+
+def _edges_gradient(prof: np.ndarray, rad: np.ndarray) -> np.ndarray:
+    """Rough edge on each ray: the peak of the radial gradient (offsets from the radius)."""
+    sign = np.sign(prof[:, :4].mean(axis=1) - prof[:, -4:].mean(axis=1))
+    g = ndimage.convolve1d(-np.gradient(prof, axis=1) * sign[:, None], [0.25, 0.5, 0.25], axis=1, mode="nearest")
+    return rad[np.argmax(g, axis=1)]
+
+
+def _edges_model(prof: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+    """Edge on each ray by the ray model (:func:`_edge_projectors`): offsets and the fit's chi-square per sample."""
+    m = _edge_projectors()
+    y = prof.astype(np.float64)
+    rss = (np.matmul(y[None], m) * y[None]).sum(axis=2).T  # y^T (I - P_e) y, ray by tried edge
+    k = np.clip(np.argmin(rss, axis=1), 1, _CAND.size - 2)
+    i = np.arange(prof.shape[0])
+    r0, r1, r2 = rss[i, k - 1], rss[i, k], rss[i, k + 1]
+    den = r0 - 2 * r1 + r2
+    off = np.clip(0.5 * (r0 - r2) / np.where(den > 0, den, np.inf), -0.5, 0.5)
+    return _CAND[k] + off * (_CAND[1] - _CAND[0]), r1 / (sigma**2 * (_SAMPLES.size - 5))
+
+
+def _fit_circle_robust(px, py, keep):
+    """Circle through the kept edge points, points off by more than 3 robust sigma dropped (twice)."""
+    for _ in range(2):
+        if keep.sum() < _N_RAYS // 2:
+            return None, keep
+        fx, fy, fr = _circle_fit(px[keep], py[keep])
+        res = np.hypot(px - fx, py - fy) - fr
+        mad = 1.4826 * np.median(np.abs(res[keep] - np.median(res[keep]))) + 0.02
+        keep = keep & (np.abs(res) < 3 * mad)
+    return (fx, fy, fr, res), keep
+
+
 def fit_ball(img: np.ndarray, cx: float, cy: float, r: float, sigma: float) -> tuple[tuple, str | None]:
-    """Sub-pixel centre and radius of the ball near (cx, cy): ((x, y, r, rms, contrast), reason left out or None)."""
+    """Return the ball's sub-pixel centre near (cx, cy): ((x, y, r, rms, contrast), None) or ((), reason left out).
+
+    The rough edges (gradient peaks on a wide window) until the circle moves by under a pixel,
+    then the ray model (:func:`_edges_model`) until it moves by under 0.005 px (at most 8 passes).
+    """
     h, w = img.shape
-    reason = None
-    for it in range(3):
-        rad = np.arange(-10.0, 10.01, 0.5) if it == 0 else np.arange(-5.0, 5.01, 0.5)
-        if cx - r - 11 < 0 or cy - r - 11 < 0 or cx + r + 11 > w - 1 or cy + r + 11 > h - 1:
+    wide, moved, kept = True, np.inf, np.ones(_N_RAYS, bool)
+    for _ in range(8):
+        rad = np.arange(-10.0, 10.01, 0.5) if wide else _SAMPLES
+        if min(cx - r, cy - r, w - 1 - cx - r, h - 1 - cy - r) < rad[-1] + 1:
             return (), "ball touches the frame's border"
-        rr = r + rad[None, :]
-        xs, ys = cx + _COS[:, None] * rr, cy + _SIN[:, None] * rr
-        prof = ndimage.map_coordinates(
-            img, [ys.ravel(), xs.ravel()], output=np.float32, order=1, prefilter=False
-        ).reshape(xs.shape)
-        inner, outer = prof[:, :4].mean(axis=1), prof[:, -4:].mean(axis=1)
-        # the edge: the peak of the (signed, slightly smoothed) radial gradient, parabolic between samples
-        g = -np.gradient(prof, axis=1) * np.sign(inner - outer)[:, None]
-        g = ndimage.convolve1d(g, [0.25, 0.5, 0.25], axis=1, mode="nearest")
-        k = np.clip(np.argmax(g[:, 1:-1], axis=1) + 1, 1, rad.size - 2)
-        i = np.arange(_N_RAYS)
-        g0, g1, g2 = g[i, k - 1], g[i, k], g[i, k + 1]
-        den = g0 - 2 * g1 + g2
-        off = np.clip(0.5 * (g0 - g2) / np.where(den < 0, den, -np.inf), -0.5, 0.5)
-        edge = r + rad[k] + off * 0.5
-        step = np.abs(inner - outer)
+        prof = _profiles(img, cx, cy, r, rad)
+        step = np.abs(prof[:, :4].mean(axis=1) - prof[:, -4:].mean(axis=1))
         keep = step > 6 * sigma
-        px, py = cx + _COS * edge, cy + _SIN * edge
-        for _ in range(2):
-            if keep.sum() < _N_RAYS // 2:
-                return (), f"ball edge seen on {int(keep.sum())} of {_N_RAYS} rays (occluded or blurred)"
-            fx, fy, fr = _circle_fit(px[keep], py[keep])
-            res = np.hypot(px - fx, py - fy) - fr
-            mad = 1.4826 * np.median(np.abs(res[keep] - np.median(res[keep]))) + 0.02
-            keep &= np.abs(res) < 3 * mad
-        cx, cy, r = fx, fy, fr
-    if keep.sum() < _N_RAYS // 2:
-        return (), f"ball edge seen on {int(keep.sum())} of {_N_RAYS} rays (occluded or blurred)"
+        if wide:
+            edge = _edges_gradient(prof, rad)
+        else:
+            edge, chi2 = _edges_model(prof, sigma)
+            keep &= (chi2 < 2.0) & kept  # a ray once dropped stays dropped: the passes settle
+        fit, keep = _fit_circle_robust(cx + _COS * (r + edge), cy + _SIN * (r + edge), keep)
+        if fit is None:
+            return (), f"ball edge seen on {int(keep.sum())} of {_N_RAYS} rays (occluded, blurred or on clutter)"
+        moved = max(abs(fit[0] - cx), abs(fit[1] - cy), abs(fit[2] - r))
+        cx, cy, r, res = fit
+        if not wide and moved < 0.005:
+            break
+        kept = keep if not wide else kept
+        wide = wide and moved > 1.0
+    if wide or moved > 0.05:
+        return (), f"ball edge fit did not settle (last step {moved:.2f} px)"
     rms = float(np.sqrt(np.mean(res[keep] ** 2)))
-    return (cx, cy, r, rms, float(np.median(step[keep]))), reason
+    return (cx, cy, r, rms, float(np.median(step[keep]))), None
 
 
 def _roi(img: np.ndarray, cx: float, cy: float, half: float) -> tuple[np.ndarray, int, int]:
@@ -221,18 +293,24 @@ class _Trail:
         return x1 + f * (x1 - x0), y1 + f * (y1 - y0)
 
 
+def _ball_candidates(img, guess, opt: TrackOptions) -> list:
+    r = opt.ball_radius_px
+    if guess is None:
+        return find_balls(img, r, opt.radius_tolerance)
+    sub, x0, y0 = _roi(img, guess[0], guess[1], 4 * r)
+    return [(x + x0, y + y0) for x, y in find_balls(sub, r, opt.radius_tolerance)]
+
+
 def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found):
     r = opt.ball_radius_px
     guess = trail.predict(k)
-    if guess is not None:
-        sub, x0, y0 = _roi(img, guess[0], guess[1], 4 * r)
-        cands = [(x + x0, y + y0) for x, y in find_balls(sub, r, opt.radius_tolerance)]
-    else:
-        cands = find_balls(img, r, opt.radius_tolerance)
-    if len(cands) != 1:
-        found.leave_out("ball", k, "no ball found" if not cands else f"{len(cands)} balls found")
-        return None
-    fit, reason = fit_ball(img, *cands[0], r, sigma)
+    fit, reason = fit_ball(img, *guess, r, sigma) if guess is not None and len(trail.last) == 2 else ((), "")
+    if not fit:  # no prediction yet, or the fit failed there: look for the disc in the region
+        cands = _ball_candidates(img, guess, opt)
+        if len(cands) != 1:
+            found.leave_out("ball", k, "no ball found" if not cands else f"{len(cands)} balls found")
+            return None
+        fit, reason = fit_ball(img, *cands[0], r, sigma)
     if reason is None and abs(fit[2] / r - 1) > opt.radius_tolerance:
         reason = f"fitted radius {fit[2]:.1f} px, expected {r:.1f} px"
     if reason:
