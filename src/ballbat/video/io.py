@@ -20,34 +20,15 @@ import fractions
 import json
 import os
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
+from .clip import ClipInfo, VideoError
+from .mraw import MRAW_EXT, mraw_frames, mraw_info
+
 VIDEO_EXT = {".mkv": "ffv1", ".mp4": "h264"}
 TIFF_EXT = (".tif", ".tiff")
-
-
-class VideoError(Exception):
-    """A clip that cannot be read or written (the message names the file and the frame)."""
-
-
-@dataclass
-class ClipInfo:
-    """Settings of a clip from its file; None where the file does not hold them."""
-
-    path: str
-    format: str
-    width: int
-    height: int
-    n_frames: int | None
-    bit_depth: int
-    fps: float | None = None
-    exposure_s: float | None = None
-    trigger_frame: int | None = None
-    frame_numbers: np.ndarray | None = None
-    source: dict[str, str] = field(default_factory=dict)
 
 
 def _tmp(path: Path) -> Path:
@@ -137,6 +118,8 @@ class Clip:
         """
         if self.info.format == "tiff":
             yield from _tiff_frames(self.info)
+        elif self.info.format == "mraw":
+            yield from mraw_frames(self.info)
         else:
             yield from _av_frames(self.info)
 
@@ -149,9 +132,13 @@ def open_clip(path: str | os.PathLike[str]) -> Clip:
     ext = path.suffix.lower()
     if ext in TIFF_EXT:
         return Clip(_tiff_info(path))
+    if ext in MRAW_EXT:
+        return Clip(mraw_info(path))
     if ext in VIDEO_EXT or ext in (".avi", ".mov"):
         return Clip(_av_info(path))
-    raise VideoError(f"{path}: unknown clip extension {ext!r} (known: .tif, .tiff, .mkv, .mp4, .avi, .mov)")
+    raise VideoError(
+        f"{path}: unknown clip extension {ext!r} (known: .tif, .tiff, .cihx, .cih, .mkv, .mp4, .avi, .mov)"
+    )
 
 
 def _apply_meta(info: ClipInfo, meta: dict, where: str) -> None:
