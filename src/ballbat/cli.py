@@ -325,12 +325,12 @@ def _number_arg(text: str, what: str) -> float:
 
 def cmd_import_tracks(args: argparse.Namespace) -> int:
     """Read tracking-tool files into ballbat's long tracks CSV; print the camera settings found as YAML."""
-    import numpy as np
     import yaml
 
     from .pipeline.ncio import atomic_write_text
     from .tracks.formats import FormatError
     from .tracks.formats.layout import DEFAULT_PATTERN, import_files
+    from .tracks.io import long_csv_text
 
     points = _pairs(args.points, "--points")
     units = _pairs(args.units, "--units") if args.units else None
@@ -357,14 +357,7 @@ def cmd_import_tracks(args: argparse.Namespace) -> int:
             print(problem, file=sys.stderr)
         print(f"ballbat import-tracks: {len(exc.problems)} problem(s); nothing written", file=sys.stderr)
         return 1
-    c = imp.columns
-    order = np.lexsort((c["frame"], c["point"], c["camera"], c["impact_id"]))
-    lines = ["impact_id,camera,point,frame,x_px,y_px"]
-    lines += [
-        f"{c['impact_id'][i]},{c['camera'][i]},{c['point'][i]},{int(c['frame'][i])},{float(c['x_px'][i])!r},{float(c['y_px'][i])!r}"
-        for i in order
-    ]
-    atomic_write_text(args.output, "\n".join(lines) + "\n")
+    atomic_write_text(args.output, long_csv_text(imp.columns))
     found = imp.settings_yaml()
     found["written"] = str(args.output)
     print(yaml.safe_dump(found, sort_keys=False), end="")

@@ -24,15 +24,12 @@ from pathlib import Path
 
 import numpy as np
 
+from ..pipeline.atomic import atomic_target
 from .clip import ClipInfo, VideoError
 from .mraw import MRAW_EXT, mraw_frames, mraw_info
 
 VIDEO_EXT = {".mkv": "ffv1", ".mp4": "h264"}
 TIFF_EXT = (".tif", ".tiff")
-
-
-def _tmp(path: Path) -> Path:
-    return path.with_name(f".{path.name}.part")
 
 
 def write_clip(
@@ -53,20 +50,16 @@ def write_clip(
     """
     path = Path(path)
     ext = path.suffix.lower()
-    tmp = _tmp(path)
+    if ext not in TIFF_EXT and ext not in VIDEO_EXT:
+        raise VideoError(f"{path}: unknown clip extension {ext!r} (written: .tif, .tiff, .mkv, .mp4)")
     meta = {"fps": float(fps), "exposure_s": exposure_s, "trigger_frame": trigger_frame}
     if frame_numbers is not None:
         meta["frame_numbers"] = [int(v) for v in frame_numbers]
-    try:
+    with atomic_target(path, suffix=ext) as tmp:
         if ext in TIFF_EXT:
             _write_tiff(tmp, frames, meta)
-        elif ext in VIDEO_EXT:
-            _write_av(tmp, frames, fps, VIDEO_EXT[ext], crf, meta)
         else:
-            raise VideoError(f"{path}: unknown clip extension {ext!r} (known: .tif, .tiff, .mkv, .mp4)")
-        os.replace(tmp, path)
-    finally:
-        tmp.unlink(missing_ok=True)
+            _write_av(tmp, frames, fps, VIDEO_EXT[ext], crf, meta)
     return path
 
 

@@ -401,3 +401,39 @@ def track_clip(clip: Clip, opt: TrackOptions) -> Found:
         if "bat_tip" in opt.points:
             _tip(img, f, opt, trails["bat_tip"], sigma, found)
     return found
+
+
+#: Columns of the quality table beside the tracks: each point found, and each left out with its reason.
+QUALITY_COLUMNS = ("residual_px", "contrast", "left_out")
+
+
+def found_columns(found: Found, impact_id: str, camera: str) -> tuple[dict, dict]:
+    """Return the long tracks table's columns of one clip, and its quality table's (found and left-out points).
+
+    The tracks hold only the points found. The quality table holds them too, with their
+    edge-fit residual (px; the ball's, NaN for centroids) and contrast (grey levels), and
+    every point left out, with empty coordinates and the reason in ``left_out``.
+    """
+    r = found.rows
+    n, m = len(r["frame"]), len(found.left_out)
+    tracks = {
+        "impact_id": np.full(n, impact_id, dtype=object),
+        "camera": np.full(n, camera, dtype=object),
+        "point": np.array(r["point"], dtype=object),
+        "frame": np.array(r["frame"], dtype=np.int64),
+        "x_px": np.array(r["x_px"], dtype=float),
+        "y_px": np.array(r["y_px"], dtype=float),
+    }
+    lo = found.left_out
+    quality = {
+        "impact_id": np.full(n + m, impact_id, dtype=object),
+        "camera": np.full(n + m, camera, dtype=object),
+        "point": np.array(r["point"] + [p for p, _, _ in lo], dtype=object),
+        "frame": np.array(r["frame"] + [k for _, k, _ in lo], dtype=np.int64),
+        "x_px": np.concatenate([tracks["x_px"], np.full(m, np.nan)]),
+        "y_px": np.concatenate([tracks["y_px"], np.full(m, np.nan)]),
+        "residual_px": np.array(r["residual_px"] + [np.nan] * m, dtype=float),
+        "contrast": np.array(r["contrast"] + [np.nan] * m, dtype=float),
+        "left_out": np.array([""] * n + [why for _, _, why in lo], dtype=object),
+    }
+    return tracks, quality
