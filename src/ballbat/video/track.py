@@ -70,9 +70,9 @@ class Found:
 
 
 def _noise_sigma(img: np.ndarray) -> float:
-    """Robust pixel noise from the differences of neighbouring pixels (MAD)."""
+    """Robust pixel noise from the differences of neighbouring pixels (MAD), at least the quantisation's (0.29)."""
     d = np.diff(img[::4, :].astype(np.float32), axis=1)
-    return float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2)) + 1e-6
+    return max(float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2)), 1 / np.sqrt(12))
 
 
 def find_balls(img: np.ndarray, radius: float, tol: float) -> list[tuple[float, float]]:
@@ -107,30 +107,31 @@ _SAMPLES = np.arange(-5.0, 5.01, 0.5)
 _CAND = np.arange(-3.0, 3.0001, 0.1)
 
 
-@functools.lru_cache(maxsize=4)
-def _edge_projectors() -> np.ndarray:
+@functools.lru_cache(maxsize=64)
+def _edge_projectors(radius: float) -> np.ndarray:
     """For each tried edge position e, I - P_e: the residual maker of the ray model with its edge at e.
 
-    The model of a ray's profile, linear in its four coefficients: the background (a constant
-    and a slope outside), the ball's limb (a constant inside) and its shading towards the limb,
-    which for a sphere goes as sqrt(e - rho) (the normal's component towards the camera). Each
-    is smoothed as the pixels sample it (a 1-px box, then the bilinear interpolation of the
-    rays: a triangle of half-width 1 px).
+    The model of a ray's profile about the radius ``radius`` (px, to 0.5 px), linear in its
+    five coefficients: the background (a constant and a slope outside) and the ball inside as
+    a Lambert sphere of radius ``radius`` + e lit from anywhere in front: a constant, the normal's
+    component towards the camera (sqrt(1 - (rho / R)^2)) and the one along the ray (rho / R).
+    Each is smoothed as the pixels sample it (a 1-px box, then the bilinear interpolation of
+    the rays: a triangle of half-width 1 px).
     """
     fine = np.arange(-9.0, 9.0, 0.02)
     box = np.ones(50) / 50
-    tri = np.convolve(box, box)
-    kern = np.convolve(box, tri)
+    kern = np.convolve(box, np.convolve(box, box))
     kern /= kern.sum()
     out = np.empty((_CAND.size, _SAMPLES.size, _SAMPLES.size))
     for j, e in enumerate(_CAND):
         inside = fine < e
+        rho = (radius + fine) / (radius + e)
         basis = [
             np.ones_like(fine),
             np.where(inside, 0.0, fine - e),
             inside * 1.0,
-            np.sqrt(np.clip(e - fine, 0, None)),
-            np.clip(e - fine, 0, None),
+            np.sqrt(np.clip(1 - rho * rho, 0, None)),
+            inside * rho,
         ]
         cols = [np.interp(_SAMPLES, fine, np.convolve(b, kern, mode="same")) for b in basis]
         d = np.column_stack(cols)
@@ -153,9 +154,9 @@ def _edges_gradient(prof: np.ndarray, rad: np.ndarray) -> np.ndarray:
     return rad[np.argmax(g, axis=1)]
 
 
-def _edges_model(prof: np.ndarray, sigma: float) -> tuple[np.ndarray, np.ndarray]:
+def _edges_model(prof: np.ndarray, r: float, sigma: float) -> tuple[np.ndarray, np.ndarray]:
     """Edge on each ray by the ray model (:func:`_edge_projectors`): offsets and the fit's chi-square per sample."""
-    m = _edge_projectors()
+    m = _edge_projectors(round(2 * r) / 2)
     y = prof.astype(np.float64)
     rss = (np.matmul(y[None], m) * y[None]).sum(axis=2).T  # y^T (I - P_e) y, ray by tried edge
     k = np.clip(np.argmin(rss, axis=1), 1, _CAND.size - 2)
@@ -196,7 +197,7 @@ def fit_ball(img: np.ndarray, cx: float, cy: float, r: float, sigma: float) -> t
         if wide:
             edge = _edges_gradient(prof, rad)
         else:
-            edge, chi2 = _edges_model(prof, sigma)
+            edge, chi2 = _edges_model(prof, r, sigma)
             keep &= (chi2 < 2.0) & kept  # a ray once dropped stays dropped: the passes settle
         fit, keep = _fit_circle_robust(cx + _COS * (r + edge), cy + _SIN * (r + edge), keep)
         if fit is None:
@@ -227,7 +228,9 @@ def find_dots(img: np.ndarray, ball: tuple, dot_r: float, sigma: float) -> tuple
     dark = ndimage.grey_closing(sub, size=(size, size)) - sub
     yy, xx = np.mgrid[0 : sub.shape[0], 0 : sub.shape[1]]
     inside = np.hypot(xx + x0 - cx, yy + y0 - cy) < r - 2
-    lab, n = ndimage.label((dark > 5 * sigma) & inside)
+    # a dot is dark: more than 5 noise sigma and a third of the ball's own level below the shading
+    level = max(5 * sigma, float(np.median(sub[inside])) / 3) if inside.any() else 5 * sigma
+    lab, n = ndimage.label((dark > level) & inside)
     if n == 0:
         return [], "no dot seen on the ball"
     idx = np.arange(1, n + 1)
@@ -304,7 +307,7 @@ def _ball_candidates(img, guess, opt: TrackOptions) -> list:
 def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found):
     r = opt.ball_radius_px
     guess = trail.predict(k)
-    fit, reason = fit_ball(img, *guess, r, sigma) if guess is not None and len(trail.last) == 2 else ((), "")
+    fit, reason = fit_ball(img, *guess, r, sigma) if guess is not None else ((), "")
     if not fit:  # no prediction yet, or the fit failed there: look for the disc in the region
         cands = _ball_candidates(img, guess, opt)
         if len(cands) != 1:
