@@ -107,8 +107,8 @@ _SAMPLES = np.arange(-5.0, 5.01, 0.5)
 _CAND = np.arange(-3.0, 3.0001, 0.1)
 
 
-@functools.lru_cache(maxsize=64)
-def _edge_projectors(radius: float) -> np.ndarray:
+@functools.lru_cache(maxsize=256)
+def _edge_projectors(radius: float, blur: float = 0.0) -> np.ndarray:
     """For each tried edge position e, I - P_e: the residual maker of the ray model with its edge at e.
 
     The model of a ray's profile about the radius ``radius`` (px, to 0.5 px), linear in its
@@ -116,11 +116,14 @@ def _edge_projectors(radius: float) -> np.ndarray:
     a Lambert sphere of radius ``radius`` + e lit from anywhere in front: a constant, the normal's
     component towards the camera (sqrt(1 - (rho / R)^2)) and the one along the ray (rho / R).
     Each is smoothed as the pixels sample it (a 1-px box, then the bilinear interpolation of
-    the rays: a triangle of half-width 1 px).
+    the rays: a triangle of half-width 1 px) and by the motion blur along the ray (a box of
+    ``blur`` px: the ball's travel during the exposure, projected on the ray).
     """
     fine = np.arange(-9.0, 9.0, 0.02)
     box = np.ones(50) / 50
     kern = np.convolve(box, np.convolve(box, box))
+    if blur >= 0.5:
+        kern = np.convolve(kern, np.ones(round(blur / 0.02)))
     kern /= kern.sum()
     out = np.empty((_CAND.size, _SAMPLES.size, _SAMPLES.size))
     for j, e in enumerate(_CAND):
@@ -154,11 +157,18 @@ def _edges_gradient(prof: np.ndarray, rad: np.ndarray) -> np.ndarray:
     return rad[np.argmax(g, axis=1)]
 
 
-def _edges_model(prof: np.ndarray, r: float, sigma: float) -> tuple[np.ndarray, np.ndarray]:
-    """Edge on each ray by the ray model (:func:`_edge_projectors`): offsets and the fit's chi-square per sample."""
-    m = _edge_projectors(round(2 * r) / 2)
+def _edges_model(prof: np.ndarray, r: float, sigma: float, blur: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Edge on each ray by the ray model (:func:`_edge_projectors`): offsets and the fit's chi-square per sample.
+
+    ``blur`` is each ray's motion blur (px), taken to 0.5 px.
+    """
     y = prof.astype(np.float64)
-    rss = (np.matmul(y[None], m) * y[None]).sum(axis=2).T  # y^T (I - P_e) y, ray by tried edge
+    rss = np.empty((y.shape[0], _CAND.size))
+    buckets = np.round(2 * blur) / 2
+    for b in np.unique(buckets):
+        sel = buckets == b
+        m = _edge_projectors(round(2 * r) / 2, float(b))
+        rss[sel] = (np.matmul(y[sel][None], m) * y[sel][None]).sum(axis=2).T  # y^T (I - P_e) y
     k = np.clip(np.argmin(rss, axis=1), 1, _CAND.size - 2)
     i = np.arange(prof.shape[0])
     r0, r1, r2 = rss[i, k - 1], rss[i, k], rss[i, k + 1]
@@ -179,12 +189,16 @@ def _fit_circle_robust(px, py, keep):
     return (fx, fy, fr, res), keep
 
 
-def fit_ball(img: np.ndarray, cx: float, cy: float, r: float, sigma: float) -> tuple[tuple, str | None]:
+def fit_ball(
+    img: np.ndarray, cx: float, cy: float, r: float, sigma: float, blur: tuple[float, float] = (0.0, 0.0)
+) -> tuple[tuple, str | None]:
     """Return the ball's sub-pixel centre near (cx, cy): ((x, y, r, rms, contrast), None) or ((), reason left out).
 
     The rough edges (gradient peaks on a wide window) until the circle moves by under a pixel,
     then the ray model (:func:`_edges_model`) until it moves by under 0.005 px (at most 8 passes).
+    ``blur`` is the ball's travel during the exposure (px, x and y), where known.
     """
+    ray_blur = np.abs(_COS * blur[0] + _SIN * blur[1])
     h, w = img.shape
     wide, moved, kept = True, np.inf, np.ones(_N_RAYS, bool)
     for _ in range(8):
@@ -197,7 +211,7 @@ def fit_ball(img: np.ndarray, cx: float, cy: float, r: float, sigma: float) -> t
         if wide:
             edge = _edges_gradient(prof, rad)
         else:
-            edge, chi2 = _edges_model(prof, r, sigma)
+            edge, chi2 = _edges_model(prof, r, sigma, ray_blur)
             keep &= (chi2 < 2.0) & kept  # a ray once dropped stays dropped: the passes settle
         fit, keep = _fit_circle_robust(cx + _COS * (r + edge), cy + _SIN * (r + edge), keep)
         if fit is None:
@@ -295,6 +309,13 @@ class _Trail:
         f = (k - k1) / (k1 - k0)
         return x1 + f * (x1 - x0), y1 + f * (y1 - y0)
 
+    def velocity(self) -> tuple[float, float]:
+        """Return the last velocity (px per frame; 0 before two positions)."""
+        if len(self.last) < 2:
+            return 0.0, 0.0
+        (k0, x0, y0), (k1, x1, y1) = self.last
+        return (x1 - x0) / (k1 - k0), (y1 - y0) / (k1 - k0)
+
 
 def _ball_candidates(img, guess, opt: TrackOptions) -> list:
     r = opt.ball_radius_px
@@ -304,16 +325,18 @@ def _ball_candidates(img, guess, opt: TrackOptions) -> list:
     return [(x + x0, y + y0) for x, y in find_balls(sub, r, opt.radius_tolerance)]
 
 
-def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found):
+def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found, exposure_frames: float):
     r = opt.ball_radius_px
     guess = trail.predict(k)
-    fit, reason = fit_ball(img, *guess, r, sigma) if guess is not None else ((), "")
+    v = trail.velocity()
+    blur = (v[0] * exposure_frames, v[1] * exposure_frames)
+    fit, reason = fit_ball(img, *guess, r, sigma, blur) if guess is not None else ((), "")
     if not fit:  # no prediction yet, or the fit failed there: look for the disc in the region
         cands = _ball_candidates(img, guess, opt)
         if len(cands) != 1:
             found.leave_out("ball", k, "no ball found" if not cands else f"{len(cands)} balls found")
             return None
-        fit, reason = fit_ball(img, *cands[0], r, sigma)
+        fit, reason = fit_ball(img, *cands[0], r, sigma, blur)
     if reason is None and abs(fit[2] / r - 1) > opt.radius_tolerance:
         reason = f"fitted radius {fit[2]:.1f} px, expected {r:.1f} px"
     if reason:
@@ -324,25 +347,41 @@ def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found):
     return fit
 
 
+def _label_dots(rel: list, rel_prev: dict) -> dict[str, int]:
+    """Name the spots (positions relative to the ball): each the label last seen nearest, greedily.
+
+    The first spots ever seen are named a, b in order of angle; a spot left over takes a label
+    never seen yet.
+    """
+    if not rel_prev:
+        order = sorted(range(len(rel)), key=lambda j: np.arctan2(rel[j][1], rel[j][0]))
+        return dict(zip(("dot_a", "dot_b"), order, strict=False))
+    pairs = sorted(
+        (np.hypot(q[0] - rel_prev[p][0], q[1] - rel_prev[p][1]), j, p) for j, q in enumerate(rel) for p in rel_prev
+    )
+    labels: dict[str, int] = {}
+    for _, j, p in pairs:
+        if p not in labels and j not in labels.values():
+            labels[p] = j
+    free = [j for j in range(len(rel)) if j not in labels.values()]
+    unseen = [p for p in ("dot_a", "dot_b") if p not in rel_prev]
+    if free and unseen:
+        labels[unseen[0]] = free[0]
+    return labels
+
+
 def _dots(img, k, ball, opt: TrackOptions, sigma, rel_prev: dict, found: Found) -> None:
     spots, reason = find_dots(img, ball, opt.dot_radius_px, sigma)
     for s in [s for s in spots if s[3] > 0.8]:
         found.leave_out("dot", k, f"spot at {s[0]:.1f}, {s[1]:.1f} on the limb ({s[3]:.2f} of the radius)")
     spots = [s for s in spots if s[3] <= 0.8]
-    if reason or len(spots) > 2 or (not rel_prev and len(spots) != 2):
-        why = reason or f"{len(spots)} dark spots inside the ball (two expected)"
+    if reason or not spots or len(spots) > 2:
+        why = reason or f"{len(spots)} dark spots inside the ball (one or two expected)"
         for p in ("dot_a", "dot_b"):
             found.leave_out(p, k, why)
         return
     rel = [(s[0] - ball[0], s[1] - ball[1]) for s in spots]
-    if not rel_prev:
-        order = sorted(range(2), key=lambda j: np.arctan2(rel[j][1], rel[j][0]))
-        labels = dict(zip(("dot_a", "dot_b"), order, strict=True))
-    else:
-        labels = {}
-        for j, q in enumerate(rel):
-            near = min(rel_prev, key=lambda p: np.hypot(q[0] - rel_prev[p][0], q[1] - rel_prev[p][1]))
-            labels.setdefault(near, j)
+    labels = _label_dots(rel, rel_prev)
     for p in ("dot_a", "dot_b"):
         if p not in labels:
             found.leave_out(p, k, "not seen inside the ball (hidden or on the limb)")
@@ -391,11 +430,13 @@ def track_clip(clip: Clip, opt: TrackOptions) -> Found:
     numbers = clip.info.frame_numbers
     t0: list = []
     sigma = None
+    info = clip.info
+    exposure_frames = info.exposure_s * info.fps if info.exposure_s and info.fps else 0.0
     for k, t, img in clip.frames():
         _check_time(clip, k, t, t0)
         f = int(numbers[k]) if numbers is not None and k < numbers.size else k
         sigma = _noise_sigma(img) if sigma is None else sigma
-        ball = _ball(img, f, opt, trails["ball"], sigma, found)
+        ball = _ball(img, f, opt, trails["ball"], sigma, found, exposure_frames)
         if ball is not None and "dot_a" in opt.points:
             _dots(img, f, ball, opt, sigma, rel_prev, found)
         elif "dot_a" in opt.points:
