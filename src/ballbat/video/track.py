@@ -119,11 +119,11 @@ def _edge_projectors(radius: float, blur: float = 0.0) -> np.ndarray:
     the rays: a triangle of half-width 1 px) and by the motion blur along the ray (a box of
     ``blur`` px: the ball's travel during the exposure, projected on the ray).
     """
-    fine = np.arange(-9.0, 9.0, 0.02)
-    box = np.ones(50) / 50
+    fine = np.arange(-9.0, 9.0, 0.05)
+    box = np.ones(20) / 20
     kern = np.convolve(box, np.convolve(box, box))
     if blur >= 0.5:
-        kern = np.convolve(kern, np.ones(round(blur / 0.02)))
+        kern = np.convolve(kern, np.ones(round(blur / 0.05)))
     kern /= kern.sum()
     out = np.empty((_CAND.size, _SAMPLES.size, _SAMPLES.size))
     for j, e in enumerate(_CAND):
@@ -195,7 +195,7 @@ def fit_ball(
     """Return the ball's sub-pixel centre near (cx, cy): ((x, y, r, rms, contrast), None) or ((), reason left out).
 
     The rough edges (gradient peaks on a wide window) until the circle moves by under a pixel,
-    then the ray model (:func:`_edges_model`) until it moves by under 0.005 px (at most 8 passes).
+    then the ray model (:func:`_edges_model`) until it moves by under 0.01 px (at most 8 passes).
     ``blur`` is the ball's travel during the exposure (px, x and y), where known.
     """
     ray_blur = np.abs(_COS * blur[0] + _SIN * blur[1])
@@ -218,7 +218,7 @@ def fit_ball(
             return (), f"ball edge seen on {int(keep.sum())} of {_N_RAYS} rays (occluded, blurred or on clutter)"
         moved = max(abs(fit[0] - cx), abs(fit[1] - cy), abs(fit[2] - r))
         cx, cy, r, res = fit
-        if not wide and moved < 0.005:
+        if not wide and moved < 0.01:
             break
         kept = keep if not wide else kept
         wide = wide and moved > 1.0
@@ -274,15 +274,14 @@ def find_marker(img: np.ndarray, cx: float, cy: float, half: float, mr: float, s
     area = ndimage.sum_labels(np.ones_like(sub), lab, idx)
     ok = idx[(area > 0.3 * np.pi * mr**2) & (area < 2.0 * np.pi * mr**2)]
     best = None
-    for j in ok:
-        yy, xx = np.nonzero(lab == j)
-        ring = ndimage.binary_dilation(lab == j, iterations=int(mr)) & (lab != j)
-        level = float(np.median(sub[ring]))
-        core = ndimage.binary_dilation(lab == j, iterations=2)
-        wy, wx = np.nonzero(core)
-        wgt = np.clip(sub[wy, wx] - level, 0, None)
-        x, y = (wgt * wx).sum() / wgt.sum() + x0, (wgt * wy).sum() / wgt.sum() + y0
-        contrast = float(sub[yy, xx].mean() - level)
+    gy, gx = np.mgrid[0 : sub.shape[0], 0 : sub.shape[1]]
+    for j, (my, mx) in zip(ok, ndimage.center_of_mass(sub, lab, ok), strict=True):
+        d = np.hypot(gx - mx, gy - my)
+        level = float(np.median(sub[(d > 1.5 * mr) & (d < 2.5 * mr)]))  # the end cap round the marker
+        core = d < 1.3 * mr
+        wgt = np.clip(sub[core] - level, 0, None)
+        x, y = (wgt * gx[core]).sum() / wgt.sum() + x0, (wgt * gy[core]).sum() / wgt.sum() + y0
+        contrast = float(sub[lab == j].mean() - level)
         if contrast > 0.3 * (float(sub.max()) - level) and (best is None or np.hypot(x - cx, y - cy) < best[3]):
             best = (float(x), float(y), contrast, float(np.hypot(x - cx, y - cy)))
     return best[:3] if best else None
