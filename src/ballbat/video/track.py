@@ -280,6 +280,8 @@ def find_marker(img: np.ndarray, cx: float, cy: float, half: float, mr: float, s
         level = float(np.median(sub[(d > 1.5 * mr) & (d < 2.5 * mr)]))  # the end cap round the marker
         core = d < 1.3 * mr
         wgt = np.clip(sub[core] - level, 0, None)
+        if wgt.sum() <= 0:
+            continue
         x, y = (wgt * gx[core]).sum() / wgt.sum() + x0, (wgt * gy[core]).sum() / wgt.sum() + y0
         contrast = float(sub[lab == j].mean() - level)
         if contrast > 0.3 * (float(sub.max()) - level) and (best is None or np.hypot(x - cx, y - cy) < best[3]):
@@ -346,30 +348,49 @@ def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found, 
     return fit
 
 
-def _label_dots(rel: list, rel_prev: dict) -> dict[str, int]:
-    """Name the spots (positions relative to the ball): each the label last seen nearest, greedily.
+@dataclass
+class _DotMemory:
+    """What names the dots: the turn from a to b (its sign, fixed on a rigid ball), each dot's last angle, the spin."""
 
-    The first spots ever seen are named a, b in order of angle; a spot left over takes a label
-    never seen yet.
+    chirality: float = 0.0
+    last: dict = field(default_factory=dict)  # label -> (frame, angle about the ball's centre)
+    spin: float = 0.0  # rad per frame
+
+    def predict(self, p: str, k: int) -> float | None:
+        """Return the angle of dot ``p`` expected at frame ``k`` (None if never seen)."""
+        if p not in self.last:
+            return None
+        k0, a0 = self.last[p]
+        return a0 + self.spin * (k - k0)
+
+    def remember(self, p: str, k: int, angle: float) -> None:
+        """Note dot ``p`` at ``angle``; a dot seen within 3 frames updates the spin."""
+        if p in self.last and 0 < k - self.last[p][0] <= 3:
+            k0, a0 = self.last[p]
+            self.spin = float(np.angle(np.exp(1j * (angle - a0)))) / (k - k0)
+        self.last[p] = (k, angle)
+
+
+def _label_dots(rel: list, k: int, mem: _DotMemory) -> dict[str, int]:
+    """Name the spots (positions relative to the ball's centre).
+
+    Two spots: by the turn from a to b, whose sign the first pair seen fixes (a, b in order of
+    angle then). One spot: the dot whose angle, carried on at the last spin, is nearest (a if
+    none was seen yet).
     """
-    if not rel_prev:
-        order = sorted(range(len(rel)), key=lambda j: np.arctan2(rel[j][1], rel[j][0]))
-        return dict(zip(("dot_a", "dot_b"), order, strict=False))
-    pairs = sorted(
-        (np.hypot(q[0] - rel_prev[p][0], q[1] - rel_prev[p][1]), j, p) for j, q in enumerate(rel) for p in rel_prev
-    )
-    labels: dict[str, int] = {}
-    for _, j, p in pairs:
-        if p not in labels and j not in labels.values():
-            labels[p] = j
-    free = [j for j in range(len(rel)) if j not in labels.values()]
-    unseen = [p for p in ("dot_a", "dot_b") if p not in rel_prev]
-    if free and unseen:
-        labels[unseen[0]] = free[0]
-    return labels
+    ang = [float(np.arctan2(q[1], q[0])) for q in rel]
+    if len(rel) == 2:
+        cross = rel[0][0] * rel[1][1] - rel[0][1] * rel[1][0]
+        if mem.chirality == 0.0:
+            first = int(np.argmin(ang))
+            mem.chirality = float(np.sign(cross)) * (1.0 if first == 0 else -1.0)
+        return {"dot_a": 0, "dot_b": 1} if np.sign(cross) == mem.chirality else {"dot_a": 1, "dot_b": 0}
+    guesses = {p: mem.predict(p, k) for p in ("dot_a", "dot_b")}
+    known = {p: abs(float(np.angle(np.exp(1j * (ang[0] - g))))) for p, g in guesses.items() if g is not None}
+    return {min(known, key=known.get) if known else "dot_a": 0}
 
 
-def _dots(img, k, ball, opt: TrackOptions, sigma, rel_prev: dict, found: Found) -> None:
+def _dots(img, k, ball, opt: TrackOptions, sigma, mem: _DotMemory, found: Found) -> None:
     spots, reason = find_dots(img, ball, opt.dot_radius_px, sigma)
     for s in [s for s in spots if s[3] > 0.8]:
         found.leave_out("dot", k, f"spot at {s[0]:.1f}, {s[1]:.1f} on the limb ({s[3]:.2f} of the radius)")
@@ -380,13 +401,13 @@ def _dots(img, k, ball, opt: TrackOptions, sigma, rel_prev: dict, found: Found) 
             found.leave_out(p, k, why)
         return
     rel = [(s[0] - ball[0], s[1] - ball[1]) for s in spots]
-    labels = _label_dots(rel, rel_prev)
+    labels = _label_dots(rel, k, mem)
     for p in ("dot_a", "dot_b"):
         if p not in labels:
             found.leave_out(p, k, "not seen inside the ball (hidden or on the limb)")
             continue
         s = spots[labels[p]]
-        rel_prev[p] = rel[labels[p]]
+        mem.remember(p, k, float(np.arctan2(rel[labels[p]][1], rel[labels[p]][0])))
         found.add(p, k, s[0], s[1], np.nan, s[2])
 
 
@@ -425,7 +446,7 @@ def track_clip(clip: Clip, opt: TrackOptions) -> Found:
     """Track one clip, streamed; frames numbered by the file's frame numbers where it has them, else from 0."""
     found = Found()
     trails = {"ball": _Trail(), "bat_tip": _Trail()}
-    rel_prev: dict = {}
+    mem = _DotMemory()
     numbers = clip.info.frame_numbers
     t0: list = []
     sigma = None
@@ -437,7 +458,7 @@ def track_clip(clip: Clip, opt: TrackOptions) -> Found:
         sigma = _noise_sigma(img) if sigma is None else sigma
         ball = _ball(img, f, opt, trails["ball"], sigma, found, exposure_frames)
         if ball is not None and "dot_a" in opt.points:
-            _dots(img, f, ball, opt, sigma, rel_prev, found)
+            _dots(img, f, ball, opt, sigma, mem, found)
         elif "dot_a" in opt.points:
             for p in ("dot_a", "dot_b"):
                 found.leave_out(p, f, "no ball")
