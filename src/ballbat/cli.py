@@ -748,6 +748,10 @@ def parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=cmd_import_tracks)
 
+    from .video.cli import add_parser as add_track_video
+
+    add_track_video(sub, fmt)
+
     p = sub.add_parser("summary", help="a dataset's headline numbers", epilog=EXAMPLES["summary"], formatter_class=fmt)
     p.add_argument("folder", help="a results folder, e.g. results/synthetic")
     p.set_defaults(func=cmd_summary)

@@ -184,32 +184,54 @@ def _tiff_frames(info: ClipInfo) -> Iterator[tuple[int, float | None, np.ndarray
         raise VideoError(f"{info.path}: frame {k}: cannot be read ({exc})") from None
 
 
+def _av_facts(c, path: Path) -> dict:
+    """Return what the container and its first video stream say: codec, pixel format, rate, frames, comment."""
+    if not c.streams.video:
+        raise VideoError(f"{path}: frame 0: no video stream")
+    s = c.streams.video[0]
+    try:
+        pix = s.format.name
+    except AttributeError:  # PyAV gives no format when FFmpeg has no decoder for the codec
+        raise VideoError(f"{path}: frame 0: no decoder for its video codec (unknown or unsupported)") from None
+    rate = s.average_rate or s.guessed_rate
+    n, slack = s.frames, 0
+    if not n and c.duration and rate:  # the duration, to its time base, in frames
+        n = round(c.duration / 1e6 * float(rate))
+        slack = int(np.ceil(float(s.time_base) * float(rate)))
+    return {
+        "name": s.codec_context.name,
+        "pix": pix,
+        "rate": rate,
+        "n": n or None,
+        "slack": slack,
+        "size": (s.width, s.height),
+        "time_base": str(s.time_base),
+        "comment": next((v for k, v in c.metadata.items() if k.lower() == "comment"), ""),
+    }
+
+
 def _av_info(path: Path) -> ClipInfo:
     import av
 
     try:
         with av.open(str(path)) as c:
-            if not c.streams.video:
-                raise VideoError(f"{path}: no video stream")
-            s = c.streams.video[0]
-            name, pix = s.codec_context.name, s.format.name if s.format else "?"
-            rate = s.average_rate or s.guessed_rate
-            tb = s.time_base
-            n = s.frames or None
-            comment = next((v for k, v in c.metadata.items() if k.lower() == "comment"), "")
+            f = _av_facts(c, path)
     except av.error.FFmpegError as exc:
         raise VideoError(f"{path}: frame 0: cannot be opened as video ({exc})") from None
-    if pix not in ("gray", "gray16le", "yuv420p", "yuvj420p", "yuv422p", "yuv444p"):
-        raise VideoError(f"{path}: pixel format {pix!r} is not read (grey or YUV; colour is taken as its luma)")
-    info = ClipInfo(str(path), name, s.width, s.height, n, 16 if pix == "gray16le" else 8)
-    if rate:
-        info.fps, info.source["fps"] = float(rate), f"{name} stream frame rate"
+    if f["pix"] not in ("gray", "gray16le", "yuv420p", "yuvj420p", "yuv422p", "yuv444p"):
+        raise VideoError(f"{path}: pixel format {f['pix']!r} is not read (grey or YUV; colour is taken as its luma)")
+    info = ClipInfo(str(path), f["name"], *f["size"], f["n"], 16 if f["pix"] == "gray16le" else 8)
+    if f["rate"]:
+        info.fps, info.source["fps"] = float(f["rate"]), f"{f['name']} stream frame rate"
     try:
-        meta = json.loads(comment) if comment.startswith("{") else {}
+        meta = json.loads(f["comment"]) if f["comment"].startswith("{") else {}
     except ValueError:
         meta = {}
     _apply_meta(info, {k: v for k, v in meta.items() if k != "fps"}, "container comment (ballbat)")
-    info.source["time_base"] = str(tb)
+    info.source["time_base"] = f["time_base"]
+    if info.frame_numbers is not None:  # ballbat's own files list every frame: the count is exact
+        info.n_frames, f["slack"] = int(info.frame_numbers.size), 0
+    info.source["frames_slack"] = str(f["slack"])
     return info
 
 
@@ -223,8 +245,15 @@ def _av_frames(info: ClipInfo) -> Iterator[tuple[int, float | None, np.ndarray]]
             s = c.streams.video[0]
             s.thread_type = "AUTO"
             fine = info.fps is not None and s.time_base is not None and float(s.time_base) * info.fps <= 0.25
+            k = -1
             for k, frame in enumerate(c.decode(s)):
                 t = float(frame.time) if fine and frame.time is not None else None
                 yield k, t, frame.to_ndarray(format=fmt)
+            slack = int(info.source.get("frames_slack", "0"))
+            if info.n_frames and k + 1 < info.n_frames - slack:
+                raise VideoError(
+                    f"{info.path}: frame {k + 1}: the stream ends after {k + 1} frames, its header says "
+                    f"{info.n_frames}: truncated or corrupt"
+                )
     except av.error.FFmpegError as exc:
         raise VideoError(f"{info.path}: frame {k}: cannot be decoded ({exc})") from None

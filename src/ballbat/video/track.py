@@ -24,11 +24,13 @@ Nothing is guessed: a point that fails a test is left out, with the reason.
 from __future__ import annotations
 
 import functools
+from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
 from scipy import ndimage
 
+from .clip import VideoError
 from .io import Clip
 
 _N_RAYS = 48
@@ -434,8 +436,6 @@ def _check_time(clip: Clip, k: int, t: float | None, t0: list) -> None:
         t0.append(t - k / fps)
     lag = (t - t0[0]) * fps - k
     if abs(lag) > 0.25:
-        from .io import VideoError
-
         raise VideoError(
             f"{clip.info.path}: frame {k}: timestamp {t:.6g} s is {lag:+.2f} frames off {fps:g} fps "
             "(a frame dropped or the clock jumped)"
@@ -465,6 +465,23 @@ def track_clip(clip: Clip, opt: TrackOptions) -> Found:
         if "bat_tip" in opt.points:
             _tip(img, f, opt, trails["bat_tip"], sigma, found)
     return found
+
+
+def require_ball(found: Found, path: str) -> None:
+    """Refuse a clip in which the ball is never found (none in view, two balls, never out of the bat's shadow).
+
+    The message names the file, the first frame and why the ball was left out there.
+    """
+    if "ball" in found.rows["point"]:
+        return
+    out = [(k, why) for p, k, why in found.left_out if p == "ball"]
+    if not out:
+        raise VideoError(f"{path}: no frames")
+    reasons = Counter(why for _, why in out)
+    raise VideoError(
+        f"{path}: frame {out[0][0]}: {out[0][1]}; the ball is found in none of its {len(out)} frames "
+        f"({', '.join(f'{n} x {why}' for why, n in reasons.most_common(3))})"
+    )
 
 
 #: Columns of the quality table beside the tracks: each point found, and each left out with its reason.
