@@ -27,6 +27,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
 from . import __version__
+from .video import cli as video_cli
 
 if TYPE_CHECKING:
     from collections.abc import Sequence
@@ -748,10 +749,7 @@ def parser() -> argparse.ArgumentParser:
     )
     p.set_defaults(func=cmd_import_tracks)
 
-    from .video.cli import add_parser as add_track_video
-
-    add_track_video(sub, fmt)
-
+    video_cli.add_parser(sub, fmt)
     p = sub.add_parser("summary", help="a dataset's headline numbers", epilog=EXAMPLES["summary"], formatter_class=fmt)
     p.add_argument("folder", help="a results folder, e.g. results/synthetic")
     p.set_defaults(func=cmd_summary)

@@ -24,7 +24,7 @@ EXAMPLE = """examples:
 """
 
 
-def add_parser(sub, formatter_class) -> None:
+def add_parser(sub: argparse._SubParsersAction, formatter_class: type[argparse.HelpFormatter]) -> None:
     """Register ``track-video`` on the ``ballbat`` command's subparsers."""
     p = sub.add_parser(
         "track-video",
