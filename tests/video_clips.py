@@ -15,16 +15,21 @@ PLAIN = Look(clutter=0, lighting=0.0, read_noise=0.004, shot_noise=0.0, exposure
 BUSY = Look(seed=4, dot_radius_m=0.008)
 
 
-def spin_truth(n: int = 8, width: int = 240, height: int = 160, v_px: float = 6.0, hide_b_from: int | None = None):
-    """A ball flying to the right at ``v_px`` per frame with two dots turning about its centre (spin camera)."""
+def spin_truth(
+    n: int = 8, width: int = 240, height: int = 160, v_px: float = 6.0, hide_b_from: int | None = None, hide_b_to=None
+):
+    """A ball flying to the right at ``v_px`` per frame with two dots turning about its centre (spin camera).
+
+    ``dot_b`` is hidden (behind the ball) from frame ``hide_b_from`` up to ``hide_b_to`` (exclusive; None: the end).
+    """
     k = np.arange(n)
     bx, by = 70.0 + v_px * k + 0.37, 80.0 - 0.8 * k + 0.21
     ang = 0.3 + 0.25 * k
     x = {"ball": bx, "dot_a": bx + 7.0 * np.cos(ang), "dot_b": bx + 6.0 * np.cos(ang + 1.6)}
     y = {"ball": by, "dot_a": by + 7.0 * np.sin(ang), "dot_b": by + 6.0 * np.sin(ang + 1.6)}
     if hide_b_from is not None:
-        x["dot_b"][hide_b_from:] = np.nan
-        y["dot_b"][hide_b_from:] = np.nan
+        x["dot_b"][hide_b_from:hide_b_to] = np.nan
+        y["dot_b"][hide_b_from:hide_b_to] = np.nan
     return ClipTruth("T1", "spin", 1000.0, width, height, 100 + k, x, y, RADIUS_PX, None, 28 / 34)
 
 

@@ -159,10 +159,10 @@ def _edges_gradient(prof: np.ndarray, rad: np.ndarray) -> np.ndarray:
     return rad[np.argmax(g, axis=1)]
 
 
-def _edges_model(prof: np.ndarray, r: float, sigma: float, blur: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _edges_model(prof: np.ndarray, r: float, sigma, blur: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Edge on each ray by the ray model (:func:`_edge_projectors`): offsets and the fit's chi-square per sample.
 
-    ``blur`` is each ray's motion blur (px), taken to 0.5 px.
+    ``sigma`` is the scale of the residuals (per ray or one), ``blur`` each ray's motion blur (px), taken to 0.5 px.
     """
     y = prof.astype(np.float64)
     rss = np.empty((y.shape[0], _CAND.size))
@@ -186,7 +186,7 @@ def _fit_circle_robust(px, py, keep):
             return None, keep
         fx, fy, fr = _circle_fit(px[keep], py[keep])
         res = np.hypot(px - fx, py - fy) - fr
-        mad = 1.4826 * np.median(np.abs(res[keep] - np.median(res[keep]))) + 0.02
+        mad = 1.4826 * np.median(np.abs(res[keep] - np.median(res[keep]))) + 0.05  # a clean edge: 0.15 px
         keep = keep & (np.abs(res) < 3 * mad)
     return (fx, fy, fr, res), keep
 
@@ -213,7 +213,8 @@ def fit_ball(
         if wide:
             edge = _edges_gradient(prof, rad)
         else:
-            edge, chi2 = _edges_model(prof, r, sigma, ray_blur)
+            # the model's own mismatch grows with the edge's contrast: 2 % of the step counts as noise
+            edge, chi2 = _edges_model(prof, r, np.maximum(sigma, 0.02 * step), ray_blur)
             keep &= (chi2 < 2.0) & kept  # a ray once dropped stays dropped: the passes settle
         fit, keep = _fit_circle_robust(cx + _COS * (r + edge), cy + _SIN * (r + edge), keep)
         if fit is None:
@@ -227,6 +228,8 @@ def fit_ball(
     if wide or moved > 0.05:
         return (), f"ball edge fit did not settle (last step {moved:.2f} px)"
     rms = float(np.sqrt(np.mean(res[keep] ** 2)))
+    if rms > 0.5:  # edge points that no circle fits: the ball half hidden, or an edge of the clutter taken
+        return (), f"ball edge not round (residual {rms:.2f} px; occluded or on clutter)"
     return (cx, cy, r, rms, float(np.median(step[keep]))), None
 
 
