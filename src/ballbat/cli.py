@@ -59,6 +59,7 @@ Prints the camera settings found in the files as YAML; exits 1 when a file canno
   ballbat summary results/synthetic
   ballbat summary results/maple""",
 }
+EXAMPLES["track-video"] = video_cli.EXAMPLE
 
 
 class UsageError(Exception):
