@@ -12,7 +12,7 @@ found. Per point:
   rays kept (occluded), the disc touching the frame's border, no such disc, or two.
 * **dot_a, dot_b** -- dark spots inside the disc: the ball's own shading (a grey closing,
   which removes spots smaller than it) minus the frame, thresholded at 5 noise sigma; each
-  spot's centroid weighted by its darkness. Left out: a spot beyond 0.8 of the radius (on
+  spot's centroid weighted by its darkness. Left out: a spot beyond 0.9 of the radius (on
   the limb: foreshortened, partly hidden), or not two spots. The labels a and b are
   arbitrary but kept from frame to frame (nearest to the last positions relative to the ball).
 * **bat_tip** -- a small bright disc (the marker) inside a dark surround (the end cap):
@@ -397,9 +397,9 @@ def _label_dots(rel: list, k: int, mem: _DotMemory) -> dict[str, int]:
 
 def _dots(img, k, ball, opt: TrackOptions, sigma, mem: _DotMemory, found: Found) -> None:
     spots, reason = find_dots(img, ball, opt.dot_radius_px, sigma)
-    for s in [s for s in spots if s[3] > 0.8]:
+    for s in [s for s in spots if s[3] > 0.9]:
         found.leave_out("dot", k, f"spot at {s[0]:.1f}, {s[1]:.1f} on the limb ({s[3]:.2f} of the radius)")
-    spots = [s for s in spots if s[3] <= 0.8]
+    spots = [s for s in spots if s[3] <= 0.9]
     if reason or not spots or len(spots) > 2:
         why = reason or f"{len(spots)} dark spots inside the ball (one or two expected)"
         for p in ("dot_a", "dot_b"):
