@@ -13,8 +13,9 @@ found. Per point:
 * **dot_a, dot_b** -- dark spots inside the disc: the ball's own shading (a grey closing,
   which removes spots smaller than it) minus the frame, thresholded at 5 noise sigma; each
   spot's centroid weighted by its darkness. Left out: a spot beyond 0.9 of the radius (on
-  the limb: foreshortened, partly hidden), or not two spots. The labels a and b are
-  arbitrary but kept from frame to frame (nearest to the last positions relative to the ball).
+  the limb: foreshortened, partly hidden), and both dots when there are none or more than two
+  spots. The names a and b are the tracker's own, kept from frame to frame (by the turn from a
+  to b when both are seen, by the angle carried on at the last spin when one is).
 * **bat_tip** -- a small bright disc (the marker) inside a dark surround (the end cap):
   its centroid weighted by brightness above the surround.
 
