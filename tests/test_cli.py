@@ -51,6 +51,7 @@ COMMANDS = {
     "check": "validate a measured impacts file",
     "fly": "carry, hang time and apex of batted balls",
     "import-tracks": "read Tracker or Kinovea files into ballbat's long tracks CSV",
+    "track-video": "track high-speed clips into ballbat's long tracks CSV",
     "summary": "a dataset's headline numbers",
     "bat": "a lab's bat measurements (ASTM F2398) as a bat-table row",
 }
@@ -64,7 +65,7 @@ def test_entry_point_is_installed():
     out = ballbat_process("--help")
     assert out.returncode == 0, out.stderr
     lines = out.stdout.splitlines()
-    assert lines[0] == "usage: ballbat [-h] [--version] {check,fly,import-tracks,summary,bat} ..."
+    assert lines[0] == "usage: ballbat [-h] [--version] {check,fly,import-tracks,track-video,summary,bat} ..."
     listed = dict(line.split(None, 1) for line in lines if line.startswith("    ") and not line.startswith("     "))
     assert listed == COMMANDS  # every command, each with its one-line help
     out = ballbat_process("fly", "--speed", "fast", "--angle", "20")

@@ -253,7 +253,9 @@ def test_cli_disk_full_keeps_the_old_file(tmp_path, lab, monkeypatch, capsys):
 
 
 def test_every_writing_command_is_tested():
-    """Every subcommand with an output option writes through ballbat.writer and is tested above (import-tracks)."""
+    """Every subcommand with an output option writes through ballbat.writer and is tested (import-tracks above,
+    track-video in test_track_video_writes_through_the_writer).
+    """
     parser = cli.parser()
     sub = next(a for a in parser._actions if a.dest == "command")
     writing = {
@@ -261,8 +263,10 @@ def test_every_writing_command_is_tested():
         for name, p in sub.choices.items()
         if any(a.dest in ("output", "out") or "-o" in a.option_strings for a in p._actions)
     }
-    assert writing == {"import-tracks"}, f"test the writer of {sorted(writing - {'import-tracks'})} here"
-    source = Path(cli.__file__).read_text()
+    assert writing == {"import-tracks", "track-video"}, f"test the writer of {sorted(writing - {'import-tracks'})} here"
+    from ballbat.video import cli as video_cli
+
+    source = Path(cli.__file__).read_text() + Path(video_cli.__file__).read_text()
     for direct in (
         r"(?<![\w.])open\(",
         r"\.write_text\(",

@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
 from . import __version__
+from .video import cli as video_cli
 from .writer import OutputFailed, OutputRefused
 
 if TYPE_CHECKING:
@@ -67,6 +68,7 @@ measured value's uncertainty does to e_x; exits 1 when the values fail a bat row
   ballbat summary results/synthetic
   ballbat summary results/maple""",
 }
+EXAMPLES["track-video"] = video_cli.EXAMPLE
 
 
 class UsageError(Exception):
@@ -345,12 +347,12 @@ def _number_arg(text: str, what: str) -> float:
 
 def cmd_import_tracks(args: argparse.Namespace) -> int:
     """Read tracking-tool files into ballbat's long tracks CSV; print the camera settings found as YAML."""
-    import numpy as np
     import yaml
 
     from .pipeline.checked import sealed_csv
     from .tracks.formats import FormatError
     from .tracks.formats.layout import DEFAULT_PATTERN, import_files
+    from .tracks.io import long_csv_text
     from .writer import STDOUT, output_problem, write_output
 
     if args.output != STDOUT:  # refused before any file is read (write_output checks again)
@@ -382,15 +384,8 @@ def cmd_import_tracks(args: argparse.Namespace) -> int:
             print(problem, file=sys.stderr)
         print(f"ballbat import-tracks: {len(exc.problems)} problem(s); nothing written", file=sys.stderr)
         return 1
-    c = imp.columns
-    order = np.lexsort((c["frame"], c["point"], c["camera"], c["impact_id"]))
-    lines = ["impact_id,camera,point,frame,x_px,y_px"]
-    lines += [
-        f"{c['impact_id'][i]},{c['camera'][i]},{c['point'][i]},{int(c['frame'][i])},{float(c['x_px'][i])!r},{float(c['y_px'][i])!r}"
-        for i in order
-    ]
     # the check line marks the file as ballbat's: only such a file is ever replaced (ballbat.writer)
-    where = write_output(args.output, sealed_csv("\n".join(lines) + "\n"), args.paths, parents=args.parents)
+    where = write_output(args.output, sealed_csv(long_csv_text(imp.columns)), args.paths, parents=args.parents)
     found = imp.settings_yaml()
     found["written"] = where
     print(yaml.safe_dump(found, sort_keys=False), end="", file=sys.stderr if args.output == STDOUT else sys.stdout)
@@ -804,6 +799,7 @@ def parser() -> argparse.ArgumentParser:
 
     _import_tracks_parser(sub, fmt)
 
+    video_cli.add_parser(sub, fmt)
     p = sub.add_parser("summary", help="a dataset's headline numbers", epilog=EXAMPLES["summary"], formatter_class=fmt)
     p.add_argument("folder", help="a results folder, e.g. results/synthetic")
     p.set_defaults(func=cmd_summary)

@@ -65,6 +65,31 @@ def read_table(
     return read_csv_table(path, required)
 
 
+def long_csv_text(cols: dict, extra: Sequence[str] = ()) -> str:
+    """Return the long tracks table as CSV text, as ``load_tracks`` reads it.
+
+    ``cols`` holds :data:`~ballbat.tracks.validate.TRACK_COLUMNS` (and any ``extra``
+    columns, written after them), one array each. Rows sorted by impact, camera, point and
+    frame; numbers written in full (``repr``), a NaN as an empty cell; cells quoted where needed.
+    """
+    import csv
+    import io
+
+    names = [*TRACK_COLUMNS, *extra]
+    order = np.lexsort(tuple(np.asarray(cols[k]) for k in ("frame", "point", "camera", "impact_id")))
+
+    def cell(v):
+        if isinstance(v, (float, np.floating)):
+            return "" if not np.isfinite(v) else repr(float(v))
+        return str(int(v)) if isinstance(v, (int, np.integer)) else str(v)
+
+    out = io.StringIO()
+    w = csv.writer(out, lineterminator="\n")
+    w.writerow(names)
+    w.writerows([cell(cols[k][i]) for k in names] for i in order)
+    return out.getvalue()
+
+
 def _truth_from_nc(path: Path) -> dict[str, np.ndarray]:
     if path.suffix.lower() not in _NC:
         return {}

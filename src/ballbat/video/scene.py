@@ -1,0 +1,102 @@
+"""The truth of a rendered clip: every point's sub-pixel position per frame, from the tracks renderer.
+
+:func:`clip_truths` runs :func:`ballbat.tracks.render.render_tracks` with no tracking noise,
+so the positions are the renderer's true ones (the physics is that module's alone), and cuts
+them into one :class:`ClipTruth` per impact and camera. The barrel's geometry on the image
+(the projected point of the pivot, about which the tip moves) comes from the same
+settings: the tip sits ``bat_axis_to_ball`` from the ball's centre along -n at impact.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..tracks.data import POINTS
+from ..tracks.render import RenderSettings, render_tracks
+
+
+@dataclass
+class ClipTruth:
+    """True positions (pixels, x right, y down) of the points one camera records in one clip.
+
+    ``x[point]``, ``y[point]`` hold one value per frame of ``frames``, NaN where the point is
+    not in view (outside the image, a dot on the ball's far side). ``bat_base_px`` is where
+    the bat's axis crosses the image at impact (the tip's position then), None for a camera
+    that does not see the bat; ``impact_depth`` is pivot_to_impact / pivot_to_tip (the part of
+    the barrel between it and the tip is in front of the ball).
+    """
+
+    impact_id: str
+    camera: str
+    fps: float
+    width: int
+    height: int
+    frames: np.ndarray
+    x: dict[str, np.ndarray]
+    y: dict[str, np.ndarray]
+    ball_radius_px: float
+    bat_base_px: tuple[float, float] | None
+    impact_depth: float
+
+    @property
+    def n_frames(self) -> int:
+        """Number of frames of the clip."""
+        return int(self.frames.size)
+
+
+def _noise_free(settings: RenderSettings) -> RenderSettings:
+    cams = {c: dataclasses.replace(getattr(settings, c), pixel_noise_px=0.0) for c in ("swing", "spin")}
+    return dataclasses.replace(settings, **cams)
+
+
+def clip_truths(
+    settings: RenderSettings,
+    truth: dict[str, np.ndarray],
+    ball_radius: np.ndarray,
+    impact_id: np.ndarray,
+    ball: np.ndarray,
+    bat: np.ndarray,
+) -> list[ClipTruth]:
+    """Return the true clips (impact by impact, swing then spin) of a rendered experiment.
+
+    Arguments as :func:`ballbat.tracks.render.render_tracks` (its tracking noise is set to 0).
+    A clip runs from the first frame the renderer records to the last in which any point is
+    in view, plus two (the ball's leaving edge).
+    """
+    tracks = render_tracks(truth, ball_radius, _noise_free(settings), impact_id, ball, bat)
+    beta = tracks.truth["truth_swing_plane"]
+    psi = np.asarray(truth["psi"], float)
+    out = []
+    for i, iid in enumerate(tracks.impact_id):
+        for cam in ("swing", "spin"):
+            rc = getattr(settings, cam)
+            ct = tracks.cameras[cam]
+            seen = np.zeros(ct.n_columns, bool)
+            for p in POINTS[cam]:
+                seen |= np.isfinite(ct.x[p][i])
+            end = min(int(np.flatnonzero(seen).max()) + 3, ct.n_columns) if seen.any() else 0
+            base = None
+            if "bat_tip" in POINTS[cam]:
+                n_dir = beta[i] + psi[i]
+                bx, by = -settings.bat_axis_to_ball * np.cos(n_dir), -settings.bat_axis_to_ball * np.sin(n_dir)
+                m = rc.camera.m_per_px
+                base = (rc.tee_px[0] + rc.camera.sign * bx / m, rc.tee_px[1] - by / m)
+            out.append(
+                ClipTruth(
+                    impact_id=str(iid),
+                    camera=cam,
+                    fps=rc.camera.fps,
+                    width=rc.width_px,
+                    height=rc.height_px,
+                    frames=ct.frames()[i, :end],
+                    x={p: ct.x[p][i, :end].copy() for p in POINTS[cam]},
+                    y={p: ct.y[p][i, :end].copy() for p in POINTS[cam]},
+                    ball_radius_px=float(ball_radius[i]) / rc.camera.m_per_px,
+                    bat_base_px=base,
+                    impact_depth=settings.rig.pivot_to_impact / settings.rig.pivot_to_tip,
+                )
+            )
+    return out

@@ -1,0 +1,42 @@
+"""Small clips made in the tests (tests/test_video_*.py): a truth by hand, drawn by ballbat.video.render."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ballbat.video.render import Look
+from ballbat.video.scene import ClipTruth
+
+#: A small camera: 0.0025 m per px puts a baseball's radius (36.6 mm) at 14.6 px.
+M_PER_PX = 0.0025
+RADIUS_PX = 0.0366 / M_PER_PX
+#: A plain look (no clutter, even light, low noise) and the default one.
+PLAIN = Look(clutter=0, lighting=0.0, read_noise=0.004, shot_noise=0.0, exposure_s=0.0, seed=3)
+BUSY = Look(seed=4, dot_radius_m=0.008)
+
+
+def spin_truth(
+    n: int = 8, width: int = 240, height: int = 160, v_px: float = 6.0, hide_b_from: int | None = None, hide_b_to=None
+):
+    """A ball flying to the right at ``v_px`` per frame with two dots turning about its centre (spin camera).
+
+    ``dot_b`` is hidden (behind the ball) from frame ``hide_b_from`` up to ``hide_b_to`` (exclusive; None: the end).
+    """
+    k = np.arange(n)
+    bx, by = 70.0 + v_px * k + 0.37, 80.0 - 0.8 * k + 0.21
+    ang = 0.3 + 0.25 * k
+    x = {"ball": bx, "dot_a": bx + 7.0 * np.cos(ang), "dot_b": bx + 6.0 * np.cos(ang + 1.6)}
+    y = {"ball": by, "dot_a": by + 7.0 * np.sin(ang), "dot_b": by + 6.0 * np.sin(ang + 1.6)}
+    if hide_b_from is not None:
+        x["dot_b"][hide_b_from:hide_b_to] = np.nan
+        y["dot_b"][hide_b_from:hide_b_to] = np.nan
+    return ClipTruth("T1", "spin", 1000.0, width, height, 100 + k, x, y, RADIUS_PX, None, 28 / 34)
+
+
+def swing_truth(n: int = 8, width: int = 240, height: int = 160, tip_start: float = 20.0):
+    """A ball at rest and the bat's tip marker moving towards it (swing camera)."""
+    k = np.arange(n)
+    x = {"ball": np.full(n, 150.3), "bat_tip": tip_start + 9.0 * k + 0.4}
+    y = {"ball": np.full(n, 70.6), "bat_tip": np.full(n, 104.2) - 0.5 * k}
+    base = (x["bat_tip"][-1] + 30.0, y["bat_tip"][-1])
+    return ClipTruth("T1", "swing", 3000.0, width, height, k, x, y, RADIUS_PX, base, 28 / 34)
