@@ -154,9 +154,16 @@ def _settings_dataclasses() -> set[type]:
     return found
 
 
+#: Settings classes with no config block yet, so nothing to check their defaults against. The video
+#: tracker's options (issue 38, first half) are set on the command line only; the `video` block of
+#: a dataset, which will own them, is still to come: then they join SETTINGS and leave this list.
+NOT_YET_IN_CONFIG = {"ballbat.video.track.TrackOptions"}
+
+
 def test_every_settings_dataclass_is_checked():
     """A new ...Settings or ...Options dataclass must be entered in SETTINGS (and so be checked)."""
-    assert _settings_dataclasses() == set(SETTINGS)
+    found = {c for c in _settings_dataclasses() if f"{c.__module__}.{c.__name__}" not in NOT_YET_IN_CONFIG}
+    assert found == set(SETTINGS)
 
 
 @pytest.mark.parametrize("cls", list(SETTINGS), ids=lambda c: c.__name__)
