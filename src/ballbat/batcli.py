@@ -141,8 +141,8 @@ def uncertainty_lines(row: dict, args: argparse.Namespace, ball: Ball) -> list[s
 
 def cmd_bat(args: argparse.Namespace) -> int:
     """Print the bat's rows, centre of percussion, recoil factors and e_x uncertainties; 1 when it fails the checks."""
-    from .cli import UsageError
     from .properties import load_balls
+    from .usage import UsageError
 
     try:
         row = lab_row(args)

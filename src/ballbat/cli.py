@@ -28,6 +28,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
 from . import __version__
+from .usage import UsageError
 from .video import cli as video_cli
 from .writer import OutputFailed, OutputRefused
 
@@ -69,10 +70,6 @@ measured value's uncertainty does to e_x; exits 1 when the values fail a bat row
   ballbat summary results/maple""",
 }
 EXAMPLES["track-video"] = video_cli.EXAMPLE
-
-
-class UsageError(Exception):
-    """A bad argument: reported as one line, exit status 2."""
 
 
 class _Parser(argparse.ArgumentParser):
