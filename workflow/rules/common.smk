@@ -11,10 +11,12 @@ from snakemake.exceptions import WorkflowError
 from ballbat.pipeline.codedeps import module_files
 from ballbat.pipeline.config import (
     BYTES_PER_CASE,
+    ConfigError,
     STUDY_BYTES_PER_REPLICATE,
     drop_nulls,
     impact_bytes,
     renders,
+    scenario_problems,
     study_impacts,
     validate_config,
 )
@@ -240,12 +242,10 @@ def get_source(wildcards):
 
 
 SCENARIOS = sorted(config.get("implications", {}).get("scenarios", {}))
-for _name, _sc in config.get("implications", {}).get("scenarios", {}).items():
-    if "e_x_from_dataset" in _sc and _sc["e_x_from_dataset"] not in DATASETS:
-        raise ValueError(
-            f"config: implications.scenarios.{_name}.e_x_from_dataset: "
-            f"{_sc['e_x_from_dataset']!r} is not a dataset ({', '.join(DATASETS)})"
-        )
+# A scenario's ball and bat, and the dataset of its e_x, checked before the DAG is built (one line each).
+_problems = scenario_problems(config)
+if _problems:
+    raise ConfigError("config is not valid:\n  " + "\n  ".join(_problems))
 
 
 wildcard_constraints:
