@@ -114,4 +114,68 @@ def test_scenario_bat_is_refused_before_the_dag(tmp_path):
     assert "Job stats" not in out.stdout + out.stderr
 
 
+# ---------------------------------------------------------------------------------------
+# Provenance
+
+
+def test_dirty_when_a_copied_workflow_differs_from_the_commit(tmp_path, monkeypatch):
+    """A copied checkout whose workflow script was edited records dirty: True (it recorded False: git status
+    looked at the package's clean checkout, not at the workflow that ran)."""
+    from workflow_helpers import make_workdir
+
+    from ballbat.pipeline import provenance
+
+    work = make_workdir(tmp_path)
+    commit = provenance.git_state(str(ROOT))["commit"]
+    assert provenance.workflow_matches_commit(work, str(ROOT), commit) == provenance.workflow_matches_commit(
+        ROOT, str(ROOT), commit
+    )  # a faithful copy is judged as the checkout itself
+    script = work / "workflow" / "scripts" / "fit_ex.py"
+    script.write_text(script.read_text() + "# a local edit\n")
+    assert not provenance.workflow_matches_commit(work, str(ROOT), commit)
+    monkeypatch.chdir(work)
+    state = provenance.git_state()
+    assert state == {"commit": commit, "dirty": True}
+    added = work / "workflow" / "rules" / "extra.smk"
+    script.write_text(script.read_text().removesuffix("# a local edit\n"))
+    added.write_text("# a rule file the commit does not have\n")
+    assert not provenance.workflow_matches_commit(work, str(ROOT), commit)
+
+
+def test_a_users_workbook_or_notes_at_an_output_path_are_not_the_workflows(tmp_path):
+    """A user's own .xlsx or .md at a product's path is named as not the workflow's: never replaced by a run
+    (foreign_outputs), and named while parsing (users_files); the workflow's own pass (test_crate.py: the
+    crate does not list such a file as the job's result)."""
+    import json
+
+    import openpyxl
+
+    from ballbat.pipeline.guards import foreign_outputs, users_files, written_by_workflow
+    from ballbat.pipeline.provenance import sha256_file
+
+    book, notes = tmp_path / "results.xlsx", tmp_path / "paper_comparison.md"
+    openpyxl.Workbook().save(book)
+    notes.write_text("| my | notes |\n")
+    assert not written_by_workflow(book) and not written_by_workflow(notes)
+    lines = foreign_outputs([book, notes])
+    assert len(lines) == 2 and all("not written by this workflow" in line for line in lines)
+    assert len(users_files([book, notes])) == 2
+    sidecar = tmp_path / "paper_comparison.provenance.json"
+    sidecar.write_text(json.dumps({"describes": [{"path": str(notes), "sha256": sha256_file(notes)}]}))
+    assert written_by_workflow(notes) and users_files([notes]) == []
+    notes.write_text("| edited | by hand |\n")
+    assert not written_by_workflow(notes)
+
+
+@pytest.mark.slow
+def test_workflow_products_carry_their_record(default_run):
+    """Every workbook, Markdown table and figure of a default run is recognised as the workflow's."""
+    from ballbat.pipeline.guards import users_files, written_by_workflow
+
+    results = default_run / "results"
+    products = [p for p in results.rglob("*") if p.suffix in (".xlsx", ".md", ".png") and "snapshot" not in str(p)]
+    assert len(products) > 10 and all(written_by_workflow(p) for p in products)
+    assert users_files(products) == []
+
+
 _ = copy, sys, Path

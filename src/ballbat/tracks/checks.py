@@ -169,29 +169,15 @@ def glitch_mask(x: np.ndarray, y: np.ndarray, skip: np.ndarray | None = None) ->
     out = np.zeros((n, m), dtype=bool)
     if m < 3:
         return out
-
-    def sh(a, k):  # a shifted so that column j holds a[:, j + k] (NaN outside)
-        b = np.full_like(a, np.nan)
-        if k > 0:
-            b[:, :-k] = a[:, k:]
-        else:
-            b[:, -k:] = a[:, : m + k]
-        return b
-
+    sh = _shifter(m)
+    rx, ry, sd = _midpoint_noise(x, y)
     with np.errstate(invalid="ignore"):
-        rx = x - 0.5 * (sh(x, -1) + sh(x, 1))
-        ry = y - 0.5 * (sh(y, -1) + sh(y, 1))
         lx, ly = x - 2 * sh(x, -1) + sh(x, -2), y - 2 * sh(y, -1) + sh(y, -2)
         qx, qy = x - 2 * sh(x, 1) + sh(x, 2), y - 2 * sh(y, 1) + sh(y, 2)
-    comps = np.concatenate([rx, ry], axis=1)
-    pooled = _mad_sd(comps.ravel())
-    if not np.isfinite(pooled):
+    if sd is None:
         return out
     with np.errstate(invalid="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows
-        enough = np.isfinite(comps).sum(axis=1) >= 10
-        med = np.where(enough, np.nanmedian(np.abs(comps), axis=1), 0.0)
-        sd = np.maximum(1.4826 * med, pooled)
         z = math.sqrt(2 * math.log(1 / GLITCH_FALSE_ALARM))
         rn = np.hypot(rx, ry)
         big = rn > z * sd[:, None]
@@ -204,6 +190,89 @@ def glitch_mask(x: np.ndarray, y: np.ndarray, skip: np.ndarray | None = None) ->
         peak = (rn >= np.nan_to_num(sh(rn, -1))) & (rn >= np.nan_to_num(sh(rn, 1)))
     out = big & same & peak & ok
     return out if skip is None else out & ~skip
+
+
+def _shifter(m: int):
+    """Return sh(a, k): ``a`` (impact, column) shifted so that column j holds a[:, j + k] (NaN outside)."""
+
+    def sh(a, k):
+        b = np.full_like(a, np.nan)
+        if k > 0:
+            b[:, :-k] = a[:, k:]
+        else:
+            b[:, -k:] = a[:, : m + k]
+        return b
+
+    return sh
+
+
+def _midpoint_noise(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """Return each point's offset from the midpoint of its neighbours (rx, ry) and the robust sd of their
+    components per impact: the track's own (1.4826 MAD, from 10 values) or, if larger, that of all impacts
+    (None when no point has two neighbours)."""
+    sh = _shifter(x.shape[1])
+    with np.errstate(invalid="ignore"):
+        rx = x - 0.5 * (sh(x, -1) + sh(x, 1))
+        ry = y - 0.5 * (sh(y, -1) + sh(y, 1))
+    comps = np.concatenate([rx, ry], axis=1)
+    pooled = _mad_sd(comps.ravel())
+    if not np.isfinite(pooled):
+        return rx, ry, None
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows
+        enough = np.isfinite(comps).sum(axis=1) >= 10
+        med = np.where(enough, np.nanmedian(np.abs(comps), axis=1), 0.0)
+    return rx, ry, np.maximum(1.4826 * med, pooled)
+
+
+#: Marks at the start of a track that :func:`misplaced_starts` tests (the glitch test needs two tracked
+#: frames on each side, so it never tests a track's first two).
+START_MARKS = 2
+
+
+@dataclass
+class MisplacedStart:
+    """Per impact: whether one of a track's first marks is far off its run, which column, how far (px), the noise."""
+
+    found: np.ndarray
+    column: np.ndarray
+    distance: np.ndarray
+    noise: np.ndarray
+
+
+def misplaced_starts(x: np.ndarray, y: np.ndarray) -> MisplacedStart:
+    """Test the first :data:`START_MARKS` marks of each track against the straight line through the next two.
+
+    A mark at column k of a track whose first mark is at f is predicted from the marks at f + 2 and
+    f + 3 (p = p2 + (2 - k)(p2 - p3)); with point noise s per coordinate its offset has sd
+    s sqrt(14) (k = 0) or s sqrt(6) (k = 1). s comes from the offsets of each mark from its
+    neighbours' midpoint (sd 1.5^0.5 s: :func:`glitch_mask`'s robust noise); the threshold is the
+    glitch test's z. A misplaced first click (hundreds of pixels off) is found; a track with fewer
+    than four marks from its start is not tested.
+    """
+    n, m = x.shape
+    found = np.zeros(n, dtype=bool)
+    column = np.zeros(n, dtype=np.int64)
+    distance = np.zeros(n)
+    _, _, sd = _midpoint_noise(x, y)
+    if sd is None or m < START_MARKS + 2:
+        return MisplacedStart(found, column, distance, np.full(n, np.nan))
+    ok = np.isfinite(x) & np.isfinite(y)
+    first = np.argmax(ok, axis=1)
+    cols = np.minimum(first[:, None] + np.arange(START_MARKS + 2)[None, :], m - 1)
+    px, py = np.take_along_axis(x, cols, axis=1), np.take_along_axis(y, cols, axis=1)
+    tested = ok.any(axis=1) & (first + START_MARKS + 1 < m) & np.all(np.take_along_axis(ok, cols, axis=1), axis=1)
+    z = math.sqrt(2 * math.log(1 / GLITCH_FALSE_ALARM))
+    point_sd = sd / math.sqrt(1.5)
+    for k in range(START_MARKS - 1, -1, -1):  # the earliest far mark is named
+        ex = px[:, k] - (px[:, 2] + (2 - k) * (px[:, 2] - px[:, 3]))
+        ey = py[:, k] - (py[:, 2] + (2 - k) * (py[:, 2] - py[:, 3]))
+        d = np.hypot(ex, ey)
+        far = tested & (d > z * point_sd * math.sqrt(1 + (3 - k) ** 2 + (2 - k) ** 2))
+        found |= far
+        column = np.where(far, first + k, column)
+        distance = np.where(far, d, distance)
+    return MisplacedStart(found, column, distance, point_sd)
 
 
 # ---------------------------------------------------------------------------------------

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..data import BY_EXTENSION, CAMERAS, FORMATS, POINTS, Tracks, tool_file_extensions
-from . import FileTracks, FormatError, close
+from . import DUPLICATE_RULE, FileTracks, FormatError, close
 from .kinovea import read_kva
 from .tables import check_units, read_kinovea_table, read_tracker_table
 from .tracker import read_trk, read_trz
@@ -228,7 +228,10 @@ def import_files(
             fr, x, y = ft.tracks[name]
             if np.unique(fr).size != fr.size:
                 u, n = np.unique(fr, return_counts=True)
-                problems.append(f"{ft.path}: track {name!r}: frame(s) {', '.join(map(str, u[n > 1][:5]))} appear twice")
+                problems.append(
+                    f"{ft.path}: track {name!r}: frame(s) {', '.join(map(str, u[n > 1][:5]))} marked twice "
+                    f"({DUPLICATE_RULE})"
+                )
                 continue
             cols["impact_id"].append(np.full(fr.size, iid))
             cols["camera"].append(np.full(fr.size, cam))
