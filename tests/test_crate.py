@@ -196,7 +196,8 @@ def _graph(results):
 
 def test_other_files_are_listed_with_their_staleness(tmp_path):
     """A target-only run's crate lists every file of the folder: the other products (an earlier run's) each
-    say so, with their staleness against the inputs Snakemake recorded for them (sha256 first, else time)."""
+    say so, with their staleness against the inputs Snakemake recorded for them (sha256 first, else time).
+    """
     from ballbat.pipeline.cratefiles import crate_file_problems
 
     results, job = _folder(tmp_path)
@@ -208,7 +209,12 @@ def test_other_files_are_listed_with_their_staleness(tmp_path):
     digest = sha256_file(tmp_path / "config" / "in.csv")
     old = {"config/in.csv": "sha256:00"}
     records = {
-        "results/old.nc": {"rule": "q", "input": ["config/in.csv"], "input_checksums": old, "log": ["results/logs/old.log"]},
+        "results/old.nc": {
+            "rule": "q",
+            "input": ["config/in.csv"],
+            "input_checksums": old,
+            "log": ["results/logs/old.log"],
+        },
         "results/same.nc": {"rule": "q", "input": ["config/in.csv"], "input_checksums": {"config/in.csv": digest}},
         "results/derived.nc": {"rule": "d", "input": ["results/old.nc"], "input_checksums": {}},
     }
@@ -221,14 +227,17 @@ def test_other_files_are_listed_with_their_staleness(tmp_path):
     assert "made by rule q; up to date with the 1 inputs it recorded" in graph["same.nc"]["description"]
     assert "its staleness is not known" in graph["unknown.tsv"]["description"]
     assert "stale: its input results/old.nc is stale" in graph["derived.nc"]["description"]
-    assert "stale: the log of the job that made results/old.nc (stale: its input" in graph["logs/old.log"]["description"]
+    assert (
+        "stale: the log of the job that made results/old.nc (stale: its input" in graph["logs/old.log"]["description"]
+    )
     assert "5 file(s) of the folder are not results of this run" in graph["./"]["description"]
     assert "old.nc" not in ids(graph["#run"]["result"]) and "a.nc" in ids(graph["#run"]["result"])
 
 
 def test_failed_run_lists_no_unfinished_job(tmp_path):
     """After a failed run the crate marks the run failed; the job that did not finish has no action, and
-    its old output is listed as not made by this run (never as its result)."""
+    its old output is listed as not made by this run (never as its result).
+    """
     results, job = _folder(tmp_path)
     _nc(results / "b.nc", "an earlier run's")
     unfinished = crate_mod.JobRecord(rule="s", wildcards={}, inputs=[], outputs=["results/b.nc"], completed=False)
@@ -277,7 +286,8 @@ def test_snapshot_copies_are_limited(tmp_path, monkeypatch):
 
 def test_validator_names_the_check_and_the_file(tmp_path, capsys):
     """A crate listing a deleted file and a changed one fails, and tests/validate_crate.py says which check
-    failed on which file (before roc-validator runs; the crate's own checks need no network)."""
+    failed on which file (before roc-validator runs; the crate's own checks need no network).
+    """
     from validate_crate import main
 
     from ballbat.pipeline.cratefiles import crate_file_problems
@@ -305,11 +315,12 @@ def test_validator_names_the_check_and_the_file(tmp_path, capsys):
 def test_target_only_and_failed_runs_tell_the_folders_truth(default_run, tmp_path):
     """Issue 34: a target-only run that changes fit_ex.nc used to rewrite the crate with its own files only
     (31 products unlisted and stale); a failed run left the old crate listing changed files. Now each crate
-    lists every file of the folder, the stale ones say so, and a failed run's crate is marked failed."""
+    lists every file of the folder, the stale ones say so, and a failed run's crate is marked failed.
+    """
     from validate_crate import main
-    from workflow_helpers import copy_run, snakemake
 
     from ballbat.pipeline.cratefiles import crate_file_problems
+    from workflow_helpers import copy_run, snakemake
 
     work = copy_run(default_run, tmp_path / "run")
     (work / "mu.yaml").write_text("analysis:\n  mu_k_example: 0.4\n")
@@ -320,8 +331,9 @@ def test_target_only_and_failed_runs_tell_the_folders_truth(default_run, tmp_pat
     assert "synthetic/fit_ex.nc" in ids(graph["#run"]["result"])
     for name in ("synthetic/results.xlsx", "synthetic/figures/fig3.png", "synthetic/paper_comparison.csv"):
         assert "stale: its input results/synthetic/fit_ex.nc has changed since" in graph[name]["description"], name
-    assert "stale: its input results/synthetic/paper_comparison.csv is stale" in (
-        graph["synthetic/paper_comparison.html"]["description"]
+    assert (
+        "stale: its input results/synthetic/paper_comparison.csv is stale"
+        in (graph["synthetic/paper_comparison.html"]["description"])
     )
     script = work / "workflow" / "scripts" / "workbook.py"
     script.write_text('raise SystemExit("a deliberate failure")\n' + script.read_text())

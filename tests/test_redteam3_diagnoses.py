@@ -8,14 +8,16 @@ expected outcome. Crate-only checks are in tests/test_crate.py.
 from __future__ import annotations
 
 import copy
+import re
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 import yaml
 from conftest import ROOT
 
-from ballbat.pipeline.config import ConfigError, drop_nulls, scenario_problems, validate_config
+from ballbat.pipeline.config import ConfigError, drop_nulls, validate_config
 
 MAPLE = ROOT / "config" / "examples" / "maple_impacts.csv"
 MAPLE_BATS = ROOT / "config" / "examples" / "maple_bats.csv"
@@ -69,6 +71,8 @@ EARLY_CASES = [
 
 def _early_problems(cfg, schema) -> list[str]:
     """What common.smk says before the DAG: the schema's lines, else the scenarios' (scenario_problems)."""
+    from ballbat.pipeline.config import scenario_problems
+
     try:
         validate_config(drop_nulls(cfg), schema, available=24 * 2**30)
     except ConfigError as err:
@@ -88,7 +92,8 @@ def test_early_errors_name_the_key(case, edit, line, schema, monkeypatch):
 
 def test_config_null_text_drops_the_dataset(schema):
     """`--config "datasets={synthetic: null}"` passes the text 'null': it drops the dataset as a YAML null does,
-    and with no dataset left the message is one line saying so (not two schema lines about 'null')."""
+    and with no dataset left the message is one line saying so (not two schema lines about 'null').
+    """
     cfg = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     cfg["datasets"]["maple"] = {"impacts": str(MAPLE), "bats": str(MAPLE_BATS)}
     cfg["datasets"]["synthetic"] = "null"  # snakemake's --config parser keeps YAML scalars as text
@@ -120,10 +125,10 @@ def test_scenario_bat_is_refused_before_the_dag(tmp_path):
 
 def test_dirty_when_a_copied_workflow_differs_from_the_commit(tmp_path, monkeypatch):
     """A copied checkout whose workflow script was edited records dirty: True (it recorded False: git status
-    looked at the package's clean checkout, not at the workflow that ran)."""
-    from workflow_helpers import make_workdir
-
+    looked at the package's clean checkout, not at the workflow that ran).
+    """
     from ballbat.pipeline import provenance
+    from workflow_helpers import make_workdir
 
     work = make_workdir(tmp_path)
     commit = provenance.git_state(str(ROOT))["commit"]
@@ -145,7 +150,8 @@ def test_dirty_when_a_copied_workflow_differs_from_the_commit(tmp_path, monkeypa
 def test_a_users_workbook_or_notes_at_an_output_path_are_not_the_workflows(tmp_path):
     """A user's own .xlsx or .md at a product's path is named as not the workflow's: never replaced by a run
     (foreign_outputs), and named while parsing (users_files); the workflow's own pass (test_crate.py: the
-    crate does not list such a file as the job's result)."""
+    crate does not list such a file as the job's result).
+    """
     import json
 
     import openpyxl
@@ -176,6 +182,143 @@ def test_workflow_products_carry_their_record(default_run):
     products = [p for p in results.rglob("*") if p.suffix in (".xlsx", ".md", ".png") and "snapshot" not in str(p)]
     assert len(products) > 10 and all(written_by_workflow(p) for p in products)
     assert users_files(products) == []
+
+
+# ---------------------------------------------------------------------------------------
+# Per-impact quality: a duplicated mark (one rule in every reader), a misplaced first click
+
+EXAMPLE = ROOT / "config" / "examples"
+
+
+def _tip_twice(tracks: dict) -> dict:
+    """The example's W01 swing tracks with the tip's frame 3 marked twice (the second mark 40 px off)."""
+    from track_files import TOOL_NAMES
+
+    out = dict(tracks)
+    f, x, y = out[TOOL_NAMES["bat_tip"]]
+    out[TOOL_NAMES["bat_tip"]] = (np.insert(f, 4, f[3]), np.insert(x, 4, x[3] + 40.0), np.insert(y, 4, y[3]))
+    return out
+
+
+def _write_trk(path, tracks):
+    from track_files import trk_text
+
+    path.write_text(trk_text(tracks, 3000.0, 0.00074))
+    from ballbat.tracks.formats.tracker import read_trk
+
+    return lambda: read_trk(path)
+
+
+def _write_trz(path, tracks):
+    from track_files import trk_text, write_trz
+
+    write_trz(path, trk_text(tracks, 3000.0, 0.00074))
+    from ballbat.tracks.formats.tracker import read_trz
+
+    return lambda: read_trz(path)
+
+
+def _write_kva(path, tracks):
+    from track_files import kva_text
+
+    path.write_text(kva_text(tracks, 3000.0, 0.00074))
+    from ballbat.tracks.formats.kinovea import read_kva
+
+    return lambda: read_kva(path)
+
+
+DUPLICATE_CASES = [
+    ("Tracker .trk", _write_trk, ".trk"),
+    ("Tracker .trz", _write_trz, ".trz"),
+    ("Kinovea .kva", _write_kva, ".kva"),
+]
+
+
+@pytest.mark.parametrize(("case", "write", "ext"), DUPLICATE_CASES, ids=[c[0] for c in DUPLICATE_CASES])
+def test_a_frame_marked_twice_is_refused_by_every_reader(case, write, ext, tmp_path):
+    """A duplicated mark is refused, naming the file, the track and the frame, with the one documented rule;
+    Tracker's reader took the later mark (v_bat -24 %) while Kinovea's refused it.
+    """
+    from track_files import TOOL_NAMES, read_long_csv
+
+    from ballbat.tracks.formats import DUPLICATE_RULE, FormatError
+
+    tracks = read_long_csv(EXAMPLE / "tracked_tracks.csv")[("W01", "swing")]
+    read = write(tmp_path / f"W01_swing{ext}", _tip_twice(tracks))
+    with pytest.raises(FormatError) as err:
+        read()
+    frame = int(tracks[TOOL_NAMES["bat_tip"]][0][3])
+    text = str(err.value)
+    assert f"W01_swing{ext}" in text and repr(TOOL_NAMES["bat_tip"]) in text, text
+    assert f"{frame}" in text and "marked twice" in text and DUPLICATE_RULE in text, text
+
+
+def test_a_frame_twice_in_a_table_or_a_long_csv_follows_the_same_rule(tmp_path):
+    """The tables' readers (through the layout) and a lab's long CSV state the same rule."""
+    import csv
+
+    from ballbat.properties import InputError
+    from ballbat.tracks.formats import DUPLICATE_RULE
+    from ballbat.tracks.io import load_tracks
+
+    with open(EXAMPLE / "tracked_tracks.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    rows.insert(5, dict(rows[4], x_px=str(float(rows[4]["x_px"]) + 40)))
+    path = tmp_path / "tracks.csv"
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    with pytest.raises(InputError) as err:
+        load_tracks(path, EXAMPLE / "tracked_impacts.csv")
+    assert "appears twice (also row 6)" in str(err.value) and DUPLICATE_RULE in str(err.value)
+
+
+def _example_reduction(edit=None):
+    """The example's rendered tracks reduced with its settings, after ``edit(tracks)``."""
+    from ballbat.properties import load_balls, load_bats
+    from ballbat.tracks.io import load_tracks
+    from ballbat.tracks.stage import reduce_in_memory
+
+    cfg = yaml.safe_load((EXAMPLE / "tracked.yaml").read_text())["datasets"]["tracked"]["tracks"]
+    from ballbat.pipeline.config import checked_block
+
+    cfg = checked_block(cfg, "tracks")
+    balls, bats = load_balls(ROOT / "config" / "balls.csv"), load_bats(ROOT / "config" / "bats.csv")
+    tracks = load_tracks(EXAMPLE / "tracked_tracks.csv", EXAMPLE / "tracked_impacts.csv", balls, bats)
+    if edit is not None:
+        edit(tracks)
+    return reduce_in_memory(tracks, cfg, balls, bats, "datasets.tracked.tracks")[0]
+
+
+@pytest.mark.parametrize("point", ["bat_tip", "ball"])
+def test_a_misplaced_first_click_is_flagged_with_its_reason(point):
+    """The first tip (or ball) click 300 px off moved v_bat 27 % with no flag; now the impact is excluded
+    (flag misplaced_mark), its reason naming the point, the frame and the distance, its values kept.
+    """
+    from ballbat.tracks.reduce import ReduceFlag
+
+    base = _example_reduction()
+    cam = "swing"
+
+    frame = []
+
+    def move(tracks):
+        ct = tracks.cameras[cam]
+        first = int(np.argmax(np.isfinite(ct.x[point][0])))
+        ct.x[point][0, first] += 300.0
+        frame.append(int(ct.frame0[0]) + first)
+
+    red = _example_reduction(move)
+    assert red.flag[0] == ReduceFlag.MISPLACED_MARK, red.reason[0]
+    found = re.search(r"(\w+)'s mark at frame (\d+) in the swing camera .* lies (\d+) px off", str(red.reason[0]))
+    assert found and found[1] == point and int(found[2]) == frame[0] and 280 <= int(found[3]) <= 320, red.reason[0]
+    assert "a misplaced click?" in red.reason[0]
+    assert red.values["v_bat"].shape == base.values["v_bat"].shape  # flagged, never dropped
+    if point == "bat_tip":  # the value is kept; it is the one the misplaced click moves
+        assert abs(red.values["v_bat"][0] / base.values["v_bat"][0] - 1) > 0.05
+    np.testing.assert_array_equal(red.flag[1:], base.flag[1:])
+    assert (base.flag == 0).all() or not (base.flag == ReduceFlag.MISPLACED_MARK).any()
 
 
 _ = copy, sys, Path

@@ -91,15 +91,18 @@ def issue_lines(result) -> list[str]:
         where = issue.violatingEntity or "the crate"
         prop = f" ({issue.violatingProperty})" if issue.violatingProperty else ""
         lines.append(f"check failed: {issue.identifier} {name!r} on {where}{prop}: {issue.message}")
-    lines += [f"check skipped: {c.identifier} {getattr(c, 'name', '')!r} (needs a document not in the cache)"
-              for c in result.skipped_checks]
+    lines += [
+        f"check skipped: {c.identifier} {getattr(c, 'name', '')!r} (needs a document not in the cache)"
+        for c in result.skipped_checks
+    ]
     return lines
 
 
 def main(argv: list[str]) -> int:
     """Check the crate of the folder named: its files (present, sha256, size, every file listed), then
     roc-validator offline, its cache seeded. Print one line per failed check, naming the check and what
-    it failed on; return 0 when all pass, else 1."""
+    it failed on; return 0 when all pass, else 1.
+    """
     from ballbat.pipeline.cratefiles import crate_file_problems
 
     crate = Path(argv[0] if argv else "results")

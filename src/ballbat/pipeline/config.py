@@ -551,7 +551,7 @@ def scenario_problems(config: dict) -> list[str]:
 
 
 def _e_x_source_problems(config: dict, where: str, scenario: dict) -> list[str]:
-    """The dataset of a scenario's ``e_x_from_dataset``: it must exist and have impacts of the scenario's ball."""
+    """Check the dataset of a scenario's ``e_x_from_dataset``: it must exist and have impacts of the scenario's ball."""
     name = scenario.get("e_x_from_dataset")
     if name is None:
         return []

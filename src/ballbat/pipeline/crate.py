@@ -244,8 +244,11 @@ class _Builder:
         return entity
 
     def input_ref(self, path: str) -> dict | None:
-        """Return a reference to an input file (added to the crate), or None when it is neither in the
-        crate nor an input data file left out of the snapshot (:data:`SNAPSHOT_FILE_LIMIT`)."""
+        """Return a reference to an input file (added to the crate), or None.
+
+        None when the file is neither in the crate nor an input data file left out of the snapshot
+        (:data:`SNAPSHOT_FILE_LIMIT`).
+        """
         cp = self.crate_path(path)
         if cp:
             self.file(cp)

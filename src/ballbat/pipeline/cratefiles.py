@@ -67,6 +67,7 @@ class Staleness:
         return self._memo[path]
 
     def is_stale(self, path: str) -> bool:
+        """Whether ``path`` is stale (:meth:`describe`)."""
         return self.describe(path).startswith("stale")
 
     def _describe(self, path: str, others: Iterable[str]) -> str:

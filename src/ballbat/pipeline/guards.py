@@ -187,7 +187,9 @@ def foreign_outputs(paths: Iterable[str | os.PathLike[str]]) -> list[str]:
     return lines
 
 
-def users_files(paths: Iterable[str | os.PathLike[str]], kinds: tuple[str, ...] = (".xlsx", ".md", ".png")) -> list[str]:
+def users_files(
+    paths: Iterable[str | os.PathLike[str]], kinds: tuple[str, ...] = (".xlsx", ".md", ".png")
+) -> list[str]:
     """Return a line for each file among the products ``paths`` that the workflow did not write (of ``kinds``).
 
     Reads only (run while Snakemake parses the workflow). Such a file (a user's workbook or notes

@@ -95,7 +95,7 @@ def workflow_source_hash(root: str | None = None) -> str:
 
 
 def git_blob_id(path: str | os.PathLike[str]) -> str:
-    """Return the id git gives a file's content (``git hash-object``): sha1 of ``blob <size>\\0<bytes>``."""
+    """Return the id git gives a file's content (``git hash-object``): sha1 of "blob <size>", a zero byte, the bytes."""
     data = Path(path).read_bytes()
     return hashlib.sha1(b"blob %d\0" % len(data) + data, usedforsecurity=False).hexdigest()
 

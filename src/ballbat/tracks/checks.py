@@ -207,9 +207,11 @@ def _shifter(m: int):
 
 
 def _midpoint_noise(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
-    """Return each point's offset from the midpoint of its neighbours (rx, ry) and the robust sd of their
-    components per impact: the track's own (1.4826 MAD, from 10 values) or, if larger, that of all impacts
-    (None when no point has two neighbours)."""
+    """Return each point's offset from the midpoint of its neighbours (rx, ry) and the robust sd per impact.
+
+    The sd of the offsets' components is the track's own (1.4826 MAD, from 10 values) or, if larger,
+    that of all impacts (None when no point has two neighbours).
+    """
     sh = _shifter(x.shape[1])
     with np.errstate(invalid="ignore"):
         rx = x - 0.5 * (sh(x, -1) + sh(x, 1))

@@ -53,8 +53,10 @@ def _number(props: dict, name: str, where: str, problems: list[str], integer: bo
 
 
 def _array(prop: ET.Element, at: str, problems: list[str]) -> dict[int, ET.Element]:
-    """Return the entries ``[n]`` of an array property by ``n``; an entry given twice is a problem
-    (:data:`ballbat.tracks.formats.DUPLICATE_RULE`: never resolved to one of them)."""
+    """Return the entries ``[n]`` of an array property by ``n``.
+
+    An entry given twice is a problem (:data:`ballbat.tracks.formats.DUPLICATE_RULE`): never resolved to one.
+    """
     out: dict[int, ET.Element] = {}
     twice: list[int] = []
     for item in prop.findall("property"):
