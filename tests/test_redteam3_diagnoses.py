@@ -321,4 +321,48 @@ def test_a_misplaced_first_click_is_flagged_with_its_reason(point):
     assert (base.flag == 0).all() or not (base.flag == ReduceFlag.MISPLACED_MARK).any()
 
 
+# ---------------------------------------------------------------------------------------
+# Diagnoses that point the right way
+
+CAMS = {"swing": {"fps": 3000.0, "m_per_px": 0.00074}, "spin": {"fps": 1000.0, "m_per_px": 0.00125}}
+
+
+def test_ids_print_as_text_not_numpys_repr():
+    """A frame far off its run names the impact as 'L005' (it printed np.str_('L005'))."""
+    from ballbat.tracks.checks import check_frame_runs
+
+    ids = np.array(["L005"] * 5)
+    lines = check_frame_runs("t.csv", ids, np.array(["swing"] * 5), np.array([1, 2, 3, 4, 10**6]), list("abcde"))
+    assert lines and "impact 'L005' in the swing camera" in lines[0] and "np.str_" not in lines[0], lines
+
+
+def test_an_nfd_file_name_matches_its_nfc_impact_id(tmp_path):
+    """A file named with a decomposed accent (NFD, as macOS writes names) is the impact whose id the table
+    holds composed (NFC): they look the same and now are the same (two identical-looking names before)."""
+    import unicodedata
+
+    from track_files import TOOL_NAMES, write_lab_folder
+
+    from ballbat.pipeline.config import checked_block
+    from ballbat.tracks.formats.layout import import_block
+
+    folder = write_lab_folder(tmp_path / "trk", EXAMPLE / "tracked_tracks.csv", "trk", CAMS)
+    nfc, nfd = unicodedata.normalize("NFC", "Wé01"), unicodedata.normalize("NFD", "Wé01")
+    assert nfc != nfd
+    for cam in ("swing", "spin"):
+        (folder / f"W01_{cam}.trk").rename(folder / f"{nfd}_{cam}.trk")
+    impacts = (EXAMPLE / "tracked_impacts.csv").read_text(encoding="utf-8").replace("W01,", f"{nfc},")
+    (tmp_path / "impacts.csv").write_text(impacts, encoding="utf-8")
+    cfg = {
+        "dir": str(folder),
+        "points": dict(TOOL_NAMES),
+        "impacts": str(tmp_path / "impacts.csv"),
+        "cameras": {"swing": {"mirror": False}, "spin": {"mirror": True}},
+        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
+    }
+    tracks, imp = import_block(checked_block(cfg, "tracks"), "datasets.lab.tracks")
+    assert nfc in set(tracks.impact_id.astype(str)) and nfd not in set(tracks.impact_id.astype(str))
+    assert {f[0] for f in imp.files} >= {nfc}
+
+
 _ = copy, sys, Path

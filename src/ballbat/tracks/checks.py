@@ -124,7 +124,7 @@ def check_frame_runs(
         lo, hi = uniq[bounds[main]], uniq[bounds[main + 1] - 1]
         out = (ff < lo) | (ff > hi)
         rows = order[s:e][out]
-        iid, cam = impact_id[rows[0]], camera[rows[0]]
+        iid, cam = str(impact_id[rows[0]]), str(camera[rows[0]])  # text, not numpy's repr np.str_('L005')
         for r in rows[:5]:
             d = frame[r] - hi if frame[r] > hi else lo - frame[r]
             side = "after" if frame[r] > hi else "before"
