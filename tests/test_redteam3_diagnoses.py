@@ -338,7 +338,8 @@ def test_ids_print_as_text_not_numpys_repr():
 
 def test_an_nfd_file_name_matches_its_nfc_impact_id(tmp_path):
     """A file named with a decomposed accent (NFD, as macOS writes names) is the impact whose id the table
-    holds composed (NFC): they look the same and now are the same (two identical-looking names before)."""
+    holds composed (NFC): they look the same and now are the same (two identical-looking names before).
+    """
     import unicodedata
 
     from track_files import TOOL_NAMES, write_lab_folder
@@ -363,6 +364,73 @@ def test_an_nfd_file_name_matches_its_nfc_impact_id(tmp_path):
     tracks, imp = import_block(checked_block(cfg, "tracks"), "datasets.lab.tracks")
     assert nfc in set(tracks.impact_id.astype(str)) and nfd not in set(tracks.impact_id.astype(str))
     assert {f[0] for f in imp.files} >= {nfc}
+
+
+def _scale_rows(rows, cfg, **kw):
+    for r in rows:
+        for col, k in kw.items():
+            r[col] = str(k * float(r[col])) if col != "frame" else str(int(k * int(r[col])))
+
+
+def _halve_scales(rows, cfg):
+    for c in ("swing", "spin"):
+        cfg["cameras"][c]["m_per_px"] /= 2
+
+
+#: (case, edit of the example's long rows and tracks block, the diagnosis expected, what it said before)
+DIAGNOSIS_CASES = [
+    (
+        "frame numbers doubled",
+        lambda rows, cfg: _scale_rows(rows, cfg, frame=2),
+        "most likely the frame numbers of the swing and spin cameras are 2x the video's",
+        "no single setting explains these",
+    ),
+    (
+        "both cameras' scales halved",
+        _halve_scales,
+        "most likely cameras.swing.m_per_px and cameras.spin.m_per_px are both 2x too low",
+        "rig lengths are in cm",
+    ),
+    (
+        "axes turned 180 deg",
+        lambda rows, cfg: _scale_rows(rows, cfg, x_px=-1, y_px=-1),
+        "most likely both cameras' axes are turned 180 deg (x points left and y up",
+        "y points up in both",
+    ),
+    (
+        "unequal x and y scales",
+        lambda rows, cfg: _scale_rows(rows, cfg, y_px=1.2),
+        "every dot traces an ellipse along the image's axes, so the x and y scales differ",
+        "do not rotate about the centre (tilted spin axis?)",
+    ),
+]
+
+
+@pytest.mark.parametrize(("case", "edit", "expected", "before"), DIAGNOSIS_CASES, ids=[c[0] for c in DIAGNOSIS_CASES])
+def test_diagnoses_point_the_right_way(case, edit, expected, before, tmp_path):
+    """Each mistake stops the dataset with the diagnosis that names it (before: a wrong or vague one)."""
+    import csv
+
+    from ballbat.pipeline.config import checked_block
+    from ballbat.properties import InputError, load_balls, load_bats
+    from ballbat.tracks.io import load_tracks
+    from ballbat.tracks.stage import reduce_in_memory
+
+    with open(EXAMPLE / "tracked_tracks.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    cfg = yaml.safe_load((EXAMPLE / "tracked.yaml").read_text())["datasets"]["tracked"]["tracks"]
+    edit(rows, cfg)
+    path = tmp_path / "tracks.csv"
+    with open(path, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(rows[0]))
+        w.writeheader()
+        w.writerows(rows)
+    balls, bats = load_balls(ROOT / "config" / "balls.csv"), load_bats(ROOT / "config" / "bats.csv")
+    tracks = load_tracks(path, EXAMPLE / "tracked_impacts.csv", balls, bats)
+    with pytest.raises(InputError) as err:
+        reduce_in_memory(tracks, checked_block(cfg, "tracks"), balls, bats, "datasets.tracked.tracks")
+    text = str(err.value)
+    assert expected in text and before not in text, text
 
 
 _ = copy, sys, Path

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -39,7 +39,7 @@ if TYPE_CHECKING:
 
     from numpy.typing import ArrayLike
 
-    from .data import CameraTracks
+    from .data import CameraTracks, Tracks
     from .reduce import Reduction
 
 #: False-alarm probability of the glitch test per tracked point (2-D Gaussian noise:
@@ -247,9 +247,11 @@ def misplaced_starts(x: np.ndarray, y: np.ndarray) -> MisplacedStart:
 
     A mark at column k of a track whose first mark is at f is predicted from the marks at f + 2 and
     f + 3 (p = p2 + (2 - k)(p2 - p3)); with point noise s per coordinate its offset has sd
-    s sqrt(14) (k = 0) or s sqrt(6) (k = 1). s comes from the offsets of each mark from its
-    neighbours' midpoint (sd 1.5^0.5 s: :func:`glitch_mask`'s robust noise); the threshold is the
-    glitch test's z. A misplaced first click (hundreds of pixels off) is found; a track with fewer
+    s sqrt(14) (k = 0) or s sqrt(6) (k = 1). It is misplaced when it is that far off and also
+    further than z s sqrt(2) from each of the other first three marks (a ball at rest whose
+    third and fourth marks already straddle the impact agrees with its neighbour). s comes from
+    the offsets of each mark from its neighbours' midpoint (sd 1.5^0.5 s: :func:`glitch_mask`'s
+    robust noise); the threshold is the glitch test's z. A misplaced first click (hundreds of pixels off) is found; a track with fewer
     than four marks from its start is not tested.
     """
     n, m = x.shape
@@ -270,7 +272,12 @@ def misplaced_starts(x: np.ndarray, y: np.ndarray) -> MisplacedStart:
         ex = px[:, k] - (px[:, 2] + (2 - k) * (px[:, 2] - px[:, 3]))
         ey = py[:, k] - (py[:, 2] + (2 - k) * (py[:, 2] - py[:, 3]))
         d = np.hypot(ex, ey)
-        far = tested & (d > z * point_sd * math.sqrt(1 + (3 - k) ** 2 + (2 - k) ** 2))
+        # a mark that sits on one of its neighbours is not misplaced (a ball at rest whose next marks
+        # already straddle the impact is not on one line with them)
+        others = [j for j in range(3) if j != k]
+        near = np.min([np.hypot(px[:, k] - px[:, j], py[:, k] - py[:, j]) for j in others], axis=0)
+        alone = near > z * point_sd * math.sqrt(2)
+        far = tested & alone & (d > z * point_sd * math.sqrt(1 + (3 - k) ** 2 + (2 - k) ** 2))
         found |= far
         column = np.where(far, first + k, column)
         distance = np.where(far, d, distance)
@@ -502,12 +509,15 @@ def weighted_mean(x: ArrayLike, err: ArrayLike) -> tuple[float, float, int]:
 # diagnosis: which one setting explains what the checks see
 
 
-def hypotheses(cameras: dict) -> list[tuple[str, dict]]:
-    """Single mistakes and what they scale (config value over true value).
+def hypotheses(cameras: dict, steps: dict | None = None) -> list[tuple[str, dict]]:
+    """Single mistakes and what they scale (config value over true value), most specific first.
 
-    Keys: ``m_swing``, ``fps_swing``, ``m_spin``, ``fps_spin``, ``rig``, ``y_swing``, ``y_spin`` (signs).
+    Keys: ``m_swing``, ``fps_swing``, ``m_spin``, ``fps_spin``, ``rig``, ``y_swing``, ``y_spin``,
+    ``x_swing``, ``x_spin`` (signs). ``steps``: the step every impact's frames share in a camera
+    (:func:`frame_steps`); a step d > 1 adds the mistake "frame numbers d x the video's", which
+    scales time as fps d x too low does and comes first (the frames show it).
     """
-    out: list[tuple[str, dict]] = []
+    out = _frame_step_hypotheses(steps or {})
     for c in ("swing", "spin"):
         out += [
             (f"cameras.{c}.fps is 2x too high", {f"fps_{c}": 2.0}),
@@ -519,6 +529,7 @@ def hypotheses(cameras: dict) -> list[tuple[str, dict]]:
                 {f"y_{c}": -1.0},
             ),
         ]
+    out += _both_camera_hypotheses()
     out += [
         ("y points up in both cameras' rows (Tracker and Kinovea export y up)", {"y_swing": -1.0, "y_spin": -1.0}),
         ("the rig lengths are in metres, not inches", {"rig": 1 / 39.37}),
@@ -543,10 +554,65 @@ def hypotheses(cameras: dict) -> list[tuple[str, dict]]:
     return out
 
 
+def _frame_step_hypotheses(steps: dict) -> list[tuple[str, dict]]:
+    """Return the mistake "frame numbers d x the video's" for the cameras whose frames all step by d > 1."""
+    cams = sorted((c for c, d in steps.items() if d > 1), reverse=True)
+    if not cams:
+        return []
+    d = max(steps[c] for c in cams)
+    which = " and ".join(cams) + (" cameras" if len(cams) > 1 else " camera")
+    name = (
+        f"the frame numbers of the {which} are {d}x the video's: every impact's tracked frames step by {d} "
+        f"(number the video's frames 0, 1, 2, ..., or divide them by {d})"
+    )
+    return [(name, {f"fps_{c}": 1.0 / steps[c] for c in cams})]
+
+
+def _both_camera_hypotheses() -> list[tuple[str, dict]]:
+    """Mistakes made alike in both cameras: a scale or frame rate off by 2, the axes turned 180 deg, a mirror."""
+    out: list[tuple[str, dict]] = []
+    for k, how in ((2.0, "2x too high"), (0.5, "2x too low (half the true value)")):
+        out.append((f"cameras.swing.m_per_px and cameras.spin.m_per_px are both {how}", {"m_swing": k, "m_spin": k}))
+        out.append((f"cameras.swing.fps and cameras.spin.fps are both {how}", {"fps_swing": k, "fps_spin": k}))
+    turned = "x points left and y up: Tracker's coordinate axes turned 180 deg, or the video upside down"
+    for c in ("swing", "spin"):
+        out.append((f"the {c} camera's axes are turned 180 deg ({turned})", {f"x_{c}": -1.0, f"y_{c}": -1.0}))
+        out.append((f"cameras.{c}.mirror is the wrong way round (the ball flies against x)", {f"x_{c}": -1.0}))
+    both = {"x_swing": -1.0, "y_swing": -1.0, "x_spin": -1.0, "y_spin": -1.0}
+    out.append((f"both cameras' axes are turned 180 deg ({turned})", both))
+    return out
+
+
+def frame_steps(tracks: Tracks, largest: int = 10) -> dict[str, int]:
+    """Return, per camera, the step d (2 to ``largest``) that every impact's tracked frames share; 1 if none.
+
+    An impact counts when it has at least three tracked frames; a camera steps by d when each such
+    impact's tracked frames (any point) are all its first frame plus a multiple of d.
+    """
+    out = {}
+    for cam, ct in tracks.cameras.items():
+        tracked = np.any([np.isfinite(v) for v in ct.x.values()], axis=0)
+        rows = tracked.sum(axis=1) >= 3
+        out[cam] = 1
+        if not rows.any():
+            continue
+        tracked = tracked[rows]
+        first = np.argmax(tracked, axis=1)[:, None]
+        cols = np.arange(tracked.shape[1])[None, :]
+        for d in range(largest, 1, -1):
+            if not np.any(tracked & ((cols - first) % d != 0)):
+                out[cam] = d
+                break
+    return out
+
+
 def predict(h: dict) -> dict:
     """Observables a mistake predicts: g over its value per camera, L_arc / L_cfg, v_swing / v_spin."""
-    f = {k: h.get(k, 1.0) for k in ("m_swing", "fps_swing", "m_spin", "fps_spin", "rig", "y_swing", "y_spin")}
+    keys = ("m_swing", "fps_swing", "m_spin", "fps_spin", "rig", "y_swing", "y_spin", "x_swing", "x_spin")
+    f = {k: h.get(k, 1.0) for k in keys}
     return {
+        "dir_swing": f["x_swing"],
+        "dir_spin": f["x_spin"],
         "g_swing": f["y_swing"] * f["m_swing"] * f["fps_swing"] ** 2,
         "g_spin": f["y_spin"] * f["m_spin"] * f["fps_spin"] ** 2,
         "arc": f["m_swing"] / f["rig"],
@@ -554,11 +620,13 @@ def predict(h: dict) -> dict:
     }
 
 
-def diagnose(observed: dict, cameras: dict) -> tuple[str, float, float] | None:
+def diagnose(observed: dict, cameras: dict, steps: dict | None = None) -> tuple[str, float, float] | None:
     """Return the single mistake that explains the observables best: (name, its chi^2, no mistake's chi^2).
 
-    ``observed`` maps ``g_swing``, ``g_spin``, ``arc``, ``speed`` to (ratio, relative error);
-    missing or non-finite ones are skipped. chi^2 compares log ratios (a wrong sign counts as 100).
+    ``observed`` maps ``g_swing``, ``g_spin``, ``arc``, ``speed`` to (ratio, relative error), and
+    ``dir_swing``, ``dir_spin`` to the sign of the ball's horizontal flight (+1: along the swing);
+    missing or non-finite ones are skipped. chi^2 compares log ratios (a wrong sign counts as 100); of
+    mistakes that explain them equally, the first of :func:`hypotheses` (``steps``: :func:`frame_steps`).
     """
 
     def chi2(pred):
@@ -574,10 +642,11 @@ def diagnose(observed: dict, cameras: dict) -> tuple[str, float, float] | None:
         return total
 
     none = chi2(predict({}))
-    best = min(((chi2(predict(h)), name) for name, h in hypotheses(cameras)), default=None)
+    scored = [(chi2(predict(h)), i, name) for i, (name, h) in enumerate(hypotheses(cameras, steps))]
+    best = min(scored, default=None)
     if best is None:
         return None
-    return best[1], best[0], none
+    return best[2], best[0], none
 
 
 # ---------------------------------------------------------------------------------------
@@ -629,8 +698,10 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
     _check_two_cameras(red, pool, fitted & disagree, n_test, setting_wrong, where, found)
     _check_tip_arc(red, pool, where, found)
     _check_spin_dots(red, pool, ball_ids, balls, where, found)
-    if found.failed:
-        _raise_setting(found, red.cameras, where)
+    _check_direction(red, pool, found)
+    _check_aspect(red, pool, where, found)
+    if found.failed or found.shape:
+        _raise_setting(found, red.cameras, where, frame_steps(red.tracks))
     pairs = _exclude_implausible(red, r, balls, bats, where)
     return Verdict(found.observed, found.lines, _usable_pairs(red, pairs, where))
 
@@ -642,6 +713,7 @@ class _Findings:
     observed: dict  # pooled observable -> (value, relative error), for :func:`diagnose`
     lines: list  # one line per check, for the log
     failed: list  # the checks that stop the dataset, each naming the setting
+    shape: list = field(default_factory=list)  # failures no setting of :func:`hypotheses` explains (the aspect)
 
 
 def _check_free_fall(red: Reduction, pool, r, m, where: str, found: _Findings) -> None:
@@ -759,12 +831,75 @@ def _check_spin_dots(red: Reduction, pool, ball_ids, balls: dict, where: str, fo
             )
 
 
-def _raise_setting(found: _Findings, cams, where: str) -> None:
+def _check_direction(red: Reduction, pool, found: _Findings) -> None:
+    """Record which way the ball flies along X in each camera (+1: the swing's direction), for :func:`diagnose`."""
+    for c in ("swing", "spin"):
+        vx = red.flight[c].vx
+        vx = vx[pool & np.isfinite(vx)]
+        if vx.size:
+            found.observed[f"dir_{c}"] = (1.0 if np.median(vx) > 0 else -1.0, 1e-3)
+
+
+#: Stretch of y against x that the spin dots' circles may show, pooled over impacts, beyond its error.
+ASPECT_TOLERANCE = 0.05
+
+
+def dot_aspect(red: Reduction) -> np.ndarray:
+    """Return each impact's and dot's y/x stretch of the circle the dot traces about the ball's centre, (impact, 2).
+
+    Fits A dx^2 + B dy^2 = 1 (an ellipse along the image axes) to the dot's offsets from the fitted
+    centre after separation; the stretch is (A / B)^0.5 (1: a circle; NaN: fewer than 6 frames).
+    """
+    t = red.times["spin"]
+    fl = red.flight["spin"]
+    cx, cy = fl.centre(t)
+    cols = np.arange(t.shape[1])[None, :]
+    after = (cols >= fl.separation[:, None]) & (fl.separation[:, None] >= 0)
+    out = []
+    with np.errstate(all="ignore"):
+        for p in ("dot_a", "dot_b"):
+            X, Y = red.phys[("spin", p)]
+            dx, dy = X - cx, Y - cy
+            m = after & np.isfinite(dx) & np.isfinite(dy)
+            a, b = np.where(m, dx**2, 0.0), np.where(m, dy**2, 0.0)
+            saa, sab, sbb = (a * a).sum(1), (a * b).sum(1), (b * b).sum(1)
+            sa, sb = a.sum(1), b.sum(1)
+            det = saa * sbb - sab**2
+            A, B = (sa * sbb - sb * sab) / det, (sb * saa - sa * sab) / det
+            ok = (m.sum(1) >= 6) & (A > 0) & (B > 0)
+            out.append(np.where(ok, np.sqrt(A / B), np.nan))
+    return np.stack(out, axis=1)
+
+
+def _check_aspect(red: Reduction, pool, where: str, found: _Findings) -> None:
+    """Check that the spin dots trace circles: unequal x and y scales stretch every one along an axis."""
+    q = dot_aspect(red)[pool].ravel()
+    q = q[np.isfinite(q)]
+    if q.size < 6:
+        return
+    med = float(np.median(q))
+    se = float(1.4826 * np.median(np.abs(q - med)) * 1.253 / math.sqrt(q.size))
+    line = (
+        f"the spin dots' circles about the ball's centre, y over x: {med:.3f} +- {se:.3f} (median over {q.size} "
+        "dots; 1 for equal scales)"
+    )
+    found.lines.append(line)
+    if abs(math.log(med)) > math.log1p(ASPECT_TOLERANCE) and abs(med - 1) > DATASET_Z * se:
+        found.shape.append(
+            f"{where}.cameras.spin: {line}: every dot traces an ellipse along the image's axes, so the x and y "
+            "scales differ (non-square pixels, or x_px and y_px scaled apart in an export); a tilted spin axis "
+            "would tilt the ellipses every way"
+        )
+
+
+def _raise_setting(found: _Findings, cams, where: str, steps: dict | None = None) -> None:
     """Stop the dataset: the failed checks, and the setting that most likely explains them."""
     from ..properties import InputError
 
     failed, observed = found.failed, found.observed
-    likely = diagnose(observed, cams)
+    if not failed:
+        raise InputError(found.shape)
+    likely = diagnose(observed, cams, steps)
     tail = []
     if likely is not None:
         name, chi2, none = likely
@@ -775,7 +910,7 @@ def _raise_setting(found: _Findings, cams, where: str) -> None:
             else f"{where}: no single setting explains these; check fps, m_per_px, mirror and the direction of y "
             "of both cameras, and the rig's units (inches)"
         ]
-    raise InputError([*failed, *tail])
+    raise InputError([*failed, *found.shape, *tail])
 
 
 def _exclude_implausible(red: Reduction, r, balls: dict, bats: dict, where: str) -> dict:
