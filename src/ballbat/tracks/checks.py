@@ -251,8 +251,8 @@ def misplaced_starts(x: np.ndarray, y: np.ndarray) -> MisplacedStart:
     further than z s sqrt(2) from each of the other first three marks (a ball at rest whose
     third and fourth marks already straddle the impact agrees with its neighbour). s comes from
     the offsets of each mark from its neighbours' midpoint (sd 1.5^0.5 s: :func:`glitch_mask`'s
-    robust noise); the threshold is the glitch test's z. A misplaced first click (hundreds of pixels off) is found; a track with fewer
-    than four marks from its start is not tested.
+    robust noise); the threshold is the glitch test's z. A misplaced first click (hundreds of
+    pixels off) is found; a track with fewer than four marks from its start is not tested.
     """
     n, m = x.shape
     found = np.zeros(n, dtype=bool)
