@@ -433,4 +433,90 @@ def test_diagnoses_point_the_right_way(case, edit, expected, before, tmp_path):
     assert expected in text and before not in text, text
 
 
+def test_a_setting_read_from_tool_files_is_named_as_such(tmp_path):
+    """A folder of Tracker files whose spin clips say 500 fps (the truth: 1000): the diagnosis names
+    cameras.spin.fps, a key the user never set, and now says the value was read from the files."""
+    import subprocess
+
+    from track_files import TOOL_NAMES, write_lab_folder
+
+    cams = copy.deepcopy(CAMS)
+    cams["spin"]["fps"] = 500.0
+    folder = write_lab_folder(tmp_path / "trk", EXAMPLE / "tracked_tracks.csv", "trk", cams)
+    block = {
+        "dir": str(folder),
+        "points": dict(TOOL_NAMES),
+        "impacts": str(EXAMPLE / "tracked_impacts.csv"),
+        "cameras": {"swing": {"mirror": False}, "spin": {"mirror": True}},
+        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
+    }
+    (tmp_path / "lab.yaml").write_text(yaml.safe_dump({"datasets": {"lab": {"tracks": block}}}))
+    ballbat = Path(sys.executable).with_name("ballbat")
+    out = subprocess.run(
+        [str(ballbat), "check", "--kind", "tracks", "--config", str(tmp_path / "lab.yaml")],
+        capture_output=True,
+        text=True,
+        timeout=300,
+        cwd=ROOT,
+    )
+    text = out.stdout + out.stderr
+    assert out.returncode == 1, text
+    assert "most likely cameras.spin.fps [the value read from the files (12 file(s): " in text, text
+    assert "not set in the config] is 2x too low" in text, text
+
+
+TIME_UNIT_CASES = [
+    ("Tracker table in s, units.time ms", "tracker_table", "ms", "units.time says 'ms'", "read as 's'"),
+    ("Kinovea export in ms, units.time s", "kinovea_table", "s", "units.time says 's'", "read as 'ms'"),
+]
+
+
+@pytest.mark.parametrize(("case", "fmt", "said", "first", "then"), TIME_UNIT_CASES, ids=[c[0] for c in TIME_UNIT_CASES])
+def test_a_wrong_time_unit_of_a_table_is_named(case, fmt, said, first, then, tmp_path):
+    """A table's times read in the wrong unit step by 1000 frames (or by none): the reader names units.time
+    and the unit that gives one frame per row (it spoke of typos, marks twice or frames not whole)."""
+    from track_files import kinovea_csv_text, read_long_csv, tracker_table_text
+
+    from ballbat.tracks.formats import FormatError
+    from ballbat.tracks.formats.tables import read_kinovea_table, read_tracker_table
+
+    tracks = read_long_csv(EXAMPLE / "tracked_tracks.csv")[("W01", "swing")]
+    path = tmp_path / "W01_swing.txt"
+    if fmt == "tracker_table":
+        path.write_text(tracker_table_text(tracks, 3000.0, 0.00074))
+        reader, length = read_tracker_table, "m"
+    else:
+        path.write_text(kinovea_csv_text(tracks, 3000.0, 0.00074))
+        reader, length = read_kinovea_table, "cm"
+    with pytest.raises(FormatError) as err:
+        reader(path, {"time": said, "length": length, "y": "up"}, 3000.0, 0.00074)
+    text = str(err.value)
+    assert first in text and then in text and "is units.time wrong" in text, text
+
+
+def test_a_wrong_length_unit_of_tables_is_suggested(tmp_path):
+    """Tracker tables in metres read with units.length cm: the diagnosis names units.length (it never did)."""
+    import subprocess
+
+    from track_files import TOOL_NAMES, write_lab_folder
+
+    folder = write_lab_folder(tmp_path / "txt", EXAMPLE / "tracked_tracks.csv", "tracker_table", CAMS)
+    block = {
+        "dir": str(folder),
+        "format": "tracker_table",
+        "units": {"time": "s", "length": "cm", "y": "up"},
+        "points": dict(TOOL_NAMES),
+        "impacts": str(EXAMPLE / "tracked_impacts.csv"),
+        "cameras": {"swing": {"mirror": False, **CAMS["swing"]}, "spin": {"mirror": True, **CAMS["spin"]}},
+        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
+    }
+    (tmp_path / "lab.yaml").write_text(yaml.safe_dump({"datasets": {"lab": {"tracks": block}}}))
+    ballbat = Path(sys.executable).with_name("ballbat")
+    cmd = [str(ballbat), "check", "--kind", "tracks", "--config", str(tmp_path / "lab.yaml")]
+    out = subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=ROOT)
+    text = out.stdout + out.stderr
+    assert out.returncode == 1, text
+    assert "most likely units.length says 'cm' but the exported tables are in m" in text, text
+
+
 _ = copy, sys, Path

@@ -574,12 +574,34 @@ def _both_camera_hypotheses() -> list[tuple[str, dict]]:
     for k, how in ((2.0, "2x too high"), (0.5, "2x too low (half the true value)")):
         out.append((f"cameras.swing.m_per_px and cameras.spin.m_per_px are both {how}", {"m_swing": k, "m_spin": k}))
         out.append((f"cameras.swing.fps and cameras.spin.fps are both {how}", {"fps_swing": k, "fps_spin": k}))
+    out += _length_unit_hypotheses()
     turned = "x points left and y up: Tracker's coordinate axes turned 180 deg, or the video upside down"
     for c in ("swing", "spin"):
         out.append((f"the {c} camera's axes are turned 180 deg ({turned})", {f"x_{c}": -1.0, f"y_{c}": -1.0}))
         out.append((f"cameras.{c}.mirror is the wrong way round (the ball flies against x)", {f"x_{c}": -1.0}))
     both = {"x_swing": -1.0, "y_swing": -1.0, "x_spin": -1.0, "y_spin": -1.0}
     out.append((f"both cameras' axes are turned 180 deg ({turned})", both))
+    return out
+
+
+#: Length units whose mix-up in an exported table (``units.length``) the diagnosis weighs, metres each.
+TABLE_LENGTHS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "ft": 0.3048}
+
+
+def _length_unit_hypotheses() -> list[tuple[str, dict]]:
+    """Lengths of both cameras scaled by the ratio of two length units: a table's ``units.length`` wrong."""
+    out = []
+    for said, s_m in TABLE_LENGTHS.items():
+        for true, t_m in TABLE_LENGTHS.items():
+            if said != true:
+                k = s_m / t_m
+                out.append(
+                    (
+                        f"units.length says {said!r} but the exported tables are in {true} (both cameras' lengths "
+                        f"{k:.4g}x the true ones; or both cameras' m_per_px off by that factor)",
+                        {"m_swing": k, "m_spin": k},
+                    )
+                )
     return out
 
 
