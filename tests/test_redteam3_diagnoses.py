@@ -435,7 +435,8 @@ def test_diagnoses_point_the_right_way(case, edit, expected, before, tmp_path):
 
 def test_a_setting_read_from_tool_files_is_named_as_such(tmp_path):
     """A folder of Tracker files whose spin clips say 500 fps (the truth: 1000): the diagnosis names
-    cameras.spin.fps, a key the user never set, and now says the value was read from the files."""
+    cameras.spin.fps, a key the user never set, and now says the value was read from the files.
+    """
     import subprocess
 
     from track_files import TOOL_NAMES, write_lab_folder
@@ -474,7 +475,8 @@ TIME_UNIT_CASES = [
 @pytest.mark.parametrize(("case", "fmt", "said", "first", "then"), TIME_UNIT_CASES, ids=[c[0] for c in TIME_UNIT_CASES])
 def test_a_wrong_time_unit_of_a_table_is_named(case, fmt, said, first, then, tmp_path):
     """A table's times read in the wrong unit step by 1000 frames (or by none): the reader names units.time
-    and the unit that gives one frame per row (it spoke of typos, marks twice or frames not whole)."""
+    and the unit that gives one frame per row (it spoke of typos, marks twice or frames not whole).
+    """
     from track_files import kinovea_csv_text, read_long_csv, tracker_table_text
 
     from ballbat.tracks.formats import FormatError
