@@ -143,7 +143,7 @@ def _frame_step(t: np.ndarray, t0: float, scale: float) -> float | None:
 
 
 def _time_unit_hint(path, cols: dict, t0: float, stated: str, fps: float) -> str:
-    """A line naming ``units.time`` when another unit gives one frame per row and the stated one does not.
+    """Return a line naming ``units.time`` when another unit gives one frame per row and the stated one does not.
 
     A table's rows are its video's frames: read in the stated unit, the times of each track step by one
     frame. Steps of 1000 frames (times in ms read as s) or of 0 (s read as ms: every row the same frame)
