@@ -521,4 +521,30 @@ def test_a_wrong_length_unit_of_tables_is_suggested(tmp_path):
     assert "most likely units.length says 'cm' but the exported tables are in m" in text, text
 
 
+@pytest.mark.slow
+def test_summary_after_a_failed_rerun_says_the_numbers_are_earlier(default_run, tmp_path):
+    """A rerun with a new config whose fit_ex job fails leaves the old fit_ex.nc: `ballbat summary` printed its
+    numbers without a word; now it says the last run failed and that fit_ex.nc is an earlier run's, outdated.
+    """
+    import subprocess
+
+    from workflow_helpers import copy_run, snakemake
+
+    work = copy_run(default_run, tmp_path / "run")
+    script = work / "workflow" / "scripts" / "fit_ex.py"
+    script.write_text('raise SystemExit("a deliberate failure")\n' + script.read_text())
+    (work / "mu.yaml").write_text("analysis:\n  mu_k_example: 0.4\n")
+    assert snakemake(work, "-c1", "--configfile", "mu.yaml", check=False).returncode != 0
+    ballbat = Path(sys.executable).with_name("ballbat")
+    out = subprocess.run([str(ballbat), "summary", "results/synthetic"], capture_output=True, text=True, cwd=work)
+    assert out.returncode == 0 and "e_x" in out.stdout, out.stderr
+    assert "note: the last run failed" in out.stderr, out.stderr
+    assert "note: synthetic/fit_ex.nc: not made by this run: outdated, its job had to run" in out.stderr, out.stderr
+    assert "these numbers may be from an earlier run or config" in out.stderr
+    clean = subprocess.run(
+        [str(ballbat), "summary", "results/synthetic"], capture_output=True, text=True, cwd=default_run
+    )
+    assert clean.returncode == 0 and "note:" not in clean.stderr, clean.stderr
+
+
 _ = copy, sys, Path

@@ -670,6 +670,15 @@ def cmd_summary(args: argparse.Namespace) -> int:
         raise UsageError(
             f"argument folder: {folder}: a results file lacks {exc} (made by another version?); rerun the workflow"
         ) from None
+    from .pipeline.cratefiles import earlier_run_notes
+
+    notes = earlier_run_notes(folder, ("reconstruct.nc", "fit_ex.nc", "stronge.nc"))
+    for note in notes:  # numbers an earlier run or config made are never shown without saying so
+        print(f"ballbat summary: note: {note}", file=sys.stderr)
+    if notes:
+        print(
+            "ballbat summary: these numbers may be from an earlier run or config, not the last run's", file=sys.stderr
+        )
     print("\n".join(lines))
     return 0
 

@@ -109,6 +109,8 @@ class JobRecord:
     end: float | None = None
     #: False for a job of a failed run that did not finish: its action is left out of the crate.
     completed: bool = True
+    #: Why Snakemake had to run it (a job that did not finish: its old outputs are outdated).
+    why: str = ""
 
     @property
     def name(self) -> str:
@@ -184,9 +186,18 @@ def jobs_from_dag(dag: Any, persistence: Any, workdir: str | os.PathLike[str], f
                 start=min(starts) if starts else None,
                 end=max(ends) if ends else None,
                 completed=not failed or not dag.needrun(job) or dag.finished(job),
+                why=_reason(dag, job) if failed and dag.needrun(job) else "",
             )
         )
     return records
+
+
+def _reason(dag: Any, job: Any) -> str:
+    """Return Snakemake's reason for running ``job``, in one line ("" when it gives none)."""
+    try:
+        return " ".join(str(dag.reason(job)).split())
+    except Exception:  # the reason is a courtesy: never fail the crate for it
+        return ""
 
 
 def _config_used(job: JobRecord, workdir: Path) -> dict[str, Any]:
@@ -388,7 +399,8 @@ def build_crate(
     run = _run(b, config, configfiles, main, all_results, engine, controls, started, ended)
     if len(done) < len(jobs):
         _failed(run, [j for j in jobs if not j.completed])
-    others = _other_files(b, results, workdir, record)
+    pending = {out: j.why for j in jobs if not j.completed for out in j.outputs}
+    others = _other_files(b, results, workdir, record, pending)
     _root(b, main, run, job_actions, ended, others)
     _ = package_source_hash, workflow_source_hash  # recorded through software_versions()
     return _single_values(b.crate.metadata.generate())
@@ -605,8 +617,14 @@ def _failed(run: Any, unfinished: list[JobRecord]) -> None:
     )
 
 
-def _other_files(b: _Builder, results: Path, workdir: Path, record: Callable[[str], Any] | None) -> list:
-    """Add every file of the folder that is not yet in the crate, each saying why and whether it is stale."""
+def _other_files(
+    b: _Builder, results: Path, workdir: Path, record: Callable[[str], Any] | None, pending: Mapping[str, str]
+) -> list:
+    """Add every file of the folder that is not yet in the crate, each saying why and whether it is stale.
+
+    ``pending``: the outputs of the jobs a failed run had to run and did not finish, with Snakemake's
+    reason; such a file is outdated whatever its inputs say (its config values may have changed).
+    """
     top = results.resolve()
     prefix = top.relative_to(workdir.resolve()).as_posix() if top.is_relative_to(workdir.resolve()) else str(results)
     state = Staleness(workdir, record or (lambda path: None))
@@ -618,6 +636,9 @@ def _other_files(b: _Builder, results: Path, workdir: Path, record: Callable[[st
             continue
         if not _made_by_workflow(results / rel):
             why = "not written by this workflow (no provenance record, or changed since): a file put here by hand"
+        elif path in pending:
+            reason = pending[path] or "no reason given"
+            why = f"not made by this run: outdated, its job had to run and did not finish ({reason}); an earlier run's"
         else:
             why = f"not made by this run; {state.describe(path, paths)}"
         others.append(b.file(rel, description=why))

@@ -151,3 +151,38 @@ def _file_problems(results: Path, ident: str, entity: dict) -> list[str]:
 def _unlisted(results: Path, listed: Iterable[str]) -> list[str]:
     known = set(listed)
     return [rel for rel in folder_files(results) if rel not in known]
+
+
+def earlier_run_notes(folder: str | os.PathLike[str], names: Iterable[str]) -> list[str]:
+    """Return notes on the files ``names`` of a dataset's folder (``results/<dataset>``) that the last run did not make.
+
+    Read from the results folder's crate: no crate where one was written before (a run under way or
+    cut short), a last run marked failed, a file the crate lists as not made by that run (with its
+    staleness) or not at all, or one changed since. Empty when the crate vouches for every file, or
+    when the folder was never described by a crate (a copy of the results).
+    """
+    folder = Path(folder)
+    results = folder.parent
+    meta = results / METADATA_NAME
+    if not meta.is_file():
+        if (results / "workflow.snapshot").is_dir():
+            return [f"{meta} is missing: a run is under way or was cut short; these numbers may be an earlier run's"]
+        return []
+    try:
+        graph = {e["@id"]: e for e in json.loads(meta.read_text(encoding="utf-8"))["@graph"]}
+    except (ValueError, KeyError, TypeError):
+        return [f"{meta} cannot be read: whether these numbers are the last run's is not known"]
+    notes = []
+    run = graph.get("#run", {})
+    if "Failed" in str(run.get("actionStatus", "")):
+        notes.append(f"the last run failed: {run.get('error', 'see its log')}")
+    for name in names:
+        rel = f"{folder.name}/{name}"
+        entity = graph.get(rel)
+        if entity is None:
+            notes.append(f"{rel} is not in the last run's crate (made after it, or put there by hand)")
+        elif str(entity.get("description", "")).startswith("not "):
+            notes.append(f"{rel}: {entity['description']}")
+        elif (results / rel).is_file() and entity.get("sha256") != sha256_file(results / rel):
+            notes.append(f"{rel} has changed since the last run's crate was written")
+    return notes
