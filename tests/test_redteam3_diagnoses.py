@@ -523,18 +523,20 @@ def test_a_wrong_length_unit_of_tables_is_suggested(tmp_path):
 
 @pytest.mark.slow
 def test_summary_after_a_failed_rerun_says_the_numbers_are_earlier(default_run, tmp_path):
-    """A rerun with a new config whose fit_ex job fails leaves the old fit_ex.nc: `ballbat summary` printed its
-    numbers without a word; now it says the last run failed and that fit_ex.nc is an earlier run's, outdated.
+    """A rerun with a new config that fails before fit_ex (normalize, here) leaves the old fit_ex.nc:
+    `ballbat summary` printed its numbers without a word; now it says the last run failed and that
+    fit_ex.nc is an earlier run's, outdated.
     """
     import subprocess
 
     from workflow_helpers import copy_run, snakemake
 
     work = copy_run(default_run, tmp_path / "run")
-    script = work / "workflow" / "scripts" / "fit_ex.py"
+    script = work / "workflow" / "scripts" / "normalize.py"
     script.write_text('raise SystemExit("a deliberate failure")\n' + script.read_text())
-    (work / "mu.yaml").write_text("analysis:\n  mu_k_example: 0.4\n")
-    assert snakemake(work, "-c1", "--configfile", "mu.yaml", check=False).returncode != 0
+    (work / "v.yaml").write_text("normalize:\n  v_ref_mph: 70.0\n")
+    assert snakemake(work, "-c1", "--configfile", "v.yaml", check=False).returncode != 0
+    assert (work / "results" / "synthetic" / "fit_ex.nc").is_file()  # the earlier run's
     ballbat = Path(sys.executable).with_name("ballbat")
     out = subprocess.run([str(ballbat), "summary", "results/synthetic"], capture_output=True, text=True, cwd=work)
     assert out.returncode == 0 and "e_x" in out.stdout, out.stderr
