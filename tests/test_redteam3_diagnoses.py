@@ -135,6 +135,13 @@ def test_dirty_when_a_copied_workflow_differs_from_the_commit(tmp_path, monkeypa
     assert provenance.workflow_matches_commit(work, str(ROOT), commit) == provenance.workflow_matches_commit(
         ROOT, str(ROOT), commit
     )  # a faithful copy is judged as the checkout itself
+    package = str(ROOT / "src" / "ballbat")  # git run from the package's folder finds the same commit's workflow
+    assert provenance.workflow_matches_commit(ROOT, package, commit) == provenance.workflow_matches_commit(
+        ROOT, str(ROOT), commit
+    )
+    assert provenance.workflow_matches_commit(ROOT, package, commit) == (
+        not provenance._git(["status", "--porcelain", "--", "Snakefile", "workflow"], str(ROOT)).strip()
+    )  # the checkout's own workflow matches its commit exactly when git sees no change in it
     script = work / "workflow" / "scripts" / "fit_ex.py"
     script.write_text(script.read_text() + "# a local edit\n")
     assert not provenance.workflow_matches_commit(work, str(ROOT), commit)

@@ -108,21 +108,27 @@ def workflow_matches_commit(root: Path, repo: str, commit: str) -> bool:
     edited differs). False when git cannot list the commit's files.
     """
     try:
-        out = subprocess.run(
-            ["git", "ls-tree", "-r", "-z", commit, "--", *WORKFLOW_PARTS],
-            cwd=repo,
-            capture_output=True,
-            timeout=10,
-            check=True,
-        ).stdout.decode("utf-8", "surrogateescape")
-    except (OSError, subprocess.SubprocessError):
+        top = Path(_git(["rev-parse", "--show-toplevel"], repo).strip())
+        base = Path(repo).resolve()
+        while base != top and not (base / "Snakefile").is_file() and base.parent != base:
+            base = base.parent  # the checkout's workflow: where its Snakefile is, at or above ``repo``
+        prefix = base.relative_to(top).as_posix()
+        parts = [p if prefix == "." else f"{prefix}/{p}" for p in WORKFLOW_PARTS]
+        out = _git(["ls-tree", "-r", "-z", "--full-tree", commit, "--", *parts], str(top))
+    except (OSError, ValueError, subprocess.SubprocessError):
         return False
     blobs = {}
     for entry in filter(None, out.split("\0")):
         meta, _, name = entry.partition("\t")
-        blobs[name] = meta.split()[-1]
+        blobs[name if prefix == "." else name.removeprefix(f"{prefix}/")] = meta.split()[-1]
     files = {p.relative_to(root).as_posix(): p for p in workflow_sources(root)}
     return set(files) == set(blobs) and all(git_blob_id(files[k]) == v for k, v in blobs.items())
+
+
+def _git(args: list[str], cwd: str) -> str:
+    """Return the output of ``git ARGS`` run in ``cwd`` (raises on failure)."""
+    out = subprocess.run(["git", *args], cwd=cwd, capture_output=True, timeout=10, check=True).stdout
+    return out.decode("utf-8", "surrogateescape")
 
 
 def git_state(where: str | None = None) -> dict:
