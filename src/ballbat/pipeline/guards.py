@@ -79,9 +79,10 @@ def hdf5_problem(path: str | os.PathLike[str]) -> str | None:
     return None
 
 
-#: The products that carry a record of what wrote them, by suffix (:func:`written_by_workflow`): a file
+#: The products guarded by the record of what wrote them, by suffix (:func:`written_by_workflow`): a file
 #: of these kinds at an output path that has none is a user's, never replaced nor listed as a job's result.
-RECORDED_SUFFIXES = (".nc", ".csv", ".xlsx", ".md", ".png")
+#: Figures carry a record too (their PNG text), but Snakemake replaces them: a figure is no one's data.
+RECORDED_SUFFIXES = (".nc", ".csv", ".xlsx", ".md")
 
 
 def written_by_workflow(path: str | os.PathLike[str]) -> bool:
@@ -187,9 +188,7 @@ def foreign_outputs(paths: Iterable[str | os.PathLike[str]]) -> list[str]:
     return lines
 
 
-def users_files(
-    paths: Iterable[str | os.PathLike[str]], kinds: tuple[str, ...] = (".xlsx", ".md", ".png")
-) -> list[str]:
+def users_files(paths: Iterable[str | os.PathLike[str]], kinds: tuple[str, ...] = (".xlsx", ".md")) -> list[str]:
     """Return a line for each file among the products ``paths`` that the workflow did not write (of ``kinds``).
 
     Reads only (run while Snakemake parses the workflow). Such a file (a user's workbook or notes
