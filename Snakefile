@@ -54,8 +54,8 @@ onstart:
     start_run(workflow.dag)
 
 
-# Every warning of the run's jobs, printed at its end, success or not; after a success, the run's
-# Provenance Run Crate (results/ro-crate-metadata.json; common.smk: write_crate).
+# Every warning of the run's jobs, printed at its end, success or not; then the run's Provenance Run
+# Crate (results/ro-crate-metadata.json; common.smk: write_crate), marked failed after a failure.
 onsuccess:
     print_warnings("results", DATASETS, SCENARIOS)
     write_crate()
@@ -63,6 +63,7 @@ onsuccess:
 
 onerror:
     print_warnings("results", DATASETS, SCENARIOS)
+    write_crate(failed=True)
 
 
 # All products of every dataset and scenario, intermediate files included (common.smk: final_targets).

@@ -159,3 +159,191 @@ def test_failed_crate_leaves_none(tmp_path, monkeypatch):
     with pytest.raises(RuntimeError, match="disk full"):
         crate_mod.write_run_crate(results, [job], config={}, configfiles=[], workdir=tmp_path)
     assert sorted(p.name for p in results.iterdir()) == ["a.nc", "workflow.snapshot"]
+
+
+# ---------------------------------------------------------------------------------------
+# Issue 34: the crate is the folder's truth (target-only and failed runs, limits, the validator's lines)
+
+
+def _nc(path, note):
+    """A small NetCDF file carrying the workflow's provenance mark."""
+    import xarray as xr
+
+    xr.Dataset({"x": ("n", [1.0])}, attrs={"provenance_rule": "r", "provenance_config": "{}", "note": note}).to_netcdf(
+        path, engine="netcdf4"
+    )
+
+
+def _folder(tmp_path):
+    """A results folder with one job's NetCDF output (with a provenance mark), its log, and an input."""
+    (tmp_path / "Snakefile").write_text("# the workflow\n")
+    (tmp_path / "config").mkdir()
+    (tmp_path / "config" / "in.csv").write_text("a,b\n1,2\n")
+    results = tmp_path / "results"
+    (results / "logs").mkdir(parents=True)
+    _nc(results / "a.nc", "a")
+    (results / "logs" / "a.log").write_text("log\n")
+    job = crate_mod.JobRecord(
+        rule="r", wildcards={}, inputs=["config/in.csv"], outputs=["results/a.nc"], logs=["results/logs/a.log"]
+    )
+    return results, job
+
+
+def _graph(results):
+    doc = json.loads((results / "ro-crate-metadata.json").read_text())
+    return {e["@id"]: e for e in doc["@graph"]}
+
+
+def test_other_files_are_listed_with_their_staleness(tmp_path):
+    """A target-only run's crate lists every file of the folder: the other products (an earlier run's) each
+    say so, with their staleness against the inputs Snakemake recorded for them (sha256 first, else time).
+    """
+    from ballbat.pipeline.cratefiles import crate_file_problems
+
+    results, job = _folder(tmp_path)
+    _nc(results / "old.nc", "old")
+    _nc(results / "same.nc", "same")
+    _nc(results / "derived.nc", "made from old.nc")
+    (results / "logs" / "old.log").write_text("log of old.nc's job\n")
+    (results / "unknown.tsv").write_text("s\n1\n")
+    digest = sha256_file(tmp_path / "config" / "in.csv")
+    old = {"config/in.csv": "sha256:00"}
+    records = {
+        "results/old.nc": {
+            "rule": "q",
+            "input": ["config/in.csv"],
+            "input_checksums": old,
+            "log": ["results/logs/old.log"],
+        },
+        "results/same.nc": {"rule": "q", "input": ["config/in.csv"], "input_checksums": {"config/in.csv": digest}},
+        "results/derived.nc": {"rule": "d", "input": ["results/old.nc"], "input_checksums": {}},
+    }
+    crate_mod.write_run_crate(
+        results, [job], config={}, configfiles=[], workdir=tmp_path, record=lambda p: records.get(p)
+    )
+    graph = _graph(results)
+    assert crate_file_problems(results) == []
+    assert "stale: its input config/in.csv has changed since (sha256)" in graph["old.nc"]["description"]
+    assert "made by rule q; up to date with the 1 inputs it recorded" in graph["same.nc"]["description"]
+    assert "its staleness is not known" in graph["unknown.tsv"]["description"]
+    assert "stale: its input results/old.nc is stale" in graph["derived.nc"]["description"]
+    assert (
+        "stale: the log of the job that made results/old.nc (stale: its input" in graph["logs/old.log"]["description"]
+    )
+    assert "5 file(s) of the folder are not results of this run" in graph["./"]["description"]
+    assert "old.nc" not in ids(graph["#run"]["result"]) and "a.nc" in ids(graph["#run"]["result"])
+
+
+def test_failed_run_lists_no_unfinished_job(tmp_path):
+    """After a failed run the crate marks the run failed; the job that did not finish has no action, and
+    its old output is listed as not made by this run (never as its result).
+    """
+    results, job = _folder(tmp_path)
+    _nc(results / "b.nc", "an earlier run's")
+    unfinished = crate_mod.JobRecord(rule="s", wildcards={}, inputs=[], outputs=["results/b.nc"], completed=False)
+    crate_mod.write_run_crate(results, [job, unfinished], config={}, configfiles=[], workdir=tmp_path)
+    graph = _graph(results)
+    assert graph["#run"]["actionStatus"]["@id"] == "http://schema.org/FailedActionStatus"
+    assert "1 job(s) did not finish (s)" in graph["#run"]["error"]
+    assert "#job-s" not in graph and "#job-r" in graph
+    assert "not made by this run" in graph["b.nc"]["description"]
+
+
+def test_a_users_file_at_an_output_path_is_not_the_jobs_result(tmp_path):
+    """A user's own workbook and Markdown file at a job's output paths are listed as not the workflow's."""
+    import openpyxl
+
+    results, job = _folder(tmp_path)
+    openpyxl.Workbook().save(results / "results.xlsx")
+    (results / "table.md").write_text("| my | table |\n")
+    job.outputs += ["results/results.xlsx", "results/table.md"]
+    crate_mod.write_run_crate(results, [job], config={}, configfiles=[], workdir=tmp_path)
+    graph = _graph(results)
+    assert ids(graph["#job-r"]["result"]) == ["a.nc", "logs/a.log"]
+    for name in ("results.xlsx", "table.md"):
+        assert graph[name]["description"].startswith("not written by this workflow"), name
+
+
+def test_snapshot_copies_are_limited(tmp_path, monkeypatch):
+    """An input data file above the snapshot's limit is not copied: the crate records its path, size and sha256."""
+    results, job = _folder(tmp_path)
+    (tmp_path / "config" / "big.csv").write_text("x\n" * 100)
+    job.inputs.append("config/big.csv")
+    monkeypatch.setattr(crate_mod, "SNAPSHOT_FILE_LIMIT", 50)
+    crate_mod.write_run_crate(results, [job], config={}, configfiles=[], workdir=tmp_path)
+    graph = _graph(results)
+    assert (results / "workflow.snapshot" / "config" / "in.csv").is_file()
+    assert not (results / "workflow.snapshot" / "config" / "big.csv").exists()
+    big = [graph[i] for i in ids(graph["#job-r"]["object"]) if i.startswith("#uncopied-")]
+    assert len(big) == 1 and big[0]["name"] == "config/big.csv" and big[0]["contentSize"] == "200"
+    assert big[0]["sha256"] == sha256_file(tmp_path / "config" / "big.csv")
+    assert "200 bytes, above the limit of 50 per file" in big[0]["description"]
+    monkeypatch.setattr(crate_mod, "SNAPSHOT_FILE_LIMIT", 10**6)
+    monkeypatch.setattr(crate_mod, "SNAPSHOT_DATA_LIMIT", 50)
+    crate_mod.write_run_crate(results, [job], config={}, configfiles=[], workdir=tmp_path)
+    assert "past the limit of 50 for all data copies" in json.dumps(_graph(results))
+
+
+def test_validator_names_the_check_and_the_file(tmp_path, capsys):
+    """A crate listing a deleted file and a changed one fails, and tests/validate_crate.py says which check
+    failed on which file (before roc-validator runs; the crate's own checks need no network).
+    """
+    from validate_crate import main
+
+    from ballbat.pipeline.cratefiles import crate_file_problems
+
+    results, job = _folder(tmp_path)
+    crate_mod.write_run_crate(results, [job], config={}, configfiles=[], workdir=tmp_path)
+    (results / "logs" / "a.log").unlink()
+    listed = _graph(results)["a.nc"]
+    with open(results / "a.nc", "ab") as fh:
+        fh.write(b"four")
+    (results / "new.txt").write_text("x")
+    size = (results / "a.nc").stat().st_size
+    assert crate_file_problems(results) == [
+        f"sha256 differs: a.nc: the crate says {listed['sha256'][:12]}..., the file has another",
+        f"size differs: a.nc: the crate says {listed['contentSize']} bytes, the file has {size}",
+        "listed file missing: logs/a.log is in the crate but not in the folder",
+        "file not listed: new.txt is in the folder but not in the crate",
+    ]
+    assert main([str(results)]) == 1
+    err = capsys.readouterr().err
+    assert "check failed: listed file missing: logs/a.log" in err and "the crate fails" in err
+
+
+@pytest.mark.slow
+def test_target_only_and_failed_runs_tell_the_folders_truth(default_run, tmp_path):
+    """Issue 34: a target-only run that changes fit_ex.nc used to rewrite the crate with its own files only
+    (31 products unlisted and stale); a failed run left the old crate listing changed files. Now each crate
+    lists every file of the folder, the stale ones say so, and a failed run's crate is marked failed.
+    """
+    from validate_crate import main
+
+    from ballbat.pipeline.cratefiles import crate_file_problems
+    from workflow_helpers import copy_run, snakemake
+
+    work = copy_run(default_run, tmp_path / "run")
+    (work / "mu.yaml").write_text("analysis:\n  mu_k_example: 0.4\n")
+    snakemake(work, "-c1", "results/synthetic/fit_ex.nc", "--configfile", "mu.yaml")
+    results = work / "results"
+    assert crate_file_problems(results) == []
+    graph = {e["@id"]: e for e in json.loads((results / "ro-crate-metadata.json").read_text())["@graph"]}
+    assert "synthetic/fit_ex.nc" in ids(graph["#run"]["result"])
+    for name in ("synthetic/results.xlsx", "synthetic/figures/fig3.png", "synthetic/paper_comparison.csv"):
+        assert "stale: its input results/synthetic/fit_ex.nc has changed since" in graph[name]["description"], name
+    assert (
+        "stale: its input results/synthetic/paper_comparison.csv is stale"
+        in (graph["synthetic/paper_comparison.html"]["description"])
+    )
+    script = work / "workflow" / "scripts" / "workbook.py"
+    script.write_text('raise SystemExit("a deliberate failure")\n' + script.read_text())
+    out = snakemake(work, "-c1", "--configfile", "mu.yaml", check=False)
+    assert out.returncode != 0 and "the provenance crate of the failed run, marked failed" in out.stderr
+    assert crate_file_problems(results) == []
+    graph = {e["@id"]: e for e in json.loads((results / "ro-crate-metadata.json").read_text())["@graph"]}
+    assert graph["#run"]["actionStatus"]["@id"] == "http://schema.org/FailedActionStatus"
+    assert "#job-workbook-dataset=synthetic" not in graph
+    assert graph["synthetic/results.xlsx"]["description"].startswith(
+        "not made by this run: outdated, its job had to run and did not finish ("
+    )
+    assert main([str(results)]) == 0

@@ -64,7 +64,7 @@ def test_clean_data_pass(rendered):
     red, verdict = run(tr, s)
     assert np.all(red.flag == 0), red.reason[red.flag != 0]
     assert all(int(v.sum()) == 0 for v in red.n_outliers.values())
-    assert verdict.warnings == [] and len(verdict.lines) == 6
+    assert verdict.warnings == [] and len(verdict.lines) == 7  # six checks and the dots' aspect (issue 34)
 
 
 def test_pixel_scale_in_mm_per_px(rendered):

@@ -233,15 +233,18 @@ def _reduce_tool_files(block: dict, where: str, balls_path: str, bats_path: str)
     The same steps as the workflow's import_tracks and reduce rules: the camera settings found
     in the files complete the block's (:func:`ballbat.tracks.data.with_found_settings`).
     """
-    from .properties import load_balls, load_bats
-    from .tracks.data import camera_block, with_found_settings
+    from .properties import InputError, load_balls, load_bats
+    from .tracks.data import camera_block, name_found_settings, with_found_settings
     from .tracks.formats.layout import import_block
     from .tracks.stage import reduce_in_memory
 
     balls, bats = load_balls(balls_path), load_bats(bats_path)
     tracks, imported = import_block(block, where, balls, bats)
     settings = with_found_settings(camera_block(block), imported.settings_yaml())
-    return reduce_in_memory(tracks, settings, balls, bats, where)
+    try:
+        return reduce_in_memory(tracks, settings, balls, bats, where)
+    except InputError as exc:  # a setting the files gave is named as read from them
+        raise InputError(name_found_settings(exc.problems, imported.settings_yaml())) from None
 
 
 def _check_tracks(path: Path | None, args: argparse.Namespace, defaults: dict) -> int:
@@ -697,6 +700,15 @@ def cmd_summary(args: argparse.Namespace) -> int:
         raise UsageError(
             f"argument folder: {folder}: a results file lacks {exc} (made by another version?); rerun the workflow"
         ) from None
+    from .pipeline.cratefiles import earlier_run_notes
+
+    notes = earlier_run_notes(folder, ("reconstruct.nc", "fit_ex.nc", "stronge.nc"))
+    for note in notes:  # numbers an earlier run or config made are never shown without saying so
+        print(f"ballbat summary: note: {note}", file=sys.stderr)
+    if notes:
+        print(
+            "ballbat summary: these numbers may be from an earlier run or config, not the last run's", file=sys.stderr
+        )
     print("\n".join(lines))
     return 0
 

@@ -11,10 +11,12 @@ from snakemake.exceptions import WorkflowError
 from ballbat.pipeline.codedeps import module_files
 from ballbat.pipeline.config import (
     BYTES_PER_CASE,
+    ConfigError,
     STUDY_BYTES_PER_REPLICATE,
     drop_nulls,
     impact_bytes,
     renders,
+    scenario_problems,
     study_impacts,
     validate_config,
 )
@@ -23,6 +25,7 @@ from ballbat.pipeline.guards import (
     foreign_outputs,
     remove_temporaries,
     unwritable_folders,
+    users_files,
     warnings_summary,
 )
 from ballbat.pipeline.provenance import sha256_file
@@ -57,7 +60,7 @@ def report_damaged_products(paths):
     Snakemake parses the workflow (dry runs, --lint, --summary and cluster jobs too), so nothing is removed."""
     if workflow.remote_exec or workflow.subprocess_exec:
         return
-    for line in damaged_products(paths):
+    for line in damaged_products(paths) + users_files(paths):
         print(f"ballbat: {line}", file=sys.stderr)
 
 
@@ -69,18 +72,29 @@ def start_run(dag):
         raise WorkflowError("\n".join(f"ballbat: {line}" for line in lines))
     for message in remove_temporaries("results"):
         print(f"ballbat: {message}", file=sys.stderr)
+    from ballbat.pipeline.crate import remove_crate
+
+    remove_crate("results")  # the run changes the folder: no crate until it ends (write_crate)
 
 
 #: When this run started (the crate's run action; no data file records a time).
 RUN_STARTED = time.time()
 
 
-def write_crate():
-    """Write the run's Provenance Run Crate, results/ro-crate-metadata.json (ballbat.pipeline.crate)."""
+def write_crate(failed=False):
+    """Write the run's Provenance Run Crate, results/ro-crate-metadata.json (ballbat.pipeline.crate): after a
+    success, or after a failure (the run marked failed; files it did not make listed with their staleness)."""
     from ballbat.pipeline.crate import write_crate_of_run
 
-    path = write_crate_of_run(workflow, config, started=RUN_STARTED)
-    print(f"ballbat: the run's provenance crate: {path}", file=sys.stderr)
+    try:
+        path = write_crate_of_run(workflow, config, started=RUN_STARTED, failed=failed)
+    except Exception as exc:
+        if not failed:
+            raise
+        print(f"ballbat: no provenance crate after the failed run ({type(exc).__name__}: {exc})", file=sys.stderr)
+        return
+    what = "of the failed run, marked failed" if failed else "of the run"
+    print(f"ballbat: the provenance crate {what}: {path}", file=sys.stderr)
 
 
 def print_warnings(results, datasets, scenarios):
@@ -247,12 +261,10 @@ def get_source(wildcards):
 
 
 SCENARIOS = sorted(config.get("implications", {}).get("scenarios", {}))
-for _name, _sc in config.get("implications", {}).get("scenarios", {}).items():
-    if "e_x_from_dataset" in _sc and _sc["e_x_from_dataset"] not in DATASETS:
-        raise ValueError(
-            f"config: implications.scenarios.{_name}.e_x_from_dataset: "
-            f"{_sc['e_x_from_dataset']!r} is not a dataset ({', '.join(DATASETS)})"
-        )
+# A scenario's ball and bat, and the dataset of its e_x, checked before the DAG is built (one line each).
+_problems = scenario_problems(config)
+if _problems:
+    raise ConfigError("config is not valid:\n  " + "\n  ".join(_problems))
 
 
 wildcard_constraints:

@@ -5,9 +5,9 @@ import yaml
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import log_exclusions, logged
-from ballbat.properties import load_balls, load_bats
+from ballbat.properties import InputError, load_balls, load_bats
 from ballbat.stages import reduce
-from ballbat.tracks.data import with_found_settings
+from ballbat.tracks.data import name_found_settings, with_found_settings
 from ballbat.tracks.io import load_tracks
 
 with logged(snakemake.log[0], snakemake.rule) as log:
@@ -25,7 +25,11 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         block, snakemake.params.where, systematics=True
     )  # checked before the files are read
     tracks = load_tracks(tracks_path, inp.get("impacts") or named.get("tracks", {}).get("impacts"), balls, bats)
-    ds = reduce.run(settings, tracks, balls, bats, source_file=tracks_path)
+    try:
+        ds = reduce.run(settings, tracks, balls, bats, source_file=tracks_path)
+    except InputError as exc:  # a setting the files gave is named as read from them
+        found = yaml.safe_load(open(inp.cameras)) if "cameras" in inp.keys() else {}
+        raise InputError(name_found_settings(exc.problems, found)) from None
     for line in ds.attrs["reduce_checks"].splitlines():
         log.info("cross-check: %s", line)
     for text in ds.attrs["reduce_warnings"].splitlines():

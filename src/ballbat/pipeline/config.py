@@ -83,24 +83,36 @@ def study_impacts(dataset: dict, parameter: str | tuple | None, values: list, tr
     return one, truth
 
 
+#: What a null reads as where ``snakemake --config`` parses a value: its YAML reader keeps every
+#: scalar as text, so ``--config "datasets={synthetic: null}"`` gives the text ``'null'``.
+NULL_TEXTS = ("null", "Null", "NULL", "~")
+
+
+def is_null(value: object) -> bool:
+    """Whether a dataset, scenario or study entry is null: YAML's null, or its text from ``--config``."""
+    return value is None or (isinstance(value, str) and value in NULL_TEXTS)
+
+
 def drop_nulls(config: dict) -> dict:
     """Drop datasets, scenarios and studies set to null (``datasets: {synthetic: null}`` in an override).
 
-    A study of a dataset dropped this way is dropped with it (it has nothing to replicate).
+    A study of a dataset dropped this way is dropped with it (it has nothing to replicate). The
+    text ``null`` (:data:`NULL_TEXTS`: what ``--config`` passes) counts as null: an entry must be a
+    mapping, so no entry can mean the text.
     """
     dropped = set()
     if isinstance(config.get("datasets"), dict):
-        dropped = {k for k, v in config["datasets"].items() if v is None}
-        config["datasets"] = {k: v for k, v in config["datasets"].items() if v is not None}
+        dropped = {k for k, v in config["datasets"].items() if is_null(v)}
+        config["datasets"] = {k: v for k, v in config["datasets"].items() if not is_null(v)}
     if isinstance(config.get("studies"), dict):
         config["studies"] = {
             k: v
             for k, v in config["studies"].items()
-            if v is not None and not (isinstance(v, dict) and v.get("dataset") in dropped)
+            if not is_null(v) and not (isinstance(v, dict) and v.get("dataset") in dropped)
         }
     imp = config.get("implications")
     if isinstance(imp, dict) and isinstance(imp.get("scenarios"), dict):
-        imp["scenarios"] = {k: v for k, v in imp["scenarios"].items() if v is not None}
+        imp["scenarios"] = {k: v for k, v in imp["scenarios"].items() if not is_null(v)}
     return config
 
 
@@ -372,6 +384,8 @@ def _message(error) -> str:
             return "; ".join(sorted({_message(e) for e in relevant}))
         inner = sorted({_message(e) for e in error.context})
         return f"{_path(error)}: matches none of the allowed forms: " + " | ".join(inner)
+    if error.validator == "minProperties" and _path(error) == "datasets":
+        return "datasets: no dataset is left (each one was set to null or removed); the workflow needs at least one"
     if error.validator in ("minimum", "maximum", "exclusiveMinimum", "exclusiveMaximum"):
         about = error.schema.get("description")
         return f"{_path(error)}: {error.message}" + (f" ({about})" if about else "")
@@ -532,3 +546,82 @@ def checked_block(block: dict, kind: str, where: str | None = None, schema: dict
     if lines:
         raise ConfigError(f"{where} is not valid:\n  " + "\n  ".join(lines))
     return fill_defaults(out, sub, sub)
+
+
+def _dataset_balls(dataset: dict) -> set[str] | None:
+    """Return the balls a validated dataset has impacts of (None when its file cannot tell: its own job will)."""
+    from ..properties import InputError
+
+    if "synthetic" in dataset:
+        return {str(b) for b, bats in dataset["synthetic"]["impacts"].items() if any((bats or {}).values())}
+    path = dataset["impacts"] if "impacts" in dataset else dataset.get("tracks", {}).get("impacts")
+    if path is None:
+        return None  # rendered tracks come from a synthetic block (above)
+    try:
+        if "impacts" in dataset:
+            from ..ingest import read_impacts_table
+
+            _, rows = read_impacts_table(path)
+        else:
+            from ..tracks.io import read_table
+
+            _, rows = read_table(path, ("impact_id", "bat", "ball"), "impact")
+    except (InputError, OSError, ValueError):
+        return None
+    balls = {row.get("ball", "").strip() for _, row in rows}
+    return (balls - {""}) or None
+
+
+def _table_names(path: str, loader) -> set[str] | None:
+    """Names of a property table's entries (None when it cannot be read: the jobs that read it say why)."""
+    from ..properties import InputError
+
+    try:
+        return set(loader(path))
+    except (InputError, OSError, ValueError, UnicodeDecodeError):
+        return None
+
+
+def scenario_problems(config: dict) -> list[str]:
+    """Check each scenario of a validated config against the files it needs, before any job runs.
+
+    Its ball and (sweep) bat must be in the property tables of config ``tables``, and the dataset of
+    ``e_x_from_dataset`` must exist and have impacts of its ball. Each problem names the scenario's key.
+    """
+    from ..properties import load_balls, load_bats
+
+    scenarios = (config.get("implications") or {}).get("scenarios") or {}
+    if not scenarios:
+        return []
+    tables = config["tables"]
+    known = {"ball": _table_names(tables["balls"], load_balls), "bat": _table_names(tables["bats"], load_bats)}
+    problems = []
+    for name, sc in scenarios.items():
+        where = f"implications.scenarios.{name}"
+        for key, table in (("ball", "balls"), ("bat", "bats")):
+            names = known[key]
+            if key in sc and names is not None and sc[key] not in names:
+                problems.append(
+                    f"{where}.{key}: {sc[key]!r} is not in the {key} table {tables[table]} "
+                    f"({', '.join(sorted(names))}); a misspelt name?"
+                )
+        problems += _e_x_source_problems(config, where, sc)
+    return problems
+
+
+def _e_x_source_problems(config: dict, where: str, scenario: dict) -> list[str]:
+    """Check the dataset of a scenario's ``e_x_from_dataset``: it must exist and have impacts of the scenario's ball."""
+    name = scenario.get("e_x_from_dataset")
+    if name is None:
+        return []
+    datasets = config.get("datasets") or {}
+    if name not in datasets:
+        return [f"{where}.e_x_from_dataset: {name!r} is not a dataset ({', '.join(sorted(datasets)) or 'none'})"]
+    balls = _dataset_balls(datasets[name])
+    if balls is not None and scenario["ball"] not in balls:
+        return [
+            f"{where}.e_x_from_dataset: dataset {name!r} has no impacts of the scenario's ball "
+            f"{scenario['ball']!r} (its balls: {', '.join(sorted(balls))}), so it has no pooled e_x for it; "
+            "name a dataset with that ball, or give e_x"
+        ]
+    return []

@@ -36,6 +36,8 @@ from typing import TYPE_CHECKING, Any
 
 from .. import __version__
 from .atomic import atomic_target
+from .cratefiles import METADATA_NAME, Staleness, folder_files
+from .guards import RECORDED_SUFFIXES, written_by_workflow
 from .provenance import (
     PACKAGE_DIR,
     git_state,
@@ -48,12 +50,15 @@ from .provenance import (
 )
 
 if TYPE_CHECKING:
-    from collections.abc import Iterable, Mapping
+    from collections.abc import Callable, Iterable, Mapping
 
-#: The crate's metadata file, in the results folder (the crate's root).
-METADATA_NAME = "ro-crate-metadata.json"
 #: Where, inside the crate, the workflow, the package source and the config files are copied.
 SNAPSHOT = "workflow.snapshot"
+#: The snapshot's copies of input data (config files, property tables, impacts, tracks, tool files):
+#: each file up to SNAPSHOT_FILE_LIMIT bytes, all of them up to SNAPSHOT_DATA_LIMIT. A file above
+#: either is not copied: the crate records it by path, size and sha256 (``#uncopied-...``).
+SNAPSHOT_FILE_LIMIT = 20_000_000
+SNAPSHOT_DATA_LIMIT = 100_000_000
 #: The profiles the crate conforms to (the root dataset's conformsTo), with name and version.
 PROFILES = {
     "https://w3id.org/ro/wfrun/process/0.5": ("Process Run Crate", "0.5"),
@@ -102,6 +107,10 @@ class JobRecord:
     snakefile: str | None = None
     start: float | None = None
     end: float | None = None
+    #: False for a job of a failed run that did not finish: its action is left out of the crate.
+    completed: bool = True
+    #: Why Snakemake had to run it (a job that did not finish: its old outputs are outdated).
+    why: str = ""
 
     @property
     def name(self) -> str:
@@ -130,8 +139,11 @@ def _iso(t: float | None) -> str | None:
     return dt.datetime.fromtimestamp(t, tz=dt.UTC).isoformat(timespec="seconds")
 
 
-def jobs_from_dag(dag: Any, persistence: Any, workdir: str | os.PathLike[str]) -> list[JobRecord]:
-    """Return a record of every job of Snakemake's DAG (run now or earlier), with times from Snakemake's metadata."""
+def jobs_from_dag(dag: Any, persistence: Any, workdir: str | os.PathLike[str], failed: bool = False) -> list[JobRecord]:
+    """Return a record of every job of Snakemake's DAG (run now or earlier), with times from Snakemake's metadata.
+
+    After a ``failed`` run, a job that had to run and did not finish is marked not ``completed``.
+    """
     here = Path(workdir).resolve()
 
     def rel(p: object) -> str:
@@ -173,9 +185,19 @@ def jobs_from_dag(dag: Any, persistence: Any, workdir: str | os.PathLike[str]) -
                 snakefile=rel(snakefile.resolve()) if snakefile else None,
                 start=min(starts) if starts else None,
                 end=max(ends) if ends else None,
+                completed=not failed or not dag.needrun(job) or dag.finished(job),
+                why=_reason(dag, job) if failed and dag.needrun(job) else "",
             )
         )
     return records
+
+
+def _reason(dag: Any, job: Any) -> str:
+    """Return Snakemake's reason for running ``job``, in one line ("" when it gives none)."""
+    try:
+        return " ".join(str(dag.reason(job)).split())
+    except Exception:  # the reason is a courtesy: never fail the crate for it
+        return ""
 
 
 def _config_used(job: JobRecord, workdir: Path) -> dict[str, Any]:
@@ -208,6 +230,8 @@ class _Builder:
         self.crate = ROCrate(version="1.1")
         self.crate.metadata.extra_terms.update(WFRUN_TERMS)
         self.files: dict[str, Any] = {}
+        #: Input data files not copied into the snapshot (above its limits): path -> why.
+        self.uncopied: dict[str, str] = {}
 
     def context(self, ident: str, props: dict) -> Any:
         from rocrate.model.contextentity import ContextEntity
@@ -229,6 +253,33 @@ class _Builder:
         entity = self.crate.add_file(dest_path=crate_path, properties={**base, **props})
         self.files[crate_path] = entity
         return entity
+
+    def input_ref(self, path: str) -> dict | None:
+        """Return a reference to an input file (added to the crate), or None.
+
+        None when the file is neither in the crate nor an input data file left out of the snapshot
+        (:data:`SNAPSHOT_FILE_LIMIT`).
+        """
+        cp = self.crate_path(path)
+        if cp:
+            self.file(cp)
+            return {"@id": cp}
+        if path not in self.uncopied:
+            return None
+        full = Path(path) if Path(path).is_absolute() else self.workdir / path
+        digest = sha256_file(full)
+        entity = self.context(
+            f"#uncopied-{digest[:16]}",
+            {
+                "@type": "CreativeWork",
+                "name": path,
+                "sha256": digest,
+                "contentSize": str(full.stat().st_size),
+                "encodingFormat": media_type(full),
+                "description": f"an input data file not copied into {SNAPSHOT}/: {self.uncopied[path]}",
+            },
+        )
+        return {"@id": entity.id}
 
     def crate_path(self, path: str) -> str | None:
         """Where a workdir-relative path is inside the crate (``None`` if not there)."""
@@ -263,10 +314,7 @@ def _copy_snapshot(results: Path, workdir: Path, extra: Iterable[str], builder: 
             wanted[f.relative_to(root).as_posix()] = f
     for f in package_sources():
         wanted[f"src/ballbat/{f.relative_to(PACKAGE_DIR).as_posix()}"] = f
-    for path in extra:
-        p = Path(path) if Path(path).is_absolute() else workdir / path
-        if p.is_file() and not p.resolve().is_relative_to(results.resolve()):
-            wanted[builder.snapshot_path(path).removeprefix(f"{SNAPSHOT}/")] = p
+    wanted.update(_data_copies(results, workdir, extra, builder))
     try:
         for rel, src in sorted(wanted.items()):
             dest = tmp / rel
@@ -277,6 +325,29 @@ def _copy_snapshot(results: Path, workdir: Path, extra: Iterable[str], builder: 
         shutil.rmtree(tmp, ignore_errors=True)
         raise
     return tmp
+
+
+def _data_copies(results: Path, workdir: Path, extra: Iterable[str], builder: _Builder) -> dict[str, Path]:
+    """Return the input data files to copy into the snapshot (snapshot path -> file), within its limits.
+
+    Each file up to :data:`SNAPSHOT_FILE_LIMIT` bytes, all up to :data:`SNAPSHOT_DATA_LIMIT` (smallest
+    first); the others are recorded in ``builder.uncopied`` with the reason.
+    """
+    found = {}
+    for path in dict.fromkeys(extra):
+        p = Path(path) if Path(path).is_absolute() else workdir / path
+        if p.is_file() and not p.resolve().is_relative_to(results.resolve()):
+            found[path] = (p, p.stat().st_size)
+    wanted, total = {}, 0
+    for path, (p, size) in sorted(found.items(), key=lambda item: (item[1][1], item[0])):
+        if size > SNAPSHOT_FILE_LIMIT:
+            builder.uncopied[path] = f"{size:,} bytes, above the limit of {SNAPSHOT_FILE_LIMIT:,} per file"
+        elif total + size > SNAPSHOT_DATA_LIMIT:
+            builder.uncopied[path] = f"{size:,} bytes, past the limit of {SNAPSHOT_DATA_LIMIT:,} for all data copies"
+        else:
+            total += size
+            wanted[builder.snapshot_path(path).removeprefix(f"{SNAPSHOT}/")] = p
+    return wanted
 
 
 def _umask() -> int:
@@ -306,19 +377,31 @@ def build_crate(
     configfiles: list[str],
     started: float | None,
     ended: float,
+    record: Callable[[str], Any] | None = None,
+    uncopied: Mapping[str, str] | None = None,
 ) -> dict:
-    """Return the crate's JSON-LD (a dict), the snapshot already in ``results/workflow.snapshot``."""
+    """Return the crate's JSON-LD (a dict), the snapshot already in ``results/workflow.snapshot``.
+
+    ``record`` returns Snakemake's metadata of an output (None: none): the staleness of the files of
+    the folder that are not results of this run. ``uncopied``: input data left out of the snapshot.
+    """
     b = _Builder(results, workdir)
+    b.uncopied.update(uncopied or {})
     git = git_state(str(workdir))
     versions = software_versions()
     smk_version = versions.get("snakemake", "unknown")
     soft_ids, engine = _software(b, versions, smk_version)
     _profiles(b)
     main = _workflow_files(b, results, git, soft_ids, smk_version)
-    tools, steps = _rules(b, jobs, soft_ids, main)
-    job_actions, controls, all_results = _job_actions(b, jobs, workdir, tools, steps)
+    done = [j for j in jobs if j.completed]
+    tools, steps = _rules(b, done, soft_ids, main)
+    job_actions, controls, all_results = _job_actions(b, done, workdir, tools, steps)
     run = _run(b, config, configfiles, main, all_results, engine, controls, started, ended)
-    _root(b, main, run, job_actions, ended)
+    if len(done) < len(jobs):
+        _failed(run, [j for j in jobs if not j.completed])
+    pending = {out: j.why for j in jobs if not j.completed for out in j.outputs}
+    others = _other_files(b, results, workdir, record, pending)
+    _root(b, main, run, job_actions, ended, others)
     _ = package_source_hash, workflow_source_hash  # recorded through software_versions()
     return _single_values(b.crate.metadata.generate())
 
@@ -435,9 +518,7 @@ def _job_actions(b: _Builder, jobs: list[JobRecord], workdir: Path, tools: dict,
     job_actions, controls, all_results = [], [], []
     for job in jobs:
         ident = f"#job-{job.key}"
-        objects = [{"@id": cp} for p in job.inputs if (cp := b.crate_path(p))]
-        for p in objects:
-            b.file(p["@id"])
+        objects = [ref for p in job.inputs if (ref := b.input_ref(p))]
         for key, value in sorted(_config_used(job, workdir).items()):
             pv = b.context(
                 f"#job-{job.key}-config-{key}",
@@ -447,7 +528,7 @@ def _job_actions(b: _Builder, jobs: list[JobRecord], workdir: Path, tools: dict,
         result = []
         for p in [*job.outputs, *job.logs, *job.benchmarks]:
             cp = b.crate_path(p)
-            if cp:
+            if cp and _made_by_workflow(b.results / cp):
                 b.file(cp)
                 result.append({"@id": cp})
         all_results += [r for r in result if r["@id"] in {b.crate_path(p) for p in job.outputs}]
@@ -486,7 +567,8 @@ def _run(b: _Builder, config, configfiles, main, all_results, engine, controls, 
         cp = b.crate_path(cf)
         if cp:
             b.file(cp, description=f"config file of the run ({cf}), merged in this order")
-            run_objects.append({"@id": cp})
+        if ref := b.input_ref(cf):
+            run_objects.append(ref)
     for key, value in sorted(config.items()):
         run_objects.append(
             b.context(f"#run-config-{key}", {"@type": "PropertyValue", "name": key, "value": _value(value)})
@@ -520,7 +602,50 @@ def _run(b: _Builder, config, configfiles, main, all_results, engine, controls, 
     return run
 
 
-def _root(b: _Builder, main, run, job_actions: list, ended: float) -> None:
+def _made_by_workflow(path: Path) -> bool:
+    """Whether a job's output is the workflow's (a kind with a record: :func:`.guards.written_by_workflow`)."""
+    return path.suffix not in RECORDED_SUFFIXES or written_by_workflow(path)
+
+
+def _failed(run: Any, unfinished: list[JobRecord]) -> None:
+    """Mark the run's action failed, naming the jobs that did not finish (their actions are not in the crate)."""
+    names = ", ".join(j.name for j in unfinished[:10]) + (", ..." if len(unfinished) > 10 else "")
+    run["actionStatus"] = {"@id": "http://schema.org/FailedActionStatus"}
+    run["error"] = (
+        f"the run failed: {len(unfinished)} job(s) did not finish ({names}); their old outputs, if any, "
+        "are listed as files not made by this run"
+    )
+
+
+def _other_files(
+    b: _Builder, results: Path, workdir: Path, record: Callable[[str], Any] | None, pending: Mapping[str, str]
+) -> list:
+    """Add every file of the folder that is not yet in the crate, each saying why and whether it is stale.
+
+    ``pending``: the outputs of the jobs a failed run had to run and did not finish, with Snakemake's
+    reason; such a file is outdated whatever its inputs say (its config values may have changed).
+    """
+    top = results.resolve()
+    prefix = top.relative_to(workdir.resolve()).as_posix() if top.is_relative_to(workdir.resolve()) else str(results)
+    state = Staleness(workdir, record or (lambda path: None))
+    paths = [f"{prefix}/{rel}" for rel in folder_files(results)]
+    others = []
+    for path in paths:
+        rel = path.removeprefix(f"{prefix}/")
+        if rel in b.files:
+            continue
+        if not _made_by_workflow(results / rel):
+            why = "not written by this workflow (no provenance record, or changed since): a file put here by hand"
+        elif path in pending:
+            reason = pending[path] or "no reason given"
+            why = f"not made by this run: outdated, its job had to run and did not finish ({reason}); an earlier run's"
+        else:
+            why = f"not made by this run; {state.describe(path, paths)}"
+        others.append(b.file(rel, description=why))
+    return others
+
+
+def _root(b: _Builder, main, run, job_actions: list, ended: float, others: list) -> None:
     """Describe the crate's root dataset: the results of one run, its workflow and actions."""
     root = b.crate.root_dataset
     root["name"] = "ballbat results"
@@ -528,6 +653,11 @@ def _root(b: _Builder, main, run, job_actions: list, ended: float) -> None:
         "The products of one run of the ballbat workflow (results/), described as a Provenance Run Crate: "
         "the workflow, every job with its inputs, config values and outputs, every file's sha256."
     )
+    if others:
+        root["description"] += (
+            f" {len(others)} file(s) of the folder are not results of this run; each File says why, and "
+            "whether it is stale against the inputs recorded for it."
+        )
     b.context(LICENSE, {"@type": "CreativeWork", "name": "MIT License", "identifier": "MIT"})
     root["license"] = {"@id": LICENSE}
     root["datePublished"] = _iso(ended)
@@ -553,18 +683,19 @@ def write_run_crate(
     configfiles: list[str],
     started: float | None = None,
     workdir: str | os.PathLike[str] | None = None,
+    record: Callable[[str], Any] | None = None,
 ) -> Path:
     """Copy the snapshot and write ``results/ro-crate-metadata.json`` (atomically); return its path.
 
     The old metadata file is removed first, so if anything fails the folder holds no crate rather
-    than a crate describing files that have changed.
+    than a crate describing files that have changed. ``record``: Snakemake's metadata of an output
+    (:func:`build_crate`).
     """
     import time
 
     results = Path(results)
     work = Path(workdir or Path.cwd()).resolve()
-    target = results / METADATA_NAME
-    target.unlink(missing_ok=True)
+    target = remove_crate(results)
     for stale in results.glob(f".{SNAPSHOT}.*"):  # left by a crate cut short (we hold Snakemake's lock)
         if stale.is_dir():
             shutil.rmtree(stale, ignore_errors=True)
@@ -576,17 +707,52 @@ def write_run_crate(
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
-    doc = build_crate(results, work, jobs, config=config, configfiles=configfiles, started=started, ended=time.time())
+    doc = build_crate(
+        results,
+        work,
+        jobs,
+        config=config,
+        configfiles=configfiles,
+        started=started,
+        ended=time.time(),
+        record=record,
+        uncopied=builder.uncopied,
+    )
     with atomic_target(target) as out:
         out.write_text(json.dumps(doc, indent=1, sort_keys=True, ensure_ascii=False) + "\n", encoding="utf-8")
     return target
 
 
-def write_crate_of_run(workflow: Any, config: Mapping[str, Any], started: float | None = None) -> Path:
-    """Write the crate of the Snakemake run ``workflow`` (call from ``onsuccess``)."""
+def remove_crate(results: str | os.PathLike[str]) -> Path:
+    """Remove the crate's metadata file (a run about to change the folder); return its path.
+
+    Called when a real run starts and before a crate is written: a run cut short (killed, a full
+    disk) then leaves no crate rather than one listing files that have changed or gone.
+    """
+    target = Path(results) / METADATA_NAME
+    target.unlink(missing_ok=True)
+    return target
+
+
+def write_crate_of_run(
+    workflow: Any, config: Mapping[str, Any], started: float | None = None, failed: bool = False
+) -> Path:
+    """Write the crate of the Snakemake run ``workflow`` (``onsuccess``; ``onerror`` with ``failed``).
+
+    Every file of ``results/`` is in it: the results of this run's jobs, and the others with their
+    staleness from Snakemake's records (:mod:`.cratefiles`).
+    """
+    from snakemake.io import IOFile
+
     workdir = Path.cwd()
-    jobs = jobs_from_dag(workflow.dag, workflow.persistence, workdir)
+    jobs = jobs_from_dag(workflow.dag, workflow.persistence, workdir, failed=failed)
     configfiles = [str(f) for f in workflow.configfiles]
     return write_run_crate(
-        workdir / "results", jobs, config=config, configfiles=configfiles, started=started, workdir=workdir
+        workdir / "results",
+        jobs,
+        config=config,
+        configfiles=configfiles,
+        started=started,
+        workdir=workdir,
+        record=lambda path: workflow.persistence.metadata(IOFile(path)),
     )

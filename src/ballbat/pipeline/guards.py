@@ -79,20 +79,61 @@ def hdf5_problem(path: str | os.PathLike[str]) -> str | None:
     return None
 
 
+#: The products guarded by the record of what wrote them, by suffix (:func:`written_by_workflow`): a file
+#: of these kinds at an output path that has none is a user's, never replaced nor listed as a job's result.
+#: Figures carry a record too (their PNG text), but Snakemake replaces them: a figure is no one's data.
+RECORDED_SUFFIXES = (".nc", ".csv", ".xlsx", ".md")
+
+
 def written_by_workflow(path: str | os.PathLike[str]) -> bool:
     """Whether ``path`` carries the workflow's record of having written it.
 
-    NetCDF: the ``provenance_rule`` attribute (looked for in the file's first 64 KiB, so that a
-    truncated file is still recognised); CSV: the check line at its end (:mod:`.checked`) or the
-    header of one of the workflow's tables (:data:`TABLE_HEADERS`).
+    NetCDF and PNG: the ``provenance_rule`` attribute or text chunk (looked for in the file's first
+    64 KiB, so that a truncated file is still recognised); CSV: the check line at its end
+    (:mod:`.checked`) or the header of one of the workflow's tables (:data:`TABLE_HEADERS`); a
+    workbook (``.xlsx``): its ``rule`` custom document property; Markdown: its provenance sidecar
+    (``<name>.provenance.json`` beside it) lists it with its present sha256.
     """
     path = Path(path)
+    if path.suffix == ".xlsx":
+        return _workbook_has_record(path)
+    if path.suffix == ".md":
+        return _sidecar_describes(path)
     with open(path, "rb") as fh:
         if path.suffix == ".csv":
             head = fh.read(256).decode("utf-8", errors="replace")
             fh.seek(max(0, path.stat().st_size - 4096))
             return head.startswith(TABLE_HEADERS) or b"\n# ballbat table: " in b"\n" + fh.read()
         return PROVENANCE_MARK in fh.read(MARK_WINDOW)
+
+
+def _workbook_has_record(path: Path) -> bool:
+    """Whether a workbook has the ``rule`` custom property the workflow's workbooks carry (ballbat.workbook)."""
+    import zipfile
+
+    try:
+        with zipfile.ZipFile(path) as zf:
+            info = zf.getinfo("docProps/custom.xml")
+            if info.file_size > MARK_WINDOW:
+                return False
+            return b'name="rule"' in zf.read(info)
+    except (zipfile.BadZipFile, KeyError, OSError):
+        return False
+
+
+def _sidecar_describes(path: Path) -> bool:
+    """Whether the provenance sidecar beside ``path`` (:func:`.provenance.write_sidecar`) lists it with its sha256."""
+    import json
+
+    from .provenance import sha256_file
+
+    sidecar = path.with_name(f"{path.stem}.provenance.json")
+    try:
+        described = json.loads(sidecar.read_text(encoding="utf-8")).get("describes", [])
+        digest = sha256_file(path)
+        return any(Path(d["path"]).name == path.name and d["sha256"] == digest for d in described)
+    except (OSError, ValueError, TypeError, KeyError, AttributeError):
+        return False
 
 
 def product_problem(path: str | os.PathLike[str]) -> str | None:
@@ -130,18 +171,38 @@ def damaged_products(paths: Iterable[str | os.PathLike[str]]) -> list[str]:
 
 
 def foreign_outputs(paths: Iterable[str | os.PathLike[str]]) -> list[str]:
-    """Return a line for each existing NetCDF or CSV file among ``paths`` that the workflow did not write.
+    """Return a line for each existing product among ``paths`` that the workflow did not write.
 
     ``paths`` are the outputs of the jobs a run is about to start: Snakemake would remove each
-    before its job runs. A run that finds any stops before that (``onstart``).
+    before its job runs. A run that finds any stops before that (``onstart``). The kinds checked
+    are those that carry a record (:data:`RECORDED_SUFFIXES`).
     """
     lines = []
     for path in sorted({str(p) for p in paths}):
         p = Path(path)
-        if p.suffix in (".nc", ".csv") and p.is_file() and not written_by_workflow(p):
+        if p.suffix in RECORDED_SUFFIXES and p.is_file() and not written_by_workflow(p):
             lines.append(
                 f"{path}: not written by this workflow (no provenance record), and this run would replace it; "
                 "nothing was changed: move it out of results/ and run again"
+            )
+    return lines
+
+
+def users_files(paths: Iterable[str | os.PathLike[str]], kinds: tuple[str, ...] = (".xlsx", ".md")) -> list[str]:
+    """Return a line for each file among the products ``paths`` that the workflow did not write (of ``kinds``).
+
+    Reads only (run while Snakemake parses the workflow). Such a file (a user's workbook or notes
+    saved at a product's path) is left alone: a run that would replace it stops (:func:`foreign_outputs`),
+    and the crate lists it as not the workflow's. NetCDF and CSV products are named by
+    :func:`damaged_products` when damaged.
+    """
+    lines = []
+    for path in sorted({str(p) for p in paths}):
+        p = Path(path)
+        if p.suffix in kinds and p.is_file() and not written_by_workflow(p):
+            lines.append(
+                f"{path}: not written by this workflow (no provenance record, or changed since it was written); "
+                "it is left alone, and is not listed as the workflow's result: move it out of results/"
             )
     return lines
 

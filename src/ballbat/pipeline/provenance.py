@@ -94,10 +94,56 @@ def workflow_source_hash(root: str | None = None) -> str:
     return h.hexdigest()
 
 
-@lru_cache(maxsize=4)
+def git_blob_id(path: str | os.PathLike[str]) -> str:
+    """Return the id git gives a file's content (``git hash-object``): sha1 of "blob <size>", a zero byte, the bytes."""
+    data = Path(path).read_bytes()
+    return hashlib.sha1(b"blob %d\0" % len(data) + data, usedforsecurity=False).hexdigest()
+
+
+def workflow_matches_commit(root: Path, repo: str, commit: str) -> bool:
+    """Whether the workflow's own files under ``root`` (:func:`workflow_sources`) are those of ``commit``.
+
+    ``root`` need not be the git checkout ``repo``: a copied checkout's workflow is compared with the
+    commit's, file by file (the same paths, each with the commit's content; a file added, removed or
+    edited differs). False when git cannot list the commit's files.
+    """
+    try:
+        top = Path(_git(["rev-parse", "--show-toplevel"], repo).strip())
+        base = Path(repo).resolve()
+        while base != top and not (base / "Snakefile").is_file() and base.parent != base:
+            base = base.parent  # the checkout's workflow: where its Snakefile is, at or above ``repo``
+        prefix = base.relative_to(top).as_posix()
+        parts = [p if prefix == "." else f"{prefix}/{p}" for p in WORKFLOW_PARTS]
+        out = _git(["ls-tree", "-r", "-z", "--full-tree", commit, "--", *parts], str(top))
+    except (OSError, ValueError, subprocess.SubprocessError):
+        return False
+    blobs = {}
+    for entry in filter(None, out.split("\0")):
+        meta, _, name = entry.partition("\t")
+        blobs[name if prefix == "." else name.removeprefix(f"{prefix}/")] = meta.split()[-1]
+    files = {p.relative_to(root).as_posix(): p for p in workflow_sources(root)}
+    return set(files) == set(blobs) and all(git_blob_id(files[k]) == v for k, v in blobs.items())
+
+
+def _git(args: list[str], cwd: str) -> str:
+    """Return the output of ``git ARGS`` run in ``cwd`` (raises on failure)."""
+    out = subprocess.run(["git", *args], cwd=cwd, capture_output=True, timeout=10, check=True).stdout
+    return out.decode("utf-8", "surrogateescape")
+
+
 def git_state(where: str | None = None) -> dict:
-    """Commit and dirtiness of the git checkout holding ``where`` (default: the package)."""
-    cwd = str(where or PACKAGE_DIR)
+    """Commit and dirtiness of the git checkout holding ``where`` (default: the package).
+
+    ``dirty`` is true when git has uncommitted changes there, and also when the workflow that runs
+    (:func:`workflow_root`: the working directory's, which may be a copy outside the checkout) is not
+    the commit's (:func:`workflow_matches_commit`): the recorded commit alone would not reproduce it.
+    """
+    root = workflow_root()
+    return _git_state(str(where or PACKAGE_DIR), str(root) if root else None)
+
+
+@lru_cache(maxsize=4)
+def _git_state(cwd: str, root: str | None) -> dict:
     try:
         commit = subprocess.run(
             ["git", "rev-parse", "HEAD"], cwd=cwd, capture_output=True, text=True, timeout=10, check=True
@@ -112,7 +158,8 @@ def git_state(where: str | None = None) -> dict:
         ).stdout
     except (OSError, subprocess.SubprocessError):
         return {"commit": "unknown", "dirty": "unknown"}
-    return {"commit": commit, "dirty": bool(status.strip())}
+    dirty = bool(status.strip()) or (root is not None and not workflow_matches_commit(Path(root), cwd, commit))
+    return {"commit": commit, "dirty": dirty}
 
 
 @lru_cache(maxsize=8)

@@ -26,7 +26,7 @@ from __future__ import annotations
 
 import math
 import warnings
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -40,7 +40,7 @@ if TYPE_CHECKING:
 
     from numpy.typing import ArrayLike
 
-    from .data import CameraTracks
+    from .data import CameraTracks, Tracks
     from .reduce import Reduction
 
 #: False-alarm probability of the glitch test per tracked point (2-D Gaussian noise:
@@ -128,7 +128,7 @@ def check_frame_runs(
         lo, hi = uniq[bounds[main]], uniq[bounds[main + 1] - 1]
         out = (ff < lo) | (ff > hi)
         rows = order[s:e][out]
-        iid, cam = str(impact_id[rows[0]]), str(camera[rows[0]])
+        iid, cam = str(impact_id[rows[0]]), str(camera[rows[0]])  # text, not numpy's repr np.str_('L005')
         for r in rows[:5]:
             d = frame[r] - hi if frame[r] > hi else lo - frame[r]
             side = "after" if frame[r] > hi else "before"
@@ -173,29 +173,15 @@ def glitch_mask(x: np.ndarray, y: np.ndarray, skip: np.ndarray | None = None) ->
     out = np.zeros((n, m), dtype=bool)
     if m < 3:
         return out
-
-    def sh(a, k):  # a shifted so that column j holds a[:, j + k] (NaN outside)
-        b = np.full_like(a, np.nan)
-        if k > 0:
-            b[:, :-k] = a[:, k:]
-        else:
-            b[:, -k:] = a[:, : m + k]
-        return b
-
+    sh = _shifter(m)
+    rx, ry, sd = _midpoint_noise(x, y)
     with np.errstate(invalid="ignore"):
-        rx = x - 0.5 * (sh(x, -1) + sh(x, 1))
-        ry = y - 0.5 * (sh(y, -1) + sh(y, 1))
         lx, ly = x - 2 * sh(x, -1) + sh(x, -2), y - 2 * sh(y, -1) + sh(y, -2)
         qx, qy = x - 2 * sh(x, 1) + sh(x, 2), y - 2 * sh(y, 1) + sh(y, 2)
-    comps = np.concatenate([rx, ry], axis=1)
-    pooled = _mad_sd(comps.ravel())
-    if not np.isfinite(pooled):
+    if sd is None:
         return out
     with np.errstate(invalid="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows
-        enough = np.isfinite(comps).sum(axis=1) >= 10
-        med = np.where(enough, np.nanmedian(np.abs(comps), axis=1), 0.0)
-        sd = np.maximum(1.4826 * med, pooled)
         z = math.sqrt(2 * math.log(1 / GLITCH_FALSE_ALARM))
         rn = np.hypot(rx, ry)
         big = rn > z * sd[:, None]
@@ -208,6 +194,98 @@ def glitch_mask(x: np.ndarray, y: np.ndarray, skip: np.ndarray | None = None) ->
         peak = (rn >= np.nan_to_num(sh(rn, -1))) & (rn >= np.nan_to_num(sh(rn, 1)))
     out = big & same & peak & ok
     return out if skip is None else out & ~skip
+
+
+def _shifter(m: int):
+    """Return sh(a, k): ``a`` (impact, column) shifted so that column j holds a[:, j + k] (NaN outside)."""
+
+    def sh(a, k):
+        b = np.full_like(a, np.nan)
+        if k > 0:
+            b[:, :-k] = a[:, k:]
+        else:
+            b[:, -k:] = a[:, : m + k]
+        return b
+
+    return sh
+
+
+def _midpoint_noise(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+    """Return each point's offset from the midpoint of its neighbours (rx, ry) and the robust sd per impact.
+
+    The sd of the offsets' components is the track's own (1.4826 MAD, from 10 values) or, if larger,
+    that of all impacts (None when no point has two neighbours).
+    """
+    sh = _shifter(x.shape[1])
+    with np.errstate(invalid="ignore"):
+        rx = x - 0.5 * (sh(x, -1) + sh(x, 1))
+        ry = y - 0.5 * (sh(y, -1) + sh(y, 1))
+    comps = np.concatenate([rx, ry], axis=1)
+    pooled = _mad_sd(comps.ravel())
+    if not np.isfinite(pooled):
+        return rx, ry, None
+    with np.errstate(invalid="ignore"), warnings.catch_warnings():
+        warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows
+        enough = np.isfinite(comps).sum(axis=1) >= 10
+        med = np.where(enough, np.nanmedian(np.abs(comps), axis=1), 0.0)
+    return rx, ry, np.maximum(1.4826 * med, pooled)
+
+
+#: Marks at the start of a track that :func:`misplaced_starts` tests (the glitch test needs two tracked
+#: frames on each side, so it never tests a track's first two).
+START_MARKS = 2
+
+
+@dataclass
+class MisplacedStart:
+    """Per impact: whether one of a track's first marks is far off its run, which column, how far (px), the noise."""
+
+    found: np.ndarray
+    column: np.ndarray
+    distance: np.ndarray
+    noise: np.ndarray
+
+
+def misplaced_starts(x: np.ndarray, y: np.ndarray) -> MisplacedStart:
+    """Test the first :data:`START_MARKS` marks of each track against the straight line through the next two.
+
+    A mark at column k of a track whose first mark is at f is predicted from the marks at f + 2 and
+    f + 3 (p = p2 + (2 - k)(p2 - p3)); with point noise s per coordinate its offset has sd
+    s sqrt(14) (k = 0) or s sqrt(6) (k = 1). It is misplaced when it is that far off and also
+    further than z s sqrt(2) from each of the other first three marks (a ball at rest whose
+    third and fourth marks already straddle the impact agrees with its neighbour). s comes from
+    the offsets of each mark from its neighbours' midpoint (sd 1.5^0.5 s: :func:`glitch_mask`'s
+    robust noise); the threshold is the glitch test's z. A misplaced first click (hundreds of
+    pixels off) is found; a track with fewer than four marks from its start is not tested.
+    """
+    n, m = x.shape
+    found = np.zeros(n, dtype=bool)
+    column = np.zeros(n, dtype=np.int64)
+    distance = np.zeros(n)
+    _, _, sd = _midpoint_noise(x, y)
+    if sd is None or m < START_MARKS + 2:
+        return MisplacedStart(found, column, distance, np.full(n, np.nan))
+    ok = np.isfinite(x) & np.isfinite(y)
+    first = np.argmax(ok, axis=1)
+    cols = np.minimum(first[:, None] + np.arange(START_MARKS + 2)[None, :], m - 1)
+    px, py = np.take_along_axis(x, cols, axis=1), np.take_along_axis(y, cols, axis=1)
+    tested = ok.any(axis=1) & (first + START_MARKS + 1 < m) & np.all(np.take_along_axis(ok, cols, axis=1), axis=1)
+    z = math.sqrt(2 * math.log(1 / GLITCH_FALSE_ALARM))
+    point_sd = sd / math.sqrt(1.5)
+    for k in range(START_MARKS - 1, -1, -1):  # the earliest far mark is named
+        ex = px[:, k] - (px[:, 2] + (2 - k) * (px[:, 2] - px[:, 3]))
+        ey = py[:, k] - (py[:, 2] + (2 - k) * (py[:, 2] - py[:, 3]))
+        d = np.hypot(ex, ey)
+        # a mark that sits on one of its neighbours is not misplaced (a ball at rest whose next marks
+        # already straddle the impact is not on one line with them)
+        others = [j for j in range(3) if j != k]
+        near = np.min([np.hypot(px[:, k] - px[:, j], py[:, k] - py[:, j]) for j in others], axis=0)
+        alone = near > z * point_sd * math.sqrt(2)
+        far = tested & alone & (d > z * point_sd * math.sqrt(1 + (3 - k) ** 2 + (2 - k) ** 2))
+        found |= far
+        column = np.where(far, first + k, column)
+        distance = np.where(far, d, distance)
+    return MisplacedStart(found, column, distance, point_sd)
 
 
 # ---------------------------------------------------------------------------------------
@@ -437,12 +515,15 @@ def weighted_mean(x: ArrayLike, err: ArrayLike) -> tuple[float, float, int]:
 # diagnosis: which one setting explains what the checks see
 
 
-def hypotheses(cameras: dict) -> list[tuple[str, dict]]:
-    """Single mistakes and what they scale (config value over true value).
+def hypotheses(cameras: dict, steps: dict | None = None) -> list[tuple[str, dict]]:
+    """Single mistakes and what they scale (config value over true value), most specific first.
 
-    Keys: ``m_swing``, ``fps_swing``, ``m_spin``, ``fps_spin``, ``rig``, ``y_swing``, ``y_spin`` (signs).
+    Keys: ``m_swing``, ``fps_swing``, ``m_spin``, ``fps_spin``, ``rig``, ``y_swing``, ``y_spin``,
+    ``x_swing``, ``x_spin`` (signs). ``steps``: the step every impact's frames share in a camera
+    (:func:`frame_steps`); a step d > 1 adds the mistake "frame numbers d x the video's", which
+    scales time as fps d x too low does and comes first (the frames show it).
     """
-    out: list[tuple[str, dict]] = []
+    out = _frame_step_hypotheses(steps or {})
     for c in ("swing", "spin"):
         out += [
             (f"cameras.{c}.fps is 2x too high", {f"fps_{c}": 2.0}),
@@ -454,6 +535,7 @@ def hypotheses(cameras: dict) -> list[tuple[str, dict]]:
                 {f"y_{c}": -1.0},
             ),
         ]
+    out += _both_camera_hypotheses()
     out += [
         ("y points up in both cameras' rows (Tracker and Kinovea export y up)", {"y_swing": -1.0, "y_spin": -1.0}),
         ("the rig lengths are in metres, not inches", {"rig": 1 / 39.37}),
@@ -478,10 +560,87 @@ def hypotheses(cameras: dict) -> list[tuple[str, dict]]:
     return out
 
 
+def _frame_step_hypotheses(steps: dict) -> list[tuple[str, dict]]:
+    """Return the mistake "frame numbers d x the video's" for the cameras whose frames all step by d > 1."""
+    cams = sorted((c for c, d in steps.items() if d > 1), reverse=True)
+    if not cams:
+        return []
+    d = max(steps[c] for c in cams)
+    which = " and ".join(cams) + (" cameras" if len(cams) > 1 else " camera")
+    name = (
+        f"the frame numbers of the {which} are {d}x the video's: every impact's tracked frames step by {d} "
+        f"(number the video's frames 0, 1, 2, ..., or divide them by {d})"
+    )
+    return [(name, {f"fps_{c}": 1.0 / steps[c] for c in cams})]
+
+
+def _both_camera_hypotheses() -> list[tuple[str, dict]]:
+    """Mistakes made alike in both cameras: a scale or frame rate off by 2, the axes turned 180 deg, a mirror."""
+    out: list[tuple[str, dict]] = []
+    for k, how in ((2.0, "2x too high"), (0.5, "2x too low (half the true value)")):
+        out.append((f"cameras.swing.m_per_px and cameras.spin.m_per_px are both {how}", {"m_swing": k, "m_spin": k}))
+        out.append((f"cameras.swing.fps and cameras.spin.fps are both {how}", {"fps_swing": k, "fps_spin": k}))
+    out += _length_unit_hypotheses()
+    turned = "x points left and y up: Tracker's coordinate axes turned 180 deg, or the video upside down"
+    for c in ("swing", "spin"):
+        out.append((f"the {c} camera's axes are turned 180 deg ({turned})", {f"x_{c}": -1.0, f"y_{c}": -1.0}))
+        out.append((f"cameras.{c}.mirror is the wrong way round (the ball flies against x)", {f"x_{c}": -1.0}))
+    both = {"x_swing": -1.0, "y_swing": -1.0, "x_spin": -1.0, "y_spin": -1.0}
+    out.append((f"both cameras' axes are turned 180 deg ({turned})", both))
+    return out
+
+
+#: Length units whose mix-up in an exported table (``units.length``) the diagnosis weighs, metres each.
+TABLE_LENGTHS = {"m": 1.0, "cm": 0.01, "mm": 0.001, "in": 0.0254, "ft": 0.3048}
+
+
+def _length_unit_hypotheses() -> list[tuple[str, dict]]:
+    """Lengths of both cameras scaled by the ratio of two length units: a table's ``units.length`` wrong."""
+    out = []
+    for said, s_m in TABLE_LENGTHS.items():
+        for true, t_m in TABLE_LENGTHS.items():
+            if said != true:
+                k = s_m / t_m
+                out.append(
+                    (
+                        f"units.length says {said!r} but the exported tables are in {true} (both cameras' lengths "
+                        f"{k:.4g}x the true ones; or both cameras' m_per_px off by that factor)",
+                        {"m_swing": k, "m_spin": k},
+                    )
+                )
+    return out
+
+
+def frame_steps(tracks: Tracks, largest: int = 10) -> dict[str, int]:
+    """Return, per camera, the step d (2 to ``largest``) that every impact's tracked frames share; 1 if none.
+
+    An impact counts when it has at least three tracked frames; a camera steps by d when each such
+    impact's tracked frames (any point) are all its first frame plus a multiple of d.
+    """
+    out = {}
+    for cam, ct in tracks.cameras.items():
+        tracked = np.any([np.isfinite(v) for v in ct.x.values()], axis=0)
+        rows = tracked.sum(axis=1) >= 3
+        out[cam] = 1
+        if not rows.any():
+            continue
+        tracked = tracked[rows]
+        first = np.argmax(tracked, axis=1)[:, None]
+        cols = np.arange(tracked.shape[1])[None, :]
+        for d in range(largest, 1, -1):
+            if not np.any(tracked & ((cols - first) % d != 0)):
+                out[cam] = d
+                break
+    return out
+
+
 def predict(h: dict) -> dict:
     """Observables a mistake predicts: g over its value per camera, L_arc / L_cfg, v_swing / v_spin."""
-    f = {k: h.get(k, 1.0) for k in ("m_swing", "fps_swing", "m_spin", "fps_spin", "rig", "y_swing", "y_spin")}
+    keys = ("m_swing", "fps_swing", "m_spin", "fps_spin", "rig", "y_swing", "y_spin", "x_swing", "x_spin")
+    f = {k: h.get(k, 1.0) for k in keys}
     return {
+        "dir_swing": f["x_swing"],
+        "dir_spin": f["x_spin"],
         "g_swing": f["y_swing"] * f["m_swing"] * f["fps_swing"] ** 2,
         "g_spin": f["y_spin"] * f["m_spin"] * f["fps_spin"] ** 2,
         "arc": f["m_swing"] / f["rig"],
@@ -489,11 +648,13 @@ def predict(h: dict) -> dict:
     }
 
 
-def diagnose(observed: dict, cameras: dict) -> tuple[str, float, float] | None:
+def diagnose(observed: dict, cameras: dict, steps: dict | None = None) -> tuple[str, float, float] | None:
     """Return the single mistake that explains the observables best: (name, its chi^2, no mistake's chi^2).
 
-    ``observed`` maps ``g_swing``, ``g_spin``, ``arc``, ``speed`` to (ratio, relative error);
-    missing or non-finite ones are skipped. chi^2 compares log ratios (a wrong sign counts as 100).
+    ``observed`` maps ``g_swing``, ``g_spin``, ``arc``, ``speed`` to (ratio, relative error), and
+    ``dir_swing``, ``dir_spin`` to the sign of the ball's horizontal flight (+1: along the swing);
+    missing or non-finite ones are skipped. chi^2 compares log ratios (a wrong sign counts as 100); of
+    mistakes that explain them equally, the first of :func:`hypotheses` (``steps``: :func:`frame_steps`).
     """
 
     def chi2(pred):
@@ -509,10 +670,11 @@ def diagnose(observed: dict, cameras: dict) -> tuple[str, float, float] | None:
         return total
 
     none = chi2(predict({}))
-    best = min(((chi2(predict(h)), name) for name, h in hypotheses(cameras)), default=None)
+    scored = [(chi2(predict(h)), i, name) for i, (name, h) in enumerate(hypotheses(cameras, steps))]
+    best = min(scored, default=None)
     if best is None:
         return None
-    return best[1], best[0], none
+    return best[2], best[0], none
 
 
 # ---------------------------------------------------------------------------------------
@@ -564,8 +726,10 @@ def cross_check(red: Reduction, balls: dict, bats: dict, where: str = "tracks") 
     _check_two_cameras(red, pool, fitted & disagree, n_test, setting_wrong, where, found)
     _check_tip_arc(red, pool, where, found)
     _check_spin_dots(red, pool, ball_ids, balls, where, found)
-    if found.failed:
-        _raise_setting(found, red.cameras, where)
+    _check_direction(red, pool, found)
+    _check_aspect(red, pool, where, found)
+    if found.failed or found.shape:
+        _raise_setting(found, red.cameras, where, frame_steps(red.tracks))
     pairs = _exclude_implausible(red, r, balls, bats, where)
     return Verdict(found.observed, found.lines, _usable_pairs(red, pairs, where))
 
@@ -577,6 +741,7 @@ class _Findings:
     observed: dict  # pooled observable -> (value, relative error), for :func:`diagnose`
     lines: list  # one line per check, for the log
     failed: list  # the checks that stop the dataset, each naming the setting
+    shape: list = field(default_factory=list)  # failures no setting of :func:`hypotheses` explains (the aspect)
 
 
 def _check_free_fall(red: Reduction, pool, r, m, where: str, found: _Findings) -> None:
@@ -694,12 +859,75 @@ def _check_spin_dots(red: Reduction, pool, ball_ids, balls: dict, where: str, fo
             )
 
 
-def _raise_setting(found: _Findings, cams, where: str) -> None:
+def _check_direction(red: Reduction, pool, found: _Findings) -> None:
+    """Record which way the ball flies along X in each camera (+1: the swing's direction), for :func:`diagnose`."""
+    for c in ("swing", "spin"):
+        vx = red.flight[c].vx
+        vx = vx[pool & np.isfinite(vx)]
+        if vx.size:
+            found.observed[f"dir_{c}"] = (1.0 if np.median(vx) > 0 else -1.0, 1e-3)
+
+
+#: Stretch of y against x that the spin dots' circles may show, pooled over impacts, beyond its error.
+ASPECT_TOLERANCE = 0.05
+
+
+def dot_aspect(red: Reduction) -> np.ndarray:
+    """Return each impact's and dot's y/x stretch of the circle the dot traces about the ball's centre, (impact, 2).
+
+    Fits A dx^2 + B dy^2 = 1 (an ellipse along the image axes) to the dot's offsets from the fitted
+    centre after separation; the stretch is (A / B)^0.5 (1: a circle; NaN: fewer than 6 frames).
+    """
+    t = red.times["spin"]
+    fl = red.flight["spin"]
+    cx, cy = fl.centre(t)
+    cols = np.arange(t.shape[1])[None, :]
+    after = (cols >= fl.separation[:, None]) & (fl.separation[:, None] >= 0)
+    out = []
+    with np.errstate(all="ignore"):
+        for p in ("dot_a", "dot_b"):
+            X, Y = red.phys[("spin", p)]
+            dx, dy = X - cx, Y - cy
+            m = after & np.isfinite(dx) & np.isfinite(dy)
+            a, b = np.where(m, dx**2, 0.0), np.where(m, dy**2, 0.0)
+            saa, sab, sbb = (a * a).sum(1), (a * b).sum(1), (b * b).sum(1)
+            sa, sb = a.sum(1), b.sum(1)
+            det = saa * sbb - sab**2
+            A, B = (sa * sbb - sb * sab) / det, (sb * saa - sa * sab) / det
+            ok = (m.sum(1) >= 6) & (A > 0) & (B > 0)
+            out.append(np.where(ok, np.sqrt(A / B), np.nan))
+    return np.stack(out, axis=1)
+
+
+def _check_aspect(red: Reduction, pool, where: str, found: _Findings) -> None:
+    """Check that the spin dots trace circles: unequal x and y scales stretch every one along an axis."""
+    q = dot_aspect(red)[pool].ravel()
+    q = q[np.isfinite(q)]
+    if q.size < 6:
+        return
+    med = float(np.median(q))
+    se = float(1.4826 * np.median(np.abs(q - med)) * 1.253 / math.sqrt(q.size))
+    line = (
+        f"the spin dots' circles about the ball's centre, y over x: {med:.3f} +- {se:.3f} (median over {q.size} "
+        "dots; 1 for equal scales)"
+    )
+    found.lines.append(line)
+    if abs(math.log(med)) > math.log1p(ASPECT_TOLERANCE) and abs(med - 1) > DATASET_Z * se:
+        found.shape.append(
+            f"{where}.cameras.spin: {line}: every dot traces an ellipse along the image's axes, so the x and y "
+            "scales differ (non-square pixels, or x_px and y_px scaled apart in an export); a tilted spin axis "
+            "would tilt the ellipses every way"
+        )
+
+
+def _raise_setting(found: _Findings, cams, where: str, steps: dict | None = None) -> None:
     """Stop the dataset: the failed checks, and the setting that most likely explains them."""
     from ..properties import InputError
 
     failed, observed = found.failed, found.observed
-    likely = diagnose(observed, cams)
+    if not failed:
+        raise InputError(found.shape)
+    likely = diagnose(observed, cams, steps)
     tail = []
     if likely is not None:
         name, chi2, none = likely
@@ -710,7 +938,7 @@ def _raise_setting(found: _Findings, cams, where: str) -> None:
             else f"{where}: no single setting explains these; check fps, m_per_px, mirror and the direction of y "
             "of both cameras, and the rig's units (inches)"
         ]
-    raise InputError([*failed, *tail])
+    raise InputError([*failed, *found.shape, *tail])
 
 
 def _exclude_implausible(red: Reduction, r, balls: dict, bats: dict, where: str) -> dict:

@@ -238,6 +238,27 @@ def with_found_settings(block: dict, found: dict) -> dict:
     return out
 
 
+def name_found_settings(problems: list[str], found: dict) -> list[str]:
+    """Return ``problems`` with each camera setting the files gave marked as read from them.
+
+    A diagnosis names config keys (``cameras.spin.fps``); for a folder of tool files the value
+    may come from the files (``found``: :meth:`~ballbat.tracks.formats.layout.Imported.settings_yaml`),
+    a key the user never set: the line then says where the value was read.
+    """
+    marks = {}
+    for cam, vals in (found.get("cameras") or {}).items():
+        for key in ("fps", "m_per_px"):
+            src = str(vals.get(f"{key}_from", ""))
+            if key in vals and src and not src.startswith("config"):
+                marks[f"cameras.{cam}.{key}"] = f"the value read from the files ({src}), not set in the config"
+    out = []
+    for line in problems:
+        for key, note in marks.items():
+            line = line.replace(f"{key} ", f"{key} [{note}] ").replace(f"{key}:", f"{key} [{note}]:")
+        out.append(line)
+    return out
+
+
 #: The formats of a ``tracks`` block's folder of tool files (``format``) and their files'
 #: extensions; here, not in :mod:`.formats`, so that the workflow's start-up (common.smk) reads
 #: them without importing the readers.

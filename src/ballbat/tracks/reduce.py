@@ -50,7 +50,7 @@ import numpy as np
 
 from ..batched import full_rank, gram, tdot
 from ..units import G
-from .checks import IMPACT_Z, camera_agreement, glitch_mask
+from .checks import IMPACT_Z, START_MARKS, camera_agreement, glitch_mask, misplaced_starts
 from .data import CONTACT_PRIOR, POINTS, Camera, CameraTracks, Rig, Tracks
 from .render import contact_distance
 
@@ -96,6 +96,7 @@ class ReduceFlag(enum.IntEnum):
     SPIN_TOO_FAST = 4
     CAMERAS_DISAGREE = 5
     IMPLAUSIBLE = 6
+    MISPLACED_MARK = 7
 
 
 #: Name of the flag the rest of the chain reads (the source stage's exclusions).
@@ -1016,7 +1017,7 @@ def reduce_tracks(
     tracks, n_outliers = remove_glitches(tracks, cameras)
     onset, flight, times, phys, contact, swing, spin = _fit_motions(tracks, cameras, rig)
     values = _measured_values(flight["swing"], swing, spin, contact, cameras, rig)
-    flag, reason, agree = _exclusions(tracks.n, onset, flight, swing, spin, cameras, opt)
+    flag, reason, agree = _exclusions(tracks, onset, flight, swing, spin, cameras, opt)
     return Reduction(
         tracks,
         cameras,
@@ -1141,13 +1142,30 @@ class _Marks:
 
 
 def _exclusions(
-    n: int, onset: dict, flight: dict, swing: Swing, spin: Spin, cameras: dict[str, Camera], opt: ReduceOptions
+    tracks: Tracks, onset: dict, flight: dict, swing: Swing, spin: Spin, cameras: dict[str, Camera], opt: ReduceOptions
 ) -> tuple[np.ndarray, np.ndarray, object]:
     """Return the flag and reason of every impact (the first reason that applies), and the cameras' agreement."""
-    mark = _Marks(n)
+    mark = _Marks(tracks.n)
+    _start_exclusions(mark, tracks)
     agree = _motion_exclusions(mark, onset, flight, swing, cameras, opt)
     _spin_exclusions(mark, flight, spin, cameras["spin"].fps, opt)
     return mark.flag, mark.reason, agree
+
+
+def _start_exclusions(mark: _Marks, tracks: Tracks) -> None:
+    """Mark impacts with a track whose first marks lie far off its run (:func:`.checks.misplaced_starts`)."""
+    for cam, ct in tracks.cameras.items():
+        for p in POINTS[cam]:
+            ms = misplaced_starts(ct.x[p], ct.y[p])
+            mark(
+                ms.found,
+                ReduceFlag.MISPLACED_MARK,
+                lambda i, cam=cam, p=p, ms=ms, ct=ct: (
+                    f"{p}'s mark at frame {int(ct.frame0[i] + ms.column[i])} in the {cam} camera (one of the track's "
+                    f"first {START_MARKS}) lies {ms.distance[i]:.0f} px off the line of its next marks (noise "
+                    f"{ms.noise[i]:.2f} px): a misplaced click? Fix or delete that mark in the tracking tool"
+                ),
+            )
 
 
 def _motion_exclusions(

@@ -14,6 +14,7 @@ from typing import TYPE_CHECKING
 from ..properties import EXTRA, cell_number, check_impact_id, header_problems, table_keys
 from .checks import SCALE_ERR_MAX
 from .data import CAMERAS, POINTS
+from .formats import DUPLICATE_RULE
 
 if TYPE_CHECKING:
     import os
@@ -124,7 +125,7 @@ def check_track_rows(
         if key in seen:
             problems.append(
                 f"{at}, column frame: frame {int(frame)} of {point} in the {cam} camera of impact {iid!r} "
-                f"appears twice (also {seen[key]})"
+                f"appears twice (also {seen[key]}); {DUPLICATE_RULE}"
             )
             continue
         seen[key] = label

@@ -39,6 +39,10 @@ LENGTH_UNITS = {
     "yd": 0.9144,
     "yards": 0.9144,
 }
+#: The one rule for a frame marked twice in one track, in every reader (Tracker's ``.trk``/``.trz``, its
+#: tables, Kinovea's ``.kva`` and exports, a lab's long CSV): the file is refused, naming the track and
+#: the frame. No reader picks one of the two marks (Tracker's XML read as a map used to keep the later).
+DUPLICATE_RULE = "a frame is marked once per track: ballbat refuses a duplicated mark rather than pick one; delete one"
 #: Seconds per time unit of a table (``frames``: the time column counts frames).
 TIME_UNITS = {"s": 1.0, "ms": 1e-3, "us": 1e-6}
 

@@ -25,7 +25,7 @@ from xml.etree import ElementTree as ET
 
 import numpy as np
 
-from . import FileTracks, FormatError, finite_number, length_to_m, read_limited, whole_frames
+from . import DUPLICATE_RULE, FileTracks, FormatError, finite_number, length_to_m, read_limited, whole_frames
 
 if TYPE_CHECKING:
     import os
@@ -171,7 +171,7 @@ def _tracks(root, path: Path, per_frame: float | None, first: float, problems: l
         seen: dict[int, str] = {}
         for f, lab in zip(frames, labels, strict=True):
             if int(f) in seen:
-                problems.append(f"{lab}: frame {int(f)} twice (also {seen[int(f)]})")
+                problems.append(f"{lab}: frame {int(f)} marked twice (also {seen[int(f)]}; {DUPLICATE_RULE})")
             seen.setdefault(int(f), lab)
         tracks[name] = (frames, np.array(x, dtype=float), np.array(y, dtype=float))
     return tracks

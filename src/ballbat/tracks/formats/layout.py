@@ -13,6 +13,7 @@ from __future__ import annotations
 
 import re
 import statistics
+import unicodedata
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -20,7 +21,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..data import BY_EXTENSION, CAMERAS, FORMATS, POINTS, Tracks, tool_file_extensions
-from . import FileTracks, FormatError, close
+from . import DUPLICATE_RULE, FileTracks, FormatError, close
 from .kinovea import read_kva
 from .tables import check_units, read_kinovea_table, read_tracker_table
 from .tracker import read_trk, read_trz
@@ -108,7 +109,7 @@ def find_files(
                     f"{q}: a {q.suffix} file is not read as {fmt or 'a tool file'} (expected {', '.join(exts)})"
                 )
                 continue
-            key = (m["impact_id"], m["camera"].lower())
+            key = (unicodedata.normalize("NFC", m["impact_id"]), m["camera"].lower())  # one form (NFC) of the id
             if key in found:
                 problems.append(f"{q}: impact {key[0]!r}, camera {key[1]} already read from {found[key]}")
                 continue
@@ -247,7 +248,10 @@ def import_files(
             fr, x, y = ft.tracks[name]
             if np.unique(fr).size != fr.size:
                 u, n = np.unique(fr, return_counts=True)
-                problems.append(f"{ft.path}: track {name!r}: frame(s) {', '.join(map(str, u[n > 1][:5]))} appear twice")
+                problems.append(
+                    f"{ft.path}: track {name!r}: frame(s) {', '.join(map(str, u[n > 1][:5]))} marked twice "
+                    f"({DUPLICATE_RULE})"
+                )
                 continue
             cols["impact_id"].append(np.full(fr.size, iid))
             cols["camera"].append(np.full(fr.size, cam))
@@ -313,6 +317,23 @@ def _src(files: list[FileTracks], path: str, key: str) -> str:
     return ft.source.get(key, key)
 
 
+def _table_spelling(imp: Imported, impacts: dict[str, str]) -> None:
+    """Give the files' impact ids the impacts table's spelling where the two differ only in Unicode form.
+
+    A file name can hold an accented id decomposed (NFD: macOS file systems) while the table holds it
+    composed (NFC), or the other way: the two look the same and are matched as the same impact.
+    """
+    table = {unicodedata.normalize("NFC", k): k for k in impacts}
+    rename = {iid: table[iid] for iid, _, _ in imp.files if iid in table and table[iid] != iid}
+    if not rename:
+        return
+    imp.files = [(rename.get(iid, iid), cam, path) for iid, cam, path in imp.files]
+    ids = imp.columns["impact_id"].astype(object)
+    for old, new in rename.items():
+        ids[ids == old] = new
+    imp.columns["impact_id"] = ids.astype(str)
+
+
 def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | None = None) -> tuple[Tracks, Imported]:
     """Read a dataset's validated ``tracks`` block that names a folder (``dir``): return (Tracks, Imported).
 
@@ -338,6 +359,7 @@ def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | 
         )
     except FormatError as exc:
         raise InputError(problems + exc.problems) from None
+    _table_spelling(imp, impacts)
     have: dict[str, set] = {}
     for iid, cam, path in imp.files:
         have.setdefault(iid, set()).add(cam)

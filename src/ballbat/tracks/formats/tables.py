@@ -114,6 +114,9 @@ def _to_file_tracks(path, cols, units, fps, m_per_px, what) -> FileTracks:
     per_px = 1.0 if units["length"] == "px" else length_to_m(units["length"], str(path)) / m_per_px
     sign = -1.0 if units["y"] == "up" else 1.0
     tracks = {}
+    hint = _time_unit_hint(path, cols, t0, units["time"], fps)
+    if hint:
+        raise FormatError([hint])
     for name, (t, x, y, labels) in cols.items():
         frames, fp = whole_frames((t - t0) * scale_t, f"time {what}", labels)
         problems += fp
@@ -126,6 +129,36 @@ def _to_file_tracks(path, cols, units, fps, m_per_px, what) -> FileTracks:
         raise FormatError(problems)
     src = {"units": f"config: time {units['time']}, length {units['length']}, y {units['y']}"}
     return FileTracks(path=str(path), tracks=tracks, fps=None, m_per_px=None, source=src)
+
+
+def _frame_step(t: np.ndarray, t0: float, scale: float) -> float | None:
+    """Median step between a track's rows in frames at ``scale`` (None: the times are not whole frames there)."""
+    f = (np.sort(t) - t0) * scale
+    if f.size < 3 or not np.all(np.abs(f - np.round(f)) <= 0.05):
+        return None
+    return float(np.median(np.diff(np.round(f))))
+
+
+def _time_unit_hint(path, cols: dict, t0: float, stated: str, fps: float) -> str:
+    """Return a line naming ``units.time`` when another unit gives one frame per row and the stated one does not.
+
+    A table's rows are its video's frames: read in the stated unit, the times of each track step by one
+    frame. Steps of 1000 frames (times in ms read as s) or of 0 (s read as ms: every row the same frame)
+    point to the time unit, not to typos in the frames or marks given twice.
+    """
+    units = {**{u: sec * fps for u, sec in TIME_UNITS.items()}, "frames": 1.0}
+    steps = {u: [_frame_step(c[0], t0, k) for c in cols.values()] for u, k in units.items()}
+    if all(st == 1.0 for st in steps[stated] if st is not None) and any(st is not None for st in steps[stated]):
+        return ""
+    fits = [u for u, st in steps.items() if u != stated and st and all(v == 1.0 for v in st)]
+    if not fits:
+        return ""
+    seen = [v for v in steps[stated] if v is not None]
+    how = f"rows {seen[0]:g} frames apart" if seen else "times that are not whole frames"
+    return (
+        f"{path}: units.time says {stated!r}, which gives {how} at {fps:g} fps; read as {fits[0]!r} the times "
+        f"step by one frame per row: is units.time wrong (the table's time column is in {fits[0]})?"
+    )
 
 
 def read_tracker_table(path: str | os.PathLike[str], units: dict, fps: float, m_per_px: float) -> FileTracks:

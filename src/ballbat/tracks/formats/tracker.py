@@ -30,6 +30,7 @@ from xml.etree import ElementTree as ET
 import numpy as np
 
 from . import (
+    DUPLICATE_RULE,
     MAX_COMPRESSION_RATIO,
     MAX_FILE_BYTES,
     FileTracks,
@@ -61,14 +62,24 @@ def _number(props: dict, name: str, where: str, problems: list[str], integer: bo
     return finite_number((p.text or "").strip(), f"{where}: {name}", problems, integer)
 
 
-def _array(prop: ET.Element) -> dict[int, ET.Element]:
-    out = {}
+def _array(prop: ET.Element, at: str, problems: list[str]) -> dict[int, ET.Element]:
+    """Return the entries ``[n]`` of an array property by ``n``.
+
+    An entry given twice is a problem (:data:`ballbat.tracks.formats.DUPLICATE_RULE`): never resolved to one.
+    """
+    out: dict[int, ET.Element] = {}
+    twice: list[int] = []
     for item in prop.findall("property"):
         name = item.get("name", "")
         if name.startswith("[") and name.endswith("]") and name[1:-1].isdigit():
             obj = item.find("object")
             if obj is not None:
+                if int(name[1:-1]) in out:
+                    twice.append(int(name[1:-1]))
                 out[int(name[1:-1])] = obj
+    if twice:
+        frames = ", ".join(map(str, sorted(set(twice))[:5]))
+        problems.append(f"{at}: frame(s) {frames} marked twice ({DUPLICATE_RULE})")
     return out
 
 
@@ -138,7 +149,11 @@ def _coordinate_system(top: dict, path: str, problems: list[str], source: dict):
     angle = 0.0
     ratio = 1.0
     coords = _child_object(top.get("coords"))
-    frames_data = _array(_props(coords)["framedata"]) if coords is not None and "framedata" in _props(coords) else {}
+    frames_data = (
+        _array(_props(coords)["framedata"], f"{path}: coords framedata", problems)
+        if coords is not None and "framedata" in _props(coords)
+        else {}
+    )
     if frames_data:
         values = []
         for n, obj in sorted(frames_data.items()):
@@ -190,7 +205,7 @@ def _point_masses(root, path: str, clip: tuple, axes: tuple, problems: list[str]
         if name in tracks:
             problems.append(f"{at}: two point masses have this name (rename one in Tracker)")
             continue
-        data = _array(tp["framedata"]) if "framedata" in tp else {}
+        data = _array(tp["framedata"], at, problems) if "framedata" in tp else {}
         frames, xs_, ys_ = [], [], []
         for n, fobj in sorted(data.items()):
             fp = _props(fobj)
