@@ -92,7 +92,7 @@ BALL_COLUMNS = {
 _DECIMAL_COMMA = re.compile(r"^[+-]?\d*,\d+([eE][+-]?\d+)?$")
 
 
-def _without_check_line(path: Path, text: str) -> str:
+def without_check_line(path: Path, text: str) -> str:
     """``text`` without ballbat's check line at its end (``ballbat import-tracks`` writes one), verified.
 
     A table that ends in the check line but no longer matches it was cut short or edited after
@@ -140,7 +140,7 @@ def read_csv_rows(path: str | os.PathLike[str]) -> tuple[list[str], list[tuple[i
                 "(a Latin-1 or Windows export?); save the file as 'CSV UTF-8'"
             ]
         ) from None
-    lines = _without_check_line(path, text).splitlines()
+    lines = without_check_line(path, text).splitlines()
     first = next((ln for ln in lines if ln.strip()), "")
     semicolon = first.count(";") > first.count(",")
     reader = csv.reader(lines, delimiter=";" if semicolon else ",")
