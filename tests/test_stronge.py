@@ -10,7 +10,6 @@ from __future__ import annotations
 
 import subprocess
 import sys
-import time
 
 import numpy as np
 import pytest
@@ -414,14 +413,12 @@ def _synthetic(balls, bats, rng, eta2=4.75, n=58, noise=0.01):
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_fit_recovers_eta2(seed, balls, bats):
     """Synthetic Eq. (vtf) data at eta2 = 4.75 with noise: recovered within 3 standard errors,
-    the 95 % profile interval brackets the fit, and one ball's fit takes < 1 s.
+    and the 95 % profile interval brackets the fit (its speed is bench/profile_study.py's, not a test's).
     """
     import lmfit  # noqa: F401  (import once, outside the timing)
 
     psi, x, y, r_x, r_y = _synthetic(balls, bats, np.random.default_rng(seed))
-    t0 = time.perf_counter()
     f = fit_eta2(psi, x, y, r_x, r_y)
-    assert time.perf_counter() - t0 < 1.0
     assert f.success and f.n == 58 and f.nfree == 57
     assert abs(f.eta2 - 4.75) < 3 * f.eta2_err
     assert f.eta2_ci_low < f.eta2 < f.eta2_ci_high
@@ -488,9 +485,7 @@ def test_robust_error_describes_repeats_of_a_design_with_fixed_bats(balls, bats)
 
 def test_fit_with_free_mu(balls, bats):
     psi, x, y, r_x, r_y = _synthetic(balls, bats, np.random.default_rng(3))
-    t0 = time.perf_counter()
     f = fit_eta2(psi, x, y, r_x, r_y, vary_mu=True)
-    assert time.perf_counter() - t0 < 2.0
     assert np.isfinite(f.mu_err) and abs(f.eta2 - 4.75) < 3 * f.eta2_err
 
 
