@@ -22,17 +22,14 @@ where the workflow writes. The guards:
 from __future__ import annotations
 
 import os
-import struct
 from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .atomic import hostname, temporary_owner
-from .checked import csv_problem
+from .checked import csv_problem, hdf5_problem
 
 if TYPE_CHECKING:
     from collections.abc import Iterable
-
-HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
 
 #: The attribute name every NetCDF file of the workflow carries (:mod:`.provenance`); netCDF
 #: writes the global attributes near the start of the file (byte ~10000 in ours).
@@ -42,41 +39,6 @@ MARK_WINDOW = 1 << 16
 #: tests/test_redteam_guards.py holds them to the writers' columns): a table written before tables
 #: carried their check line is still recognised as the workflow's.
 TABLE_HEADERS = ("quantity,ball,bat,paper,", "setting,quantity,ball,bat,", "parameter,setting,ball,bat,")
-
-
-def hdf5_problem(path: str | os.PathLike[str]) -> str | None:
-    """Return why ``path`` is not a whole HDF5 (NetCDF-4) file, or None when it is.
-
-    Reads the superblock (versions 0-3 of the HDF5 format): the file must start with the HDF5
-    signature and be at least as long as the end-of-file address it records. A file whose
-    header is whole can still be damaged inside: :func:`ballbat.pipeline.checked.verify_netcdf`
-    checks every byte of its contents.
-    """
-    path = Path(path)
-    size = path.stat().st_size
-    with open(path, "rb") as fh:
-        head = fh.read(96)
-    if not head.startswith(HDF5_SIGNATURE):
-        return f"not a NetCDF-4/HDF5 file ({size} bytes, no HDF5 signature)"
-    if len(head) < 12:
-        return f"truncated: {size} bytes, shorter than an HDF5 superblock"
-    version = head[8]
-    if version in (0, 1):
-        size_of_offsets = head[13]
-        base_at = 24 if version == 0 else 28
-    elif version in (2, 3):
-        size_of_offsets = head[9]
-        base_at = 12
-    else:
-        return None  # a newer superblock: not judged here
-    fmt = {4: "<I", 8: "<Q"}.get(size_of_offsets)
-    if fmt is None or len(head) < base_at + 3 * size_of_offsets:
-        return None
-    base = struct.unpack_from(fmt, head, base_at)[0]
-    eof = struct.unpack_from(fmt, head, base_at + 2 * size_of_offsets)[0]
-    if size < base + eof:
-        return f"truncated: {size} bytes, but its HDF5 superblock says it ends at byte {base + eof}"
-    return None
 
 
 #: The products guarded by the record of what wrote them, by suffix (:func:`written_by_workflow`): a file
