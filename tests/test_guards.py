@@ -17,12 +17,12 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ballbat.pipeline import guards
+from ballbat.pipeline import checked, guards
 from ballbat.pipeline.atomic import hostname
 from ballbat.pipeline.checked import sealed_csv
 from ballbat.pipeline.ncio import write_dataset
 
-SIG = guards.HDF5_SIGNATURE
+SIG = checked.HDF5_SIGNATURE
 
 
 def product(path: Path) -> Path:
@@ -64,22 +64,22 @@ def dead_pid() -> int:
 
 
 def test_hdf5_problem_of_a_whole_file(tmp_path):
-    assert guards.hdf5_problem(product(tmp_path / "own.nc")) is None
-    assert guards.hdf5_problem(users_netcdf4(tmp_path / "user.nc")) is None
+    assert checked.hdf5_problem(product(tmp_path / "own.nc")) is None
+    assert checked.hdf5_problem(users_netcdf4(tmp_path / "user.nc")) is None
 
 
 def test_hdf5_problem_not_hdf5(tmp_path):
     path = tmp_path / "x.nc"
     path.write_bytes(b"CDF\x01" + bytes(96))  # NetCDF-3 classic
-    assert guards.hdf5_problem(path) == "not a NetCDF-4/HDF5 file (100 bytes, no HDF5 signature)"
+    assert checked.hdf5_problem(path) == "not a NetCDF-4/HDF5 file (100 bytes, no HDF5 signature)"
     path.write_bytes(b"")
-    assert guards.hdf5_problem(path) == "not a NetCDF-4/HDF5 file (0 bytes, no HDF5 signature)"
+    assert checked.hdf5_problem(path) == "not a NetCDF-4/HDF5 file (0 bytes, no HDF5 signature)"
 
 
 def test_hdf5_problem_shorter_than_a_superblock(tmp_path):
     path = tmp_path / "x.nc"
     path.write_bytes(SIG + b"\x02")
-    assert guards.hdf5_problem(path) == "truncated: 9 bytes, shorter than an HDF5 superblock"
+    assert checked.hdf5_problem(path) == "truncated: 9 bytes, shorter than an HDF5 superblock"
 
 
 def test_hdf5_problem_truncated_real_file(tmp_path):
@@ -88,7 +88,7 @@ def test_hdf5_problem_truncated_real_file(tmp_path):
     with open(path, "r+b") as fh:
         fh.truncate(whole - 1)
     assert (
-        guards.hdf5_problem(path)
+        checked.hdf5_problem(path)
         == f"truncated: {whole - 1} bytes, but its HDF5 superblock says it ends at byte {whole}"
     )
 
@@ -98,19 +98,19 @@ def test_hdf5_problem_truncated_real_file(tmp_path):
 def test_hdf5_problem_reads_each_superblock_version(tmp_path, version, size_of_offsets):
     path = tmp_path / "x.nc"
     path.write_bytes(superblock(version, size_of_offsets, base=0, eof=96))
-    assert guards.hdf5_problem(path) is None  # exactly as long as it says
+    assert checked.hdf5_problem(path) is None  # exactly as long as it says
     path.write_bytes(superblock(version, size_of_offsets, base=4, eof=96))  # the base address counts too
-    assert guards.hdf5_problem(path) == "truncated: 96 bytes, but its HDF5 superblock says it ends at byte 100"
+    assert checked.hdf5_problem(path) == "truncated: 96 bytes, but its HDF5 superblock says it ends at byte 100"
     path.write_bytes(superblock(version, size_of_offsets, base=0, eof=5000))
-    assert guards.hdf5_problem(path) == "truncated: 96 bytes, but its HDF5 superblock says it ends at byte 5000"
+    assert checked.hdf5_problem(path) == "truncated: 96 bytes, but its HDF5 superblock says it ends at byte 5000"
 
 
 def test_hdf5_problem_leaves_what_it_cannot_judge(tmp_path):
     path = tmp_path / "x.nc"
     path.write_bytes(superblock(4, 8, base=0, eof=10**9))  # a newer superblock: not judged
-    assert guards.hdf5_problem(path) is None
+    assert checked.hdf5_problem(path) is None
     path.write_bytes(superblock(2, 2, base=0, eof=10**9))  # 2-byte offsets: not a layout it reads
-    assert guards.hdf5_problem(path) is None
+    assert checked.hdf5_problem(path) is None
 
 
 # --- written_by_workflow, product_problem ------------------------------------------------

@@ -24,6 +24,7 @@ from ballbat.pipeline.atomic import atomic_target, hostname, temporary_owner
 from ballbat.pipeline.checked import (
     CHECKSUM_ATTR,
     DamagedFileError,
+    hdf5_problem,
     netcdf_problem,
     read_sealed_csv,
     sealed_csv,
@@ -103,7 +104,7 @@ def test_verify_netcdf_reads_every_byte(tmp_path):
     assert 0 < at < len(data) - 1000
     data[at + 3] ^= 0xFF
     path.write_bytes(bytes(data))
-    assert guards.hdf5_problem(path) is None  # the header is whole: only the checksum finds it
+    assert hdf5_problem(path) is None  # the header is whole: only the checksum finds it
     with pytest.raises(DamagedFileError, match=r"x\.nc: damaged: its contents differ"):
         read_dataset(path)
     path.write_bytes(bytes(data[: len(data) // 2]))

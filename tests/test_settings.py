@@ -24,7 +24,7 @@ import pytest
 
 import ballbat
 from ballbat import studies
-from ballbat.pipeline.config import block_schema, checked_block, packaged_schema, renders, validate_config
+from ballbat.pipeline.config import block_schema, checked_block, packaged_schema, validate_config
 from ballbat.properties import InputError
 from ballbat.stages.fit_ex import FitExSettings
 from ballbat.stages.implications import ImplicationsSettings
@@ -34,6 +34,7 @@ from ballbat.stages.reconstruct import ReconstructSettings
 from ballbat.stages.reduce import ReduceSettings
 from ballbat.stages.stronge import StrongeSettings
 from ballbat.studies import StudySettings
+from ballbat.sweeps import renders
 from ballbat.synthetic import SyntheticSettings
 from ballbat.tracks.data import Camera, Rig, camera_block
 from ballbat.tracks.formats.layout import DEFAULT_PATTERN

@@ -36,10 +36,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 import xarray as xr
 
-from .pipeline.config import renders
 from .pipeline.products import Var, build_dataset
 from .study_settings import StudySettings
-from .sweeps import point_dataset
+from .sweeps import point_dataset, renders
 
 if TYPE_CHECKING:
     from collections.abc import Iterable, Iterator, Sequence

@@ -22,10 +22,17 @@ __all__ = [
     "check_study_sweep",
     "check_sweep",
     "point_dataset",
+    "renders",
     "study_dataset",
     "sweep_points",
     "truth_counts",
 ]
+
+
+def renders(dataset: dict) -> bool:
+    """Whether a validated dataset renders camera tracks (its render block's ``enabled``, default filled)."""
+    return "render" in dataset and bool(dataset["render"]["enabled"])
+
 
 #: What a sweep may vary: name -> what it sets in the dataset's settings.
 SWEEP_PARAMETERS = {
@@ -99,17 +106,15 @@ def check_sweep(
     ``at`` is the config key of the values (default ``{where}.sweep.values``; a grid's
     ``{where}.sweep.grid.{parameter}``).
     """
-    from .pipeline.config import renders as renders_tracks
-
     if parameter is None:
         return []
     at = at or f"{where}.sweep.values"
     name_at = f"{where}.sweep.parameter" if at.endswith(".values") else at
     problems = []
-    renders = renders_tracks(dataset)
-    if parameter in RENDER_PARAMETERS and not renders:
+    rendered = renders(dataset)
+    if parameter in RENDER_PARAMETERS and not rendered:
         problems.append(f"{name_at}: {parameter} needs a dataset that renders camera tracks")
-    if parameter == "noise_scale" and renders:
+    if parameter == "noise_scale" and rendered:
         problems.append(f"{name_at}: noise_scale scales the direct noise, but the dataset renders tracks")
     for i, v in enumerate(values):
         why = _value_problem(parameter, float(v))
@@ -130,8 +135,6 @@ def check_study_sweep(dataset: dict, study: dict, where: str) -> list[str]:
     else:
         problems += check_sweep(dataset, sweep.get("parameter"), sweep.get("values", ()), where)
     if study["draw_calibration"]:  # the validated study block (its defaults filled)
-        from .pipeline.config import renders
-
         if not renders(dataset):
             problems.append(f"{where}.draw_calibration: needs a dataset that renders camera tracks")
         else:

@@ -15,11 +15,11 @@ from ballbat.pipeline.config import (
     STUDY_BYTES_PER_REPLICATE,
     drop_nulls,
     impact_bytes,
-    renders,
     scenario_problems,
     study_impacts,
     validate_config,
 )
+from ballbat.sweeps import renders
 from ballbat.pipeline.guards import (
     damaged_products,
     foreign_outputs,

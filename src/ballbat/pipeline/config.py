@@ -12,6 +12,8 @@ import math
 import re
 from typing import TYPE_CHECKING
 
+from ..sweeps import renders
+
 if TYPE_CHECKING:
     import os
 
@@ -38,11 +40,6 @@ BYTES_PER_CASE = 60_000
 #: arrays): 34-35 kB measured (2026-11, 7000 and 28000 impacts through render, reduce and the
 #: Sec. IV fits); 50 kB leaves room.
 BYTES_PER_TRACKED_IMPACT = 50_000
-
-
-def renders(dataset: dict) -> bool:
-    """Whether a validated dataset renders camera tracks (its render block's ``enabled``, default filled)."""
-    return "render" in dataset and bool(dataset["render"]["enabled"])
 
 
 def impact_bytes(dataset: dict) -> int:
@@ -563,7 +560,7 @@ def _dataset_balls(dataset: dict) -> set[str] | None:
 
             _, rows = read_impacts_table(path)
         else:
-            from ..tracks.io import read_table
+            from ..properties import read_table
 
             _, rows = read_table(path, ("impact_id", "bat", "ball"), "impact")
     except (InputError, OSError, ValueError):

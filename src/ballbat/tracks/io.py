@@ -17,7 +17,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import xarray as xr
 
-from ..properties import InputError, cell_text, read_csv_table
+from ..properties import NETCDF_SUFFIXES as _NC
+from ..properties import InputError, read_table
 from .checks import check_frame_runs
 from .data import POINTS, Camera, Rig, Tracks, dense_problems, to_dense
 from .validate import (
@@ -32,37 +33,6 @@ from .validate import (
 if TYPE_CHECKING:
     import os
     from collections.abc import Sequence
-
-_NC = (".nc", ".nc4", ".netcdf")
-
-
-def _read_nc(path: Path, dim: str, columns) -> tuple[list[str], list[tuple[str, dict]]]:
-    try:
-        with xr.open_dataset(path) as ds:
-            ds = ds.load()
-    except (OSError, ValueError) as exc:
-        raise InputError([f"{path}: cannot be read as NetCDF ({exc})"]) from None
-    if dim not in ds.dims:
-        raise InputError([f"{path}: no dimension {dim!r} (expected variables {', '.join(columns)} along it)"])
-    header = [str(k) for k, v in ds.variables.items() if v.dims == (dim,) and k != dim]
-    cols = {k: ds[k].values for k in header}
-    if dim == "impact" and "impact_id" not in header and "impact" in ds.coords:
-        header.insert(0, "impact_id")  # rendered tracks: the impact ids are the dimension's coordinate
-        cols["impact_id"] = ds["impact"].values
-    rows = [(f"{dim} {i}", {k: cell_text(v[i]) for k, v in cols.items()}) for i in range(ds.sizes[dim])]
-    return header, rows
-
-
-def read_table(
-    path: str | os.PathLike[str], required: Sequence[str], dim: str
-) -> tuple[list[str], list[tuple[str, dict]]]:
-    """Header and rows (label, {column: text}) of a CSV or NetCDF file; problems raised whole."""
-    path = Path(path)
-    if not path.is_file():
-        raise InputError([f"{path}: file not found"])
-    if path.suffix.lower() in _NC:
-        return _read_nc(path, dim, required)
-    return read_csv_table(path, required)
 
 
 def long_csv_text(cols: dict, extra: Sequence[str] = ()) -> str:
