@@ -78,7 +78,12 @@ def test_contact_sweep_sets_a_narrow_range_about_the_value(config):
         ),
         (
             lambda g: g.update(pixel_noise_px=[0.0, 3.0]),
-            "studies.robustness.sweep.grid.pixel_noise_px[0]: pixel_noise_px must be positive",
+            "studies.robustness.sweep.grid.pixel_noise_px[0]: pixel_noise_px must be positive in a study",
+        ),
+        (  # the schema owns the range of a swept setting (0 to 100 px), as of any other
+            lambda g: g.update(pixel_noise_px=[2.0, 150.0]),
+            "studies.robustness.sweep (pixel_noise_px = 150): render.cameras.swing.pixel_noise_px: 150.0 is greater "
+            "than the maximum of 100",
         ),
         (lambda g: g.update(pixel_noise_px=[1.0, 1.0]), "studies.robustness.sweep.grid.pixel_noise_px: a value is"),
         (

@@ -82,8 +82,13 @@ def _value_problem(parameter: str, v: float) -> str | None:
         return f"{parameter} must be a finite number, not {v}"
     if parameter == "impacts_per_bat" and (v != int(v) or v < 3):
         return f"impacts per bat must be a whole number >= 3, not {v:g}"
-    if parameter in ("swing_fps", "spin_fps", "pixel_noise_px", "noise_scale") and v <= 0:
+    if parameter in ("swing_fps", "spin_fps", "noise_scale") and v <= 0:
         return f"{parameter} must be positive, not {v:g}"
+    if parameter == "pixel_noise_px" and v <= 0:  # the schema allows 0 for a dataset, not for a study
+        return (
+            f"pixel_noise_px must be positive in a study, not {v:g}: a study measures how the tracking "
+            "noise spreads the estimates around the truth, and without noise there is no spread to measure"
+        )
     if parameter == "e_x" and not -1.0 < v < 1.0:
         return f"e_x must lie in (-1, 1), not {v:g}"
     from .tracks.data import CONTACT_PRIOR  # the reduction's prior: the renderer's contacts must lie in it

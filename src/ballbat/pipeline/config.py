@@ -157,7 +157,7 @@ def _names(config: dict) -> list[str]:
     return problems
 
 
-def _studies(config: dict) -> list[str]:
+def _studies(config: dict, schema: dict | None = None) -> list[str]:
     """Check that each study names a synthetic dataset and that its sweep suits that dataset."""
     from ..sweeps import check_study_sweep
 
@@ -176,7 +176,31 @@ def _studies(config: dict) -> list[str]:
                 f"{where}.dataset: {study['dataset']!r} is not synthetic (a study replicates a synthetic experiment)"
             )
         else:
-            problems += check_study_sweep(ds, study, where)
+            found = check_study_sweep(ds, study, where)
+            problems += found or _sweep_point_problems(ds, study, where, schema)
+    return problems
+
+
+def _sweep_point_problems(dataset: dict, study: dict, where: str, schema: dict | None = None) -> list[str]:
+    """Return the schema's problems of the dataset at each swept value (the schema owns every setting's range).
+
+    Each value of each swept setting is checked once (a grid's settings are independent keys).
+    """
+    import jsonschema
+
+    from ..sweeps import point_dataset, sweep_points
+
+    names, points = sweep_points(study.get("sweep"))
+    problems = []
+    schema = packaged_schema() if schema is None else schema
+    kinds = [k for k in ("synthetic", "render") if k in dataset]
+    validators = {k: jsonschema.Draft202012Validator(block_schema(k, schema)) for k in kinds}
+    for i, name in enumerate(names):
+        for value in sorted({p[i] for p in points}):
+            point = point_dataset(dataset, name, value)
+            for kind, validator in validators.items():
+                for err in validator.iter_errors(point[kind]):
+                    problems.append(f"{where}.sweep ({name} = {value:g}): {kind}.{_message(err)}")
     return problems
 
 
@@ -454,7 +478,7 @@ def validate_config(config: dict, schema: dict, source: str = "config", availabl
         lines = _synthetic_keys(config) + _offsets(config)
     if not lines:
         fill_defaults(config, schema)
-        lines = _studies(config) + _sizes(config, _available_memory() if available is None else available)
+        lines = _studies(config, schema) + _sizes(config, _available_memory() if available is None else available)
     if lines:
         raise ConfigError(f"{source} is not valid:\n  " + "\n  ".join(lines))
     return config
