@@ -25,7 +25,7 @@ from unittest import mock
 
 import numpy as np
 
-from ballbat import fitting, studies
+from ballbat import chain, fitting, studies
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
 from ballbat.stages import study_batch
@@ -90,11 +90,12 @@ def main() -> None:
     cfg = load_config()
     balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
     cache: dict = {}
-    real_source = studies._source
+    real_source = chain.source
 
-    def cached_source(dataset, seeds, balls_, bats_):
+    def cached_source(settings, balls_, bats_):
+        seeds = (settings.synthetic.seed, settings.render.seed if settings.render else None)
         if seeds not in cache:
-            cache[seeds] = real_source(dataset, seeds, balls_, bats_)
+            cache[seeds] = real_source(settings, balls_, bats_)
         return cache[seeds]
 
     for name in names:
@@ -106,7 +107,7 @@ def main() -> None:
         truth = [studies.population_truth(s, 0, balls, bats)]
         t_truth = time.perf_counter() - t0
         out = [f"{name}: {s.replicates} replicates (truth {t_truth:.0f} s)"]
-        with mock.patch.object(studies, "_source", cached_source):
+        with mock.patch.object(chain, "source", cached_source):
             for label in ("before", "after"):
                 t0 = time.perf_counter()
                 if label == "before":

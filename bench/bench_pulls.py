@@ -1,7 +1,7 @@
 """Per-impact pulls of the reduced quantities at one point of the robustness grid.
 
 Renders and reduces replicate experiments as a replicate study does
-(:func:`ballbat.studies._source`) and prints, per ball and quantity, the mean and spread of
+(:func:`ballbat.studies.replicate_source`) and prints, per ball and quantity, the mean and spread of
 (value − truth) / stated error over every impact the reduction keeps. A mean away from 0 is a
 bias of every impact. It becomes about mean * sqrt(n) standard errors on anything fitted to n
 impacts (docs/studies.md, "Where softballs' implied e_y goes wrong").
@@ -35,7 +35,7 @@ def pulls(px: float, per_bat: int, contact_ms: float, replicates: int, draw: boo
     dataset = point_dataset(s.dataset, s.parameter, s.values[0])
     out: dict = {}
     for rep in range(replicates):
-        src = studies._source(dataset, studies.replicate_seeds(s.seed, rep), balls, bats, check=False)
+        src = studies.replicate_source(dataset, studies.replicate_seeds(s.seed, rep), balls, bats, check=False)
         kept = src["ingest_flag"].values == 0
         ball = src["ball"].values.astype(str)
         for b in np.unique(ball):

@@ -284,8 +284,8 @@ def test_a_frame_twice_in_a_table_or_a_long_csv_follows_the_same_rule(tmp_path):
 def _example_reduction(edit=None):
     """The example's rendered tracks reduced with its settings, after ``edit(tracks)``."""
     from ballbat.properties import load_balls, load_bats
+    from ballbat.stages.reduce import ReduceSettings, reduce_and_check
     from ballbat.tracks.io import load_tracks
-    from ballbat.tracks.stage import reduce_in_memory
 
     cfg = yaml.safe_load((EXAMPLE / "tracked.yaml").read_text())["datasets"]["tracked"]["tracks"]
     from ballbat.pipeline.config import checked_block
@@ -295,7 +295,8 @@ def _example_reduction(edit=None):
     tracks = load_tracks(EXAMPLE / "tracked_tracks.csv", EXAMPLE / "tracked_impacts.csv", balls, bats)
     if edit is not None:
         edit(tracks)
-    return reduce_in_memory(tracks, cfg, balls, bats, "datasets.tracked.tracks")[0]
+    settings = ReduceSettings.from_config(cfg, "datasets.tracked.tracks", systematics=False)
+    return reduce_and_check(settings, tracks, balls, bats)[0]
 
 
 @pytest.mark.parametrize("point", ["bat_tip", "ball"])
@@ -420,8 +421,8 @@ def test_diagnoses_point_the_right_way(case, edit, expected, before, tmp_path):
 
     from ballbat.pipeline.config import checked_block
     from ballbat.properties import InputError, load_balls, load_bats
+    from ballbat.stages.reduce import ReduceSettings, reduce_and_check
     from ballbat.tracks.io import load_tracks
-    from ballbat.tracks.stage import reduce_in_memory
 
     with open(EXAMPLE / "tracked_tracks.csv", newline="") as fh:
         rows = list(csv.DictReader(fh))
@@ -435,7 +436,10 @@ def test_diagnoses_point_the_right_way(case, edit, expected, before, tmp_path):
     balls, bats = load_balls(ROOT / "config" / "balls.csv"), load_bats(ROOT / "config" / "bats.csv")
     tracks = load_tracks(path, EXAMPLE / "tracked_impacts.csv", balls, bats)
     with pytest.raises(InputError) as err:
-        reduce_in_memory(tracks, checked_block(cfg, "tracks"), balls, bats, "datasets.tracked.tracks")
+        settings = ReduceSettings.from_config(
+            checked_block(cfg, "tracks"), "datasets.tracked.tracks", systematics=False
+        )
+        reduce_and_check(settings, tracks, balls, bats)
     text = str(err.value)
     assert expected in text and before not in text, text
 

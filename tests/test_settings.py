@@ -4,7 +4,7 @@ Every settings dataclass is checked against the schema: a field default that dif
 schema's, or that the schema does not give, fails; every default the schema gives a render,
 reduce, camera, synthetic or study setting arrives in the settings built from a block that
 leaves it out; no code restates a schema default through ``.get(key, default)``. And a
-replicate of a study (``studies._source``) and the workflow's rule functions give the same
+replicate of a study (``studies.replicate_source``) and the workflow's rule functions give the same
 reduced impacts whichever render or reduce setting is changed, one at a time.
 """
 
@@ -24,6 +24,7 @@ import pytest
 
 import ballbat
 from ballbat import studies
+from ballbat.chain import DatasetSettings
 from ballbat.pipeline.config import block_schema, checked_block, packaged_schema, validate_config
 from ballbat.properties import InputError
 from ballbat.stages.fit_ex import FitExSettings
@@ -31,7 +32,7 @@ from ballbat.stages.implications import ImplicationsSettings
 from ballbat.stages.ingest import IngestSettings
 from ballbat.stages.normalize import NormalizeSettings
 from ballbat.stages.reconstruct import ReconstructSettings
-from ballbat.stages.reduce import ReduceSettings
+from ballbat.stages.reduce import ReduceSettings, reduce_options
 from ballbat.stages.stronge import StrongeSettings
 from ballbat.studies import StudySettings
 from ballbat.sweeps import renders
@@ -41,7 +42,6 @@ from ballbat.tracks.formats.layout import DEFAULT_PATTERN
 from ballbat.tracks.io import cameras_from_config
 from ballbat.tracks.reduce import ReduceOptions
 from ballbat.tracks.render import RenderCamera, RenderSettings, settings_from_config
-from ballbat.tracks.stage import reduce_options
 from ballbat.units import DEGREE, INCH
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -100,6 +100,8 @@ SETTINGS = {
     ImplicationsSettings: ("implications", {}),
     ReconstructSettings: ("analysis", {}),  # no setting yet: the property tables are inputs
     IngestSettings: ("analysis", {}),  # no setting yet: the files are inputs
+    # the chain's settings hold the stages' (above); its name and block are no config keys
+    DatasetSettings: ("analysis", {}),
     StudySettings: (
         "study",
         {k: ((k,), _same) for k in ("replicates", "seed", "batch_size", "truth_impacts")}
@@ -459,9 +461,9 @@ SEEDS = (11, 12)
 
 
 def _replicate(ds: dict, balls, bats):
-    """The study's replicate (studies._source): the reduced impacts, or the problems that stop it."""
+    """The study's replicate (studies.replicate_source): the reduced impacts, or the problems that stop it."""
     try:
-        return studies._source(ds, SEEDS, balls, bats)
+        return studies.replicate_source(ds, SEEDS, balls, bats)
     except InputError as exc:
         return exc.problems
 
@@ -566,7 +568,7 @@ def test_enabled_and_seed(config, small, balls, bats, baselines, tmp_path):
     ds = copy.deepcopy(small)
     ds["render"]["enabled"] = False
     ds = _validated(config, ds)
-    replicate = studies._source(ds, SEEDS, balls, bats)
+    replicate = studies.replicate_source(ds, SEEDS, balls, bats)
     from ballbat.stages import simulate
 
     sim = simulate.run(SyntheticSettings(**{**ds["synthetic"], "seed": SEEDS[0]}), balls, bats)

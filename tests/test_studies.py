@@ -341,7 +341,7 @@ def test_a_replicate_and_the_workflow_reduce_alike(config, balls, bats, root, tm
     schema = yaml.safe_load((root / "workflow" / "schemas" / "config.schema.yaml").read_text())
     ds = validate_config(raw, schema)["datasets"]["synthetic"]
     seeds = (11, 12)
-    replicate = studies._source(ds, seeds, balls, bats)
+    replicate = studies.replicate_source(ds, seeds, balls, bats)
     sim = simulate.run(SyntheticSettings(**{**ds["synthetic"], "seed": seeds[0]}), balls, bats)
     cfg = {**ds["render"], "seed": seeds[1]}
     tracks_nc = tmp_path / "tracks.nc"

@@ -15,10 +15,10 @@ from test_tracks import BALLS, BATS, experiment, render, render_cfg
 from ballbat import systematics
 from ballbat.pipeline.config import checked_block
 from ballbat.stages import fit_ex, normalize, reconstruct, stronge
+from ballbat.stages import reduce as reduce_stage
 from ballbat.stages.fit_ex import FIT_FAMILIES
 from ballbat.stages.reduce import reduction_dataset
 from ballbat.tracks.data import camera_block
-from ballbat.tracks.stage import reduce_in_memory
 
 STRONGE = {
     "e_y": 0.5,
@@ -38,7 +38,10 @@ def chain(swing=(), spin=(), rig=(), vary_e_y=False):
     cfg = render_cfg(swing=dict(swing), spin=dict(spin))
     cfg["rig"].update(dict(rig))
     tr, _ = render(ds, cfg, {k: ds[f"truth_{k}"].values for k in ("e_x", "e_y")})
-    red, _ = reduce_in_memory(tr, camera_block(checked_block(cfg, "render")), BALLS, BATS, "test", systematics=True)
+    settings = reduce_stage.ReduceSettings.from_config(
+        camera_block(checked_block(cfg, "render")), "test", systematics=True
+    )
+    red, _ = reduce_stage.reduce_and_check(settings, tr, BALLS, BATS)
     rec = reconstruct.run(
         reconstruct.ReconstructSettings(),
         normalize.run(normalize.NormalizeSettings(77.0), reduction_dataset(red)),

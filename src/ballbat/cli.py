@@ -12,7 +12,7 @@ place the workflow's defaults live. Errors are one line naming the bad argument 
 
 ``ballbat check --kind tracks --config YAML`` checks raw camera tracks as the ``reduce`` rule
 does (the same steps: read and check the files, reduce, cross-check;
-:func:`ballbat.tracks.stage.reduce_checked`).
+:func:`ballbat.chain.reduce_tracks_block`).
 """
 
 from __future__ import annotations
@@ -137,9 +137,9 @@ def _range_problem(val: float, limits: dict, unit: str) -> str | None:
 
 def cmd_check(args: argparse.Namespace) -> int:
     """Validate a measured impacts file as the ingest rule does; print every problem and warning."""
+    from .chain import fit_problems, schema_settings
     from .properties import InputError, load_balls, load_bats
     from .stages import ingest
-    from .stages.fit_ex import fit_problems
 
     defaults = _schema_defaults()["tables"]
     if args.kind == "tracks" and args.file is None:
@@ -167,7 +167,8 @@ def cmd_check(args: argparse.Namespace) -> int:
             print(problem)
         print(f"{path}: not usable: {len(exc.problems)} problem(s)", file=sys.stderr)
         return 1
-    problems = fit_problems(ds, load_balls(args.balls or defaults["balls"]), load_bats(args.bats or defaults["bats"]))
+    balls, bats = load_balls(args.balls or defaults["balls"]), load_bats(args.bats or defaults["bats"])
+    problems = fit_problems(schema_settings({"impacts": str(path)}, "check"), ds, balls, bats)
     if problems:  # what the workflow's fit_ex would stop on: the same chain and test (issue 19)
         for text in [*problems, *warnings]:
             print(f"{path}: {text}" if text.startswith("the fit") else f"warning: {text}")
@@ -227,59 +228,31 @@ def _tracks_dataset(args: argparse.Namespace, defaults: dict) -> tuple[str, dict
     return args.dataset, block, {k: ds.get(k, tables[k]) for k in ("balls", "bats")}
 
 
-def _reduce_tool_files(block: dict, where: str, balls_path: str, bats_path: str) -> tuple:
-    """Import a ``tracks`` block's folder of tool files, then reduce and cross-check them.
-
-    The same steps as the workflow's import_tracks and reduce rules: the camera settings found
-    in the files complete the block's (:func:`ballbat.tracks.data.with_found_settings`).
-    """
-    from .properties import InputError, load_balls, load_bats
-    from .tracks.data import camera_block, name_found_settings, with_found_settings
-    from .tracks.formats.layout import import_block
-    from .tracks.stage import reduce_in_memory
-
-    balls, bats = load_balls(balls_path), load_bats(bats_path)
-    tracks, imported = import_block(block, where, balls, bats)
-    settings = with_found_settings(camera_block(block), imported.settings_yaml())
-    try:
-        return reduce_in_memory(tracks, settings, balls, bats, where)
-    except InputError as exc:  # a setting the files gave is named as read from them
-        raise InputError(name_found_settings(exc.problems, imported.settings_yaml())) from None
-
-
 def _check_tracks(path: Path | None, args: argparse.Namespace, defaults: dict) -> int:
     """Check raw tracks as the workflow's reduce rule does: read, validate, reduce, cross-check.
 
-    With ``--config``: the reduce rule's steps (:func:`ballbat.tracks.stage.reduce_checked`),
+    With ``--config``: the reduce rule's steps (:func:`ballbat.chain.reduce_tracks_block`),
     then what the workflow would do with every impact; exit 1 when the dataset would stop or
     a ball would have fewer than three usable impacts. Without: the files are only read.
     """
     import numpy as np
 
+    from .chain import reduce_tracks_block
     from .linefit import MIN_FIT_IMPACTS
     from .properties import InputError, load_balls, load_bats
     from .tracks.io import load_tracks
-    from .tracks.stage import reduce_checked
 
     if args.config:
         name, block, tables = _tracks_dataset(args, defaults)
         where = f"datasets.{name}.tracks"
+        shown = path or Path(block["dir"] if "dir" in block else block["file"])
         try:
-            if "dir" in block and path is None:  # a folder of tool files: imported as the workflow does
-                path = Path(block["dir"])
-                red, verdict = _reduce_tool_files(
-                    block, where, args.balls or tables["balls"], args.bats or tables["bats"]
-                )
-            else:
-                path = path or Path(block["file"])
-                impacts = args.impacts or block.get("impacts")
-                red, verdict = reduce_checked(
-                    path, impacts, block, args.balls or tables["balls"], args.bats or tables["bats"], where
-                )
+            balls, bats = load_balls(args.balls or tables["balls"]), load_bats(args.bats or tables["bats"])
+            red, verdict = reduce_tracks_block(block, where, balls, bats, path, args.impacts)
         except InputError as exc:
             for problem in exc.problems:
                 print(problem)
-            print(f"{path}: the workflow would stop at reduce: {len(exc.problems)} problem(s)", file=sys.stderr)
+            print(f"{shown}: the workflow would stop at reduce: {len(exc.problems)} problem(s)", file=sys.stderr)
             return 1
         for line in verdict.lines:
             print(f"cross-check: {line}")
@@ -293,7 +266,7 @@ def _check_tracks(path: Path | None, args: argparse.Namespace, defaults: dict) -
         short = [b for b, k in per_ball.items() if k < MIN_FIT_IMPACTS]
         n_out = int(sum(np.sum(v) for v in red.n_outliers.values()))
         summary = (
-            f"{path}: {int(usable.sum())} of {red.tracks.n} impacts usable (per ball: {listing}), "
+            f"{shown}: {int(usable.sum())} of {red.tracks.n} impacts usable (per ball: {listing}), "
             f"{red.tracks.n - int(usable.sum())} excluded, {n_out} tracking glitch(es) removed, "
             f"{len(verdict.warnings)} warning(s)"
         )

@@ -45,6 +45,7 @@ if TYPE_CHECKING:
 
     from numpy.typing import ArrayLike
 
+    from .chain import DatasetSettings
     from .properties import Ball, Bat
 
 #: The quantities of paper_comparison.csv a study records (those with an uncertainty and a truth).
@@ -70,7 +71,44 @@ def replicate_seeds(seed: int, replicate: int) -> tuple[int, int]:
 # one replicate
 
 
-def _source(
+def chain_settings(
+    settings: StudySettings | None, dataset: dict, seeds: tuple[int, int], where: str = "render", check: bool = True
+) -> DatasetSettings:
+    """Return the chain's settings of one replicate (:class:`ballbat.chain.DatasetSettings`).
+
+    The dataset block at the replicate's sweep point (:func:`point_dataset`), drawn from the
+    replicate's seeds (experiment, tracks). A study records every replicate's numbers as they
+    come (no refusal of an unphysical e_x) and fits no systematic (:func:`run_replicate` asks
+    for the calibration's where the replicate draws its calibration); the tracks are reduced
+    again at +-1 sigma of each stated calibration uncertainty only where the calibration is drawn
+    (the workflow's reduce always does). ``check=False``: no cross-checks and no reruns (the truth
+    job's large experiment, whose truth needs neither; :attr:`ReduceSettings.cross_check`).
+    ``settings`` None: the reference bat speed and the example's friction are the schema's (they
+    do not enter the source, :func:`replicate_source`).
+    """
+    from .chain import DatasetSettings, schema_settings
+    from .stages import fit_ex, normalize
+
+    drawn = renders(dataset) and bool(dataset["render"]["draw_calibration"])
+    if settings is None:
+        defaults = schema_settings({}, "study")
+        norm, mu_k = defaults.normalize, defaults.fit_ex.mu_k_example
+    else:
+        norm, mu_k = normalize.NormalizeSettings(v_ref_mph=settings.v_ref_mph), settings.mu_k_example
+    base = DatasetSettings.from_block(
+        dataset,
+        "study",
+        norm,
+        fit_ex.FitExSettings(mu_k, systematic=False, check_physical=False),
+        systematics=drawn,
+        where=where,
+    ).with_seeds(*seeds)
+    if check or base.reduce is None:
+        return base
+    return base.replace(reduce=replace(base.reduce, cross_check=False, systematics=False))
+
+
+def replicate_source(
     dataset: dict,
     seeds: tuple[int, int],
     balls: dict[str, Ball],
@@ -78,36 +116,10 @@ def _source(
     where: str = "render",
     check: bool = True,
 ) -> xr.Dataset:
-    """Simulate one experiment and, when the dataset renders tracks, render, reduce and cross-check them.
+    """Return one replicate's impacts: the chain's source (simulate; render and reduce) on :func:`chain_settings`."""
+    from . import chain
 
-    The same stages as the workflow's simulate, render_tracks and reduce rules
-    (:mod:`ballbat.stages`), so every render and reduce setting is honoured alike; the tracks
-    stay in memory (the workflow's make a round trip through tracks.nc). A dataset that draws
-    its calibration (``render.draw_calibration``) is reduced again at +-1 sigma of each stated
-    calibration uncertainty, as the workflow's reduce does, so that its replicates report the
-    calibration systematics. ``check=False`` skips the cross-checks of the settings
-    (:func:`ballbat.tracks.checks.cross_check`): for the truth job's large experiment, whose
-    truth needs no check, and where the checks' tight errors over some 70000 impacts flag a
-    small bias of the tip's arc at 5 px as a wrong rig (kappa 1.34 +- 0.006 against at most 1.23).
-    """
-    from .stages import reduce, render, simulate
-    from .synthetic import SyntheticSettings
-
-    sim = simulate.run(SyntheticSettings(**{**dataset["synthetic"], "seed": seeds[0]}), balls, bats)
-    block = dataset.get("render") or {}
-    if not renders(dataset):
-        return sim
-    from .tracks.data import camera_block
-    from .tracks.render import settings_from_config
-
-    cfg = {**block, "seed": seeds[1]}
-    tracks = render.render(settings_from_config(cfg), sim, balls)
-    settings = reduce.ReduceSettings.from_config(camera_block(cfg), where, systematics=bool(cfg["draw_calibration"]))
-    if not check:
-        from .tracks.reduce import reduce_tracks
-
-        return reduce.reduction_dataset(reduce_tracks(tracks, settings.cameras, settings.rig, settings.options))
-    return reduce.run(settings, tracks, balls, bats)
+    return chain.source(chain_settings(None, dataset, seeds, where, check), balls, bats)
 
 
 def _truth_source(src: xr.Dataset) -> xr.Dataset:
@@ -165,7 +177,7 @@ def run_replicate(
     balls, bats : dict
         Property tables.
     check : bool
-        Cross-check the reduced tracks' settings (:func:`_source`; off for the truth job).
+        Cross-check the reduced tracks' settings (:func:`chain_settings`; off for the truth job).
 
     Returns
     -------
@@ -175,25 +187,22 @@ def run_replicate(
         calibration_effect, where the calibration is drawn, the first-order change the draw made:
         :func:`_calibration_effect`).
     """
-    from .stages import fit_ex, normalize, reconstruct
-
-    seeds = replicate_seeds(settings.seed, replicate)
-    src = _source(dataset, seeds, balls, bats, f"render (replicate {replicate})", check)
-    norm = normalize.NormalizeSettings(v_ref_mph=settings.v_ref_mph)
-    rec = reconstruct.run(reconstruct.ReconstructSettings(), normalize.run(norm, src), balls, bats)
-    # the calibration systematics where the replicate draws its calibration (the combined interval's
-    # coverage); every replicate's numbers are recorded as they come
+    from . import chain
     from .systematics import has_shifts
     from .tracks.render import calibration_draws
 
-    drawn = has_shifts(rec)
-    fit, fs = fit_ex.fit(fit_ex.FitExSettings(settings.mu_k_example, systematic=drawn, check_physical=False), rec)
+    seeds = replicate_seeds(settings.seed, replicate)
+    cs = chain_settings(settings, dataset, seeds, f"render (replicate {replicate})", check)
+    src = chain.source(cs, balls, bats)
+    # the calibration systematics where the replicate draws its calibration (the combined interval's
+    # coverage); every replicate's numbers are recorded as they come
+    drawn = has_shifts(src)
+    run = chain.run(cs.replace(fit_ex=replace(cs.fit_ex, systematic=drawn)), src, balls, bats)
+    rec, fit, fs = run.reconstruct, run.fit_ex, run.fit_systematics
     z = calibration_draws({**dataset["render"], "seed": seeds[1]}) if drawn else None
     rows = fit_quantity_rows(fit, None if fs is None else _calibration_effect(fit, fs.signed, z))
     if "eta2" in STUDY_QUANTITIES:
-        rec_truth = reconstruct.run(
-            reconstruct.ReconstructSettings(), normalize.run(norm, _truth_source(src)), balls, bats
-        )
+        rec_truth = chain.reconstructed(cs, _truth_source(src), balls, bats)
         balls_fitted = fit["ball"].values.astype(str)
         nan = np.full(balls_fitted.size, np.nan)
         syst, effect = _eta2_systematic(rec, balls_fitted, settings.stronge, z) if drawn else (nan, nan)

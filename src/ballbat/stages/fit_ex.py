@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..fitting import FitGrid, FitStatus, ImplausibleFit, Sec4, analyze_impacts, check_physical, fit_status
+from ..fitting import FitGrid, FitStatus, Sec4, analyze_impacts, check_physical, fit_status
 from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 from ..systematics import FIT_QUANTITIES, SIDES, SOURCES, FitSystematics, has_shifts, shifted_impacts
 from .systematics import systematic_vars
@@ -197,27 +197,6 @@ def not_fitted(ds: xr.Dataset) -> list[str]:
             reason = FitStatus(int(status.values[idx])).name.lower().replace("_", " ")
             lines.append(f"{name} ({where}): not fitted: {reason} ({int(n.values[idx])} usable impacts)")
     return lines
-
-
-def fit_problems(ds: xr.Dataset, balls: dict, bats: dict) -> list[str]:
-    """Return why the workflow's fit_ex would stop on these impacts (empty when it would not).
-
-    The same chain as the workflow's (normalize, reconstruct, the Sec. IV fits) and the same
-    test (:func:`ballbat.fitting.check_physical`: every fitted e_x in [-1, 1]), so that
-    ``ballbat check`` never calls usable a file that fit_ex refuses (the ingest job itself
-    stays light: it imports no fitting). The
-    reference bat speed and the friction of the Sec. IV example do not enter e_x.
-    """
-    from . import normalize, reconstruct
-
-    rec = reconstruct.run(
-        reconstruct.ReconstructSettings(), normalize.run(normalize.NormalizeSettings(v_ref_mph=77.0), ds), balls, bats
-    )
-    try:
-        check_physical(analyze_impacts(rec, mu_k_example=0.5, systematic=False), source="the fit of e_x (fit_ex)")
-    except ImplausibleFit as exc:
-        return [str(exc)]
-    return []
 
 
 # ---------------------------------------------------------------------------------------

@@ -110,7 +110,7 @@ class ReduceOptions:
     """Fewest frames per fit (the fits need at least two more than their parameters).
 
     No field has a default: the defaults are the config schema's ``min_frames`` alone
-    (:func:`ballbat.tracks.stage.reduce_options`; :meth:`schema_defaults`).
+    (:func:`ballbat.stages.reduce.reduce_options`; :meth:`schema_defaults`).
     """
 
     min_tip_frames: int
