@@ -42,13 +42,12 @@ rate to unwrap. Exclude, never drop.
 from __future__ import annotations
 
 import enum
-import warnings
 from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..batched import full_rank, gram, tdot
+from ..batched import full_rank, gram, nanmedian_rows, tdot
 from ..units import G
 from .checks import IMPACT_Z, START_MARKS, camera_agreement, glitch_mask, misplaced_starts
 from .data import CONTACT_PRIOR, POINTS, Camera, CameraTracks, Rig, Tracks
@@ -195,10 +194,8 @@ def find_onset(x: np.ndarray, y: np.ndarray) -> Onset:
     rank = np.cumsum(valid, axis=1)
     early = valid & (rank <= N_REST)
     cols = np.arange(x.shape[1])[None, :]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        x0 = np.nanmedian(np.where(early, x, np.nan), axis=1)
-        y0 = np.nanmedian(np.where(early, y, np.nan), axis=1)
+    x0 = nanmedian_rows(np.where(early, x, np.nan))  # numpy.nanmedian's numbers, without masked arrays
+    y0 = nanmedian_rows(np.where(early, y, np.nan))
     # Two passes: the tracking scatter from the first frames, then from every frame at rest
     # before the impact that pass found (more frames, a steadier threshold).
     rest_frames = early
