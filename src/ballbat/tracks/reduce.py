@@ -42,6 +42,7 @@ rate to unwrap. Exclude, never drop.
 from __future__ import annotations
 
 import enum
+import functools
 from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING
 
@@ -372,10 +373,24 @@ def _beta_weights(grid: np.ndarray, p: ArrayLike) -> np.ndarray:
     """
     m = 1.0 / (1.0 + np.exp(-p[0]))
     kappa = min(np.exp(p[1]), m * (1 - m) * (grid.size / CONTACT_MIN_SD_STEPS) ** 2)
-    x = (np.arange(grid.size) + 0.5) / grid.size
-    logw = (m * kappa - 1) * np.log(x) + ((1 - m) * kappa - 1) * np.log1p(-x)
+    log_x, log_1mx = _beta_logs(grid.size)
+    logw = (m * kappa - 1) * log_x + ((1 - m) * kappa - 1) * log_1mx
     w = np.exp(logw - logw.max())
     return w / w.sum()
+
+
+@functools.lru_cache(maxsize=8)
+def _beta_logs(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """log(x) and log(1 - x) at the cell centres x of a grid of ``n`` (read-only; computed once per n).
+
+    :func:`_beta_weights` runs inside the Nelder-Mead search of :func:`_contact_population`, a
+    hundred times a replicate, on the same grid.
+    """
+    x = (np.arange(n) + 0.5) / n
+    logs = np.log(x), np.log1p(-x)
+    for a in logs:
+        a.flags.writeable = False
+    return logs
 
 
 def _contact_population(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -> np.ndarray:
