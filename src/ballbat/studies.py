@@ -143,7 +143,7 @@ def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> t
     kw = {k: stronge[k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")}
     d = vtf_data(rec, sel)
     try:
-        fit = fit_ball(d, **kw)
+        fit = fit_ball(d, interval=False, **kw)  # the study keeps the value, error and dof, not the interval
         truth = fit_ball(
             vtf_data(rec_truth, sel),
             sigma=d.sigma,

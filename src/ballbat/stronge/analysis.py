@@ -384,13 +384,12 @@ def finite_sample_bias(data: VtfData, w: NDArray[np.float64] | None, at: dict[st
     """
     w = np.ones_like(data.x) if w is None else w
 
-    def r(eta2: float) -> NDArray[np.float64]:
-        e = stronge_ex(data.psi, ContactParams(eta2, at["e_y"], at["mu"], data.r_x, data.r_y, data.alpha))
-        return (data.y - (1.0 + e) * data.x) / w
-
     t0 = at["eta2"]
     h = FINITE_SAMPLE_STEP * t0
-    rm2, rm1, r0, rp1, rp2 = (r(t0 + k * h) for k in (-2, -1, 0, 1, 2))
+    # the five steps in one call of the elementwise model (each row as a call of its own, to round-off)
+    eta2 = t0 + np.array([-2.0, -1.0, 0.0, 1.0, 2.0])[:, None] * h
+    e = stronge_ex(data.psi, ContactParams(eta2, at["e_y"], at["mu"], data.r_x, data.r_y, data.alpha))
+    rm2, rm1, r0, rp1, rp2 = (data.y - (1.0 + e) * data.x) / w
     r1 = (rp1 - rm1) / (2 * h)
     r2 = (rp1 - 2 * r0 + rm1) / h**2
     r3 = (rp2 - 2 * rp1 + 2 * rm1 - rm2) / (2 * h**3)
@@ -424,25 +423,41 @@ def eiv_step(data: VtfData, w: NDArray[np.float64], at: dict[str, float], names:
     """
     psi, x = data.psi, data.x
     nz = data.noise
-
-    def ex(dpsi: float = 0.0, **shift: float) -> NDArray[np.float64]:
-        p = {k: at[k] + shift.get(k, 0.0) for k in ("eta2", "e_y", "mu")}
-        return stronge_ex(psi + dpsi, ContactParams(p["eta2"], p["e_y"], p["mu"], data.r_x, data.r_y, data.alpha))
-
-    dpsi = nz.jx * (np.cos(psi) ** 2 * (1.0 + data.r_x))[:, None]  # x = tan psi / (1 + r_x)
     hp = EIV_STEP_PSI
-    e_psi = (ex(hp) - ex(-hp)) / (2 * hp)
-    dr = (nz.jy - (1 + ex())[:, None] * nz.jx - (e_psi * x)[:, None] * dpsi) / w[:, None]
+    steps = {k: EIV_STEP_PARAM * max(abs(at[k]), 1e-3) for k in names}
+    ex = _ex_at(data, at, steps, hp)
+    dpsi = nz.jx * (np.cos(psi) ** 2 * (1.0 + data.r_x))[:, None]  # x = tan psi / (1 + r_x)
+    e_psi = (ex[hp, None, 0] - ex[-hp, None, 0]) / (2 * hp)
+    dr = (nz.jy - (1 + ex[0.0, None, 0])[:, None] * nz.jx - (e_psi * x)[:, None] * dpsi) / w[:, None]
     J, c = [], []
-    for k in names:
-        h = EIV_STEP_PARAM * max(abs(at[k]), 1e-3)
-        e_k = (ex(**{k: h}) - ex(**{k: -h})) / (2 * h)
-        e_k_psi = (ex(hp, **{k: h}) - ex(-hp, **{k: h}) - ex(hp, **{k: -h}) + ex(-hp, **{k: -h})) / (4 * hp * h)
+    for k, h in steps.items():
+        e_k = (ex[0.0, k, 1] - ex[0.0, k, -1]) / (2 * h)
+        e_k_psi = (ex[hp, k, 1] - ex[-hp, k, 1] - ex[hp, k, -1] + ex[-hp, k, -1]) / (4 * hp * h)
         dr_k = -((e_k_psi * x)[:, None] * dpsi + e_k[:, None] * nz.jx) / w[:, None]
         J.append(-e_k * x / w)
         c.append(np.sum(dr * dr_k * nz.sigma**2))
     J = np.stack(J, axis=1)
     return np.linalg.solve(J.T @ J, np.asarray(c))
+
+
+def _ex_at(
+    data: VtfData, at: dict[str, float], steps: dict[str, float], hp: float
+) -> dict[tuple[float, str | None, int], NDArray[np.float64]]:
+    """e_x of the impacts at the points :func:`eiv_step` differentiates, from one call of the model.
+
+    Keys ``(dpsi, name, sign)``: psi shifted by ``dpsi`` (0 or +-``hp``) and parameter ``name``
+    by ``sign`` times its step (``(dpsi, None, 0)``: no parameter shifted). The model is
+    elementwise, so each row equals a call at that point alone (to round-off: the Newton
+    iterations of :func:`stronge_ex` stop when the whole batch has converged).
+    """
+    keys = [(hp, None, 0), (-hp, None, 0), (0.0, None, 0)]
+    for k in steps:
+        keys += [(0.0, k, 1), (0.0, k, -1), (hp, k, 1), (-hp, k, 1), (hp, k, -1), (-hp, k, -1)]
+    dpsi = np.array([d for d, _, _ in keys])[:, None]
+    shift = {q: np.array([s * steps[k] if k == q else 0.0 for _, k, s in keys])[:, None] for q in ("eta2", "e_y", "mu")}
+    p = {q: at[q] + shift[q] for q in ("eta2", "e_y", "mu")}
+    ex = stronge_ex(data.psi + dpsi, ContactParams(p["eta2"], p["e_y"], p["mu"], data.r_x, data.r_y, data.alpha))
+    return dict(zip(keys, ex, strict=True))
 
 
 def analyse_ball(

@@ -79,18 +79,27 @@ def _describe(psi, e_y, mu, vary_e_y, vary_mu) -> str:
     )
 
 
-def _jacobian(residual, at: dict[str, float], names: list[str]) -> np.ndarray:
-    """Central-difference Jacobian (n, len(names)) of ``residual(eta2, e_y, mu)`` at ``at``."""
-    cols = []
+def _jacobian(residual, at: dict[str, float], names: list[str]) -> tuple[np.ndarray, np.ndarray]:
+    """Central-difference Jacobian (n, len(names)) of ``residual(eta2, e_y, mu)`` at ``at``, and the residual there.
+
+    One call of ``residual`` with the parameters as columns (m, 1) evaluates ``at`` and the
+    two steps of every parameter at once: the model is elementwise, so each row is the
+    residual a call at that point alone gives (to round-off: the Newton iterations of
+    :func:`ballbat.stronge.model.stronge_ex` stop when the whole batch has converged).
+    """
+    points = [dict(at)]
+    steps = []
     for k in names:
         h = 1e-6 * max(abs(at[k]), 1e-3)
         up, down = dict(at), dict(at)
         up[k] += h
         down[k] -= h
-        cols.append(
-            (residual(up["eta2"], up["e_y"], up["mu"]) - residual(down["eta2"], down["e_y"], down["mu"])) / (2 * h)
-        )
-    return np.stack(cols, axis=1)
+        points += [up, down]
+        steps.append(h)
+    col = {q: np.array([pt[q] for pt in points])[:, None] for q in ("eta2", "e_y", "mu")}
+    rows = residual(col["eta2"], col["e_y"], col["mu"])
+    cols = [(rows[1 + 2 * i] - rows[2 + 2 * i]) / (2 * h) for i, h in enumerate(steps)]
+    return np.stack(cols, axis=1), rows[0]
 
 
 def fit_eta2(
@@ -298,8 +307,8 @@ def _robust_errors(params, residual, strata, level: float) -> tuple[dict[str, fl
 
     errs = _lmfit_errors(params)
     names = [k for k in ("eta2", "e_y", "mu") if params[k].vary]
-    J = _jacobian(residual, {k: params[k].value for k in ("eta2", "e_y", "mu")}, names)
-    cov = sandwich_cov(J, residual(params["eta2"].value, params["e_y"].value, params["mu"].value), strata)
+    J, r = _jacobian(residual, {k: params[k].value for k in ("eta2", "e_y", "mu")}, names)
+    cov = sandwich_cov(J, r, strata)
     errs.update({k: float(np.sqrt(cov[i, i])) for i, k in enumerate(names)})
     dof = sandwich_dof(J, strata, 0)
     var_unscaled = float(np.linalg.inv(J.T @ J)[0, 0])

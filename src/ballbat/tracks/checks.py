@@ -31,7 +31,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..batched import gram, tdot
+from ..batched import gram, nanmedian_rows, tdot
 from ..units import INCH, G
 
 if TYPE_CHECKING:
@@ -227,7 +227,7 @@ def _midpoint_noise(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarra
     with np.errstate(invalid="ignore"), warnings.catch_warnings():
         warnings.simplefilter("ignore", RuntimeWarning)  # all-NaN rows
         enough = np.isfinite(comps).sum(axis=1) >= 10
-        med = np.where(enough, np.nanmedian(np.abs(comps), axis=1), 0.0)
+        med = np.where(enough, nanmedian_rows(np.abs(comps)), 0.0)  # numpy.nanmedian's numbers, faster
     return rx, ry, np.maximum(1.4826 * med, pooled)
 
 

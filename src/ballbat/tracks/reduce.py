@@ -42,13 +42,13 @@ rate to unwrap. Exclude, never drop.
 from __future__ import annotations
 
 import enum
-import warnings
+import functools
 from dataclasses import dataclass, fields, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..batched import full_rank, gram, tdot
+from ..batched import full_rank, gram, nanmedian_rows, tdot
 from ..units import G
 from .checks import IMPACT_Z, START_MARKS, camera_agreement, glitch_mask, misplaced_starts
 from .data import CONTACT_PRIOR, POINTS, Camera, CameraTracks, Rig, Tracks
@@ -195,10 +195,8 @@ def find_onset(x: np.ndarray, y: np.ndarray) -> Onset:
     rank = np.cumsum(valid, axis=1)
     early = valid & (rank <= N_REST)
     cols = np.arange(x.shape[1])[None, :]
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore", RuntimeWarning)
-        x0 = np.nanmedian(np.where(early, x, np.nan), axis=1)
-        y0 = np.nanmedian(np.where(early, y, np.nan), axis=1)
+    x0 = nanmedian_rows(np.where(early, x, np.nan))  # numpy.nanmedian's numbers, without masked arrays
+    y0 = nanmedian_rows(np.where(early, y, np.nan))
     # Two passes: the tracking scatter from the first frames, then from every frame at rest
     # before the impact that pass found (more frames, a steadier threshold).
     rest_frames = early
@@ -375,10 +373,24 @@ def _beta_weights(grid: np.ndarray, p: ArrayLike) -> np.ndarray:
     """
     m = 1.0 / (1.0 + np.exp(-p[0]))
     kappa = min(np.exp(p[1]), m * (1 - m) * (grid.size / CONTACT_MIN_SD_STEPS) ** 2)
-    x = (np.arange(grid.size) + 0.5) / grid.size
-    logw = (m * kappa - 1) * np.log(x) + ((1 - m) * kappa - 1) * np.log1p(-x)
+    log_x, log_1mx = _beta_logs(grid.size)
+    logw = (m * kappa - 1) * log_x + ((1 - m) * kappa - 1) * log_1mx
     w = np.exp(logw - logw.max())
     return w / w.sum()
+
+
+@functools.lru_cache(maxsize=8)
+def _beta_logs(n: int) -> tuple[np.ndarray, np.ndarray]:
+    """log(x) and log(1 - x) at the cell centres x of a grid of ``n`` (read-only; computed once per n).
+
+    :func:`_beta_weights` runs inside the Nelder-Mead search of :func:`_contact_population`, a
+    hundred times a replicate, on the same grid.
+    """
+    x = (np.arange(n) + 0.5) / n
+    logs = np.log(x), np.log1p(-x)
+    for a in logs:
+        a.flags.writeable = False
+    return logs
 
 
 def _contact_population(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -> np.ndarray:
@@ -838,6 +850,26 @@ def _spin_joint_fit(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, inter
     return tuple(joined)
 
 
+def _spin_dot_rows(p, j, ct_x, ct_y, m, wd, ud, zero_one):
+    """Residual rows (x, y) and their Jacobian blocks (impact, frame, 9) of dot ``j`` at the parameters ``p``.
+
+    For :func:`_spin_block`: the dot at the ball's centre plus its radius turned by the
+    spin; ``m`` its tracked frames, ``wd`` their weights, ``ud`` their times (0 untracked),
+    ``zero_one`` arrays of 0 and 1 of their shape.
+    """
+    zero, one = zero_one
+    rho, phase = p[:, [5 + 2 * j]], p[:, [6 + 2 * j]]
+    ang = phase + p[:, [4]] * ud
+    c, sn = np.cos(ang), np.sin(ang)
+    dcx, dcy = p[:, [0]] + p[:, [1]] * ud, p[:, [2]] + p[:, [3]] * ud - 0.5 * G * ud**2
+    rows = [np.where(m, (ct_x - dcx - rho * c) * wd, 0.0), np.where(m, (ct_y - dcy - rho * sn) * wd, 0.0)]
+    jx = [-one, -ud, zero, zero, rho * sn * ud] + ([-c, rho * sn, zero, zero] if j == 0 else [zero, zero, -c, rho * sn])
+    jy = [zero, zero, -one, -ud, -rho * c * ud] + (
+        [-sn, -rho * c, zero, zero] if j == 0 else [zero, zero, -sn, -rho * c]
+    )
+    return rows, [np.stack(jx, axis=-1) * wd[..., None], np.stack(jy, axis=-1) * wd[..., None]]
+
+
 def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept, radius, masks, s_dot):
     """Fit the spin, the dots' radii and phases and the ball's flight together, on positions.
 
@@ -873,35 +905,24 @@ def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept
         axis=1,
     )
     wb = np.where(flight.mask, 1.0 / flight.sigma[:, None], 0.0)
+    dots = ("dot_a", "dot_b")
     with np.errstate(all="ignore"):
+        # what does not change between iterations: the dots' weights and times, the ball's Jacobian
+        wd = {d: np.where(masks[d], 1.0 / s_dot[:, None], 0.0) for d in dots}
+        ud = {d: np.where(masks[d], u, 0.0) for d in dots}
+        zero, one = np.zeros_like(u), np.ones_like(u)
+        ball_jac = [
+            np.stack([-one, -ub, zero, zero] + [zero] * 5, axis=-1) * wb[..., None],
+            np.stack([zero, zero, -one, -ub] + [zero] * 5, axis=-1) * wb[..., None],
+        ]
         for _ in range(SPIN_GN_ITERATIONS):
-            rows, jac = [], []
             cx, cy = p[:, [0]] + p[:, [1]] * ub, p[:, [2]] + p[:, [3]] * ub - 0.5 * G * ub**2
-            zero, one = np.zeros_like(u), np.ones_like(u)
-            rows += [np.where(wb > 0, (X - cx) * wb, 0.0), np.where(wb > 0, (Y - cy) * wb, 0.0)]
-            jac += [
-                np.stack([-one, -ub, zero, zero] + [zero] * 5, axis=-1) * wb[..., None],
-                np.stack([zero, zero, -one, -ub] + [zero] * 5, axis=-1) * wb[..., None],
-            ]
-            for j, d in enumerate(("dot_a", "dot_b")):
-                m = masks[d]
-                wd = np.where(m, 1.0 / s_dot[:, None], 0.0)
-                ud = np.where(m, u, 0.0)
-                rho, phase = p[:, [5 + 2 * j]], p[:, [6 + 2 * j]]
-                ang = phase + p[:, [4]] * ud
-                c, sn = np.cos(ang), np.sin(ang)
-                dcx, dcy = p[:, [0]] + p[:, [1]] * ud, p[:, [2]] + p[:, [3]] * ud - 0.5 * G * ud**2
-                rows += [
-                    np.where(m, (ct_x[d] - dcx - rho * c) * wd, 0.0),
-                    np.where(m, (ct_y[d] - dcy - rho * sn) * wd, 0.0),
-                ]
-                jx = [-one, -ud, zero, zero, rho * sn * ud] + (
-                    [-c, rho * sn, zero, zero] if j == 0 else [zero, zero, -c, rho * sn]
-                )
-                jy = [zero, zero, -one, -ud, -rho * c * ud] + (
-                    [-sn, -rho * c, zero, zero] if j == 0 else [zero, zero, -sn, -rho * c]
-                )
-                jac += [np.stack(jx, axis=-1) * wd[..., None], np.stack(jy, axis=-1) * wd[..., None]]
+            rows = [np.where(wb > 0, (X - cx) * wb, 0.0), np.where(wb > 0, (Y - cy) * wb, 0.0)]
+            jac = list(ball_jac)
+            for j, d in enumerate(dots):
+                r_d, j_d = _spin_dot_rows(p, j, ct_x[d], ct_y[d], masks[d], wd[d], ud[d], (zero, one))
+                rows += r_d
+                jac += j_d
             r = np.concatenate(rows, axis=1)
             J = np.concatenate(jac, axis=1)
             A = gram(J)
@@ -919,11 +940,10 @@ def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept
         # score test of a common offset of the dots' circles (the last iteration's residuals and design)
         Jo = np.zeros((*r.shape, 2))
         nb = 2 * u.shape[1]  # the ball's x and y rows come first, then x and y of each dot
-        for j, d in enumerate(("dot_a", "dot_b")):
-            wd = np.where(masks[d], 1.0 / s_dot[:, None], 0.0)
+        for j, d in enumerate(dots):
             k = nb + 2 * j * u.shape[1]
-            Jo[:, k : k + u.shape[1], 0] = -wd
-            Jo[:, k + u.shape[1] : k + 2 * u.shape[1], 1] = -wd
+            Jo[:, k : k + u.shape[1], 0] = -wd[d]
+            Jo[:, k + u.shape[1] : k + 2 * u.shape[1], 1] = -wd[d]
         B = gram(J, Jo)
         V = gram(Jo) - gram(B, cov @ B)
         g = tdot(Jo, r)
