@@ -27,15 +27,14 @@ from ballbat import studies
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
 from ballbat.stages import fit_ex, normalize, reconstruct, reduce, render, simulate, study_batch
-from ballbat.tracks import stage as tracks_stage
 
 #: (module, function name, label): the stage functions a replicate calls, timed where they are looked up.
 STAGES = [
     (simulate, "run", "simulate"),
     (render, "render", "render tracks"),
     (reduce, "run", "reduce (with cross-checks)"),
-    (tracks_stage, "reduce_tracks", "  of which: the track fits"),
-    (tracks_stage, "cross_check", "  of which: the cross-checks"),
+    (reduce, "reduce_tracks", "  of which: the track fits"),
+    (reduce, "cross_check", "  of which: the cross-checks"),
     (normalize, "run", "normalize"),
     (reconstruct, "run", "reconstruct (x2: measured, truth)"),
     (fit_ex, "fit", "fit_ex (Sec. IV fits)"),
