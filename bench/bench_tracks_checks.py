@@ -5,7 +5,7 @@
 Renders the default config's ``synthetic`` dataset (108 impacts, 2 px tracking noise, 3 % of
 tilted spin axes) with ``n_seeds`` seeds (default 50; the simulation and the rendering
 seeds both vary), reduces and cross-checks each as the reduce rule does
-(:func:`ballbat.tracks.checks.cross_check`), and counts what the checks added: datasets
+(:func:`ballbat.tracks.verdict.cross_check`), and counts what the checks added: datasets
 stopped, impacts excluded by a new reason (cameras disagree, implausible), glitches removed,
 and warnings. Also prints the pooled observables' spread over the seeds (g, speed ratio, tip
 arc, dot radius). Clean data should raise none.
@@ -28,11 +28,11 @@ from ballbat.properties import InputError, load_balls, load_bats
 from ballbat.stages import simulate
 from ballbat.stages.impacts import SIMULATED_TRUTH
 from ballbat.synthetic import SyntheticSettings
-from ballbat.tracks.checks import cross_check
 from ballbat.tracks.data import CameraTracks, Rig, camera_block
 from ballbat.tracks.io import cameras_from_config
 from ballbat.tracks.reduce import ReduceFlag, reduce_tracks
 from ballbat.tracks.render import render_tracks, settings_from_config
+from ballbat.tracks.verdict import cross_check
 
 ROOT = Path(__file__).resolve().parents[1]
 ARGS = [a for a in sys.argv[1:] if not a.startswith("--")]

@@ -14,10 +14,10 @@ from test_tracks import BALLS, BATS, experiment, render, render_cfg
 
 from ballbat.properties import InputError
 from ballbat.stages.reduce import reduction_dataset
-from ballbat.tracks.checks import cross_check
 from ballbat.tracks.data import CameraTracks, Rig, to_long
 from ballbat.tracks.io import cameras_from_config, load_tracks
 from ballbat.tracks.reduce import ReduceFlag, reduce_tracks
+from ballbat.tracks.verdict import cross_check
 
 
 @pytest.fixture(scope="module")

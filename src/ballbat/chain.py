@@ -31,10 +31,10 @@ if TYPE_CHECKING:
     import xarray as xr
 
     from .properties import Ball, Bat
-    from .tracks.checks import Verdict
     from .tracks.data import Tracks
     from .tracks.reduce import Reduction
     from .tracks.render import RenderSettings
+    from .tracks.verdict import Verdict
 
 
 @dataclass(frozen=True)
@@ -133,7 +133,7 @@ class DatasetSettings:
             render=render.settings_from_config({**self.block["render"], "seed": render_seed}) if rendered else None,
         )
 
-    def replace(self, **changes) -> DatasetSettings:
+    def replace(self, **changes: object) -> DatasetSettings:
         """Return a copy with ``changes`` (:func:`dataclasses.replace`)."""
         return dataclasses.replace(self, **changes)
 

@@ -366,7 +366,7 @@ def run_replicates(
     the point (:meth:`StudySettings.batch_range`), its rows (:func:`run_replicate`) and, when the
     chain refused its data, why ("" otherwise; no rows then).
 
-    A check of the data (:func:`ballbat.tracks.checks.cross_check`) refuses a lab's dataset at
+    A check of the data (:func:`ballbat.tracks.verdict.cross_check`) refuses a lab's dataset at
     a false-alarm rate of about 1e-3 per test; over a study's thousands of replicates some are
     refused by chance, and a lab whose data were refused would not report them either. They
     are counted (``n_refused`` of the coverage table), not hidden. More than

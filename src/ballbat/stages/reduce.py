@@ -2,7 +2,7 @@
 
 :func:`reduction_table` declares the file (the impacts table of :mod:`.impacts` with the fits'
 diagnostics); :func:`run` reduces the tracks (:func:`ballbat.tracks.reduce.reduce_tracks`),
-cross-checks the result (:func:`ballbat.tracks.checks.cross_check`) and assembles the file.
+cross-checks the result (:func:`ballbat.tracks.verdict.cross_check`) and assembles the file.
 """
 
 from __future__ import annotations
@@ -13,9 +13,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..pipeline.products import Var, build_dataset, flag_attrs
-from ..tracks.checks import Verdict, cross_check
 from ..tracks.io import cameras_from_config
 from ..tracks.reduce import FLAG_VAR, ReduceFlag, ReduceOptions, Reduction, reduce_tracks
+from ..tracks.verdict import Verdict, cross_check
 from .impacts import IMPACT_COORDS, QUANTITIES, measured, truth_var
 from .systematics import add_shifts
 
@@ -47,7 +47,7 @@ class ReduceSettings:
         (:func:`ballbat.systematics.reduce_shifts`): the workflow does, a replicate of a study
         does where it draws its calibration.
     cross_check : bool
-        Cross-check the settings against the reduced tracks (:func:`ballbat.tracks.checks.cross_check`).
+        Cross-check the settings against the reduced tracks (:func:`ballbat.tracks.verdict.cross_check`).
         Always, but in a study's truth job: its truth needs no check, and the checks' tight errors
         over some 70000 impacts flag a small bias of the tip's arc at 5 px as a wrong rig.
     """
@@ -265,7 +265,7 @@ def run(
     Raises
     ------
     ballbat.properties.InputError
-        A cross-check that stops the dataset (:func:`ballbat.tracks.checks.cross_check`).
+        A cross-check that stops the dataset (:func:`ballbat.tracks.verdict.cross_check`).
     """
     red, verdict = reduce_and_check(settings, tracks, balls, bats)
     ds = reduction_dataset(red)
