@@ -115,8 +115,8 @@ def _v(units, long_name, role=None, **extra):
     return Var(("impact",), units, long_name, attrs)
 
 
-def reduction_table(truth_names: Sequence[str] = ()) -> dict[str, Var]:
-    """Return the declared variables of ``reduce.nc``."""
+def _measured_table() -> dict[str, Var]:
+    """Return the measured values of reduce.nc with their uncertainties, angles and contact times."""
     table: dict[str, Var] = {}
     for k in QUANTITIES:
         anc = f"{k}_err {k}_err_scale" if k in ("v_bat", "v_ball") else f"{k}_err"
@@ -139,6 +139,12 @@ def reduction_table(truth_names: Sequence[str] = ()) -> dict[str, Var]:
         "s", "fitted time the contact began (end of the bat-tip fit), from the swing camera's frame origin"
     )
     table["contact_start_time_err"] = _v("s", "standard uncertainty of the fitted contact start")
+    return table
+
+
+def _motion_table() -> dict[str, Var]:
+    """Return the frames and fitted motions of reduce.nc: impact, separation, flights, the tip's fit."""
+    table: dict[str, Var] = {}
     for cam in ("swing", "spin"):
         table[f"impact_frame_{cam}"] = _v("1", f"first {cam}-camera frame with the ball moving (-1: none)")
         table[f"separation_frame_{cam}"] = _v("1", f"first {cam}-camera frame of the ball's free flight (-1: none)")
@@ -157,6 +163,12 @@ def reduction_table(truth_names: Sequence[str] = ()) -> dict[str, Var]:
         for c, what in (("x", "along the swing"), ("y", "upward")):
             table[f"flight_{c}0_{cam}"] = _v("m", f"fitted ball position {what} at separation, {cam} camera")
             table[f"flight_v{c}_{cam}"] = _v("m s-1", f"fitted ball velocity {what} at separation, {cam} camera")
+    return table
+
+
+def _spin_table() -> dict[str, Var]:
+    """Return the tip's and the spin's fitted parameters, the glitches removed and the flag."""
+    table: dict[str, Var] = {}
     table["tip_offset"] = _v("m", "fitted tip position along the swing at the alignment time (from the tip centroid)")
     table["tip_centroid_x"] = _v("m", "centroid of the fitted tip positions along the image x (swing-positive)")
     table["tip_centroid_y"] = _v("m", "centroid of the fitted tip positions, upward")
@@ -176,6 +188,12 @@ def reduction_table(truth_names: Sequence[str] = ()) -> dict[str, Var]:
         ("impact",), "1", "exclusion flag set when the camera tracks were reduced (0: usable)", flag_attrs(ReduceFlag)
     )
     table[f"{FLAG_VAR}_reason"] = Var(("impact",), None, "why the impact is excluded (ok if it is not)")
+    return table
+
+
+def reduction_table(truth_names: Sequence[str] = ()) -> dict[str, Var]:
+    """Return the declared variables of ``reduce.nc``."""
+    table = {**_measured_table(), **_motion_table(), **_spin_table()}
     for k in truth_names:
         table[k] = truth_var(k)
     return table
