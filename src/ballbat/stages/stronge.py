@@ -182,8 +182,46 @@ def run(settings: StrongeSettings, impacts: xr.Dataset) -> xr.Dataset:
         No ball has ``MIN_FIT_IMPACTS`` usable impacts.
     """
     rec = impacts
+    balls, skipped, psi_grid, res = _fit_balls(settings, rec)
+    # Fig. 10: time histories at psi_history for the fitted parameters, on one time grid that
+    # reaches the last separation (the balls' e_y differ when e_y is fitted).
+    t_max = max(1.0 + r.fit.e_y for r in res)
+    hist = [
+        time_history(np.deg2rad(settings.psi_history_deg), r.params, n_time=settings.n_time, t_max=t_max) for r in res
+    ]
+    values = _stronge_values(balls, psi_grid, res, hist)
+    t = hist[0].t
+    coords = {
+        "ball": np.array(balls, dtype=str),
+        "psi_grid": psi_grid,
+        "sample": np.arange(t.size, dtype=np.int64),
+        "t_over_tc": t,
+        "impact_fit": np.arange(values["data_ball"].size, dtype=np.int64),
+    }
+    attrs = {
+        "psi_history_deg": float(settings.psi_history_deg),
+        "frame": "bat (recoil factors r_x, r_y)",
+        **carried_warnings(rec),
+    }
+    if skipped:
+        attrs["balls_not_fitted"] = "; ".join(
+            f"{b}: {n} usable impacts (< {MIN_FIT_IMPACTS})" for b, n in sorted(skipped.items())
+        )
+    ds = build_dataset(
+        stronge_variables(settings.vary_e_y, settings.vary_mu),
+        values,
+        coords={k: (var, coords[k]) for k, var in STRONGE_COORDS.items()},
+        attrs=attrs,
+    )
+    return stronge_systematics(
+        ds, rec, e_y=settings.e_y, mu=settings.mu, vary_e_y=settings.vary_e_y, vary_mu=settings.vary_mu
+    )
+
+
+def _fit_balls(settings: StrongeSettings, rec: xr.Dataset) -> tuple[list[str], dict[str, int], np.ndarray, list]:
+    """Fit each ball with at least ``MIN_FIT_IMPACTS`` usable impacts: (balls, the others' counts, psi grid, fits)."""
     e_y, mu, vary_e_y, vary_mu = settings.e_y, settings.mu, settings.vary_e_y, settings.vary_mu
-    psi_grid_deg, psi_history_deg, n_time = settings.psi_grid_deg, settings.psi_history_deg, settings.n_time
+    psi_grid_deg = settings.psi_grid_deg
     usable = rec["flag"].values == 0
     ball_ids = rec["ball"].values.astype(str)
     # A ball needs at least MIN_FIT_IMPACTS usable impacts for a fit (as the e_x fits do).
@@ -205,10 +243,11 @@ def run(settings: StrongeSettings, impacts: xr.Dataset) -> xr.Dataset:
         )
         for ball in balls
     ]
-    # Fig. 10: time histories at psi_history for the fitted parameters, on one time grid that
-    # reaches the last separation (the balls' e_y differ when e_y is fitted).
-    t_max = max(1.0 + r.fit.e_y for r in res)
-    hist = [time_history(np.deg2rad(psi_history_deg), r.params, n_time=n_time, t_max=t_max) for r in res]
+    return balls, skipped, psi_grid, res
+
+
+def _stronge_values(balls: list[str], psi_grid: np.ndarray, res: list, hist: list) -> dict[str, np.ndarray]:
+    """Return the values of stronge.nc's variables from the fits and the time histories."""
     nan_curve = ModelCurves(*(np.full(psi_grid.size, np.nan),) * 3)
     curves_pub = [nan_curve if r.published is None else r.published for r in res]
     values = {
@@ -239,30 +278,7 @@ def run(settings: StrongeSettings, impacts: xr.Dataset) -> xr.Dataset:
             [r.data.sigma if r.data.sigma is not None else np.full(r.data.x.size, np.nan) for r in res]
         ),
     }
-    t = hist[0].t
-    coords = {
-        "ball": np.array(balls, dtype=str),
-        "psi_grid": psi_grid,
-        "sample": np.arange(t.size, dtype=np.int64),
-        "t_over_tc": t,
-        "impact_fit": np.arange(values["data_ball"].size, dtype=np.int64),
-    }
-    attrs = {
-        "psi_history_deg": float(psi_history_deg),
-        "frame": "bat (recoil factors r_x, r_y)",
-        **carried_warnings(rec),
-    }
-    if skipped:
-        attrs["balls_not_fitted"] = "; ".join(
-            f"{b}: {n} usable impacts (< {MIN_FIT_IMPACTS})" for b, n in sorted(skipped.items())
-        )
-    ds = build_dataset(
-        stronge_variables(vary_e_y, vary_mu),
-        values,
-        coords={k: (var, coords[k]) for k, var in STRONGE_COORDS.items()},
-        attrs=attrs,
-    )
-    return stronge_systematics(ds, rec, e_y=e_y, mu=mu, vary_e_y=vary_e_y, vary_mu=vary_mu)
+    return values
 
 
 # ---------------------------------------------------------------------------------------
