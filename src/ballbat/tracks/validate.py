@@ -137,28 +137,35 @@ def check_track_rows(
             f"{path}: {where}, column impact_id: impact {iid!r} is not in {impacts_path} (add a row impact_id,bat,ball)"
         )
     if impacts is not None:
-        have: dict[str, set] = {}
-        for iid, cam, point in {(k[0], k[1], k[2]) for k in seen}:
-            have.setdefault(iid, set()).add((cam, point))
-        for iid, label in impacts.items():
-            got = have.get(iid)
-            if not got and iid not in unknown_impacts:
-                problems.append(f"{impacts_path}: {label}: impact {iid!r} has no tracks in {path}")
-                continue
-            for cam in CAMERAS:
-                pts = [p for p in POINTS[cam] if (cam, p) in got]
-                if not pts:
-                    problems.append(
-                        f"{path}: impact {iid!r} ({impacts_path}: {label}): the {cam} camera is missing "
-                        f"(no rows with camera {cam}; each impact needs both cameras)"
-                    )
-                elif len(pts) < len(POINTS[cam]):
-                    miss = [p for p in POINTS[cam] if p not in pts]
-                    problems.append(
-                        f"{path}: impact {iid!r} ({impacts_path}: {label}): the {cam} camera has no rows of "
-                        f"point(s) {', '.join(miss)}"
-                    )
+        problems += _missing_tracks(path, seen, impacts, impacts_path, unknown_impacts)
     return out, problems
+
+
+def _missing_tracks(path, seen: dict, impacts: dict, impacts_path, unknown_impacts: dict) -> list[str]:
+    """Name each impact of the impacts file without tracks, or without a camera or a point of one."""
+    problems = []
+    have: dict[str, set] = {}
+    for iid, cam, point in {(k[0], k[1], k[2]) for k in seen}:
+        have.setdefault(iid, set()).add((cam, point))
+    for iid, label in impacts.items():
+        got = have.get(iid)
+        if not got and iid not in unknown_impacts:
+            problems.append(f"{impacts_path}: {label}: impact {iid!r} has no tracks in {path}")
+            continue
+        for cam in CAMERAS:
+            pts = [p for p in POINTS[cam] if (cam, p) in got]
+            if not pts:
+                problems.append(
+                    f"{path}: impact {iid!r} ({impacts_path}: {label}): the {cam} camera is missing "
+                    f"(no rows with camera {cam}; each impact needs both cameras)"
+                )
+            elif len(pts) < len(POINTS[cam]):
+                miss = [p for p in POINTS[cam] if p not in pts]
+                problems.append(
+                    f"{path}: impact {iid!r} ({impacts_path}: {label}): the {cam} camera has no rows of "
+                    f"point(s) {', '.join(miss)}"
+                )
+    return problems
 
 
 def check_cameras(cfg: object, where: str) -> list[str]:
@@ -175,38 +182,50 @@ def check_cameras(cfg: object, where: str) -> list[str]:
         at = f"{where}.cameras.{name}"
         if c is None:
             problems.append(f"{at}: camera missing (give fps, m_per_px, mirror)")
-            continue
-        if not isinstance(c, dict):
+        elif not isinstance(c, dict):
             problems.append(f"{at}: expected a mapping of fps, m_per_px, mirror")
-            continue
-        for k in CAMERA_REQUIRED:
-            if k not in c:
-                problems.append(f"{at}.{k}: missing")
-        for k in c:
-            if k not in CAMERA_KEYS:
-                problems.append(f"{at}.{k}: unknown setting (known: {', '.join(sorted(CAMERA_KEYS))})")
-        for k in ("fps", "m_per_px"):
-            if k in c and not (_is_number(c[k]) and c[k] > 0):
-                problems.append(f"{at}.{k}: {c[k]!r} must be a positive number")
-        if "m_per_px_err" in c and not (_is_number(c["m_per_px_err"]) and c["m_per_px_err"] >= 0):
-            problems.append(f"{at}.m_per_px_err: {c['m_per_px_err']!r} must be a number >= 0 (relative uncertainty)")
-        elif "m_per_px_err" in c and c["m_per_px_err"] >= SCALE_ERR_MAX:
-            problems.append(
-                f"{at}.m_per_px_err: {c['m_per_px_err']!r} is a relative uncertainty ({100 * c['m_per_px_err']:g} %): "
-                f"a pixel scale known no better than {100 * SCALE_ERR_MAX:g} % shifts e_x by about as much as e_x "
-                f"varies between bats. For {c['m_per_px_err']!r} % write {c['m_per_px_err'] / 100:g}"
-            )
-        if "fps_err" in c and not (_is_number(c["fps_err"]) and 0 <= c["fps_err"] < SCALE_ERR_MAX):
-            problems.append(
-                f"{at}.fps_err: {c['fps_err']!r} must be a relative uncertainty >= 0 and below {SCALE_ERR_MAX:g} "
-                "(0.001 for 0.1 %)"
-            )
-        if "mirror" in c and not isinstance(c["mirror"], bool):
-            problems.append(f"{at}.mirror: {c['mirror']!r} must be true or false")
+        else:
+            problems += _camera_problems(c, at)
     rig = cfg.get("rig")
     if not isinstance(rig, dict):
         problems.append(f"{where}.rig: missing (give {', '.join(RIG_KEYS)})")
         return problems
+    return problems + _rig_problems(rig, where)
+
+
+def _camera_problems(c: dict, at: str) -> list[str]:
+    """Problems of one camera's settings (``at``: its config key)."""
+    problems: list[str] = []
+    for k in CAMERA_REQUIRED:
+        if k not in c:
+            problems.append(f"{at}.{k}: missing")
+    for k in c:
+        if k not in CAMERA_KEYS:
+            problems.append(f"{at}.{k}: unknown setting (known: {', '.join(sorted(CAMERA_KEYS))})")
+    for k in ("fps", "m_per_px"):
+        if k in c and not (_is_number(c[k]) and c[k] > 0):
+            problems.append(f"{at}.{k}: {c[k]!r} must be a positive number")
+    if "m_per_px_err" in c and not (_is_number(c["m_per_px_err"]) and c["m_per_px_err"] >= 0):
+        problems.append(f"{at}.m_per_px_err: {c['m_per_px_err']!r} must be a number >= 0 (relative uncertainty)")
+    elif "m_per_px_err" in c and c["m_per_px_err"] >= SCALE_ERR_MAX:
+        problems.append(
+            f"{at}.m_per_px_err: {c['m_per_px_err']!r} is a relative uncertainty ({100 * c['m_per_px_err']:g} %): "
+            f"a pixel scale known no better than {100 * SCALE_ERR_MAX:g} % shifts e_x by about as much as e_x "
+            f"varies between bats. For {c['m_per_px_err']!r} % write {c['m_per_px_err'] / 100:g}"
+        )
+    if "fps_err" in c and not (_is_number(c["fps_err"]) and 0 <= c["fps_err"] < SCALE_ERR_MAX):
+        problems.append(
+            f"{at}.fps_err: {c['fps_err']!r} must be a relative uncertainty >= 0 and below {SCALE_ERR_MAX:g} "
+            "(0.001 for 0.1 %)"
+        )
+    if "mirror" in c and not isinstance(c["mirror"], bool):
+        problems.append(f"{at}.mirror: {c['mirror']!r} must be true or false")
+    return problems
+
+
+def _rig_problems(rig: dict, where: str) -> list[str]:
+    """Problems of the rig's lengths and their uncertainties (inches)."""
+    problems: list[str] = []
     for k in RIG_KEYS:
         if k not in rig:
             problems.append(f"{where}.rig.{k}: missing")
