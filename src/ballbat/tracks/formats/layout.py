@@ -194,21 +194,7 @@ def import_files(
         Every problem of every file at once.
     """
     cameras = cameras or {}
-    problems = check_points(points, f"{where}.points")
-    if fmt is not None and fmt not in FORMATS:
-        problems.append(f"{where}.format: {fmt!r} is not one of {', '.join(FORMATS)}")
-        fmt = None
-    if units is not None and fmt not in TABLES:
-        problems.append(
-            f"{where}.units: given, but only a table (format tracker_table or kinovea_table) needs it: "
-            "the tools' own files say their units"
-        )
-    if fmt in TABLES:
-        problems += check_units(units, f"{where}.units")
-        for c in CAMERAS:
-            for k in ("fps", "m_per_px"):
-                if k not in (cameras.get(c) or {}):
-                    problems.append(f"{where}.cameras.{c}.{k}: missing (a {fmt} holds no {k}; no default)")
+    problems = _block_problems(points, fmt, units, cameras, where)
     if problems:
         raise FormatError(problems)
     files, problems = find_files(paths, pattern, fmt)
@@ -264,6 +250,26 @@ def import_files(
         raise FormatError(problems)
     out = {k: np.concatenate(v) if v else np.array([]) for k, v in cols.items()}
     return Imported(out, settings, [(i, c, ft.path) for i, c, ft in read], ignored)
+
+
+def _block_problems(points: dict, fmt: str | None, units: dict | None, cameras: dict, where: str) -> list[str]:
+    """Problems of the block's settings for its files: points, format, units, what a table needs from the config."""
+    problems = check_points(points, f"{where}.points")
+    if fmt is not None and fmt not in FORMATS:
+        problems.append(f"{where}.format: {fmt!r} is not one of {', '.join(FORMATS)}")
+        fmt = None
+    if units is not None and fmt not in TABLES:
+        problems.append(
+            f"{where}.units: given, but only a table (format tracker_table or kinovea_table) needs it: "
+            "the tools' own files say their units"
+        )
+    if fmt in TABLES:
+        problems += check_units(units, f"{where}.units")
+        for c in CAMERAS:
+            for k in ("fps", "m_per_px"):
+                if k not in (cameras.get(c) or {}):
+                    problems.append(f"{where}.cameras.{c}.{k}: missing (a {fmt} holds no {k}; no default)")
+    return problems
 
 
 def _camera_settings(cam: str, files: list[FileTracks], config: dict, where: str) -> tuple[dict, list[str]]:
