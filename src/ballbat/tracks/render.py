@@ -298,6 +298,25 @@ def _observed(pts: dict, points: tuple, cam, t: np.ndarray, rng) -> tuple[dict, 
     return xs, ys
 
 
+def _dot_geometry(rng: np.random.Generator, n: int, axis_offset: float) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+    """Each dot's distance from the spin axis and its angle at time 0, drawn for ``n`` impacts.
+
+    The dots are two adjacent corners of a square; the spin axis is offset from its centre by up
+    to ``axis_offset`` (uniform over the disc), and the square is turned by a uniform angle.
+    """
+    off_r = axis_offset * np.sqrt(rng.uniform(size=n))
+    off_a = rng.uniform(0, 2 * np.pi, n)
+    rot0 = rng.uniform(0, 2 * np.pi, n)
+    h = DOT_SQUARE / 2
+    corners = np.array([[h, h], [-h, h]])  # dot_a, dot_b in the square's frame
+    dots = {}
+    for j, p in enumerate(("dot_a", "dot_b")):
+        cx = corners[j, 0] - off_r * np.cos(off_a)
+        cy = corners[j, 1] - off_r * np.sin(off_a)
+        dots[p] = (np.hypot(cx, cy), np.arctan2(cy, cx) + rot0)
+    return dots
+
+
 def render_tracks(
     truth: dict[str, np.ndarray],
     ball_radius: np.ndarray,
@@ -338,19 +357,7 @@ def render_tracks(
     tilted = rng.uniform(size=n) < settings.tilted_fraction
     chi = np.where(tilted, rng.uniform(*settings.tilt, n), 0.0)
     zeta = rng.uniform(0, 2 * np.pi, n)
-    # dots: two adjacent corners of the square; the spin axis is offset from its centre
-    off_r = settings.axis_offset * np.sqrt(rng.uniform(size=n))
-    off_a = rng.uniform(0, 2 * np.pi, n)
-    rot0 = rng.uniform(0, 2 * np.pi, n)
-    h = DOT_SQUARE / 2
-    corners = np.array([[h, h], [-h, h]])  # dot_a, dot_b in the square's frame
-    dots = {}
-    for j, p in enumerate(("dot_a", "dot_b")):
-        cx = corners[j, 0] - off_r * np.cos(off_a)
-        cy = corners[j, 1] - off_r * np.sin(off_a)
-        rho = np.hypot(cx, cy)
-        dots[p] = (rho, np.arctan2(cy, cx) + rot0)
-
+    dots = _dot_geometry(rng, n, settings.axis_offset)
     axis = np.stack([np.sin(chi) * np.cos(zeta), np.sin(chi) * np.sin(zeta), np.cos(chi)])
     e1 = np.stack([np.cos(zeta) * np.cos(chi), np.sin(zeta) * np.cos(chi), -np.sin(chi)])
     e2 = np.stack([-np.sin(zeta), np.cos(zeta), np.zeros(n)])
