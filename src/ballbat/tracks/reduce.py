@@ -525,6 +525,26 @@ def fit_contact(
     )
 
 
+def _swing_axis(X: np.ndarray, Y: np.ndarray, t: np.ndarray, w: np.ndarray, n: np.ndarray) -> tuple:
+    """Return the tip's centroid and the principal axis of its marks, oriented along the motion.
+
+    Returns ``cx, cy, ux, uy, tm, along, perp``: the centroid, the axis' unit vector (later
+    frames further along), the mean time, and each mark's distance along and across the axis.
+    """
+    cx, cy = _msum(X, w) / n, _msum(Y, w) / n
+    dx, dy = X - cx[:, None], Y - cy[:, None]
+    sxx, syy, sxy = _msum(dx * dx, w), _msum(dy * dy, w), _msum(dx * dy, w)
+    phi = 0.5 * np.arctan2(2 * sxy, sxx - syy)  # principal axis
+    ux, uy = np.cos(phi), np.sin(phi)
+    # orient along the motion: later frames further along
+    tm = _msum(t, w) / n
+    forward = _msum((t - tm[:, None]) * (dx * ux[:, None] + dy * uy[:, None]), w) >= 0
+    ux, uy = np.where(forward, ux, -ux), np.where(forward, uy, -uy)
+    along = dx * ux[:, None] + dy * uy[:, None]
+    perp = -dx * uy[:, None] + dy * ux[:, None]
+    return cx, cy, ux, uy, tm, along, perp
+
+
 def fit_swing(
     X: ArrayLike,
     Y: ArrayLike,
@@ -567,17 +587,7 @@ def fit_swing(
     w = mask.astype(float)
     n = _msum(np.ones_like(X), w)
     with np.errstate(all="ignore"):
-        cx, cy = _msum(X, w) / n, _msum(Y, w) / n
-        dx, dy = X - cx[:, None], Y - cy[:, None]
-        sxx, syy, sxy = _msum(dx * dx, w), _msum(dy * dy, w), _msum(dx * dy, w)
-        phi = 0.5 * np.arctan2(2 * sxy, sxx - syy)  # principal axis
-        ux, uy = np.cos(phi), np.sin(phi)
-        # orient along the motion: later frames further along
-        tm = _msum(t, w) / n
-        forward = _msum((t - tm[:, None]) * (dx * ux[:, None] + dy * uy[:, None]), w) >= 0
-        ux, uy = np.where(forward, ux, -ux), np.where(forward, uy, -uy)
-        along = dx * ux[:, None] + dy * uy[:, None]
-        perp = -dx * uy[:, None] + dy * ux[:, None]
+        cx, cy, ux, uy, tm, along, perp = _swing_axis(X, Y, t, w, n)
         beta = np.arctan2(uy, ux)
         s_perp = np.sqrt(_msum(perp**2, w) / (n - 2))
         # Student-t: with few frames the scatter estimate is itself uncertain (sd of t with n - 2 dof)
