@@ -719,6 +719,21 @@ def _centre_variance(ct_x, ct_y, cx, cy, t, flight: Flight, sums, masks, sxy):
     )
 
 
+def _dot_about_centre(dx: np.ndarray, dy: np.ndarray, t: np.ndarray, after: np.ndarray) -> tuple:
+    """Return one dot's marks after separation about the ball's centre (errors ignored by the caller).
+
+    ``mask, weights, count, mean distance, its sd, unwrapped angle, largest step`` per impact.
+    """
+    m = after & np.isfinite(dx) & np.isfinite(dy)
+    w = m.astype(float)
+    n = _msum(np.ones_like(t), w)
+    rho = np.hypot(dx, dy)
+    radius = _msum(rho, w) / n
+    radius_sd = np.sqrt(_msum((rho - radius[:, None]) ** 2, w) / (n - 1))
+    phi, step = _unwrap(np.arctan2(dy, dx), m)
+    return m, w, n, radius, radius_sd, phi, step
+
+
 def fit_spin(
     ct_x: ArrayLike, ct_y: ArrayLike, t: ArrayLike, flight: Flight, cam: Camera, ball: tuple | None = None
 ) -> Spin:
@@ -756,14 +771,7 @@ def fit_spin(
     sums = {}
     with np.errstate(all="ignore"):
         for p in ("dot_a", "dot_b"):
-            dx, dy = ct_x[p] - cx, ct_y[p] - cy
-            m = after & np.isfinite(dx) & np.isfinite(dy)
-            w = m.astype(float)
-            n = _msum(np.ones_like(t), w)
-            rho = np.hypot(dx, dy)
-            radius[p] = _msum(rho, w) / n
-            radius_sd[p] = np.sqrt(_msum((rho - radius[p][:, None]) ** 2, w) / (n - 1))
-            phi, step = _unwrap(np.arctan2(dy, dx), m)
+            m, w, n, radius[p], radius_sd[p], phi, step = _dot_about_centre(ct_x[p] - cx, ct_y[p] - cy, t, after)
             max_step = np.maximum(max_step, step)
             tm = _msum(t, w) / n
             pm = _msum(phi, w) / n
