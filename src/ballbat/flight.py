@@ -277,6 +277,23 @@ def _dp_step(model, t, X, V, A0, h):
     return X1, V1, A1, ex, ev
 
 
+def _dp_error(Xi, Vi, X1, V1, ex, ev, rtol: float, atol: float) -> np.ndarray:
+    """Return each trajectory's Dormand-Prince error estimate in units of its tolerance (RMS over the 6 states)."""
+    sx = atol + rtol * np.maximum(np.abs(Xi), np.abs(X1))
+    sv = atol + rtol * np.maximum(np.abs(Vi), np.abs(V1))
+    return np.sqrt((np.sum((ex / sx) ** 2, axis=1) + np.sum((ev / sv) ** 2, axis=1)) / 6.0)
+
+
+def _refuse_late(active: np.ndarray, t: np.ndarray, X: np.ndarray, t_max: float) -> None:
+    """Raise a RuntimeError naming the trajectories still airborne after ``t_max``."""
+    late = active & (t > t_max)
+    if late.any():
+        raise RuntimeError(
+            f"fly: {late.sum()} trajectories still airborne after t_max = {t_max} s "
+            f"(first: index {np.flatnonzero(late)[0]}, z = {X[late][0, 2]:.3g} m)"
+        )
+
+
 def _fly_accurate(model, X0, V0, rtol, atol, t_max, keep_history):
     """Adaptive Dormand-Prince 5(4), one step size per trajectory, on the active ones only.
 
@@ -305,9 +322,7 @@ def _fly_accurate(model, X0, V0, rtol, atol, t_max, keep_history):
         mdl = model.take(idx)
         ti, Xi, Vi, Ai, hi = t[idx], X[idx], V[idx], A[idx], h[idx]
         X1, V1, A1, ex, ev = _dp_step(mdl, ti, Xi, Vi, Ai, hi)
-        sx = atol + rtol * np.maximum(np.abs(Xi), np.abs(X1))
-        sv = atol + rtol * np.maximum(np.abs(Vi), np.abs(V1))
-        err = np.sqrt((np.sum((ex / sx) ** 2, axis=1) + np.sum((ev / sv) ** 2, axis=1)) / 6.0)
+        err = _dp_error(Xi, Vi, X1, V1, ex, ev, rtol, atol)
         ok = err <= 1.0
         fac = np.clip(0.9 * np.maximum(err, 1e-10) ** -0.2, 0.2, 5.0)
         h[idx] = hi * np.where(ok, fac, np.minimum(fac, 1.0))
@@ -330,12 +345,7 @@ def _fly_accurate(model, X0, V0, rtol, atol, t_max, keep_history):
             apex[acc] = np.maximum(apex[acc], X1[:, 2])
             t[acc] = ti + hi
             X[acc], V[acc], A[acc] = X1, V1, A1
-        late = active & (t > t_max)
-        if late.any():
-            raise RuntimeError(
-                f"fly: {late.sum()} trajectories still airborne after t_max = {t_max} s "
-                f"(first: index {np.flatnonzero(late)[0]}, z = {X[late][0, 2]:.3g} m)"
-            )
+        _refuse_late(active, t, X, t_max)
         if keep_history:
             history.append((t.copy(), X.copy(), V.copy(), A.copy()))
 
