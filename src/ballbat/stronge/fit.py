@@ -102,6 +102,27 @@ def _jacobian(residual, at: dict[str, float], names: list[str]) -> tuple[np.ndar
     return np.stack(cols, axis=1), rows[0]
 
 
+def _least_squares(residual, start: tuple, bounds: tuple, vary: tuple, scale_covar: bool, what: str):
+    """Return lmfit's Levenberg-Marquardt fit of ``residual(eta2, e_y, mu)`` from ``start`` (eta2, e_y, mu).
+
+    eta^2 is held in ``bounds``; e_y (0.05-1) and mu (0.001-10) vary where ``vary`` says.
+    """
+    import lmfit
+
+    params = lmfit.Parameters()
+    params.add("eta2", value=start[0], min=bounds[0], max=bounds[1])
+    params.add("e_y", value=start[1], min=0.05, max=1.0, vary=vary[0])
+    params.add("mu", value=start[2], min=1e-3, max=10.0, vary=vary[1])
+
+    def fcn(p):
+        return residual(p["eta2"].value, p["e_y"].value, p["mu"].value)
+
+    try:
+        return lmfit.minimize(fcn, params, method="leastsq", scale_covar=scale_covar)
+    except (ValueError, RuntimeError) as exc:  # pragma: no cover - lmfit internals
+        raise Eta2FitError(f"fit_eta2: lmfit raised {exc!r} ({what})") from exc
+
+
 def fit_eta2(
     psi: ArrayLike,
     x: ArrayLike,
@@ -162,8 +183,6 @@ def fit_eta2(
     starting value is the best of a logarithmic scan of ``eta2_bounds``; the local
     least-squares fit (lmfit, Levenberg-Marquardt) starts there.
     """
-    import lmfit
-
     psi = np.asarray(psi, dtype=float).ravel()
     what = _describe(psi, e_y, mu, vary_e_y, vary_mu)
     x, y, r_x, r_y, alpha, sig = _checked_inputs(psi, x, y, r_x, r_y, alpha, sigma, vary_e_y, vary_mu, what)
@@ -174,24 +193,12 @@ def fit_eta2(
 
     bounds = (float(eta2_bounds[0]), float(eta2_bounds[1]))
     start = _scan_start(psi, x, y, r_x, r_y, alpha, sig, e_y, mu, bounds)
-    params = lmfit.Parameters()
-    params.add("eta2", value=start, min=bounds[0], max=bounds[1])
-    params.add("e_y", value=e_y, min=0.05, max=1.0, vary=vary_e_y)
-    params.add("mu", value=mu, min=1e-3, max=10.0, vary=vary_mu)
-
-    def fcn(p):
-        return residual(p["eta2"].value, p["e_y"].value, p["mu"].value)
-
-    try:
-        res = lmfit.minimize(fcn, params, method="leastsq", scale_covar=scale_covar)
-    except (ValueError, RuntimeError) as exc:  # pragma: no cover - lmfit internals
-        raise Eta2FitError(f"fit_eta2: lmfit raised {exc!r} ({what})") from exc
+    res = _least_squares(residual, (start, e_y, mu), bounds, (vary_e_y, vary_mu), scale_covar, what)
     best = res.params["eta2"].value
     if not res.success or not np.isfinite(best):
         raise Eta2FitError(f"fit_eta2: fit failed ({res.message}) ({what})")
 
-    chi_min = float(res.chisqr)
-    nfree = int(res.nfree)
+    chi_min, nfree = float(res.chisqr), int(res.nfree)
     redchi = chi_min / nfree
     e_best, mu_best = res.params["e_y"].value, res.params["mu"].value
     if robust:
@@ -205,9 +212,11 @@ def fit_eta2(
     if vary_e_y or vary_mu:
 
         def profile(h):
+            import lmfit
+
             q = res.params.copy()
             q["eta2"].set(value=h, vary=False)
-            r = lmfit.minimize(fcn, q, method="leastsq")
+            r = lmfit.minimize(lambda p: residual(p["eta2"].value, p["e_y"].value, p["mu"].value), q, method="leastsq")
             return float(r.chisqr)
     else:
 
