@@ -770,6 +770,28 @@ def _regimes(pc: _Pieces):
     return np.array(names, dtype=f"<U{width}")[inv.ravel()], comp, nph
 
 
+def _phase_times(pc, n: int, idx: np.ndarray, to_t: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return the end of the first stick, the start of a re-stick and of the final slip (t/t_c; NaN: none)."""
+    P = pc.start.shape[1]
+    valid = np.arange(P)[None, :] < pc.n[:, None]
+    cat = np.where(pc.mode == 0, _STICK, _SLIP)
+    # transitions between consecutive pieces
+    prevcat = np.concatenate([np.zeros((n, 1), int), cat[:, :-1]], axis=1)
+    trans = valid & (np.arange(P)[None, :] > 0) & (cat != prevcat)
+    first_stick = cat[:, 0] == _STICK
+    k1 = np.where(trans.any(axis=1), np.argmax(trans, axis=1), -1)
+    t_stick_end = np.where(first_stick & (k1 > 0), pc.start[idx, np.maximum(k1, 0)] * to_t, np.nan)
+    rest = trans & (cat == _STICK)
+    kr = np.argmax(rest, axis=1)
+    t_restick = np.where(rest.any(axis=1), pc.start[idx, kr] * to_t, np.nan)
+    last_cat = cat[idx, pc.n - 1]
+    # last transition index
+    kl = P - 1 - np.argmax(trans[:, ::-1], axis=1)
+    t_final = np.where(trans.any(axis=1), pc.start[idx, kl] * to_t, 0.0)
+    t_final = np.where(last_cat == _SLIP, t_final, np.nan)
+    return t_stick_end, t_restick, t_final
+
+
 def stronge_solve(
     psi: ArrayLike,
     contact: ContactParams,
@@ -813,23 +835,7 @@ def stronge_solve(
     pc = _engine(p, idx)
     regime, _comp, nph = _regimes(pc)
     to_t = 1.0 / HALF_PI
-    P = pc.start.shape[1]
-    valid = np.arange(P)[None, :] < pc.n[:, None]
-    cat = np.where(pc.mode == 0, _STICK, _SLIP)
-    # transitions between consecutive pieces
-    prevcat = np.concatenate([np.zeros((n, 1), int), cat[:, :-1]], axis=1)
-    trans = valid & (np.arange(P)[None, :] > 0) & (cat != prevcat)
-    first_stick = cat[:, 0] == _STICK
-    k1 = np.where(trans.any(axis=1), np.argmax(trans, axis=1), -1)
-    t_stick_end = np.where(first_stick & (k1 > 0), pc.start[idx, np.maximum(k1, 0)] * to_t, np.nan)
-    rest = trans & (cat == _STICK)
-    kr = np.argmax(rest, axis=1)
-    t_restick = np.where(rest.any(axis=1), pc.start[idx, kr] * to_t, np.nan)
-    last_cat = cat[idx, pc.n - 1]
-    # last transition index
-    kl = P - 1 - np.argmax(trans[:, ::-1], axis=1)
-    t_final = np.where(trans.any(axis=1), pc.start[idx, kl] * to_t, 0.0)
-    t_final = np.where(last_cat == _SLIP, t_final, np.nan)
+    t_stick_end, t_restick, t_final = _phase_times(pc, n, idx, to_t)
     tsm, smax = _stretch_max(pc, p.rho, p.Lam, p.e, p.thf)
     with np.errstate(invalid="ignore"):
         smax = smax * p.tan_psi
