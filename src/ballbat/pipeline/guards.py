@@ -139,15 +139,11 @@ def foreign_outputs(paths: Iterable[str | os.PathLike[str]]) -> list[str]:
     before its job runs. A run that finds any stops before that (``onstart``). The kinds checked
     are those that carry a record (:data:`RECORDED_SUFFIXES`).
     """
-    lines = []
-    for path in sorted({str(p) for p in paths}):
-        p = Path(path)
-        if p.suffix in RECORDED_SUFFIXES and p.is_file() and not written_by_workflow(p):
-            lines.append(
-                f"{path}: not written by this workflow (no provenance record), and this run would replace it; "
-                "nothing was changed: move it out of results/ and run again"
-            )
-    return lines
+    return [
+        f"{path}: not written by this workflow (no provenance record), and this run would replace it; "
+        "nothing was changed: move it out of results/ and run again"
+        for path in _not_written(paths, RECORDED_SUFFIXES)
+    ]
 
 
 def users_files(paths: Iterable[str | os.PathLike[str]], kinds: tuple[str, ...] = (".xlsx", ".md")) -> list[str]:
@@ -158,15 +154,20 @@ def users_files(paths: Iterable[str | os.PathLike[str]], kinds: tuple[str, ...] 
     and the crate lists it as not the workflow's. NetCDF and CSV products are named by
     :func:`damaged_products` when damaged.
     """
-    lines = []
-    for path in sorted({str(p) for p in paths}):
-        p = Path(path)
-        if p.suffix in kinds and p.is_file() and not written_by_workflow(p):
-            lines.append(
-                f"{path}: not written by this workflow (no provenance record, or changed since it was written); "
-                "it is left alone, and is not listed as the workflow's result: move it out of results/"
-            )
-    return lines
+    return [
+        f"{path}: not written by this workflow (no provenance record, or changed since it was written); "
+        "it is left alone, and is not listed as the workflow's result: move it out of results/"
+        for path in _not_written(paths, kinds)
+    ]
+
+
+def _not_written(paths: Iterable[str | os.PathLike[str]], kinds: tuple[str, ...]) -> list[str]:
+    """Return the existing files among ``paths`` (sorted, once each) of ``kinds`` that the workflow did not write."""
+    return [
+        path
+        for path in sorted({str(p) for p in paths})
+        if Path(path).suffix in kinds and Path(path).is_file() and not written_by_workflow(Path(path))
+    ]
 
 
 def _alive(pid: int) -> bool:
