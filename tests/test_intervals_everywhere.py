@@ -104,3 +104,36 @@ def test_the_switch_turns_the_term_off(monkeypatch):
     x, y, jx, jy, sigma = _scattered_line(np.random.default_rng(6), 200, 1.3, 0.1)
     monkeypatch.setattr(linefit, "SCATTER_TERM", False)
     assert np.isnan(eiv_line(x, y, jx, jy, sigma, scatter=True).scatter)
+
+
+def _dataset():
+    from ballbat.pipeline.config import load_config
+
+    return load_config()["datasets"]["synthetic"]
+
+
+def test_sweep_sets_scatter_psi_range_and_spin_noise():
+    from ballbat.sweeps import point_dataset
+
+    base = _dataset()
+    ds = point_dataset(base, ["e_x_scatter", "psi_max_scale", "spin_pixel_noise_px"], [0.02, 0.4, 3.5])
+    assert ds["synthetic"]["e_x_scatter"] == 0.02
+    for ball, (lo, hi) in base["synthetic"]["psi_deg"].items():
+        assert ds["synthetic"]["psi_deg"][ball] == pytest.approx([lo, 0.4 * hi])
+    assert ds["render"]["cameras"]["spin"]["pixel_noise_px"] == 3.5
+    assert ds["render"]["cameras"]["swing"]["pixel_noise_px"] == base["render"]["cameras"]["swing"]["pixel_noise_px"]
+
+
+@pytest.mark.parametrize(
+    ("parameter", "value", "words"),
+    [
+        ("e_x_scatter", -0.01, "e_x_scatter must lie"),
+        ("psi_max_scale", 0.0, "psi_max_scale must lie"),
+        ("spin_pixel_noise_px", 0.0, "must be positive"),
+    ],
+)
+def test_sweep_refuses_bad_values(parameter, value, words):
+    from ballbat.sweeps import check_sweep
+
+    problems = check_sweep(_dataset(), parameter, [value], "studies.x")
+    assert any(words in p for p in problems)
