@@ -315,7 +315,7 @@ def implied_e_y(
 
 
 #: The form of implied e_y's sandwich (:func:`e_y_variance`): ``"hc3"``, ``"hc2"`` or ``"hc0k"``.
-E_Y_SANDWICH = "hc3"
+E_Y_SANDWICH = "hc2"
 
 
 def e_y_variance(

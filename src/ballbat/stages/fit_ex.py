@@ -101,7 +101,7 @@ def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) 
     table["e_y_implied_err"] = Var(
         ("ball",),
         "1",
-        "standard error of e_y implied (leverage-corrected HC3 sandwich: the impacts' influences via the slope "
+        "standard error of e_y implied (leverage-corrected HC2 sandwich: the impacts' influences via the slope "
         "and e_x)",
     )
     table["mu_k_lower_bound"] = Var(
