@@ -256,7 +256,8 @@ UNCERTAINTY_NOTES = {
         "the measurement uncertainty of the largest tan(psi - theta), not a standard error of a sample "
         "maximum: it says how well the largest value of these impacts is measured (docs/studies.md)"
     ),
-    "e_y_implied": "a sandwich standard error (the impacts' influences through the Eq. ratio slope and e_x per bat)",
+    "e_y_implied": "a leverage-corrected (HC2) sandwich standard error (the impacts' influences through the Eq. "
+    "ratio slope and e_x per bat)",
     "spin_theta_slope": "a sandwich (HC3) standard error",
     "speed_theta_slope": "a sandwich (HC3) standard error",
     "eta2": (

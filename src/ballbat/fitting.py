@@ -42,7 +42,7 @@ import numpy as np
 
 from .designs import MEASURED, Measured, measured_sigma, normalized_theta_design, spin_design, tan_ratio_design
 from .kinematics import gross_slip_onset, normalize_to_bat_speed, tan_ratio_slope_model
-from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, wls_slope
+from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, scatter_gain, wls_slope
 from .systematics import has_shifts
 
 if TYPE_CHECKING:
@@ -121,10 +121,12 @@ PER_BALL = (
 )
 
 
-def _weights(jx, jy, sigma, slope):
+def _weights(jx, jy, sigma, slope, fit=None, x=None):
     if sigma is None or not np.isfinite(slope):
         return None
     var = np.sum((jy - slope * jx) ** 2 * sigma**2, axis=1)
+    if fit is not None and np.isfinite(fit.scatter) and fit.scatter > 0:  # the fit's intrinsic-scatter term
+        var = var + fit.scatter**2 * scatter_gain(x, np.sum(jx**2 * sigma**2, axis=1))
     return 1.0 / np.sqrt(var) if np.all(var > 0) else None
 
 
@@ -157,26 +159,27 @@ def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool)
     bat_of = ds["bat"].values.astype(str)
     per_bat, pooled = FitGrid.empty((len(balls), len(bats))), FitGrid.empty((len(balls),))
 
-    def spin_fit(sel):
+    def spin_fit(sel, scatter):
         n = int(np.sum(sel))
         if n < MIN_FIT_IMPACTS:  # too few for a slope and its error: report, do not fit
             return LineFit.not_fitted(n), np.nan
         r, r_x, alpha = (ds[k].values[sel] for k in ("r", "r_x", "alpha"))
         x, y, jx, jy = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
         sig = measured_sigma(ds, sel)
-        fit = fit_line(x, y, jx, jy, sig, errors_in_variables=True)
+        fit = fit_line(x, y, jx, jy, sig, errors_in_variables=True, scatter=scatter)
         t = np.nan
         if with_truth and fit.success:
             xt, yt, _, _ = spin_design(Measured.from_dataset(ds, sel, "truth_"), r, r_x, alpha)
-            t = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope))[0] - 1.0
+            t = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope, fit, x))[0] - 1.0
         return fit, t
 
     for i, ball in enumerate(balls):
         in_ball = usable & (ball_of == ball)
         for bat in sorted(set(bat_of[ball_of == ball])):
             j = bats.index(bat)
-            per_bat.fits[i, j], per_bat.truth[i, j] = spin_fit(in_ball & (bat_of == bat))
-        pooled.fits[i], pooled.truth[i] = spin_fit(in_ball)
+            per_bat.fits[i, j], per_bat.truth[i, j] = spin_fit(in_ball & (bat_of == bat), True)
+        # pooled: the bats' differences are the design's (the same bats in every repetition), not scatter
+        pooled.fits[i], pooled.truth[i] = spin_fit(in_ball, False)
     return per_bat, pooled
 
 
@@ -275,19 +278,22 @@ def implied_e_y(
     var_xs, cov_s = _noise_moments(jxs, jys, sig)
     one_plus = np.empty(n)
     influence_ex = np.empty(n)
+    lev_ex = np.zeros(n)
     groups = []
     for bat in sorted(set(bat_of)):
         m = bat_of == bat
         fit, m_fit = res.e_x.fits[i, res.bats.index(bat)], m
         if not (fit.success and np.isfinite(fit.slope)):  # no fit of its own: the pooled one
             fit, m_fit = res.e_x_pooled.fits[i], np.ones(n, dtype=bool)
-        w = _weights(jxs[m_fit], jys[m_fit], None if sig is None else sig[m_fit], fit.slope)
+        w = _weights(jxs[m_fit], jys[m_fit], None if sig is None else sig[m_fit], fit.slope, fit, xs[m_fit])
         ws = np.ones(int(m_fit.sum())) if w is None else w**2
         # the e_x fit's estimating function (moment-corrected for the bracket's noise, as the fit)
         score = xs[m_fit] * (ys[m_fit] - fit.slope * xs[m_fit]) + fit.slope * var_xs[m_fit] - cov_s[m_fit]
         infl = np.zeros(n)
         infl[m_fit] = ws * score / np.sum(ws * (xs[m_fit] ** 2 - var_xs[m_fit]))
-        one_plus[m], influence_ex[m] = fit.slope, infl[m]
+        lev = np.zeros(n)
+        lev[m_fit] = ws * xs[m_fit] ** 2 / np.sum(ws * xs[m_fit] ** 2)
+        one_plus[m], influence_ex[m], lev_ex[m] = fit.slope, infl[m], lev[m]
         groups.append(m)
     # each impact's Eq. ratio slope times (1 + e_y): its recoil factors and its bat's e_x
     k_i = tan_ratio_slope_model(one_plus - 1.0, 0.0, r_x, r_y, alpha)
@@ -303,10 +309,46 @@ def implied_e_y(
     for m in groups:
         share[m] = np.sum((W * x2 * k_i / one_plus)[m])
     infl_t = W * (x * y - cov_xy - k_i / (1.0 + e_y) * x2)
-    infl = share * influence_ex / d - infl_t / t
-    k = len(groups) + 1
-    var = np.sum(infl**2) * n / max(n - k, 1)
+    lev_t = W * x * x / np.sum(W * x * x)
+    var = e_y_variance(share * influence_ex / d, infl_t / t, lev_ex, lev_t, len(groups) + 1)
     return float(e_y), float((1.0 + e_y) * np.sqrt(var))
+
+
+#: The form of implied e_y's sandwich (:func:`e_y_variance`): ``"hc3"``, ``"hc2"`` or ``"hc0k"``.
+E_Y_SANDWICH = "hc2"
+
+
+def e_y_variance(
+    infl_ex: np.ndarray, infl_t: np.ndarray, lev_ex: np.ndarray, lev_t: np.ndarray, k: int, form: str | None = None
+) -> float:
+    """Variance of ln(1 + e_y) from the impacts' influences through e_x and through the Eq. ratio sum.
+
+    Parameters
+    ----------
+    infl_ex, infl_t : ndarray
+        Each impact's influence on ln D (through its bat's e_x fit) and on ln T (the Eq. ratio sum).
+    lev_ex, lev_t : ndarray
+        Each impact's leverage in its bat's e_x fit and in the Eq. ratio fit (in [0, 1)).
+    k : int
+        Slopes fitted (bats + 1).
+    form : str, optional
+        ``"hc0k"``: the plain sandwich with n / (n - k) (the first version); ``"hc2"``: each part
+        divided by sqrt(1 - h) of its own fit; ``"hc3"``: by 1 - h (the delete-one jackknife to
+        first order). Default :data:`E_Y_SANDWICH`.
+
+    Returns
+    -------
+    float
+    """
+    form = E_Y_SANDWICH if form is None else form
+    n = infl_ex.size
+    if form == "hc0k":
+        return float(np.sum((infl_ex - infl_t) ** 2) * n / max(n - k, 1))
+    power = {"hc2": 0.5, "hc3": 1.0}.get(form)
+    if power is None:
+        raise ValueError(f"e_y_variance: form must be 'hc0k', 'hc2' or 'hc3', not {form!r}")
+    keep = np.clip(1.0 - lev_ex, 1e-6, None) ** power, np.clip(1.0 - lev_t, 1e-6, None) ** power
+    return float(np.sum((infl_ex / keep[0] - infl_t / keep[1]) ** 2))
 
 
 #: Points of the grid on which :func:`largest_value` integrates the distribution of the largest value.

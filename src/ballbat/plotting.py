@@ -637,6 +637,9 @@ GRID_LABELS = {
     "spin_fps": "cam2 {v:g} fps",
     "noise_scale": "noise x{v:g}",
     "e_x": "e_x {v:g}",
+    "e_x_scatter": "tau {v:g}",
+    "psi_max_scale": "psi x{v:g}",
+    "spin_pixel_noise_px": "cam2 {v:g} px",
 }
 
 

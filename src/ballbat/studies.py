@@ -303,7 +303,7 @@ def fit_quantity_rows(fit: xr.Dataset, effect: xr.Dataset | None = None) -> list
                 var = "tan_ratio_slope" if q == "e_y_implied" else q
                 n = at(f"{var}_n", ball, bat) if q != "mu_k_lower_bound" else None
                 dof = math.inf if n is None else int(n) - dof_of.get(var, 1)
-                if q == "e_y_implied":  # its sandwich has n / (n - k) for the k = bats + 1 slopes it rests on
+                if q == "e_y_implied":  # Student's t with n - k for the k = bats + 1 slopes its sandwich rests on
                     dof = int(n) - (sum(at("e_x_n", ball, b) > 0 for b in bats) + 1)
                 rows.append(
                     {

@@ -43,6 +43,9 @@ SWEEP_PARAMETERS = {
     "noise_scale": "factor on every direct measurement noise (datasets that do not render tracks)",
     "e_x": "true e_x of every bat and ball",
     "contact_ms": "rendered contact time (ms): drawn uniformly within CONTACT_HALF_WIDTH_MS of the value",
+    "e_x_scatter": "intrinsic impact-to-impact standard deviation of every bat's true e_x",
+    "psi_max_scale": "factor on the upper end of every ball's psi range (1: as configured; 0.4: a narrow range)",
+    "spin_pixel_noise_px": "tracking noise of the spin camera alone (pixels; datasets that render tracks)",
 }
 
 #: A ``contact_ms`` sweep point c draws the renderer's contact times uniformly from
@@ -51,7 +54,7 @@ SWEEP_PARAMETERS = {
 CONTACT_HALF_WIDTH_MS = 0.05
 
 #: Settings that need a dataset that renders camera tracks.
-RENDER_PARAMETERS = ("pixel_noise_px", "swing_fps", "spin_fps", "contact_ms")
+RENDER_PARAMETERS = ("pixel_noise_px", "swing_fps", "spin_fps", "contact_ms", "spin_pixel_noise_px")
 
 
 def sweep_points(sweep: dict | None) -> tuple[tuple[str, ...], list[tuple[float, ...]]]:
@@ -84,11 +87,15 @@ def _value_problem(parameter: str, v: float) -> str | None:
         return f"impacts per bat must be a whole number >= 3, not {v:g}"
     if parameter in ("swing_fps", "spin_fps", "noise_scale") and v <= 0:
         return f"{parameter} must be positive, not {v:g}"
-    if parameter == "pixel_noise_px" and v <= 0:  # the schema allows 0 for a dataset, not for a study
+    if parameter in ("pixel_noise_px", "spin_pixel_noise_px") and v <= 0:  # the schema allows 0, a study not
         return (
-            f"pixel_noise_px must be positive in a study, not {v:g}: a study measures how the tracking "
+            f"{parameter} must be positive in a study, not {v:g}: a study measures how the tracking "
             "noise spreads the estimates around the truth, and without noise there is no spread to measure"
         )
+    if parameter == "e_x_scatter" and not 0.0 <= v < 0.5:
+        return f"e_x_scatter must lie in [0, 0.5), not {v:g}"
+    if parameter == "psi_max_scale" and not 0.0 < v <= 2.0:
+        return f"psi_max_scale must lie in (0, 2], not {v:g}"
     if parameter == "e_x" and not -1.0 < v < 1.0:
         return f"e_x must lie in (-1, 1), not {v:g}"
     from .tracks.data import CONTACT_PRIOR  # the reduction's prior: the renderer's contacts must lie in it
@@ -188,6 +195,12 @@ def point_dataset(dataset: dict, parameter: str | Sequence[str] | None, value: f
             cam["pixel_noise_px"] = float(value)
     elif parameter in ("swing_fps", "spin_fps"):
         ds["render"]["cameras"][parameter.split("_")[0]]["fps"] = float(value)
+    elif parameter == "e_x_scatter":
+        syn["e_x_scatter"] = float(value)
+    elif parameter == "psi_max_scale":
+        syn["psi_deg"] = {b: [float(lo), float(value) * float(hi)] for b, (lo, hi) in syn["psi_deg"].items()}
+    elif parameter == "spin_pixel_noise_px":
+        ds["render"]["cameras"]["spin"]["pixel_noise_px"] = float(value)
     elif parameter == "contact_ms":
         ds["render"]["contact_ms"] = [float(value) - CONTACT_HALF_WIDTH_MS, float(value) + CONTACT_HALF_WIDTH_MS]
     else:

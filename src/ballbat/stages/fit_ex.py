@@ -91,6 +91,7 @@ def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) 
         table[f"{name}_status"] = Var(
             dims, "1", f"why {name} has no value (0: it has one; the count is {name}_n)", flag_attrs(FitStatus)
         )
+    table.update(scatter_vars())
     table["e_y_implied"] = Var(
         ("ball",),
         "1",
@@ -98,7 +99,10 @@ def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) 
         {"ancillary_variables": "e_y_implied_err"},
     )
     table["e_y_implied_err"] = Var(
-        ("ball",), "1", "standard error of e_y implied (sandwich: the impacts' influences via the slope and e_x)"
+        ("ball",),
+        "1",
+        "standard error of e_y implied (leverage-corrected HC2 sandwich: the impacts' influences via the slope "
+        "and e_x)",
     )
     table["mu_k_lower_bound"] = Var(
         ("ball",),
@@ -127,6 +131,24 @@ def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) 
     return table
 
 
+def scatter_vars() -> dict[str, Var]:
+    """Declare the intrinsic scatter of e_x per bat and ball and its 95 % interval (``linefit.eiv_line``)."""
+    table = {
+        "e_x_scatter": Var(
+            ("ball", "bat"),
+            "1",
+            "intrinsic impact-to-impact standard deviation tau of e_x, fitted with e_x (Paule-Mandel; 0: the "
+            "measurement errors explain the scatter)",
+            {"ancillary_variables": "e_x_scatter_ci_low e_x_scatter_ci_high"},
+        )
+    }
+    for side, bound in (("low", "lower"), ("high", "upper")):
+        table[f"e_x_scatter_ci_{side}"] = Var(
+            ("ball", "bat"), "1", f"{bound} bound of the 95 % interval of e_x_scatter (Q-profile)"
+        )
+    return table
+
+
 def results_dataset(res: Sec4) -> xr.Dataset:
     """fit_ex.nc's contents: the :class:`Sec4` results on the declared table (dims ball, bat)."""
     values: dict[str, np.ndarray] = {}
@@ -143,6 +165,8 @@ def results_dataset(res: Sec4) -> xr.Dataset:
             values[f"truth_{name}"] = grid.truth
     for name in ("spin_theta_slope", "speed_theta_slope"):
         values[f"{name}_intercept"] = getattr(res, name).field("intercept")
+    for k in ("scatter", "scatter_ci_low", "scatter_ci_high"):
+        values[f"e_x_{k}"] = res.e_x.field(k)
     for name in _SLOPE_IS_ONE_PLUS:
         values[f"{name}_status"] = np.vectorize(lambda f: int(fit_status(f)), otypes=[np.int8])(getattr(res, name).fits)
     values.update({k: v for k, v in res.per_ball.items() if res.has_truth or not k.startswith("truth_")})

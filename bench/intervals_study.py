@@ -1,0 +1,114 @@
+"""Issue 36: coverage of implied e_y's interval forms and of e_x with intrinsic scatter, per set-up.
+
+Each set-up's replicate experiments are simulated, rendered and reduced once
+(:func:`ballbat.studies._source`, cached) and fitted once per estimator variant on the same
+replicates: implied e_y's sandwich form (:data:`ballbat.fitting.E_Y_SANDWICH`: ``hc0k``, the
+first version; ``hc2``, shipped; ``hc3``) and the e_x fits with or without the intrinsic-scatter
+term (:data:`ballbat.linefit.SCATTER_TERM`). Variants: ``before`` (hc0k, no term), ``hc2`` (no
+term), ``after`` (hc3 and the term), ``shipped`` (hc2 and the term); name some on the command
+line to run only those. Stronge's eta^2 is not fitted (it is not judged here).
+The calibration is not drawn (statistical intervals; the combined ones need the drawn
+calibration of the robustness grid).
+
+Run: ``nice -n 10 .venv/bin/python bench/intervals_study.py REPLICATES SETUP [SETUP ...]``.
+Prints, per set-up, variant and quantity (e_y_implied, tan_ratio_slope, e_x per bat,
+e_x_pooled), the 95 % coverage with its binomial error, bias / SE and spread / SE.
+"""
+
+from __future__ import annotations
+
+import sys
+import time
+from unittest import mock
+
+from ballbat import fitting, linefit, studies
+from ballbat.pipeline.config import load_config
+from ballbat.properties import load_balls, load_bats
+from ballbat.stages import study_batch
+
+
+def _cameras(ds: dict, swing: float, spin: float) -> dict:
+    ds["render"]["cameras"]["swing"]["pixel_noise_px"] = swing
+    ds["render"]["cameras"]["spin"]["pixel_noise_px"] = spin
+    return ds
+
+
+def _narrow(ds: dict) -> dict:
+    ds["synthetic"]["psi_deg"] = {"baseball": [0.0, 12.0], "softball": [0.0, 15.0]}
+    return ds
+
+
+def _scatter(ds: dict, tau: float) -> dict:
+    ds["synthetic"]["e_x_scatter"] = tau
+    return ds
+
+
+#: name -> a change of the calibration study's dataset
+SETUPS = {
+    "calibration": lambda ds: ds,
+    "lab2_cameras": lambda ds: _cameras(ds, 1.0, 3.5),
+    "narrow_psi": _narrow,
+    "scatter0.02": lambda ds: _scatter(ds, 0.02),
+    "scatter0.01": lambda ds: _scatter(ds, 0.01),
+}
+
+#: variant -> (E_Y_SANDWICH, SCATTER_TERM)
+VARIANTS = {"before": ("hc0k", False), "hc2": ("hc2", False), "after": ("hc3", True), "shipped": ("hc2", True)}
+
+
+def table(cov, label: str) -> list[str]:
+    """Lines of the coverage table of one variant (e_y, ratio slope, e_x)."""
+    lines = []
+    for j, q in enumerate(cov["quantity"].values.astype(str)):
+        if q.split(":")[0] not in ("e_y_implied", "tan_ratio_slope", "e_x", "e_x_pooled"):
+            continue
+        c, e = 100 * cov["coverage_95"].values[0, j], 100 * cov["coverage_95_err"].values[0, j]
+        b, sp = cov["bias_over_se"].values[0, j], cov["spread_over_se"].values[0, j]
+        lines.append(f"  {label:6s} {q:40s} {c:5.1f} ± {e:3.1f} %   bias/SE {b:+.3f}   spread/SE {sp:.2f}")
+    return lines
+
+
+def main() -> None:
+    """Run the set-ups named on the command line and print their tables."""
+    args = sys.argv[1:]
+    reps = int(args.pop(0))
+    names = args or list(SETUPS)
+    variants = [v for v in VARIANTS if v in names] or list(VARIANTS)
+    names = [n for n in names if n in SETUPS]
+    cfg = load_config()
+    balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
+    cache: dict = {}
+    real_source = studies._source
+
+    def cached_source(dataset, seeds, *rest):
+        if seeds not in cache:
+            cache[seeds] = real_source(dataset, seeds, *rest)
+        return cache[seeds]
+
+    quantities = tuple(q for q in studies.STUDY_QUANTITIES if q != "eta2")
+    for name in names:
+        s = studies.StudySettings.from_config(cfg, "calibration")
+        s = studies.replace(s, dataset=SETUPS[name](s.dataset), replicates=reps, batch_size=reps, truth_impacts=2000)
+        cache.clear()
+        t0 = time.perf_counter()
+        truth = [studies.population_truth(s, 0, balls, bats)]
+        out = [f"{name}: {reps} replicates (truth {time.perf_counter() - t0:.0f} s)"]
+        with (
+            mock.patch.object(studies, "_source", cached_source),
+            mock.patch.object(studies, "STUDY_QUANTITIES", quantities),
+        ):
+            for label in variants:
+                form, term = VARIANTS[label]
+                t0 = time.perf_counter()
+                with (
+                    mock.patch.object(fitting, "E_Y_SANDWICH", form),
+                    mock.patch.object(linefit, "SCATTER_TERM", term),
+                ):
+                    rep = study_batch.run(s, 0, balls, bats)
+                    truth_v = [studies.population_truth(s, 0, balls, bats)] if term else truth
+                out += [*table(studies.coverage(rep, truth_v), label), f"  {label}: {time.perf_counter() - t0:.0f} s"]
+        print("\n".join(out), flush=True)
+
+
+if __name__ == "__main__":
+    main()
