@@ -381,6 +381,37 @@ def largest_value(y: ArrayLike, sigma: ArrayLike) -> float:
     return 2 * top - mean
 
 
+def _empty_sec4(ball_list: list[str], bat_list: list[str], has_truth: bool, mu_k_example: float) -> Sec4:
+    """Return the Sec. IV results of these balls and bats with every fit still to be made (NaN)."""
+    nb, nt = len(ball_list), len(bat_list)
+    res = Sec4(
+        ball_list,
+        bat_list,
+        has_truth,
+        float(mu_k_example),
+        e_x=FitGrid.empty((nb, nt)),
+        e_x_pooled=FitGrid.empty((nb,)),
+        tan_ratio_slope=FitGrid.empty((nb,)),
+        spin_theta_slope=FitGrid.empty((nb,)),
+        speed_theta_slope=FitGrid.empty((nb,)),
+        per_ball={k: np.full(nb, np.nan) for k in PER_BALL},
+    )
+    res.per_ball["mu_k_lower_bound_impact"] = np.full(nb, -1, dtype=np.int64)
+    return res
+
+
+def _mu_k_bound(pb: dict, i: int, y: np.ndarray, jy: np.ndarray, sig: np.ndarray | None, impact: np.ndarray) -> None:
+    """Set ball ``i``'s lower bound on mu_k (Eq. muk): the largest true tan(psi - theta), and its impact."""
+    k = int(np.nanargmax(y))
+    if sig is not None:
+        sy = np.sqrt(np.sum(jy**2 * sig**2, axis=1))
+        pb["mu_k_lower_bound"][i] = largest_value(y, sy)  # corrected for picking the largest
+        pb["mu_k_lower_bound_err"][i] = float(sy[k])
+    else:
+        pb["mu_k_lower_bound"][i] = float(y[k])
+    pb["mu_k_lower_bound_impact"][i] = int(impact[k])
+
+
 def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True) -> Sec4:
     """Sec. IV analysis of a normalised and reconstructed dataset (output of ``reconstruct``).
 
@@ -399,21 +430,7 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
     has_truth = all(f"truth_{k}" in ds for k in MEASURED)
     ball_list = sorted(set(balls))
     bat_list = sorted(set(bats))
-    nb, nt = len(ball_list), len(bat_list)
-    res = Sec4(
-        ball_list,
-        bat_list,
-        has_truth,
-        float(mu_k_example),
-        e_x=FitGrid.empty((nb, nt)),
-        e_x_pooled=FitGrid.empty((nb,)),
-        tan_ratio_slope=FitGrid.empty((nb,)),
-        spin_theta_slope=FitGrid.empty((nb,)),
-        speed_theta_slope=FitGrid.empty((nb,)),
-        per_ball={k: np.full(nb, np.nan) for k in PER_BALL},
-    )
-    res.per_ball["mu_k_lower_bound_impact"] = np.full(nb, -1, dtype=np.int64)
-
+    res = _empty_sec4(ball_list, bat_list, has_truth, mu_k_example)
     res.e_x, res.e_x_pooled = fit_e_x(ds, ball_list, bat_list, with_truth=has_truth)
     pb = res.per_ball
     for i, ball in enumerate(ball_list):
@@ -433,15 +450,7 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
         a = float(np.mean(alpha))
         e_y, e_y_err = implied_e_y(ds, in_ball, res, i, (x, y, jx, jy, sig), rfit)
         pb["e_y_implied"][i], pb["e_y_implied_err"][i] = e_y, e_y_err
-        # Eq. muk: the largest true tan(psi - theta) bounds mu_k from below
-        k = int(np.nanargmax(y))
-        if sig is not None:
-            sy = np.sqrt(np.sum(jy**2 * sig**2, axis=1))
-            pb["mu_k_lower_bound"][i] = largest_value(y, sy)  # corrected for picking the largest
-            pb["mu_k_lower_bound_err"][i] = float(sy[k])
-        else:
-            pb["mu_k_lower_bound"][i] = float(y[k])
-        pb["mu_k_lower_bound_impact"][i] = int(ds["impact"].values[in_ball][k])
+        _mu_k_bound(pb, i, y, jy, sig, ds["impact"].values[in_ball])
         psi_g, theta_g, omega_g = gross_slip_onset(
             mu_k_example, rfit.slope, v_ref, exf.slope - 1.0, float(np.mean(r)), float(np.mean(r_x)), a
         )

@@ -783,6 +783,37 @@ def _interval_columns(ok: np.ndarray, d: np.ndarray, e: np.ndarray, dof: np.ndar
     return {(k[:-4] + tag + "_err" if k.endswith("_err") else k + tag): v for k, v in col.items()}
 
 
+def _empty_point(p: int, what: str, n: int) -> EmptySweepPoint:
+    """Return the error of sweep point ``p`` (``what``: its settings) whose ``n`` replicates estimated nothing."""
+    return EmptySweepPoint(
+        f"sweep point {p}{f' ({what})' if what else ''}: none of its {n} replicates gave a "
+        "usable estimate (value, uncertainty and truth) of any quantity; the setting is beyond what the "
+        "chain can fit: drop the point or change it"
+    )
+
+
+def _combined_columns(ok: np.ndarray, d: np.ndarray, e: np.ndarray, syst: np.ndarray, dof: np.ndarray) -> dict:
+    """Return the combined interval's columns (statistical and systematic in quadrature) of one sweep point.
+
+    Only where a systematic is reported: a quantity without one gets NaN, not the statistical
+    coverage again. ``d``: estimate minus truth; ``e``, ``syst``, ``dof``: per replicate and quantity.
+    """
+    out = {}
+    oks = ok & np.isfinite(syst) & (syst >= 0)
+    ns = oks.sum(axis=0)
+    out["n_systematic"] = ns
+    s_used = np.where(oks, syst, 0.0)
+    out["mean_systematic"] = s_used.sum(axis=0) / np.where(ns > 0, ns, np.nan)
+    combined = np.hypot(e, s_used)
+    dof_combined = combined_dof(e, s_used, dof)
+    for q in (68, 95):
+        half = _t(q / 100, dof_combined) * combined
+        frac = np.where(oks, np.abs(d) <= half, False).sum(axis=0) / np.where(ns > 0, ns, np.nan)
+        out[f"coverage_{q}_combined"] = frac
+        out[f"coverage_{q}_combined_err"] = np.sqrt(frac * (1 - frac) / ns)
+    return out
+
+
 def coverage(
     rep: xr.Dataset, truths: Sequence[dict] | None = None, truth_scale: Sequence[float] | None = None
 ) -> xr.Dataset:
@@ -824,12 +855,7 @@ def coverage(
         ok = np.isfinite(v) & np.isfinite(e) & np.isfinite(t) & (e > 0)
         n = ok.sum(axis=0)
         if not n.any():
-            what = point_label(swept, table[p]) if swept else ""
-            raise EmptySweepPoint(
-                f"sweep point {p}{f' ({what})' if what else ''}: none of its {int(sel.sum())} replicates gave a "
-                "usable estimate (value, uncertainty and truth) of any quantity; the setting is beyond what the "
-                "chain can fit: drop the point or change it"
-            )
+            raise _empty_point(p, point_label(swept, table[p]) if swept else "", int(sel.sum()))
         out["n_replicates"][p] = n
         out["n_refused"][p] = refused[sel].sum()
         okc = ok & np.isfinite(eff)
@@ -848,20 +874,8 @@ def coverage(
             d = np.where(ok, v - t, np.nan)
             out["spread"][p] = np.nanstd(d, axis=0, ddof=1)
             out["mean_uncertainty"][p] = np.nanmean(np.where(ok, e, np.nan), axis=0)
-            # the combined interval (statistical and systematic in quadrature), where a systematic is
-            # reported; a quantity without one gets NaN, not the statistical coverage again
-            oks = ok & np.isfinite(syst) & (syst >= 0)
-            ns = oks.sum(axis=0)
-            out["n_systematic"][p] = ns
-            s_used = np.where(oks, syst, 0.0)
-            out["mean_systematic"][p] = s_used.sum(axis=0) / np.where(ns > 0, ns, np.nan)
-            combined = np.hypot(e, s_used)
-            dof_combined = combined_dof(e, s_used, dof)
-            for q in (68, 95):
-                half = _t(q / 100, dof_combined) * combined
-                frac = np.where(oks, np.abs(d) <= half, False).sum(axis=0) / np.where(ns > 0, ns, np.nan)
-                out[f"coverage_{q}_combined"][p] = frac
-                out[f"coverage_{q}_combined_err"][p] = np.sqrt(frac * (1 - frac) / ns)
+            for k, col in _combined_columns(ok, d, e, syst, dof).items():
+                out[k][p] = col
             out["mean_value"][p] = np.nanmean(np.where(ok, v, np.nan), axis=0)
             out["mean_truth"][p] = np.nanmean(np.where(ok, t, np.nan), axis=0)
             out["mean_dof"][p] = np.nanmean(np.where(ok, dof, np.nan), axis=0)
