@@ -193,25 +193,36 @@ LAB_STUDIES = {
 
 
 #: The order of the test modules (``make test``: ``--dist loadscope --no-loadscope-reorder``, a
-#: module per pytest-xdist process, in this order), so that both processes stay busy and end
-#: together: the lab run's heaviest tests first (their process builds it), the default run's beside
-#: them, then unit tests while the lab run builds, then the rest of its tests.
+#: module per pytest-xdist process, in this order, each process taking the next module when it is
+#: nearly done), so that both processes stay busy and end together. One process builds the lab run
+#: (test_workflow.py, its first module) while the other builds the default run and runs its tests,
+#: then the unit tests (no shared run); the lab run's other tests come last (:data:`LAST`), so that
+#: no process waits for the lab run while there is other work, and both share its reruns.
 FIRST = (
     "test_workflow.py",
     "test_crate.py",
-    "test_faults.py",
     "test_lab_numbers.py",
-    "test_settings.py",
-    "test_systematics.py",
-    "test_tracks.py",
-    "test_cli.py",
-    "test_redteam.py",
+    "test_redteam3_diagnoses.py",
+    "test_report_browser.py",
+)
+
+#: The modules that copy or read the lab run, after every other module: the heaviest first (their
+#: Snakemake reruns), the quick ones last so that the two processes end together.
+LAST = (
+    "test_faults_runs.py",
+    "test_faults.py",
+    "test_workflow_rerun.py",
     "test_redteam_guards.py",
     "test_byod.py",
+    "test_redteam.py",
+    "test_studies.py",
+    "test_study_grid.py",
+    "test_track_formats.py",
 )
 
 
 def pytest_collection_modifyitems(config, items):
-    """Order the modules: :data:`FIRST`, then the rest as collected (the same order in every process)."""
+    """Order the modules: :data:`FIRST`, the rest as collected, then :data:`LAST` (the same order in every process)."""
     rank = {name: i for i, name in enumerate(FIRST)}
+    rank.update({name: len(FIRST) + 1 + i for i, name in enumerate(LAST)})
     items.sort(key=lambda item: rank.get(item.path.name, len(FIRST)))

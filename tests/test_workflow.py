@@ -1,5 +1,7 @@
 """End to end: the suite's lab run (conftest.lab_run: rendered dataset ``small``, the measured
-example ``maple``, scenarios paper and flyballs) in a copy of its folder.
+example ``maple``, scenarios paper and flyballs) in a copy of its folder. The rerun of small's chain
+(byte-identical): test_workflow_rerun.py, a module of its own so that the other pytest-xdist process
+runs it beside this module's tests.
 """
 
 from __future__ import annotations
@@ -9,7 +11,6 @@ import json
 import re
 import subprocess
 import sys
-import time
 from pathlib import Path
 
 import numpy as np
@@ -101,26 +102,6 @@ def test_implications_outputs(run_dir):
     rows = {r["quantity"]: r for r in read_csv(imp / "paper_comparison.csv")}
     assert rows["carry_max"]["paper"] == "400" and 350 < float(rows["carry_max"]["value"]) < 450
     assert rows["carry_max"]["unit"] == "ft" and rows["D_at_carry_max"]["unit"] == "in"
-
-
-def test_rerun_is_noop_and_byte_identical(lab_run, tmp_path):
-    """Nothing to do in a finished run; small's chain made again (its data, workbook, a figure of each
-    kind, the paper scenario): the same, byte for byte.
-    """
-    wd = copy_run(lab_run, tmp_path / "wd")
-    assert planned_jobs(wd) == {}
-    res = wd / "results"
-    files = [*sorted((res / "small").glob("*.nc")), res / "small" / "results.xlsx"]  # workbooks: fixed metadata
-    figures = ["fig3", "fig9a", "tracks_impacts"]  # figures: no timestamps (scatter and lines, curves, QA)
-    files += [res / "small" / "figures" / f"{name}.png" for name in figures]
-    files += [res / "implications" / "paper.nc", res / "implications" / "figures" / "paper_fig11a.png"]
-    assert len(files) == 7 + 1 + 3 + 2
-    before = {p: sha256_file(p) for p in files}
-    started = time.time()
-    snakemake(wd, "-c2", "--forcerun", "simulate", "--", *(str(p.relative_to(wd)) for p in files))
-    assert all(p.stat().st_mtime >= started - 1 for p in files)  # every one made again
-    after = {p: sha256_file(p) for p in files}
-    assert before == after
 
 
 #: Two datasets (small and maple) draw the paper's figures; the scenarios draw Fig. 11 (paper) and

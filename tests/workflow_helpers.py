@@ -36,6 +36,31 @@ SMALL_SYNTHETIC = {
 }
 
 
+#: The targets of the fault tests' reruns (test_faults.py, test_faults_runs.py): the maple dataset's
+#: data files (its figures and the report's front page are not what these tests are about).
+MAPLE_DATA = [
+    f"results/maple/{name}"
+    for name in (
+        "ingest.nc",
+        "normalize.nc",
+        "reconstruct.nc",
+        "fit_ex.nc",
+        "stronge.nc",
+        "paper_comparison.csv",
+        "results.xlsx",
+    )
+]
+
+
+def maple_data_files(wd: Path) -> dict[str, str]:
+    """Every NetCDF file of the maple dataset and the comparison table, with its sha256."""
+    from ballbat.pipeline.provenance import sha256_file
+
+    res = wd / "results" / "maple"
+    files = [*sorted(res.glob("*.nc")), res / "paper_comparison.csv", res / "results.xlsx"]
+    return {p.name: sha256_file(p) for p in files}
+
+
 def write_config(workdir: Path, edit) -> None:
     """Edit the workdir's config/config.yaml in place: ``edit(cfg)`` changes the loaded mapping."""
     import yaml
