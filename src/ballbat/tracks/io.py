@@ -202,7 +202,7 @@ def _fast_csv(path: Path, impacts: dict) -> dict | None:
     """Return the long columns of a CSV tracks file when every vectorised check passes, else None.
 
     Columns, not a dict per row: a plain file (commas, no quotes, no spaces, as programs write
-    them) of 10^6 rows is checked in about a second, and one whose track is too long to lay out
+    them) of 10^6 rows is checked in seconds, and one whose track is too long to lay out
     is named before any row-by-row work. Anything else (a semicolon file, a quoted cell, a
     missing or surplus cell, a text where a number belongs) returns None, and the row-by-row
     checks read it as labs make them and name what is wrong.
