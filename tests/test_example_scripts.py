@@ -12,11 +12,12 @@ EXAMPLES = Path(__file__).resolve().parents[1] / "config" / "examples"
 
 
 @pytest.mark.slow
-def test_make_maple_regenerates_the_committed_table(tmp_path):
-    """config/examples/make_maple.py (the forward model with its seed) gives maple_impacts.csv exactly."""
-    out = tmp_path / "maple_impacts.csv"
+@pytest.mark.parametrize("name", ["maple", "hickory"])
+def test_example_script_regenerates_the_committed_table(tmp_path, name):
+    """config/examples/make_<name>.py (the forward model with its seed) gives <name>_impacts.csv exactly."""
+    out = tmp_path / f"{name}_impacts.csv"
     run = subprocess.run(
-        [sys.executable, str(EXAMPLES / "make_maple.py"), str(out)], capture_output=True, text=True, check=False
+        [sys.executable, str(EXAMPLES / f"make_{name}.py"), str(out)], capture_output=True, text=True, check=False
     )
     assert run.returncode == 0, run.stderr
-    assert out.read_bytes() == (EXAMPLES / "maple_impacts.csv").read_bytes()
+    assert out.read_bytes() == (EXAMPLES / f"{name}_impacts.csv").read_bytes()
