@@ -1,6 +1,7 @@
-"""What the example scripts share (make_maple.py, make_hickory.py): a bat's impacts drawn with
-ballbat's forward model and written as a lab records them (mph, deg, rpm, rounded, with their
-standard uncertainties).
+"""What the example scripts make_maple.py and make_hickory.py share.
+
+A bat's impacts drawn with ballbat's forward model and written as a lab records them (mph, deg,
+rpm, rounded, with their standard uncertainties).
 """
 
 import csv
