@@ -221,8 +221,8 @@ def fit_problems(settings: DatasetSettings, impacts: xr.Dataset, balls: dict, ba
 
     try:
         run(settings.replace(fit_ex=dataclasses.replace(settings.fit_ex, systematic=False)), impacts, balls, bats)
-    except ImplausibleFit as exc:  # named as the fit's, not the job's: the check runs no job
-        return [str(exc).replace("fit_ex: ", "the fit of e_x (fit_ex): ", 1)]
+    except ImplausibleFit as exc:
+        return [str(exc)]
     return []
 
 

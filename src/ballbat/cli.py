@@ -170,8 +170,10 @@ def cmd_check(args: argparse.Namespace) -> int:
     balls, bats = load_balls(args.balls or defaults["balls"]), load_bats(args.bats or defaults["bats"])
     problems = fit_problems(schema_settings({"impacts": str(path)}, "check"), ds, balls, bats)
     if problems:  # what the workflow's fit_ex would stop on: the same chain and test (issue 19)
-        for text in [*problems, *warnings]:
-            print(f"{path}: {text}" if text.startswith("the fit") else f"warning: {text}")
+        for text in problems:
+            print(f"{path}: {text}")
+        for text in warnings:
+            print(f"warning: {text}")
         print(f"{path}: not usable: {len(problems)} problem(s)", file=sys.stderr)
         return 1
     for text in warnings:
