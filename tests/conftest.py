@@ -168,6 +168,24 @@ def lab_run(tmp_path_factory):
     return _shared_run(tmp_path_factory, "lab_run", build)
 
 
+@pytest.fixture(scope="session")
+def maple_reference(lab_run):
+    """The maple example's files of a clean run (lab_run: maple beside a rendered synthetic dataset)."""
+    from workflow_helpers import maple_data_files
+
+    return maple_data_files(lab_run)
+
+
+@pytest.fixture
+def maple_copy(lab_run, maple_reference, tmp_path):
+    """A copy of the lab run (timestamps kept) for one fault test to damage, with the clean run's maple files."""
+    from workflow_helpers import copy_run, maple_data_files
+
+    wd = copy_run(lab_run, tmp_path / "wd")
+    assert maple_data_files(wd) == maple_reference
+    return wd, maple_reference
+
+
 #: The lab run's studies (of dataset ``small``).
 LAB_STUDIES = {
     "calibration": {"dataset": "small", "seed": 1, "replicates": 4, "batch_size": 3, "truth_impacts": 40},

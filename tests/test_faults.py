@@ -13,37 +13,23 @@ import os
 import pytest
 
 from workflow_helpers import MAPLE_DATA as DATA
-from workflow_helpers import copy_run, snakemake
 from workflow_helpers import maple_data_files as data_files
+from workflow_helpers import snakemake
 
 pytestmark = pytest.mark.slow
 
 
-@pytest.fixture(scope="module")
-def reference(lab_run):
-    """The maple example's files of a clean run (conftest.lab_run: maple beside a rendered synthetic dataset)."""
-    return data_files(lab_run)
-
-
-@pytest.fixture
-def clean(lab_run, reference, tmp_path):
-    """A copy of the clean run (timestamps kept) for one test to damage, with the clean run's files."""
-    wd = copy_run(lab_run, tmp_path / "wd")
-    assert data_files(wd) == reference
-    return wd, reference
-
-
-def test_deleted_intermediate_is_rebuilt(clean):
-    wd, reference = clean
+def test_deleted_intermediate_is_rebuilt(maple_copy):
+    wd, reference = maple_copy
     (wd / "results" / "maple" / "fit_ex.nc").unlink()
     (wd / "results" / "maple" / "normalize.nc").unlink()
     snakemake(wd, "-c2", *DATA)
     assert data_files(wd) == reference
 
 
-def test_truncated_intermediate_is_named_and_rebuilt(clean):
+def test_truncated_intermediate_is_named_and_rebuilt(maple_copy):
     """Named by any invocation with the command that rebuilds it; nothing removed while parsing (issue 19)."""
-    wd, reference = clean
+    wd, reference = maple_copy
     path = wd / "results" / "maple" / "reconstruct.nc"
     with open(path, "r+b") as fh:
         fh.truncate(path.stat().st_size // 2)
@@ -56,9 +42,9 @@ def test_truncated_intermediate_is_named_and_rebuilt(clean):
     assert data_files(wd) == reference
 
 
-def test_input_replaced_by_an_older_copy_reruns(clean):
+def test_input_replaced_by_an_older_copy_reruns(maple_copy):
     """Cp -p / tar / rsync -a keep an old timestamp: the rerun must follow the content."""
-    wd, reference = clean
+    wd, reference = maple_copy
     src = wd / "config" / "examples" / "maple_impacts.csv"
     original = src.read_bytes()
     old = os.stat(src).st_mtime - 10 * 86400

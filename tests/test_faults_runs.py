@@ -18,29 +18,15 @@ import yaml
 
 from ballbat.pipeline.atomic import hostname
 from workflow_helpers import MAPLE_DATA as DATA
-from workflow_helpers import copy_run, snakemake
 from workflow_helpers import maple_data_files as data_files
+from workflow_helpers import snakemake
 
 pytestmark = pytest.mark.slow
 
 
-@pytest.fixture(scope="module")
-def reference(lab_run):
-    """The maple example's files of a clean run (conftest.lab_run: maple beside a rendered synthetic dataset)."""
-    return data_files(lab_run)
-
-
-@pytest.fixture
-def clean(lab_run, reference, tmp_path):
-    """A copy of the clean run (timestamps kept) for one test to damage, with the clean run's files."""
-    wd = copy_run(lab_run, tmp_path / "wd")
-    assert data_files(wd) == reference
-    return wd, reference
-
-
-def test_job_killed_while_writing(clean):
+def test_job_killed_while_writing(maple_copy):
     """Kill the run while jobs run: the rerun cleans the temporaries and ends as a clean run."""
-    wd, reference = clean
+    wd, reference = maple_copy
     for p in (wd / "results" / "maple").glob("*.nc"):
         p.unlink()
     env = dict(os.environ)
@@ -69,11 +55,11 @@ def test_job_killed_while_writing(clean):
     assert data_files(wd) == reference
 
 
-def test_missing_input_stops_only_its_dataset(clean, tmp_path):
+def test_missing_input_stops_only_its_dataset(maple_copy, tmp_path):
     """A dataset whose file is missing, or a directory, fails its own job with --keep-going; the
     others complete (before, a missing file stopped every dataset when the DAG was built).
     """
-    wd, reference = clean
+    wd, reference = maple_copy
     (wd / "missing.yaml").write_text(
         yaml.safe_dump(
             {
@@ -94,11 +80,11 @@ def test_missing_input_stops_only_its_dataset(clean, tmp_path):
     assert not list((wd / "results" / "gone").rglob("*.nc"))
 
 
-def test_warnings_reach_every_product_and_the_end_of_the_run(clean, tmp_path):
+def test_warnings_reach_every_product_and_the_end_of_the_run(maple_copy, tmp_path):
     """A measured file's warnings are in fit_ex.nc, stronge.nc, the comparison and the workbook,
     and the run prints them when it ends.
     """
-    wd, _ = clean
+    wd, _ = maple_copy
     lines = (wd / "config" / "examples" / "maple_impacts.csv").read_text().splitlines()
     head = lines[0].split(",")
     keep = [i for i, h in enumerate(head) if h != "theta_deg_err"]  # 3 of the 4 uncertainty columns
