@@ -39,7 +39,7 @@ if TYPE_CHECKING:
 
 @dataclass(frozen=True)
 class DatasetSettings:
-    """Every setting of one dataset's chain (frozen; a replicate or a sweep point is a :meth:`replace`).
+    """Every setting of one dataset's chain (frozen; a change is a :func:`dataclasses.replace`).
 
     Attributes
     ----------
@@ -133,10 +133,6 @@ class DatasetSettings:
             render=render.settings_from_config({**self.block["render"], "seed": render_seed}) if rendered else None,
         )
 
-    def replace(self, **changes: object) -> DatasetSettings:
-        """Return a copy with ``changes`` (:func:`dataclasses.replace`)."""
-        return dataclasses.replace(self, **changes)
-
 
 def source(
     settings: DatasetSettings,
@@ -220,7 +216,8 @@ def fit_problems(settings: DatasetSettings, impacts: xr.Dataset, balls: dict, ba
     from .fitting import ImplausibleFit
 
     try:
-        run(settings.replace(fit_ex=dataclasses.replace(settings.fit_ex, systematic=False)), impacts, balls, bats)
+        fit = dataclasses.replace(settings.fit_ex, systematic=False)
+        run(dataclasses.replace(settings, fit_ex=fit), impacts, balls, bats)
     except ImplausibleFit as exc:
         return [str(exc)]
     return []

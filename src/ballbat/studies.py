@@ -105,7 +105,7 @@ def chain_settings(
     ).with_seeds(*seeds)
     if check or base.reduce is None:
         return base
-    return base.replace(reduce=replace(base.reduce, cross_check=False, systematics=False))
+    return replace(base, reduce=replace(base.reduce, cross_check=False, systematics=False))
 
 
 def replicate_source(
@@ -197,7 +197,7 @@ def run_replicate(
     # the calibration systematics where the replicate draws its calibration (the combined interval's
     # coverage); every replicate's numbers are recorded as they come
     drawn = has_shifts(src)
-    run = chain.run(cs.replace(fit_ex=replace(cs.fit_ex, systematic=drawn)), src, balls, bats)
+    run = chain.run(replace(cs, fit_ex=replace(cs.fit_ex, systematic=drawn)), src, balls, bats)
     rec, fit, fs = run.reconstruct, run.fit_ex, run.fit_systematics
     z = calibration_draws({**dataset["render"], "seed": seeds[1]}) if drawn else None
     rows = fit_quantity_rows(fit, None if fs is None else _calibration_effect(fit, fs.signed, z))
