@@ -80,12 +80,11 @@ def copy_run(finished: Path, dest: Path) -> Path:
     return dest
 
 
-#: Snakemake's own modules, imported once per test process by a fork server: every run of
-#: :func:`snakemake` is a child forked from it (the real ``snakemake`` command line, ``main``),
-#: so that the suite's many short runs do not each pay the interpreter's start and Snakemake's
-#: imports. Nothing of ballbat is preloaded: each run imports it afresh (from ``workdir/src``
-#: when the run has its own copy), as ``python -m snakemake`` does.
-PRELOAD = ["snakemake.cli", "snakemake.api", "snakemake.workflow", "snakemake.persistence", "snakemake.dag"]
+#: Imported once per test process by a fork server (:mod:`snakemake_preload`: Snakemake, the
+#: third-party libraries its start imports, its plugin registries): every run of :func:`snakemake`
+#: is a child forked from it (the real ``snakemake`` command line, ``main``), so that the suite's
+#: many short runs do not each pay the interpreter's start and those imports.
+PRELOAD = ["snakemake_preload"]
 _CONTEXT = None
 
 
@@ -94,13 +93,29 @@ def _context():
     if _CONTEXT is None:
         import multiprocessing
 
+        from multiprocessing import forkserver
+
         _CONTEXT = multiprocessing.get_context("forkserver")
         _CONTEXT.set_forkserver_preload(PRELOAD)
+        # The server starts with this folder on its path, so that it finds the preload module
+        # (Python 3.11's fork server ignores the parent's sys.path, and skips a preload it
+        # cannot import without a word); the runs it forks set their own environment.
+        saved = os.environ.get("PYTHONPATH")
+        os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(Path(__file__).parent), saved) if p)
+        try:
+            forkserver.ensure_running()
+        finally:
+            if saved is None:
+                del os.environ["PYTHONPATH"]
+            else:
+                os.environ["PYTHONPATH"] = saved
     return _CONTEXT
 
 
 def _snakemake_main(workdir: str, args: list[str], env: dict, out: str, err: str) -> None:
     """The child: ``python -m snakemake ARGS`` in ``workdir`` with ``env``, its output in two files."""
+    if PRELOAD[0] not in sys.modules:  # the server skips a preload it cannot import, silently
+        raise RuntimeError(f"the fork server did not preload {PRELOAD[0]}: see workflow_helpers._context")
     os.chdir(workdir)
     os.environ.clear()
     os.environ.update(env)
