@@ -82,6 +82,7 @@ rule reduce:
     params:
         settings=get_reduce_settings,
         where=get_reduce_where,
+        files=data_files,
         sha256=data_hashes,
     script:
         "../scripts/reduce.py"

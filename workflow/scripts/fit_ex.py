@@ -5,7 +5,7 @@ from ballbat.pipeline.runlog import logged
 from ballbat.stages import fit_ex
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    settings = fit_ex.FitExSettings.from_config(snakemake.config)
+    settings = fit_ex.FitExSettings.from_params(dict(snakemake.params))
     ds = fit_ex.run(settings, read_dataset(snakemake.input.impacts))
     for line in fit_ex.not_fitted(ds):
         log.warning(line)

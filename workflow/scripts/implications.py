@@ -7,7 +7,7 @@ from ballbat.properties import load_balls, load_bats
 from ballbat.stages import implications
 
 with logged(snakemake.log[0], snakemake.rule):
-    settings = implications.ImplicationsSettings.from_config(snakemake.config, snakemake.wildcards.scenario)
+    settings = implications.ImplicationsSettings.from_params(dict(snakemake.params))
     ds = implications.run(
         settings,
         balls=load_balls(snakemake.input.balls),

@@ -7,7 +7,7 @@ from ballbat.stages import ingest
 with logged(snakemake.log[0], snakemake.rule) as log:
     files = snakemake.params.files  # as the config names them: a missing one is reported by the ingest
     ds = ingest.run(
-        ingest.IngestSettings.from_config(snakemake.config), files["impacts"], balls=files["balls"], bats=files["bats"]
+        ingest.IngestSettings(), files["impacts"], balls=files["balls"], bats=files["bats"]
     )
     for text in ingest.warnings(ds):
         log.warning(text)

@@ -5,7 +5,7 @@ from ballbat.pipeline.runlog import logged
 from ballbat.stages import normalize
 
 with logged(snakemake.log[0], snakemake.rule):
-    settings = normalize.NormalizeSettings.from_config(snakemake.config)
+    settings = normalize.NormalizeSettings.from_params(dict(snakemake.params))
     ds = normalize.run(settings, read_dataset(snakemake.input.impacts))
     write_job_output(
         ds,

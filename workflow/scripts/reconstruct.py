@@ -8,7 +8,7 @@ from ballbat.stages import reconstruct
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     ds = reconstruct.run(
-        reconstruct.ReconstructSettings.from_config(snakemake.config),
+        reconstruct.ReconstructSettings(),
         read_dataset(snakemake.input.impacts),
         balls=load_balls(snakemake.params.files["balls"]),
         bats=load_bats(snakemake.params.files["bats"]),

@@ -17,14 +17,13 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         block = with_found_settings(block, yaml.safe_load(open(inp.cameras)))
     # a file the config names but that is missing is no input (common.smk: existing); reading it
     # by its configured name fails this job alone, with a message naming the file
-    named = snakemake.config["datasets"][snakemake.wildcards.dataset]
-    tables = {k: named.get(k, snakemake.config["tables"][k]) for k in ("balls", "bats")}
-    tracks_path = inp.get("tracks") or named["tracks"]["file"]
-    balls, bats = load_balls(inp.get("balls") or tables["balls"]), load_bats(inp.get("bats") or tables["bats"])
+    named = snakemake.params.files
+    tracks_path = inp.get("tracks") or named["tracks"]
+    balls, bats = load_balls(inp.get("balls") or named["balls"]), load_bats(inp.get("bats") or named["bats"])
     settings = reduce.ReduceSettings.from_config(
         block, snakemake.params.where, systematics=True
     )  # checked before the files are read
-    tracks = load_tracks(tracks_path, inp.get("impacts") or named.get("tracks", {}).get("impacts"), balls, bats)
+    tracks = load_tracks(tracks_path, inp.get("impacts") or named.get("tracks_impacts"), balls, bats)
     try:
         ds = reduce.run(settings, tracks, balls, bats, source_file=tracks_path)
     except InputError as exc:  # a setting the files gave is named as read from them

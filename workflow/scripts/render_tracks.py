@@ -7,7 +7,7 @@ from ballbat.properties import load_balls
 from ballbat.stages import render
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    settings = render.from_config(snakemake.config, snakemake.wildcards.dataset)
+    settings = render.from_params(snakemake.params.settings)
     ds = render.run(settings, read_dataset(snakemake.input.truth), load_balls(snakemake.input.balls))
     log.info("%d impacts, %d tracked points", ds.sizes["impact"], ds.sizes["row"])
     write_dataset(

@@ -7,7 +7,7 @@ from ballbat.stages import simulate
 
 with logged(snakemake.log[0], snakemake.rule):
     ds = simulate.run(
-        simulate.from_config(snakemake.config, snakemake.wildcards.dataset),
+        simulate.from_params(snakemake.params.settings),
         balls=load_balls(snakemake.params.files["balls"]),
         bats=load_bats(snakemake.params.files["bats"]),
     )

@@ -18,6 +18,8 @@ from ..systematics import FIT_QUANTITIES, SIDES, SOURCES, FitSystematics, has_sh
 from .systematics import systematic_vars
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     import xarray as xr
 
 
@@ -44,7 +46,12 @@ class FitExSettings:
     @classmethod
     def from_config(cls, config: dict) -> FitExSettings:
         """Return the workflow's settings from the validated config."""
-        return cls(mu_k_example=float(config["analysis"]["mu_k_example"]), systematic=True, check_physical=True)
+        return cls.from_params(config["analysis"])
+
+    @classmethod
+    def from_params(cls, params: Mapping) -> FitExSettings:
+        """Return the workflow's settings from the rule's params (``mu_k_example``, as config ``analysis``)."""
+        return cls(mu_k_example=float(params["mu_k_example"]), systematic=True, check_physical=True)
 
 
 # ---------------------------------------------------------------------------------------

@@ -17,6 +17,8 @@ from ..implications import run_scenario
 from ..pipeline.products import Var
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     from ..properties import Ball, Bat
 
 C, CP = ("case",), ("case", "point")
@@ -40,7 +42,13 @@ class ImplicationsSettings:
     @classmethod
     def from_config(cls, config: dict, name: str) -> ImplicationsSettings:
         """Return scenario ``name``'s settings from the validated config."""
-        return cls(scenario=config["implications"]["scenarios"][name], air=config["implications"]["air"])
+        block = config["implications"]
+        return cls.from_params({"scenario": block["scenarios"][name], "air": block["air"]})
+
+    @classmethod
+    def from_params(cls, params: Mapping) -> ImplicationsSettings:
+        """Return a scenario's settings from its rule's params (``scenario``, ``air``)."""
+        return cls(scenario=params["scenario"], air=params["air"])
 
 
 def scenario_table(sweep: bool, mu: float | None = None) -> dict[str, Var]:

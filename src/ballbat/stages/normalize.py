@@ -14,6 +14,8 @@ from ..pipeline.products import Var, add_variables
 from ..units import MPH
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     import xarray as xr
 
 
@@ -26,7 +28,12 @@ class NormalizeSettings:
     @classmethod
     def from_config(cls, config: dict) -> NormalizeSettings:
         """Return the workflow's settings from the validated config."""
-        return cls(v_ref_mph=float(config["normalize"]["v_ref_mph"]))
+        return cls.from_params(config["normalize"])
+
+    @classmethod
+    def from_params(cls, params: Mapping) -> NormalizeSettings:
+        """Return the workflow's settings from the rule's params (``v_ref_mph``, as config ``normalize``)."""
+        return cls(v_ref_mph=float(params["v_ref_mph"]))
 
 
 #: Variables that ``normalize`` adds.

@@ -18,12 +18,14 @@ from ..tracks.render import RenderSettings, render_tracks, settings_from_config
 from .impacts import IMPACT_COORDS, SIMULATED_TRUTH, truth_var
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     import xarray as xr
 
     from ..properties import Ball
     from ..tracks.data import Tracks
 
-__all__ = ["RenderSettings", "from_config", "render", "run", "tracks_dataset"]
+__all__ = ["RenderSettings", "from_config", "from_params", "render", "run", "tracks_dataset"]
 
 
 #: The variables of a tracks file (long rows along ``row``, the impact table along ``impact``);
@@ -42,7 +44,12 @@ TRACKS_TABLE = {
 
 def from_config(config: dict, dataset: str) -> RenderSettings:
     """Return the rendering settings of dataset ``dataset`` from the validated config (its ``render`` block)."""
-    return settings_from_config(config["datasets"][dataset]["render"])
+    return from_params(config["datasets"][dataset]["render"])
+
+
+def from_params(block: Mapping) -> RenderSettings:
+    """Return the rendering settings from the rule's params (the dataset's ``render`` block)."""
+    return settings_from_config(block)
 
 
 def render(settings: RenderSettings, simulated: xr.Dataset, balls: dict[str, Ball]) -> Tracks:

@@ -14,15 +14,22 @@ from ..synthetic import SyntheticSettings, draw_experiment
 from .impacts import IMPACTS, QUANTITIES, SIMULATED_TRUTH, impact_coords, truth_var
 
 if TYPE_CHECKING:
+    from collections.abc import Mapping
+
     from ..pipeline.products import Var
     from ..properties import Ball, Bat
 
-__all__ = ["SyntheticSettings", "from_config", "run", "simulate_table"]
+__all__ = ["SyntheticSettings", "from_config", "from_params", "run", "simulate_table"]
 
 
 def from_config(config: dict, dataset: str) -> SyntheticSettings:
     """Return the settings of dataset ``dataset``'s synthetic experiment from the validated config."""
-    return SyntheticSettings(**config["datasets"][dataset]["synthetic"])
+    return from_params(config["datasets"][dataset]["synthetic"])
+
+
+def from_params(block: Mapping) -> SyntheticSettings:
+    """Return the settings of a synthetic experiment from its rule's params (the dataset's ``synthetic`` block)."""
+    return SyntheticSettings(**block)
 
 
 def simulate_table() -> dict[str, Var]:

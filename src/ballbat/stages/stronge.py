@@ -29,7 +29,7 @@ from ..systematics import SIDES, SOURCES, has_shifts, shifted_impacts
 from .systematics import systematic_vars
 
 if TYPE_CHECKING:
-    from collections.abc import Sequence
+    from collections.abc import Mapping, Sequence
 
     import xarray as xr
     from numpy.typing import NDArray
@@ -64,7 +64,11 @@ class StrongeSettings:
     @classmethod
     def from_config(cls, config: dict) -> StrongeSettings:
         """Return the workflow's settings from the validated config (its ``stronge`` section)."""
-        s = config["stronge"]
+        return cls.from_params(config["stronge"])
+
+    @classmethod
+    def from_params(cls, s: Mapping) -> StrongeSettings:
+        """Return the workflow's settings from the rule's params (the config's ``stronge`` section)."""
         return cls(
             e_y=s["e_y"],
             mu=s["mu"],
