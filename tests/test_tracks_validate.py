@@ -221,3 +221,19 @@ def test_shipped_example_reduces():
     up = ds["v_ball_shift"].sel(systematic="swing_m_per_px", shift=1).values
     np.testing.assert_allclose(up, 0.005 * ds["v_ball"].values, rtol=0.01)  # the flight's gravity term aside
     assert not ds["v_bat_shift"].sel(systematic="swing_fps").values.any()
+
+
+def test_one_limit_for_a_calibration_uncertainty(schema, raw):
+    """The schema and the tracks' own check refuse a relative fps or pixel-scale uncertainty at the same value."""
+    from ballbat.pipeline.config import validate_config
+    from ballbat.tracks.checks import SCALE_ERR_MAX
+
+    for camera in ("track_camera", "render_camera"):
+        props = schema["$defs"][camera]["properties"]
+        for k in ("m_per_px_err", "fps_err"):
+            assert props[k]["exclusiveMaximum"] == SCALE_ERR_MAX and "maximum" not in props[k], (camera, k)
+    raw["datasets"]["synthetic"]["render"]["cameras"]["swing"]["m_per_px_err"] = 0.3  # 0.3 % meant
+    with pytest.raises(
+        ValueError, match=r"m_per_px_err: 0.3 is greater than or equal to the maximum of 0.1 .*0.005 for 0.5 %"
+    ):
+        validate_config(raw, schema)
