@@ -2,7 +2,7 @@
 
 For each set-up (the shipped calibration; 5 px tracking noise at the paper's size; 3.5 px
 with 60 impacts per bat) it runs replicate experiments through the study's chain
-(:func:`ballbat.stages.study_batch.run`) twice on the same replicates: with the fits as they
+(:func:`ballbat.study_batch.run`) twice on the same replicates: with the fits as they
 were (weighted least squares, which the abscissa's noise attenuates) and with the
 moment-corrected fits (``linefit.eiv_line``, ``fitting.implied_e_y``). Each replicate's
 experiment and tracks are simulated once and reused by the second pass. The design's truth
@@ -28,7 +28,7 @@ import numpy as np
 from ballbat import chain, fitting, studies
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.stages import study_batch
+from ballbat import study_batch
 
 #: name -> (replicates, [(sweep parameter, value), ...])
 SETUPS = {

@@ -1,7 +1,7 @@
 """Calls of Stronge's model and CPU time of the eta^2 fits in calibration replicates (issue 39).
 
 Runs ``N`` replicates (default 5) of the calibration study as its batch job does
-(``ballbat.stages.study_batch.run``, batch 1) after one warm-up replicate and prints, per
+(``ballbat.study_batch.run``, batch 1) after one warm-up replicate and prints, per
 replicate, how many times :func:`ballbat.stronge.model.stronge_ex` is called and from where
 (the function that called it), and the CPU time (``time.process_time``) of the eta^2 fits
 (``studies._eta2``: the measured fit and the noise-free truth of each ball). Repeat the run
@@ -20,7 +20,7 @@ import traceback
 from ballbat import studies
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.stages import study_batch
+from ballbat import study_batch
 from ballbat.stronge import analysis, fit, model
 
 CALLS: collections.Counter[str] = collections.Counter()

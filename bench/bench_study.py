@@ -29,7 +29,7 @@ CHILD = """
 import resource, sys, time
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.stages import study_batch
+from ballbat import study_batch
 from ballbat.studies import StudySettings
 n = int(sys.argv[1])
 cfg = load_config()

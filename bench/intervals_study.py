@@ -24,7 +24,7 @@ from unittest import mock
 from ballbat import fitting, linefit, studies
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.stages import study_batch
+from ballbat import study_batch
 
 
 def _cameras(ds: dict, swing: float, spin: float) -> dict:

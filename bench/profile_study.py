@@ -1,7 +1,7 @@
 """Profile of a replicate study: where one replicate's time goes, by stage and by function (issue 39).
 
 Runs ``N`` replicates (default 10) of a shipped study (default ``calibration``) in this
-process, exactly as its batch job does (``ballbat.stages.study_batch.run``), after one warm-up
+process, exactly as its batch job does (``ballbat.study_batch.run``), after one warm-up
 replicate, and prints:
 
 1. CPU time per replicate of each stage of the chain (simulate, render, reduce with its

@@ -102,3 +102,31 @@ def test_a_cycle_is_found():
     assert cycles({"a": {"b"}, "b": {"a"}, "c": set()}) == [["a", "b"]]
     assert cycles({"a": {"b"}, "b": {"c"}, "c": {"a"}}) == [["a", "b", "c"]]
     assert cycles({"a": {"b"}, "b": set()}) == []
+
+
+#: The orchestration above the stages: the chain, the studies and the command line.
+ORCHESTRATION = (
+    "ballbat.chain",
+    "ballbat.studies",
+    "ballbat.study_batch",
+    "ballbat.cli",
+    "ballbat.batcli",
+    "ballbat.video.cli",
+)
+
+#: Layers that import nothing of the orchestration (issue 33: no upward imports).
+BELOW_ORCHESTRATION = ("ballbat.stages", "ballbat.tracks", "ballbat.stronge", "ballbat.pipeline")
+
+
+def test_no_upward_import():
+    """The stage layer, the tracks, Stronge's model and the plumbing import no orchestrator; the plumbing no stage."""
+    graph = import_graph()
+    upward = sorted(
+        (module, target)
+        for module, targets in graph.items()
+        if module.startswith(BELOW_ORCHESTRATION)
+        for target in targets
+        if target in ORCHESTRATION
+        or (module.startswith("ballbat.pipeline") and target.startswith(("ballbat.stages", "ballbat.tracks")))
+    )
+    assert upward == []

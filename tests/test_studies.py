@@ -16,7 +16,7 @@ from scipy import stats
 from ballbat import studies
 from ballbat.pipeline.config import ConfigError, validate_config
 from ballbat.pipeline.ncio import read_table_csv
-from ballbat.stages import study_batch
+from ballbat import study_batch
 
 
 def settings(config, name="calibration", **over):

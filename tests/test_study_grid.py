@@ -13,7 +13,7 @@ import xarray as xr
 
 from ballbat import studies
 from ballbat.pipeline.config import ConfigError, validate_config
-from ballbat.stages import study_batch
+from ballbat import study_batch
 from ballbat.sweeps import CONTACT_HALF_WIDTH_MS, point_dataset, sweep_points
 from ballbat.tracks.data import camera_block
 from ballbat.tracks.render import calibration_draws, drawn_calibration, settings_from_config

@@ -360,7 +360,7 @@ class TooManyRefused(ValueError):
 def run_replicates(
     settings: StudySettings, batch: int, balls: dict[str, Ball], bats: dict[str, Bat]
 ) -> Iterator[tuple[int, int, int, list[dict], str]]:
-    """Run the replicates of batch ``batch`` one after the other (the file: :func:`ballbat.stages.study_batch.run`).
+    """Run the replicates of batch ``batch`` one after the other (the file: :func:`ballbat.study_batch.run`).
 
     Yields, per replicate: its number over the whole study, its sweep point, its number within
     the point (:meth:`StudySettings.batch_range`), its rows (:func:`run_replicate`) and, when the

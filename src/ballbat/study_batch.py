@@ -13,15 +13,15 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..pipeline.products import Var, build_dataset
-from ..studies import PER_QUANTITY_UNITS, StudySettings, quantity_coords, row_labels, run_replicates, study_attrs
+from .pipeline.products import Var, build_dataset
+from .studies import PER_QUANTITY_UNITS, StudySettings, quantity_coords, row_labels, run_replicates, study_attrs
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     import xarray as xr
 
-    from ..properties import Ball, Bat
+    from .properties import Ball, Bat
 
 __all__ = ["BATCH_TABLE", "StudySettings", "run"]
 
