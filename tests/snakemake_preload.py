@@ -11,10 +11,10 @@ has its own copy), as ``python -m snakemake`` does.
 import jsonschema  # noqa: F401
 import pandas  # noqa: F401
 import smart_open  # noqa: F401
-import snakemake.api  # noqa: F401
-import snakemake.dag  # noqa: F401
-import snakemake.persistence  # noqa: F401
-import snakemake.report  # noqa: F401
+import snakemake.api
+import snakemake.dag
+import snakemake.persistence
+import snakemake.report
 import snakemake.workflow  # noqa: F401
 from snakemake.cli import get_argument_parser
 

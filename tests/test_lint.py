@@ -109,3 +109,15 @@ def test_functions_stay_short():
                 long[f"{module}.{name}"] = n
     assert not long, f"functions over 60 lines of code (split them into named steps): {long}"
     assert lengths.function_lengths(root / "tracks" / "reduce.py")  # the count sees the functions
+
+
+def test_no_test_module_imports_another(root):
+    """Shared test helpers live in conftest.py or helpers.py / workflow_helpers.py, not in a test module."""
+    found = []
+    for path in sorted((root / "tests").glob("*.py")):
+        for node in ast.walk(ast.parse(path.read_text())):
+            names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
+            if isinstance(node, ast.ImportFrom) and node.module:
+                names = [node.module]
+            found += [f"{path.name}: {n}" for n in names if n.split(".")[0].startswith("test_")]
+    assert found == []

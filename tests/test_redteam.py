@@ -155,7 +155,7 @@ def test_range_message_says_why(base, schema):
 
 def _replicates(n, value=np.nan, parameter=""):
     """Replicates (n) of one quantity with honest errors, at a sweep point of ``parameter = value``."""
-    from test_studies import fake_replicates
+    from helpers import fake_replicates
 
     ds = fake_replicates(n, se=0.01, spread=0.01)
     ds.attrs.update(sweep_values=np.array([value]), sweep_parameter=parameter)

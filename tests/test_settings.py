@@ -589,7 +589,7 @@ def test_enabled_and_seed(config, small, balls, bats, baselines, tmp_path):
 
 def test_study_files_hold_si_and_the_table_prints_paper_units():
     """A slope stored in rad s-1 rad-1 with its unit: coverage.nc keeps SI, coverage.csv prints rpm/deg."""
-    from test_studies import fake_replicates
+    from helpers import fake_replicates
 
     from ballbat.pipeline.ncio import MetadataError, check_metadata
     from ballbat.units import DEGREE, RPM

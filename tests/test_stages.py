@@ -15,6 +15,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import SMALL
 
 from ballbat import fitting, studies
 from ballbat.stages import fit_ex, implications, ingest, normalize, reconstruct, reduce, render, simulate, stronge
@@ -24,7 +25,6 @@ from ballbat.tracks.data import camera_block
 from ballbat.tracks.render import settings_from_config
 from workflow_helpers import ROOT
 
-SMALL = {"baseball": {"wood": 8, "metal_rough": 8}, "softball": {"wood": 8}}
 MAPLE = ROOT / "config" / "examples" / "maple_impacts.csv"
 MAPLE_BATS = ROOT / "config" / "examples" / "maple_bats.csv"
 

@@ -11,12 +11,12 @@ import numpy as np
 import pytest
 import xarray as xr
 import yaml
+from helpers import fake_replicates
 from scipy import stats
 
-from ballbat import studies
+from ballbat import studies, study_batch
 from ballbat.pipeline.config import ConfigError, validate_config
 from ballbat.pipeline.ncio import read_table_csv
-from ballbat import study_batch
 
 
 def settings(config, name="calibration", **over):
@@ -112,29 +112,6 @@ def test_a_frame_rate_sweep_needs_rendered_tracks(raw, schema):
     raw["studies"]["design"]["sweep"] = {"parameter": "spin_fps", "values": [1000]}
     with pytest.raises(ConfigError, match="spin_fps needs a dataset that renders camera tracks"):
         validate_config(raw, schema, available=24 * 2**30)
-
-
-def fake_replicates(n, se, spread, truth=1.0, dof=np.inf, seed=0):
-    """Return n replicates of one quantity: estimates truth + N(0, spread) reporting ``se``."""
-    rng = np.random.default_rng(seed)
-    ds = xr.Dataset(
-        {
-            "value": (("replicate", "quantity"), truth + spread * rng.standard_normal((n, 1))),
-            "uncertainty": (("replicate", "quantity"), np.full((n, 1), se)),
-            "truth": (("replicate", "quantity"), np.full((n, 1), truth)),
-            "dof": (("replicate", "quantity"), np.full((n, 1), dof)),
-            "point": (("replicate",), np.zeros(n, dtype=int)),
-        },
-        coords={
-            "quantity": ["e_x:baseball:wood"],
-            "quantity_name": ("quantity", ["e_x"]),
-            "ball": ("quantity", ["baseball"]),
-            "bat": ("quantity", ["wood"]),
-            "units": ("quantity", ["1"]),
-        },
-        attrs={"sweep_values": np.array([np.nan]), "study_seed": 0, "replicates_per_point": n, "sweep_parameter": ""},
-    )
-    return ds
 
 
 def test_coverage_arithmetic():

@@ -11,9 +11,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ballbat import studies
+from ballbat import studies, study_batch
 from ballbat.pipeline.config import ConfigError, validate_config
-from ballbat import study_batch
 from ballbat.sweeps import CONTACT_HALF_WIDTH_MS, point_dataset, sweep_points
 from ballbat.tracks.data import camera_block
 from ballbat.tracks.render import calibration_draws, drawn_calibration, settings_from_config
@@ -226,7 +225,7 @@ def _with_systematic(n=4000, se=0.01, syst=0.02, seed=0):
     """Replicates of two quantities: one whose estimate is off by a shared calibration error of sd ``syst``
     (reported as its systematic), one without a systematic.
     """
-    from test_studies import fake_replicates
+    from helpers import fake_replicates
 
     rng = np.random.default_rng(seed + 1000)  # not fake_replicates' own stream
     a = fake_replicates(n, se, se, seed=seed)
@@ -262,7 +261,7 @@ def test_the_calibration_effect_takes_the_draw_out_of_bias_spread_and_statistica
     precision (the raw bias is 4x less sharp), the spread is the statistical one and the statistical
     interval covers 95 %; a replicate without an effect (not drawn) leaves the *_calibrated columns NaN.
     """
-    from test_studies import fake_replicates
+    from helpers import fake_replicates
 
     n, se, syst, bias = 4000, 0.01, 0.04, 0.3
     rng = np.random.default_rng(7)
@@ -293,7 +292,7 @@ def test_the_calibration_effect_takes_the_draw_out_of_bias_spread_and_statistica
 
 
 def test_batches_without_a_systematic_still_aggregate():
-    from test_studies import fake_replicates
+    from helpers import fake_replicates
 
     cov = studies.coverage(fake_replicates(200, 0.01, 0.01)).isel(point=0, quantity=0)
     assert np.isnan(float(cov.coverage_95_combined)) and int(cov.n_systematic) == 0
@@ -301,7 +300,7 @@ def test_batches_without_a_systematic_still_aggregate():
 
 def _grid_replicates(n=150):
     """Fake replicates of one quantity at the 8 corners of a 2 x 2 x 2 grid (coverage ~95 % everywhere)."""
-    from test_studies import fake_replicates
+    from helpers import fake_replicates
 
     table = np.array(list(itertools.product([1.0, 5.0], [12.0, 60.0], [0.5, 1.0])))
     rep = fake_replicates(n * len(table), 0.01, 0.01)
@@ -421,7 +420,7 @@ def test_the_calibration_effect_is_what_the_true_calibration_would_have_given(co
     the declared one must give value + calibration_effect, up to second order: the study uses this to
     take the draw's spread out of a bias and to judge the statistical interval where calibration is drawn.
     """
-    from test_stages import SMALL
+    from helpers import SMALL
 
     dataset = copy.deepcopy(config["datasets"]["synthetic"])
     dataset["synthetic"]["impacts"] = SMALL

@@ -10,7 +10,7 @@ import functools
 
 import numpy as np
 import pytest
-from test_tracks import BALLS, BATS, experiment, render, render_cfg
+from helpers import BALLS, BATS, experiment, render, render_cfg
 
 from ballbat import systematics
 from ballbat.pipeline.config import checked_block

@@ -6,70 +6,16 @@ from dataclasses import replace
 
 import numpy as np
 import pytest
+from helpers import BALLS, BATS, experiment, render, render_cfg
 
-from ballbat.pipeline.config import checked_block
 from ballbat.pipeline.ncio import read_dataset, write_dataset
-from ballbat.properties import load_balls, load_bats
-from ballbat.stages import simulate
 from ballbat.stages.reduce import reduction_dataset
 from ballbat.stages.render import tracks_dataset
-from ballbat.synthetic import SyntheticSettings
 from ballbat.tracks.io import load_tracks
 from ballbat.tracks.reduce import FLAG_VAR, ReduceFlag, reduce_tracks
-from ballbat.tracks.render import render_tracks, settings_from_config
 from ballbat.units import RPM, G
 
-BALLS = load_balls("config/balls.csv")
-BATS = load_bats("config/bats.csv")
 QUANTITIES = ("v_bat", "v_ball", "theta", "omega")
-
-
-def render_cfg(**over):
-    cfg = {
-        "cameras": {
-            "swing": {"fps": 3000, "m_per_px": 0.00074, "mirror": False, "tee_px": [540, 480], "pixel_noise_px": 0.5},
-            "spin": {
-                "fps": 1000,
-                "m_per_px": 0.00125,
-                "mirror": False,
-                "tee_px": [600, 480],
-                "pre_impact_frames": 5,
-                "pixel_noise_px": 0.5,
-            },
-        },
-        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
-        "seed": 1,
-        "tilted_fraction": 0.0,
-    }
-    for k, v in over.items():
-        if k in ("swing", "spin"):
-            cfg["cameras"][k] = {**cfg["cameras"][k], **v}
-        else:
-            cfg[k] = v
-    return cfg
-
-
-def experiment(seed=0, per_bat=8):
-    settings = SyntheticSettings(
-        impacts={"baseball": {"wood": per_bat, "metal_rough": per_bat}, "softball": {"softball_composite": per_bat}},
-        e_x={"baseball": {"wood": 0.464, "metal_rough": 0.356}, "softball": {"softball_composite": 0.128}},
-        e_y={"baseball": 0.45, "softball": 0.32},
-        seed=seed,
-        v_bat_mph=(63.0, 88.0),  # the schema's defaults (SyntheticSettings takes every field)
-        psi_deg={},
-        e_x_scatter=0.0,
-        noise={"v_bat_mph": 0.5, "v_ball_mph": 0.5, "theta_deg": 0.5, "omega_rpm": 75.0},
-    )
-    return simulate.run(settings, BALLS, BATS)
-
-
-def render(ds, cfg, truth_over=None):
-    s = settings_from_config(checked_block(cfg, "render"))  # the schema's defaults, as the workflow's config has them
-    truth = {k: ds[f"truth_{k}"].values.copy() for k in ("v_bat", "v_ball", "theta", "omega", "psi")}
-    truth.update(truth_over or {})
-    r = np.array([BALLS[b].r for b in ds["ball"].values])
-    tr = render_tracks(truth, r, s, ds["impact"].values.astype(str), ds["ball"].values, ds["bat"].values)
-    return tr, s
 
 
 def reduce(tr, s, **cams):

@@ -10,7 +10,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from test_tracks import BALLS, BATS, experiment, render, render_cfg
+from helpers import BALLS, BATS, experiment, render, render_cfg
 
 from ballbat.properties import InputError
 from ballbat.stages.reduce import reduction_dataset

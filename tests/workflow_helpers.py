@@ -92,7 +92,6 @@ def _context():
     global _CONTEXT
     if _CONTEXT is None:
         import multiprocessing
-
         from multiprocessing import forkserver
 
         _CONTEXT = multiprocessing.get_context("forkserver")
