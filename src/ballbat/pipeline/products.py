@@ -109,21 +109,26 @@ def estimate_vars(
 def build_dataset(
     table: Mapping[str, Var],
     values: Mapping[str, Any],
-    coords: Mapping[str, tuple[Var, Any]] | None = None,
+    coords: Mapping[str, tuple] | None = None,
     attrs: Mapping[str, Any] | None = None,
 ) -> xr.Dataset:
     """Return an :class:`xarray.Dataset` of ``values`` described by ``table``.
 
     Every key of ``values`` must be declared in ``table`` and every declared variable
     given (a :class:`KeyError` names the difference): the table is the file's contents.
-    ``coords`` maps a coordinate name to its declaration and values.
+    ``coords`` maps a coordinate name to its declaration and values, ``(Var, values)``, or to
+    a coordinate already in xarray's form, ``(dims, values, attributes)``
+    (:func:`ballbat.stages.impacts.impact_coords`).
     """
     undeclared = sorted(set(values) - set(table))
     missing = sorted(set(table) - set(values))
     if undeclared or missing:
         raise KeyError(f"values do not match the declared table: undeclared {undeclared}, missing {missing}")
     data_vars = {name: (var.dims, np.asarray(values[name]), var.attributes()) for name, var in table.items()}
-    coord_vars = {name: (var.dims, np.asarray(val), var.attributes()) for name, (var, val) in (coords or {}).items()}
+    coord_vars = {
+        name: (c[0].dims, np.asarray(c[1]), c[0].attributes()) if isinstance(c[0], Var) else c
+        for name, c in (coords or {}).items()
+    }
     return xr.Dataset(data_vars, coords=coord_vars, attrs=dict(attrs or {}))
 
 

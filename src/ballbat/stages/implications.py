@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 
 from ..implications import run_scenario
-from ..pipeline.products import Var
+from ..pipeline.products import Var, build_dataset
 
 if TYPE_CHECKING:
     from collections.abc import Mapping
@@ -101,7 +101,6 @@ def run(
     for i, axis in enumerate("xyz"):
         values[f"trajectory_{axis}"] = res.points[..., i]
     table = scenario_table("sweep" in scenario, scenario.get("mu"))
-    data = {name: (var.dims, np.asarray(values[name]), var.attributes()) for name, var in table.items()}
     n = np.size(got.launch["exit_speed"])
     coords = {
         "case": ("case", np.arange(n, dtype=np.int64), {"units": "1", "long_name": "case number"}),
@@ -111,9 +110,11 @@ def run(
             {"units": "1", "long_name": "trajectory sample"},
         ),
     }
-    ds = xr.Dataset(data, coords=coords)
-    ds.attrs.update(
-        {
+    return build_dataset(
+        table,
+        {name: values[name] for name in table},
+        coords=coords,
+        attrs={
             "ball": scenario["ball"],
             "bat": scenario.get("bat", ""),
             "kind": "D sweep" if "sweep" in scenario else "launch conditions",
@@ -121,6 +122,5 @@ def run(
             "air_density": got.air_density,
             "air_density_units": "kg m-3",
             "flight_method": scenario["flight"]["method"],
-        }
+        },
     )
-    return ds

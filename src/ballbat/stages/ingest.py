@@ -15,7 +15,7 @@ import xarray as xr
 
 from ..ingest import MEASURED_COLUMNS, read_measured
 from ..kinematics import ImpactFlag
-from ..pipeline.products import Var, flag_attrs
+from ..pipeline.products import Var, build_dataset, flag_attrs
 from .impacts import IMPACTS, impact_coords
 
 if TYPE_CHECKING:
@@ -69,14 +69,15 @@ def run(
     values["source_row"] = cols["label"].astype(str)
     values["ingest_flag"] = got.flag
     values["ingest_flag_reason"] = got.reason
-    data = {name: (var.dims, values[name], var.attributes()) for name, var in INGEST_TABLE.items() if name in values}
-    ds = xr.Dataset(data, coords=impact_coords(got.ball, got.bat))
-    ds.attrs["source_file"] = str(impacts)
-    ds.attrs["n_impacts"] = len(got.ball)
-    ds.attrs["n_excluded"] = int((got.flag != 0).sum())
-    ds.attrs["n_warnings"] = len(got.warnings)
-    ds.attrs["ingest_warnings"] = "\n".join(got.warnings)
-    return ds
+    given = {name: var for name, var in INGEST_TABLE.items() if name in values}  # the *_err columns are optional
+    attrs = {
+        "source_file": str(impacts),
+        "n_impacts": len(got.ball),
+        "n_excluded": int((got.flag != 0).sum()),
+        "n_warnings": len(got.warnings),
+        "ingest_warnings": "\n".join(got.warnings),
+    }
+    return build_dataset(given, values, coords=impact_coords(got.ball, got.bat), attrs=attrs)
 
 
 def warnings(ds: xr.Dataset) -> list[str]:

@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING
 
 import xarray as xr
 
+from ..pipeline.products import build_dataset
 from ..synthetic import SyntheticSettings, draw_experiment
 from .impacts import IMPACTS, QUANTITIES, SIMULATED_TRUTH, impact_coords, truth_var
 
@@ -49,7 +50,6 @@ def run(settings: SyntheticSettings, balls: dict[str, Ball], bats: dict[str, Bat
         values[k] = exp.measured[k]
         values[f"{k}_err"] = exp.sd[k]
     values.update({f"truth_{k}": exp.truth[k] for k in SIMULATED_TRUTH})
-    data = {name: (var.dims, values[name], var.attributes()) for name, var in simulate_table().items()}
-    ds = xr.Dataset(data, coords=impact_coords(exp.ball, exp.bat))
-    ds.attrs["synthetic_seed"] = exp.seed
-    return ds
+    return build_dataset(
+        simulate_table(), values, coords=impact_coords(exp.ball, exp.bat), attrs={"synthetic_seed": exp.seed}
+    )
