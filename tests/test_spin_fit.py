@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ballbat.tracks.reduce import OFFSET_FALSE_ALARM, Flight, _line_fit, fit_spin
+from ballbat.tracks.fit_flight import Flight, _line_fit
+from ballbat.tracks.fit_spin import OFFSET_FALSE_ALARM, fit_spin
 from ballbat.units import G
 
 FPS = 1000.0

@@ -375,7 +375,8 @@ def test_contact_prior_of_uninformative_frames_stays_uniform():
     """Flat likelihoods (no frame inside any contact) keep the uniform prior, beta(1, 1): nothing in them
     prefers another, and a narrower one would make every start overconfident.
     """
-    from ballbat.tracks.reduce import CONTACT_GRID, CONTACT_PRIOR, _contact_population
+    from ballbat.tracks.data import CONTACT_PRIOR
+    from ballbat.tracks.fit_contact import CONTACT_GRID, _contact_population
 
     grid = np.linspace(*CONTACT_PRIOR, CONTACT_GRID)
     prior = _contact_population(np.ones((50, grid.size)), np.zeros(50, int), grid)
@@ -399,7 +400,8 @@ def test_contact_prior_finds_short_contacts_from_weak_frames():
     every contact near 1.1 ms, 0.2-0.5 ms too long, and moved the bat's alignment time and v_bat
     alike in every impact (mean pull -0.12 at 5 px, 60 impacts per bat: docs/studies.md).
     """
-    from ballbat.tracks.reduce import CONTACT_GRID, CONTACT_PRIOR, _contact_population
+    from ballbat.tracks.data import CONTACT_PRIOR
+    from ballbat.tracks.fit_contact import CONTACT_GRID, _contact_population
 
     grid = np.linspace(*CONTACT_PRIOR, CONTACT_GRID)
     rng = np.random.default_rng(3)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from ballbat.tracks.reduce import CONTACT_MIN_SD_STEPS, _beta_logs, _beta_weights
+from ballbat.tracks.fit_contact import CONTACT_MIN_SD_STEPS, _beta_logs, _beta_weights
 
 
 def _direct(grid: np.ndarray, p) -> np.ndarray:

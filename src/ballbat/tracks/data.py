@@ -21,7 +21,7 @@ from ..units import INCH
 #: Prior range of a ball-on-bat contact time (s), uniform: generous bounds around the
 #: literature's 0.6-0.7 ms of a baseball on a bat and about 1 ms or more of a softball
 #: (docs/tracks.md, "The contact time"). The reduction fits each impact's contact time within
-#: it (:func:`ballbat.tracks.reduce.fit_contact`); a study's rendered contacts must lie inside.
+#: it (:func:`ballbat.tracks.fit_contact.fit_contact`); a study's rendered contacts must lie inside.
 CONTACT_PRIOR = (0.2e-3, 2.0e-3)
 
 #: Points each camera tracks.

@@ -27,7 +27,9 @@ from .checks import (
     tip_arc,
     weighted_mean,
 )
-from .reduce import STAGE, TAU_PRIOR_FRAMES, ReduceFlag, fit_contact
+from .fit_contact import fit_contact
+from .fit_swing import TAU_PRIOR_FRAMES
+from .reduce import STAGE, ReduceFlag
 
 if TYPE_CHECKING:
     from .reduce import Reduction
