@@ -1,0 +1,320 @@
+"""The workflow's input functions, target lists and resource plans, from the validated config.
+
+Snakemake's rule files hold rules; what they compute about the config (each rule's inputs,
+params, memory and time, and the lists of targets) is this module's, so that it is read,
+tested and changed as Python (tests/test_workflow_inputs.py). ``workflow/rules/common.smk``
+builds one :class:`WorkflowInputs` from the validated config and hands its methods to the
+rules: each method that takes ``wildcards`` is an input, params or resources function.
+"""
+
+from __future__ import annotations
+
+import math
+from argparse import Namespace
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+from .pipeline.codedeps import module_files
+from .pipeline.config import BYTES_PER_CASE, STUDY_BYTES_PER_REPLICATE, impact_bytes, study_impacts
+from .pipeline.provenance import sha256_file
+from .sweeps import renders
+from .tracks.data import camera_block, tool_file_extensions
+
+if TYPE_CHECKING:
+    from .study_settings import StudySettings
+
+#: Every figure of a dataset (results/{dataset}/figures/).
+DATASET_FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig9a", "fig9b", "fig10")
+
+
+def existing(path: str) -> str | list:
+    """Return ``path`` as an input when it is a file, none when it is missing or not a file.
+
+    So only this dataset's job fails, with a message that says what the path is (not the whole DAG).
+    """
+    return path if Path(path).is_file() else []
+
+
+def file_hashes(files: dict[str, str]) -> dict[str, str]:
+    """Return the sha256 of each of ``files`` (name -> path).
+
+    A param of the rules that read them, so that their jobs rerun when the content changes, even to
+    a copy with an older timestamp (cp -p, tar, rsync -a).
+    """
+    return {k: sha256_file(v) if Path(v).is_file() else "not a file" for k, v in files.items()}
+
+
+class WorkflowInputs:
+    """The rules' view of one validated config (``basedir``: the workflow's folder, for its scripts).
+
+    ``wildcards``: Snakemake's wildcards of a job (or any object with the same attributes, e.g.
+    an :class:`argparse.Namespace`).
+    """
+
+    def __init__(self, config: dict, basedir: str | Path) -> None:
+        self.config = config
+        self.scripts = Path(basedir) / "workflow" / "scripts"
+        self.datasets = sorted(config["datasets"])
+        self.tracked = [d for d in self.datasets if self.uses_tracks(d)]
+        self.scenarios = sorted(config.get("implications", {}).get("scenarios", {}))
+        scenarios = config.get("implications", {}).get("scenarios", {})
+        self.sweep_scenarios = [s for s in self.scenarios if "sweep" in scenarios[s]]
+        self.launch_scenarios = [s for s in self.scenarios if s not in self.sweep_scenarios]
+        self.all_studies = sorted(config.get("studies") or {})
+        self.studies = [s for s in self.all_studies if not config["studies"][s]["on_request"]]
+
+    # -- code and datasets ----------------------------------------------------------------
+
+    def code(self, script: str) -> list[str]:
+        """Return the package modules a script imports (so editing them reruns the rule)."""
+        here = Path.cwd()
+        files = module_files(str(self.scripts / script))
+        return [str(Path(f).relative_to(here)) if Path(f).is_relative_to(here) else f for f in files]
+
+    def dataset_config(self, wildcards: Namespace) -> dict:
+        """Return the dataset's validated config block."""
+        return self.config["datasets"][wildcards.dataset]
+
+    def get_synthetic_settings(self, wildcards: Namespace) -> dict:
+        """Return the dataset's ``synthetic`` block (the simulate rule's params)."""
+        return self.dataset_config(wildcards)["synthetic"]
+
+    def data_files(self, wildcards: Namespace) -> dict[str, str]:
+        """Return the dataset's data files as the config names them: impacts (measured), balls, bats, tracks."""
+        ds = self.dataset_config(wildcards)
+        tables = self.config["tables"]
+        files = {"balls": ds.get("balls", tables["balls"]), "bats": ds.get("bats", tables["bats"])}
+        if "impacts" in ds:
+            files["impacts"] = ds["impacts"]
+        if "tracks" in ds:
+            if "file" in ds["tracks"]:
+                files["tracks"] = ds["tracks"]["file"]
+            files["tracks_impacts"] = ds["tracks"]["impacts"]
+        return files
+
+    def get_balls_table(self, wildcards: Namespace) -> str | list:
+        """Return the dataset's ball table as an input (:func:`existing`)."""
+        return existing(self.data_files(wildcards)["balls"])
+
+    def get_bats_table(self, wildcards: Namespace) -> str | list:
+        """Return the dataset's bat table as an input (:func:`existing`)."""
+        return existing(self.data_files(wildcards)["bats"])
+
+    def data_hashes(self, wildcards: Namespace) -> dict[str, str]:
+        """Return the sha256 of each data file of a dataset (:func:`file_hashes`)."""
+        return file_hashes(self.data_files(wildcards))
+
+    def tables_hashes(self, wildcards: Namespace) -> dict[str, str]:
+        """Return the sha256 of the property tables of config ``tables`` (the implications' balls and bats)."""
+        return file_hashes(self.config["tables"])
+
+    def is_measured(self, name: str) -> bool:
+        """Return whether a dataset is measured (it names its impacts file; a synthetic one has ``synthetic``)."""
+        return "impacts" in self.config["datasets"][name]
+
+    def get_measured_impacts(self, wildcards: Namespace) -> str | list:
+        """Return a measured dataset's impacts file as an input (:func:`existing`)."""
+        return existing(self.dataset_config(wildcards)["impacts"])
+
+    def uses_tracks(self, name: str) -> bool:
+        """Return whether a dataset starts from raw camera tracks (reduce.nc is its source)."""
+        d = self.config["datasets"][name]
+        return "tracks" in d or renders(d)
+
+    def dataset_kind(self, name: str) -> str:
+        """Return what a dataset is, in words (the report's front page)."""
+        if self.uses_tracks(name):
+            return "camera tracks" if "tracks" in self.config["datasets"][name] else "synthetic, rendered camera tracks"
+        return "measured" if self.is_measured(name) else "synthetic"
+
+    def get_source(self, wildcards: Namespace) -> str:
+        """Return the first product of a dataset: its experiment, its measured impacts or its reduced tracks."""
+        if self.uses_tracks(wildcards.dataset):  # raw camera tracks: workflow/rules/tracks.smk
+            return f"results/{wildcards.dataset}/reduce.nc"
+        stage = "ingest" if self.is_measured(wildcards.dataset) else "simulate"
+        return f"results/{wildcards.dataset}/{stage}.nc"
+
+    # -- camera tracks --------------------------------------------------------------------
+
+    def get_render_settings(self, wildcards: Namespace) -> dict:
+        """Return the dataset's ``render`` block (the render rule's params)."""
+        return self.dataset_config(wildcards)["render"]
+
+    def get_tracks_inputs(self, wildcards: Namespace) -> dict:
+        """Return the reduce rule's track inputs.
+
+        A lab's tracks and impacts files, its imported tool files (imported_tracks.nc and the
+        camera settings found in them), or the rendered tracks.nc (both .nc hold their impact table).
+        """
+        d = self.dataset_config(wildcards)
+        if "tracks" in d and "dir" in d["tracks"]:
+            out = f"results/{wildcards.dataset}/imported"
+            return {"tracks": f"{out}_tracks.nc", "cameras": f"{out}_cameras.yaml"}
+        if "tracks" in d:  # a missing file fails this dataset's reduce job only (existing), not the DAG
+            return {"tracks": existing(d["tracks"]["file"]), "impacts": existing(d["tracks"]["impacts"])}
+        return {"tracks": f"results/{wildcards.dataset}/tracks.nc"}
+
+    def get_tool_files(self, wildcards: Namespace) -> dict:
+        """Return the tool files of a dataset whose tracks block names a folder (dir), and its impacts file."""
+        t = self.dataset_config(wildcards)["tracks"]
+        exts = tool_file_extensions(t.get("format"))
+        found = sorted(str(p) for p in Path(t["dir"]).glob("*") if p.is_file() and p.suffix.lower() in exts)
+        return {"files": found, "impacts": existing(t["impacts"])}
+
+    def tool_file_hashes(self, wildcards: Namespace) -> dict[str, str]:
+        """Return the sha256 of every tool file of a ``tracks.dir`` folder and of the dataset's tables.
+
+        A tool file replaced by other content reruns the import, whatever its timestamp (:func:`file_hashes`).
+        """
+        files = {Path(f).name: f for f in self.get_tool_files(wildcards)["files"]}
+        return {**self.data_hashes(wildcards), **file_hashes(files)}
+
+    def get_import_settings(self, wildcards: Namespace) -> dict:
+        """Return the dataset's ``tracks`` block (the import rule's params)."""
+        return self.dataset_config(wildcards)["tracks"]
+
+    def get_reduce_settings(self, wildcards: Namespace) -> dict:
+        """Return the camera block the reduction reads (of ``tracks``, or of ``render``)."""
+        d = self.dataset_config(wildcards)
+        return camera_block(d["tracks"] if "tracks" in d else d["render"])
+
+    def get_reduce_where(self, wildcards: Namespace) -> str:
+        """Return the config key the reduction's messages name."""
+        key = "tracks" if "tracks" in self.dataset_config(wildcards) else "render"
+        return f"config datasets.{wildcards.dataset}.{key}"
+
+    # -- resources ------------------------------------------------------------------------
+
+    def dataset_mem_mb(self, wildcards: Namespace) -> int:
+        """Return the memory a dataset's job may need, MB.
+
+        Over a 500 MB base, 4 kB per impact (measured ~1 kB), 50 kB per impact rendered as camera
+        tracks (measured 35 kB).
+        """
+        d = self.dataset_config(wildcards)
+        syn = d.get("synthetic")
+        n = sum(sum(bats.values()) for bats in syn["impacts"].values()) if syn else 10_000
+        return 500 + n * impact_bytes(d) // 1_000_000
+
+    def scenario_mem_mb(self, wildcards: Namespace) -> int:
+        """Return the memory a scenario's job may need, MB: 60 kB per case (measured 52-59 kB) over 500 MB."""
+        sc = self.get_scenario(wildcards)
+        if "sweep" in sc:
+            n = int(sc["sweep"]["D_in"]["num"])
+        else:
+            sizes = [len(v) if isinstance(v, list) else 1 for k, v in sc["launch"].items() if k != "combine"]
+            n = math.prod(sizes) if sc["launch"]["combine"] == "grid" else max(sizes)
+        return 500 + n * BYTES_PER_CASE // 1_000_000
+
+    # -- scenarios ------------------------------------------------------------------------
+
+    def get_scenario(self, wildcards: Namespace) -> dict:
+        """Return the scenario's config block."""
+        return self.config["implications"]["scenarios"][wildcards.scenario]
+
+    def get_scenario_fit(self, wildcards: Namespace) -> dict:
+        """Return fit_ex.nc of the dataset whose e_x the scenario uses (none by default)."""
+        name = self.get_scenario(wildcards).get("e_x_from_dataset")
+        return {"fit": f"results/{name}/fit_ex.nc"} if name else {}
+
+    def final_targets(self) -> list[str]:
+        """Return everything a default run makes.
+
+        Every dataset's intermediate files, fits, figures and tables, and every scenario's (rule all
+        asks for these; an intermediate deleted by hand is therefore rebuilt).
+        """
+        per_dataset = ["normalize.nc", "reconstruct.nc", "fit_ex.nc", "stronge.nc"]
+        per_dataset += ["paper_comparison.csv", "paper_comparison.html", "results.xlsx"]
+        per_dataset += [f"figures/{fig}.png" for fig in DATASET_FIGURES]
+        targets = [self.get_source(Namespace(dataset=d)) for d in self.datasets]
+        targets += [f"results/{d}/figures/tracks_{fig}.png" for d in self.tracked for fig in ("impacts", "summary")]
+        targets += [f"results/{d}/{f}" for d in self.datasets for f in per_dataset]
+        targets += [f"results/implications/{s}.nc" for s in self.scenarios]
+        targets += ["results/implications/results.xlsx"] if self.scenarios else []
+        targets += [f"results/implications/figures/{s}_fig11{p}.png" for s in self.sweep_scenarios for p in "ab"]
+        targets += [f"results/implications/figures/{s}_launch.png" for s in self.launch_scenarios]
+        if "paper" in self.sweep_scenarios:  # the paper's own scenario is compared with Sec. V.B
+            targets += ["results/implications/paper_comparison.csv", "results/implications/paper_comparison.html"]
+        return targets
+
+    # -- replicate studies ----------------------------------------------------------------
+
+    def study_settings(self, name: str) -> StudySettings:
+        """Return study ``name``'s settings."""
+        from .study_settings import StudySettings
+
+        return StudySettings.from_config(self.config, name)
+
+    def get_study_config(self, wildcards: Namespace) -> dict:
+        """Return everything a study's results depend on (its, its dataset's and the chain's settings)."""
+        from .study_settings import study_block
+
+        return study_block(self.config, wildcards.study)
+
+    def _study_dataset(self, wildcards: Namespace) -> Namespace:
+        return Namespace(dataset=self.config["studies"][wildcards.study]["dataset"])
+
+    def study_hashes(self, wildcards: Namespace) -> dict[str, str]:
+        """Return the sha256 of a study's property tables (a changed table reruns the study)."""
+        return self.data_hashes(self._study_dataset(wildcards))
+
+    def get_study_balls(self, wildcards: Namespace) -> str | list:
+        """Return the ball table of the study's dataset as an input."""
+        return self.get_balls_table(self._study_dataset(wildcards))
+
+    def get_study_bats(self, wildcards: Namespace) -> str | list:
+        """Return the bat table of the study's dataset as an input."""
+        return self.get_bats_table(self._study_dataset(wildcards))
+
+    def get_study_batches(self, wildcards: Namespace) -> list[str]:
+        """Return the study's batch files."""
+        n = self.study_settings(wildcards.study).n_batches
+        return [f"results/studies/{wildcards.study}/batches/batch{b}.nc" for b in range(n)]
+
+    def study_batch_mem_mb(self, wildcards: Namespace) -> int:
+        """Return a batch job's memory, MB: one replicate at a time (measured ~180 MB at the paper's size)."""
+        s = self.study_settings(wildcards.study)
+        largest = study_impacts(s.dataset, s.parameter, s.values, s.truth_impacts)[0]
+        return 500 + math.ceil(largest * impact_bytes(s.dataset) / 1e6)
+
+    def study_truth_mem_mb(self, wildcards: Namespace) -> int:
+        """Return a truth job's memory, MB: its point's large noise-free design (StudySettings.truth_mem_mb)."""
+        return self.study_settings(wildcards.study).truth_mem_mb(int(wildcards.point))
+
+    def study_aggregate_mem_mb(self, wildcards: Namespace) -> int:
+        """Return the aggregate's memory, MB: every replicate's table (STUDY_BYTES_PER_REPLICATE) over 500 MB."""
+        s = self.study_settings(wildcards.study)
+        return 500 + math.ceil(s.total * STUDY_BYTES_PER_REPLICATE / 1e6)
+
+    def study_batch_runtime(self, wildcards: Namespace) -> int:
+        """Return a batch job's time, minutes: about a second per replicate of the paper's size, with room."""
+        s = self.study_settings(wildcards.study)
+        return max(10, math.ceil(s.batch_size * 2 / 60) + 5)
+
+    def get_study_truth_points(self, wildcards: Namespace) -> list[str]:
+        """Return the study's truth files, one per sweep point."""
+        n = self.study_settings(wildcards.study).n_points
+        return [f"results/studies/{wildcards.study}/truth/point{p}.nc" for p in range(n)]
+
+    def study_truth_runtime(self, wildcards: Namespace) -> int:
+        """Return a truth job's time, minutes (StudySettings.truth_runtime_min)."""
+        return self.study_settings(wildcards.study).truth_runtime_min(int(wildcards.point))
+
+    def study_targets(self, on_request: bool = False) -> list[str]:
+        """Return every product of every study (of ``studies``, or with on_request ``studies_on_request``).
+
+        Its truth and batches included, so that one deleted by hand is rebuilt (Snakemake does not
+        rebuild a missing intermediate whose consumers are up to date). A one-parameter sweep has a
+        design, a grid its grid figure.
+        """
+        targets = []
+        for name in self.studies if not on_request else sorted(set(self.all_studies) - set(self.studies)):
+            targets += [f"results/studies/{name}/coverage.{ext}" for ext in ("nc", "csv", "png")]
+            sweep = self.config["studies"][name].get("sweep") or {}
+            if "grid" in sweep:
+                targets += [f"results/studies/{name}/grid.png"]
+            elif sweep:
+                targets += [f"results/studies/{name}/design.{ext}" for ext in ("nc", "csv", "png")]
+            targets += [f"results/studies/{name}/truth.nc", *self.get_study_truth_points(Namespace(study=name))]
+            targets += self.get_study_batches(Namespace(study=name))
+        return targets

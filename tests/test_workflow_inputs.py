@@ -1,0 +1,91 @@
+"""The rules' view of the config (ballbat.workflow_inputs): inputs, params, resources and targets, as Python."""
+
+from __future__ import annotations
+
+import copy
+from argparse import Namespace
+
+import pytest
+
+from ballbat.pipeline.config import impact_bytes
+from ballbat.workflow_inputs import DATASET_FIGURES, WorkflowInputs, existing, file_hashes
+from workflow_helpers import ROOT
+
+
+@pytest.fixture
+def inputs(config):
+    return WorkflowInputs(copy.deepcopy(config), ROOT)
+
+
+def test_default_targets(inputs):
+    targets = inputs.final_targets()
+    assert len(targets) == len(set(targets))
+    assert targets[0] == "results/synthetic/reduce.nc"  # the default renders camera tracks
+    per = [t for t in targets if t.startswith("results/synthetic/")]
+    # the source, 2 track figures, 4 intermediate files, 3 tables and the workbook, 7 figures
+    assert len(per) == 1 + 2 + 4 + 3 + len(DATASET_FIGURES)
+    assert "results/implications/paper.nc" in targets and "results/implications/paper_comparison.csv" in targets
+    assert inputs.datasets == ["synthetic"] and inputs.tracked == ["synthetic"]
+    assert inputs.dataset_kind("synthetic") == "synthetic, rendered camera tracks"
+
+
+def test_a_measured_and_a_tool_file_dataset(config, tmp_path):
+    cfg = copy.deepcopy(config)
+    cfg["datasets"]["lab"] = {"impacts": "lab.csv", "bats": "lab_bats.csv"}
+    cfg["datasets"]["trk"] = {"tracks": {"dir": str(tmp_path), "impacts": "imp.csv"}}
+    inputs = WorkflowInputs(cfg, ROOT)
+    lab, trk = Namespace(dataset="lab"), Namespace(dataset="trk")
+    assert inputs.get_source(lab) == "results/lab/ingest.nc" and inputs.dataset_kind("lab") == "measured"
+    assert inputs.data_files(lab) == {"balls": cfg["tables"]["balls"], "bats": "lab_bats.csv", "impacts": "lab.csv"}
+    assert inputs.get_bats_table(lab) == []  # missing: this dataset's job fails, not the DAG
+    assert inputs.get_tracks_inputs(trk) == {
+        "tracks": "results/trk/imported_tracks.nc",
+        "cameras": "results/trk/imported_cameras.yaml",
+    }
+    assert (
+        inputs.get_source(trk) == "results/trk/reduce.nc"
+        and inputs.get_reduce_where(trk) == "config datasets.trk.tracks"
+    )
+
+
+def test_tool_file_content_is_in_the_params(config, tmp_path):
+    """A tool file replaced by other content changes the import's params, whatever its timestamp."""
+    cfg = copy.deepcopy(config)
+    (tmp_path / "W01_swing.trk").write_text("a")
+    (tmp_path / "notes.txt").write_text("not a tool file")
+    cfg["datasets"]["trk"] = {"tracks": {"dir": str(tmp_path), "impacts": "imp.csv"}}
+    inputs = WorkflowInputs(cfg, ROOT)
+    trk = Namespace(dataset="trk")
+    assert inputs.get_tool_files(trk)["files"] == [str(tmp_path / "W01_swing.trk")]
+    before = inputs.tool_file_hashes(trk)
+    (tmp_path / "W01_swing.trk").write_text("b")
+    after = inputs.tool_file_hashes(trk)
+    assert before["W01_swing.trk"] != after["W01_swing.trk"] and before["balls"] == after["balls"]
+    assert file_hashes({"x": str(tmp_path / "none")}) == {"x": "not a file"}
+    assert existing(str(tmp_path)) == []  # a folder is no input file
+
+
+def test_memory_plans(inputs, config):
+    synthetic = Namespace(dataset="synthetic")
+    n = 108  # Table I: 58 baseball and 50 softball impacts
+    assert inputs.dataset_mem_mb(synthetic) == 500 + n * impact_bytes(config["datasets"]["synthetic"]) // 1_000_000
+    sweep = inputs.get_scenario(Namespace(scenario="paper"))["sweep"]["D_in"]["num"]
+    assert inputs.scenario_mem_mb(Namespace(scenario="paper")) >= 500 and sweep > 1
+
+
+def test_study_targets(inputs):
+    """Every product of each study, its truth points and batches included; on_request ones apart."""
+    calibration = [t for t in inputs.study_targets() if "/calibration/" in t]
+    s = inputs.study_settings("calibration")
+    assert len([t for t in calibration if "/batches/" in t]) == s.n_batches == -(-s.replicates // s.batch_size)
+    assert "results/studies/calibration/coverage.png" in calibration
+    assert "results/studies/design/design.nc" in inputs.study_targets()
+    on_request = inputs.study_targets(on_request=True)
+    assert "results/studies/robustness/grid.png" in on_request
+    assert not any("/robustness/" in t for t in inputs.study_targets())
+
+
+def test_code_lists_the_modules_a_script_imports(inputs):
+    files = inputs.code("simulate.py")
+    assert any(f.endswith("src/ballbat/stages/simulate.py") for f in files)
+    assert not any(f.endswith("src/ballbat/plotting.py") for f in files)
