@@ -5,7 +5,8 @@ rule does (the same function, :func:`ballbat.stages.ingest.run`); ``ballbat fly`
 balls with Nathan's trajectory model (:func:`ballbat.flight.fly`), one from options or many
 from a CSV file; ``ballbat summary results/{dataset}`` prints a dataset's headline numbers; ``ballbat import-tracks``
 reads Tracker or Kinovea files into the long tracks CSV (:mod:`ballbat.tracks.formats`); ``ballbat
-bat`` turns a lab's bat measurements into a bat-table row (:mod:`ballbat.batcli`).
+bat`` turns a lab's bat measurements into a bat-table row (:mod:`ballbat.batcli`); ``ballbat compare
+FOLDER...`` prints the bats league table of results folders (:mod:`ballbat.league_cli`).
 Defaults (air, spin decay, integrator, property tables) are the config schema's, the one
 place the workflow's defaults live. Errors are one line naming the bad argument (exit 2);
 ``check`` exits 1 when the file is not usable.
@@ -788,6 +789,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("folder", help="a results folder, e.g. results/synthetic")
     p.set_defaults(func=cmd_summary)
     _add_bat(sub, Path(d["tables"]["balls"]))
+    _add_compare(sub)
     return top
 
 
@@ -796,6 +798,13 @@ def _add_bat(sub: argparse._SubParsersAction, balls: Path) -> None:
     from .batcli import register
 
     register(sub, _finite, balls, EXAMPLES["bat"])
+
+
+def _add_compare(sub: argparse._SubParsersAction) -> None:
+    """Add ``ballbat compare`` (:mod:`ballbat.league_cli`, imported only here: it needs numpy)."""
+    from .league_cli import register
+
+    register(sub, _finite)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
