@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, NoReturn
 
 from . import __version__
 from .usage import UsageError
+from . import league_cli
 from .video import cli as video_cli
 from .writer import OutputFailed, OutputRefused
 
@@ -71,6 +72,7 @@ measured value's uncertainty does to e_x; exits 1 when the values fail a bat row
   ballbat summary results/maple""",
 }
 EXAMPLES["track-video"] = video_cli.EXAMPLE
+EXAMPLES["compare"] = league_cli.EXAMPLE
 
 
 class _Parser(argparse.ArgumentParser):
@@ -802,9 +804,7 @@ def _add_bat(sub: argparse._SubParsersAction, balls: Path) -> None:
 
 def _add_compare(sub: argparse._SubParsersAction) -> None:
     """Add ``ballbat compare`` (:mod:`ballbat.league_cli`, imported only here: it needs numpy)."""
-    from .league_cli import register
-
-    register(sub, _finite)
+    league_cli.register(sub, _finite)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

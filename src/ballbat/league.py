@@ -23,7 +23,7 @@ This module joins them into one table and compares the bats:
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from itertools import combinations
 from pathlib import Path
 
@@ -57,28 +57,25 @@ class LeagueInputError(ValueError):
 
 @dataclass(frozen=True)
 class LeagueSettings:
-    """Settings of the league table (config ``league``; defaults in the config schema).
+    """Settings of the league table (config ``league``; the defaults live in the config schema).
 
     ``reference_bat``: the bat of the equivalence tests (None: per ball, the bat with the most
     impacts); ``margin``: the equivalence margin in e_x; ``alpha``: the level of every test;
     ``sharing``: source -> ``session``/``lab``/``bat``, overriding :data:`SHARING`.
     """
 
-    reference_bat: str | None = None
-    margin: float = 0.02
-    alpha: float = 0.05
-    sharing: dict = field(default_factory=dict)
+    reference_bat: str | None
+    margin: float
+    alpha: float
+    sharing: dict
 
     @classmethod
     def from_config(cls, config: dict) -> LeagueSettings:
-        """Return the settings of the validated config's ``league`` block (absent: the defaults)."""
-        block = config.get("league") or {}
-        return cls(
-            reference_bat=block.get("reference_bat"),
-            margin=float(block.get("margin", 0.02)),
-            alpha=float(block.get("alpha", 0.05)),
-            sharing=dict(block.get("sharing") or {}),
-        )
+        """Return the settings of a config's ``league`` block, checked, the schema's defaults filled."""
+        from .pipeline.config import checked_block
+
+        block = checked_block(config.get("league") or {}, "league")
+        return cls(block["reference_bat"], float(block["margin"]), float(block["alpha"]), dict(block["sharing"]))
 
     def kind(self, source: str) -> str:
         """How ``source``'s systematic is shared (``session``, ``lab`` or ``bat``)."""
@@ -193,7 +190,7 @@ def entries(sessions: list[Session]) -> dict[str, np.ndarray]:
 
 
 def covariance(ent: dict[str, np.ndarray], settings: LeagueSettings) -> tuple[np.ndarray, np.ndarray]:
-    """The entries' statistical and systematic covariance matrices.
+    """Return the entries' statistical and systematic covariance matrices.
 
     Statistical: diagonal, ``stat**2``. Systematic: for each source k, entries i and j that
     share its calibration (:meth:`LeagueSettings.kind`) covary by ``s_ik * s_jk``; others not.
@@ -220,7 +217,7 @@ def gls_weights(cov: np.ndarray) -> np.ndarray:
 
 
 def combine(x: np.ndarray, stat: np.ndarray, syst: np.ndarray) -> dict[str, float]:
-    """The GLS mean of one bat's session values ``x`` and its consistency chi-square.
+    """Return the GLS mean of one bat's session values ``x`` and its consistency chi-square.
 
     ``stat`` and ``syst``: the values' covariance matrices. Returns ``mean``, ``stat``, ``syst``
     (standard errors of the mean), ``chi2`` (the residuals' ``r' V^-1 r``, ``V = stat + syst``),
@@ -293,7 +290,7 @@ def _bat_rows(ent: dict, stat: np.ndarray, syst: np.ndarray) -> list[dict]:
 
 
 def _difference(a: dict, b: dict, nent: int, stat: np.ndarray, syst: np.ndarray) -> dict[str, float]:
-    """The difference of two bat rows' means with its stat. and syst. standard errors."""
+    """Return the difference of two bat rows' means with its stat. and syst. standard errors."""
     if a["weights"] is None or b["weights"] is None:
         return {"d": np.nan, "stat": np.nan, "syst": np.nan, "se": np.nan}
     w = np.zeros(nent)
@@ -319,7 +316,7 @@ def _pairs(rows: list[dict], nent: int, stat: np.ndarray, syst: np.ndarray) -> l
 
 
 def reference_bats(rows: list[dict], settings: LeagueSettings) -> dict[str, str | None]:
-    """The reference bat of each ball: the configured one where measured, else the bat with the most impacts.
+    """Return the reference bat of each ball: the configured one where measured, else the bat with the most impacts.
 
     A configured reference bat that no ball has raises ValueError naming it.
     """
@@ -356,11 +353,11 @@ def _equivalence(rows: list[dict], refs: dict, nent: int, stat, syst, settings: 
 
 
 def league(sessions: list[Session], settings: LeagueSettings | None = None) -> xr.Dataset:
-    """The league table of ``sessions``: entries, bats (GLS over sessions), pairs and TOST, one Dataset.
+    """Return the league table of ``sessions``: entries, bats (GLS over sessions), pairs and TOST, one Dataset.
 
     Raises ValueError when the sessions hold no entry or two sessions share a name and a bat.
     """
-    settings = settings or LeagueSettings()
+    settings = settings or LeagueSettings.from_config({})
     ent = entries(sessions)
     if not len(ent["e_x"]):
         raise ValueError("league: the results hold no bat with impacts")
@@ -495,7 +492,7 @@ CSV_COLUMNS = {
 
 
 def ranked(ds: xr.Dataset) -> list[int]:
-    """The rows of the league Dataset ``ds`` in league order: per ball, e_x from the highest."""
+    """Return the rows of the league Dataset ``ds`` in league order: per ball, e_x from the highest."""
     balls = list(dict.fromkeys(str(b) for b in ds["ball"].values))
     e = ds["e_x"].values
     key = [(balls.index(str(b)), -v if np.isfinite(v) else np.inf) for b, v in zip(ds["ball"].values, e, strict=True)]
@@ -530,7 +527,7 @@ def _p(v: float) -> str:
 
 
 def table_lines(ds: xr.Dataset) -> list[str]:
-    """The league table in words: e_x with stat. and syst. per bat, sessions, consistency, TOST."""
+    """Return the league table in words: e_x with stat. and syst. per bat, sessions, consistency, TOST."""
     margin, alpha = ds.attrs["league_margin"], ds.attrs["league_alpha"]
     out = [
         f"League table (e_x per bat; reference bats: {ds.attrs['league_reference_bats']}; "
@@ -552,7 +549,7 @@ def table_lines(ds: xr.Dataset) -> list[str]:
 
 
 def pair_lines(ds: xr.Dataset) -> list[str]:
-    """The pairwise differences in words, with Holm-adjusted p-values."""
+    """Return the pairwise differences in words, with Holm-adjusted p-values."""
     alpha = ds.attrs["league_alpha"]
     out = [
         f"Pairwise differences (Holm over {ds.sizes['pair']} pairs; differs: adjusted p < {alpha:g})",

@@ -18,9 +18,9 @@ if TYPE_CHECKING:
     from collections.abc import Callable
 
 EXAMPLE = """examples:
-  ballbat compare results
+  ballbat compare results/
   ballbat compare results/2026-11-h01 results/2026-11-h02 results/2026-12-maple
-  ballbat compare results --reference-bat wood --margin 0.02 --alpha 0.05
+  ballbat compare results/ --reference-bat wood --margin 0.02 --alpha 0.05
 Folders hold {dataset}/fit_ex.nc (or fit_ex.nc itself); each dataset is a test session."""
 
 
@@ -28,7 +28,7 @@ def register(sub: argparse._SubParsersAction, number: Callable[[str], float]) ->
     """Add the ``compare`` command to ``sub`` (``number`` parses a finite number)."""
     from .league import LeagueSettings
 
-    d = LeagueSettings()
+    d = LeagueSettings.from_config({})
     p = sub.add_parser(
         "compare",
         help="the bats league table of results folders: e_x per bat, pairwise tests, equivalence",
@@ -51,10 +51,11 @@ def cmd_compare(args: argparse.Namespace) -> int:
     if args.margin <= 0:
         raise UsageError(f"--margin {args.margin}: must be positive")
     sessions = []
+    block = {"reference_bat": args.reference_bat, "margin": args.margin, "alpha": args.alpha}
     try:
         for folder in args.folders:
             sessions += read_folder(folder)
-        ds = league(sessions, LeagueSettings(args.reference_bat, args.margin, args.alpha))
+        ds = league(sessions, LeagueSettings.from_config({"league": block}))
     except (LeagueInputError, ValueError) as exc:
         raise UsageError(str(exc)) from None
     names = ", ".join(dict.fromkeys(s.name for s in sessions))

@@ -58,7 +58,7 @@ def _panel(ax, ds: xr.Dataset, ball: str, ref: str | None) -> None:
 
 
 def forest_figure(ds: xr.Dataset) -> Figure:
-    """The forest plot of a league Dataset (:func:`ballbat.league.league`): one panel per ball."""
+    """Draw the forest plot of a league Dataset (:func:`ballbat.league.league`): one panel per ball."""
     balls = list(dict.fromkeys(str(b) for b in ds["ball"].values))
     refs = dict(part.split(": ") for part in ds.attrs["league_reference_bats"].split("; "))
     heights = [max(1, int((ds["ball"].values == b).sum())) + 1 for b in balls]

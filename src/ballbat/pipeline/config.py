@@ -517,6 +517,7 @@ SCHEMA_BLOCKS = {
     "normalize": ("properties", "normalize"),
     "analysis": ("properties", "analysis"),
     "implications": ("properties", "implications"),
+    "league": ("properties", "league"),
 }
 
 
