@@ -28,9 +28,8 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
-from . import __version__
+from . import __version__, league_cli
 from .usage import UsageError
-from . import league_cli
 from .video import cli as video_cli
 from .writer import OutputFailed, OutputRefused
 
