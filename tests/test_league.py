@@ -112,7 +112,7 @@ def test_across_sessions_systematics_add_in_quadrature(tmp_path):
 
 
 def test_holm_against_a_hand_computation():
-    """p = (0.01, 0.04, 0.03, 0.005): sorted 0.005 x 4, 0.01 x 3, 0.03 x 2, 0.04 x 1, made monotone."""
+    """P = (0.01, 0.04, 0.03, 0.005): sorted 0.005 x 4, 0.01 x 3, 0.03 x 2, 0.04 x 1, made monotone."""
     assert league.holm(np.array([0.01, 0.04, 0.03, 0.005])) == pytest.approx([0.03, 0.06, 0.06, 0.02])
     assert league.holm(np.array([0.5, 0.9])) == pytest.approx([1.0, 1.0])  # capped at 1
     out = league.holm(np.array([0.02, np.nan, 0.04]))  # no value, no test: m = 2
@@ -120,7 +120,7 @@ def test_holm_against_a_hand_computation():
 
 
 def test_consistency_of_a_bat_in_three_sessions(tmp_path):
-    """x = 0.40, 0.42, 0.44 with 0.01 each: mean 0.42, chi2 = 8 on 2 dof, p = exp(-4)."""
+    """X = 0.40, 0.42, 0.44 with 0.01 each: mean 0.42, chi2 = 8 on 2 dof, p = exp(-4)."""
     for k, x in enumerate((0.40, 0.42, 0.44)):
         fit_file(tmp_path / f"s{k}", "d", {"A": (x, 0.01, 20, 0.0), "B": (0.3, 0.01, 20, 0.0)})
     r = row(table(*(tmp_path / f"s{k}" for k in range(3))), "A")
