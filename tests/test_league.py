@@ -166,7 +166,7 @@ def test_tost_in_the_table_uses_the_reference_bat(tmp_path):
     se = math.hypot(0.004, 0.004)
     assert near["tost_p"] == pytest.approx(stats.norm.cdf((0.005 - 0.02) / se), rel=1e-9)
     assert near["tost_equivalent"] == 1 and far["tost_equivalent"] == 0 and row(ds, "ref")["tost_equivalent"] == -1
-    with pytest.raises(ValueError, match="league.reference_bat: 'oak' has no e_x here"):
+    with pytest.raises(ValueError, match=r"league\.reference_bat: 'oak' has no e_x here"):
         table(tmp_path / "s1", reference_bat="oak")
 
 
