@@ -197,10 +197,8 @@ def test_compare_bad_folders_are_one_line_naming_the_folder(tmp_path):
     (tmp_path / "empty").mkdir()
     out = run_compare(str(tmp_path / "empty"))
     assert out.returncode == 2 and out.stdout == ""
-    assert (
-        out.stderr
-        == f"ballbat compare: error: {tmp_path / 'empty'}: no fit_ex.nc in it or in its dataset folders (run the workflow first)\n"
-    )
+    what = "no fit_ex.nc in it or in its dataset folders (run the workflow first)"
+    assert out.stderr == f"ballbat compare: error: {tmp_path / 'empty'}: {what}\n"
     fit_file(tmp_path / "old", "d", {"A": (0.45, 0.006, 20, 0.005)}, older=True)
     out = run_compare(str(tmp_path / "old"))
     assert out.returncode == 2 and len(out.stderr.splitlines()) == 1
