@@ -91,8 +91,12 @@ def test_implications_outputs(run_dir):
     imp = run_dir / "results" / "implications"
     paper = xr.open_dataset(imp / "paper.nc")
     fit = xr.open_dataset(run_dir / "results" / "small" / "fit_ex.nc")
-    # e_x taken from the dataset's pooled baseball fit, recorded in the file and its inputs
-    assert paper.attrs["e_x"] == pytest.approx(float(fit.e_x_pooled.sel(ball="baseball")), rel=1e-12)
+    # e_x taken from the dataset's fit of the scenario's bat (wood) with its ball (issue 37: the bat's own
+    # e_x, no longer the pooled one), recorded in the file and its inputs, with its bands
+    assert paper.attrs["e_x"] == pytest.approx(float(fit.e_x.sel(ball="baseball", bat="wood")), rel=1e-12)
+    assert paper.attrs["e_x_source"] == "bat e_x of dataset small"
+    assert paper.attrs["e_x_stat"] == pytest.approx(float(fit.e_x_err.sel(ball="baseball", bat="wood")), rel=1e-12)
+    assert (paper.carry_low95 <= paper.carry_low68).all() and (paper.carry_high68 <= paper.carry_high95).all()
     assert any(r["name"] == "fit" for r in json.loads(paper.attrs["provenance_inputs"]))
     assert paper.sizes["case"] == 26 and paper.D.attrs["units"] == "m"
     assert set(np.unique(paper.exceeds_mu.values)) <= {0, 1}

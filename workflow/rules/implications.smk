@@ -1,9 +1,15 @@
+def scenario_tables(wildcards):
+    """The property tables of a scenario: those of its e_x_from_dataset dataset (a lab's own bat), else tables."""
+    name = get_scenario(wildcards).get("e_x_from_dataset")
+    block = config["datasets"][name] if name else {}
+    return {k: block.get(k, config["tables"][k]) for k in ("balls", "bats")}
+
+
 rule implications:
     """Collide a pitched ball with a bat and fly it, or fly given launch conditions (Sec. V.B)."""
     input:
         unpack(get_scenario_fit),
-        balls=config["tables"]["balls"],
-        bats=config["tables"]["bats"],
+        unpack(scenario_tables),
         code=code("implications.py"),
     output:
         scenario="results/implications/{scenario}.nc",
@@ -20,7 +26,7 @@ rule implications:
     params:
         scenario=get_scenario,
         air=config["implications"]["air"],
-        sha256=tables_hashes,
+        sha256=lambda w: file_hashes(scenario_tables(w)),
     script:
         "../scripts/implications.py"
 
