@@ -79,6 +79,19 @@ def dataset_e_x(fit: xr.Dataset, ball: str, bat: str | None, dataset: str) -> Da
     return DatasetEx(value, stat, _finite_or_zero(fit, "e_x_pooled_syst", ball=ball), "pooled", dataset)
 
 
+def case_attrs(scenario: dict) -> dict:
+    """Return a D sweep's pitch and swing as attributes, and ``paper_case`` (1: Sec. V.B's case, 0: another one)."""
+    from .published import PAPER_IMPLICATIONS_CASE
+
+    if "sweep" not in scenario:
+        return {}
+    out = {k: float(scenario["sweep"][k]) for k in PAPER_IMPLICATIONS_CASE if k != "ball"}
+    same = scenario["ball"] == PAPER_IMPLICATIONS_CASE["ball"] and all(
+        np.isclose(v, PAPER_IMPLICATIONS_CASE[k]) for k, v in out.items()
+    )
+    return {**out, "paper_case": int(same)}
+
+
 def bands(
     settings: stage.ImplicationsSettings, balls: dict[str, Ball], bats: dict[str, Bat], ex: DatasetEx
 ) -> dict[str, np.ndarray]:
@@ -108,6 +121,7 @@ def scenario_with_bands(
     scenario has no e_x in it, so it gets no bands either.
     """
     ds = stage.run(settings, balls, bats, e_x=None if ex is None else ex.value)
+    ds.attrs.update(case_attrs(settings.scenario))
     if ex is None:
         return ds
     ds.attrs.update(
