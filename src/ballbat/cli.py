@@ -6,7 +6,8 @@ balls with Nathan's trajectory model (:func:`ballbat.flight.fly`), one from opti
 from a CSV file; ``ballbat summary results/{dataset}`` prints a dataset's headline numbers; ``ballbat import-tracks``
 reads Tracker or Kinovea files into the long tracks CSV (:mod:`ballbat.tracks.formats`); ``ballbat
 bat`` turns a lab's bat measurements into a bat-table row (:mod:`ballbat.batcli`); ``ballbat compare
-FOLDER...`` prints the bats league table of results folders (:mod:`ballbat.league_cli`).
+FOLDER...`` prints the bats league table of results folders (:mod:`ballbat.league_cli`); ``ballbat hit``
+turns a pitch and a swing into a batted ball with bands from a dataset's e_x (:mod:`ballbat.hit_cli`).
 Defaults (air, spin decay, integrator, property tables) are the config schema's, the one
 place the workflow's defaults live. Errors are one line naming the bad argument (exit 2);
 ``check`` exits 1 when the file is not usable.
@@ -28,7 +29,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
-from . import __version__, league_cli
+from . import __version__, hit_cli, league_cli
 from .usage import UsageError
 from .video import cli as video_cli
 from .writer import OutputFailed, OutputRefused
@@ -72,6 +73,7 @@ measured value's uncertainty does to e_x; exits 1 when the values fail a bat row
 }
 EXAMPLES["track-video"] = video_cli.EXAMPLE
 EXAMPLES["compare"] = league_cli.EXAMPLE
+EXAMPLES["hit"] = hit_cli.EXAMPLE
 
 
 class _Parser(argparse.ArgumentParser):
@@ -791,6 +793,7 @@ def parser() -> argparse.ArgumentParser:
     p.set_defaults(func=cmd_summary)
     _add_bat(sub, Path(d["tables"]["balls"]))
     _add_compare(sub)
+    hit_cli.register(sub, _finite, d["tables"])
     return top
 
 
