@@ -167,17 +167,34 @@ STRONGE_COLUMNS = (
     Column("psi_gross_slip_boundary", "deg"),
 )
 
-#: A batted-ball scenario's cases (implications/{scenario}.nc).
+#: A batted-ball scenario's cases (implications/{scenario}.nc); the 68 % and 95 % bands from e_x's
+#: uncertainty where the scenario takes e_x from a dataset (:mod:`ballbat.scenario_bands`).
 SCENARIO_COLUMNS = (
     Column("case", "1"),
     Column("D", "in"),
     Column("psi", "deg"),
     Column("exit_speed", "mph"),
+    Column("exit_speed_low68", "mph"),
+    Column("exit_speed_high68", "mph"),
+    Column("exit_speed_low95", "mph"),
+    Column("exit_speed_high95", "mph"),
     Column("launch_angle", "deg"),
+    Column("launch_angle_low68", "deg"),
+    Column("launch_angle_high68", "deg"),
+    Column("launch_angle_low95", "deg"),
+    Column("launch_angle_high95", "deg"),
     Column("spray_angle", "deg"),
     Column("backspin", "rpm"),
+    Column("backspin_low68", "rpm"),
+    Column("backspin_high68", "rpm"),
+    Column("backspin_low95", "rpm"),
+    Column("backspin_high95", "rpm"),
     Column("sidespin", "rpm"),
     Column("carry", "ft"),
+    Column("carry_low68", "ft"),
+    Column("carry_high68", "ft"),
+    Column("carry_low95", "ft"),
+    Column("carry_high95", "ft"),
     Column("apex", "ft"),
     Column("hang_time", "s"),
     Column("landing_x", "ft"),
