@@ -67,7 +67,9 @@ def test_entry_point_is_installed():
     out = ballbat_process("--help")
     assert out.returncode == 0, out.stderr
     lines = out.stdout.splitlines()
-    assert lines[0] == "usage: ballbat [-h] [--version] {check,fly,import-tracks,track-video,summary,bat,compare,hit} ..."
+    assert (
+        lines[0] == "usage: ballbat [-h] [--version] {check,fly,import-tracks,track-video,summary,bat,compare,hit} ..."
+    )
     listed = dict(line.split(None, 1) for line in lines if line.startswith("    ") and not line.startswith("     "))
     assert listed == COMMANDS  # every command, each with its one-line help
     out = ballbat_process("fly", "--speed", "fast", "--angle", "20")

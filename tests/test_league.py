@@ -100,7 +100,10 @@ def test_across_sessions_systematics_add_in_quadrature(tmp_path):
     p = pair(ds, "A", "B")
     assert p["syst"] == pytest.approx(math.hypot(0.005, 0.004), rel=1e-12)
     assert p["se"] == pytest.approx(math.sqrt(0.006**2 + 0.008**2 + 0.005**2 + 0.004**2), rel=1e-12)
-    assert p["p"] == pytest.approx(2 * stats.norm.sf(0.05 / p["se"]), rel=1e-9)
+    # Student t on Welch-Satterthwaite's dof: each stat. variance on n - 1 = 19, the systematics known
+    dof = p["se"] ** 4 / (0.006**4 / 19 + 0.008**4 / 19)
+    assert p["dof"] == pytest.approx(dof, rel=1e-9)
+    assert p["p"] == pytest.approx(2 * stats.t.sf(0.05 / p["se"], dof), rel=1e-9)
     assert sorted(ds["entry_session"].values) == ["s1/d1", "s2/d2"]  # the session: folder/dataset
     # a source calibrated once for every session (sharing: lab) cancels across sessions too
     lab = table(tmp_path / "s1", tmp_path / "s2", sharing={"swing_m_per_px": "lab"})
@@ -164,7 +167,8 @@ def test_tost_in_the_table_uses_the_reference_bat(tmp_path):
     ds = table(tmp_path / "s1", tmp_path / "s2", reference_bat="ref", margin=0.02)
     near, far = row(ds, "near"), row(ds, "far")
     se = math.hypot(0.004, 0.004)
-    assert near["tost_p"] == pytest.approx(stats.norm.cdf((0.005 - 0.02) / se), rel=1e-9)
+    assert near["tost_dof"] == pytest.approx(se**4 / (2 * 0.004**4 / 29), rel=1e-9)
+    assert near["tost_p"] == pytest.approx(stats.t.cdf((0.005 - 0.02) / se, near["tost_dof"]), rel=1e-9)
     assert near["tost_equivalent"] == 1 and far["tost_equivalent"] == 0 and row(ds, "ref")["tost_equivalent"] == -1
     with pytest.raises(ValueError, match=r"league\.reference_bat: 'oak' has no e_x here"):
         table(tmp_path / "s1", reference_bat="oak")

@@ -253,14 +253,14 @@ def holm(p: np.ndarray) -> np.ndarray:
     return out
 
 
-def tost(d: float, se: float, margin: float) -> tuple[float, float, float]:
-    """Two one-sided tests of ``|d| < margin`` (normal): ``(p, p_lower, p_upper)``, ``p`` the larger.
+def tost(d: float, se: float, margin: float, dof: float = np.inf) -> tuple[float, float, float]:
+    """Two one-sided tests of ``|d| < margin`` (Student t on ``dof``): ``(p, p_lower, p_upper)``, ``p`` the larger.
 
     ``p_lower`` tests H0 d <= -margin, ``p_upper`` H0 d >= +margin; equivalence at level
     alpha when ``p < alpha`` (the (1 - 2 alpha) interval of d inside +-margin).
     """
-    p_lower = float(stats.norm.sf((d + margin) / se))
-    p_upper = float(stats.norm.cdf((d - margin) / se))
+    p_lower = float(stats.t.sf((d + margin) / se, dof))
+    p_upper = float(stats.t.cdf((d - margin) / se, dof))
     return max(p_lower, p_upper), p_lower, p_upper
 
 
@@ -289,27 +289,34 @@ def _bat_rows(ent: dict, stat: np.ndarray, syst: np.ndarray) -> list[dict]:
     return rows
 
 
-def _difference(a: dict, b: dict, nent: int, stat: np.ndarray, syst: np.ndarray) -> dict[str, float]:
-    """Return the difference of two bat rows' means with its stat. and syst. standard errors."""
+def _difference(a: dict, b: dict, ent: dict, stat: np.ndarray, syst: np.ndarray) -> dict[str, float]:
+    """Return the difference of two bat rows' means with its stat. and syst. standard errors and its dof.
+
+    ``dof``: Welch-Satterthwaite's effective degrees of freedom of the variance, each entry's
+    statistical variance estimated on ``n - 1`` degrees of freedom, the systematics taken as known.
+    """
     if a["weights"] is None or b["weights"] is None:
-        return {"d": np.nan, "stat": np.nan, "syst": np.nan, "se": np.nan}
-    w = np.zeros(nent)
+        return {"d": np.nan, "stat": np.nan, "syst": np.nan, "se": np.nan, "dof": np.nan}
+    w = np.zeros(len(ent["e_x"]))
     w[a["idx"]] += a["weights"]
     w[b["idx"]] -= b["weights"]
     vs, vy = float(w @ stat @ w), max(float(w @ syst @ w), 0.0)
-    return {"d": a["mean"] - b["mean"], "stat": np.sqrt(vs), "syst": np.sqrt(vy), "se": np.sqrt(vs + vy)}
+    parts = w**2 * np.diag(stat)
+    denom = float(np.sum(parts**2 / np.maximum(ent["n"] - 1.0, 1.0)))
+    dof = (vs + vy) ** 2 / denom if denom > 0 else np.inf
+    return {"d": a["mean"] - b["mean"], "stat": np.sqrt(vs), "syst": np.sqrt(vy), "se": np.sqrt(vs + vy), "dof": dof}
 
 
-def _pairs(rows: list[dict], nent: int, stat: np.ndarray, syst: np.ndarray) -> list[dict]:
-    """Every pair of bats of the same ball: difference, errors, z, two-sided p, Holm's p."""
+def _pairs(rows: list[dict], ent: dict, stat: np.ndarray, syst: np.ndarray) -> list[dict]:
+    """Every pair of bats of the same ball: difference, errors, t, two-sided p (Student t), Holm's p."""
     out = []
     for a, b in combinations(rows, 2):
         if a["ball"] != b["ball"]:
             continue
-        diff = _difference(a, b, nent, stat, syst)
+        diff = _difference(a, b, ent, stat, syst)
         z = diff["d"] / diff["se"] if diff["se"] > 0 else np.nan
         out.append({"ball": a["ball"], "bat_a": a["bat"], "bat_b": b["bat"], **diff, "z": z})
-    p = np.array([2 * stats.norm.sf(abs(r["z"])) if np.isfinite(r["z"]) else np.nan for r in out])
+    p = np.array([2 * stats.t.sf(abs(r["z"]), r["dof"]) if np.isfinite(r["z"]) else np.nan for r in out])
     for r, pi, ph in zip(out, p, holm(p), strict=True):
         r["p"], r["p_holm"] = float(pi), float(ph)
     return out
@@ -339,17 +346,18 @@ def reference_bats(rows: list[dict], settings: LeagueSettings) -> dict[str, str 
     return out
 
 
-def _equivalence(rows: list[dict], refs: dict, nent: int, stat, syst, settings: LeagueSettings) -> None:
+def _equivalence(rows: list[dict], refs: dict, ent: dict, stat, syst, settings: LeagueSettings) -> None:
     """Add each row's TOST against its ball's reference bat (``tost_*``; NaN where not tested)."""
     by_key = {(r["ball"], r["bat"]): r for r in rows}
     for r in rows:
-        r.update(tost_d=np.nan, tost_se=np.nan, tost_p=np.nan, tost_equivalent=-1)
+        r.update(tost_d=np.nan, tost_se=np.nan, tost_dof=np.nan, tost_p=np.nan, tost_equivalent=-1)
         ref = refs.get(r["ball"])
         if ref is None or ref == r["bat"] or not np.isfinite(r["mean"]):
             continue
-        diff = _difference(r, by_key[(r["ball"], ref)], nent, stat, syst)
-        p = tost(diff["d"], diff["se"], settings.margin)[0]
-        r.update(tost_d=diff["d"], tost_se=diff["se"], tost_p=p, tost_equivalent=int(p < settings.alpha))
+        diff = _difference(r, by_key[(r["ball"], ref)], ent, stat, syst)
+        p = tost(diff["d"], diff["se"], settings.margin, diff["dof"])[0]
+        r.update(tost_d=diff["d"], tost_se=diff["se"], tost_dof=diff["dof"], tost_p=p)
+        r["tost_equivalent"] = int(p < settings.alpha)
 
 
 def league(sessions: list[Session], settings: LeagueSettings | None = None) -> xr.Dataset:
@@ -367,9 +375,9 @@ def league(sessions: list[Session], settings: LeagueSettings | None = None) -> x
         raise ValueError(f"league: {dup[1]} ({dup[0]}) twice in test session {dup[2]!r}: name the sessions apart")
     stat, syst = covariance(ent, settings)
     rows = _bat_rows(ent, stat, syst)
-    pairs = _pairs(rows, len(ent["e_x"]), stat, syst)
+    pairs = _pairs(rows, ent, stat, syst)
     refs = reference_bats(rows, settings)
-    _equivalence(rows, refs, len(ent["e_x"]), stat, syst, settings)
+    _equivalence(rows, refs, ent, stat, syst, settings)
     ds = xr.Dataset(
         {**_entry_vars(ent, stat, syst), **_row_vars(rows, settings), **_pair_vars(pairs, settings)},
         attrs={
@@ -423,6 +431,7 @@ def _row_vars(rows: list[dict], settings: LeagueSettings) -> dict[str, tuple]:
         "consistency_p": variable(r, col["p"], "1", "p-value of consistency_chi2 (NaN: one session)"),
         "tost_difference": variable(r, col["tost_d"], "1", "e_x of the bat minus the reference bat's"),
         "tost_se": variable(r, col["tost_se"], "1", "standard error of tost_difference (stat. and syst.)"),
+        "tost_dof": variable(r, col["tost_dof"], "1", "Welch-Satterthwaite degrees of freedom of tost_se"),
         "tost_p": variable(
             r, col["tost_p"], "1", f"p-value of the two one-sided tests of |difference| < {settings.margin}"
         ),
@@ -440,7 +449,8 @@ def _row_vars(rows: list[dict], settings: LeagueSettings) -> dict[str, tuple]:
 
 def _pair_vars(pairs: list[dict], settings: LeagueSettings) -> dict[str, tuple]:
     p = "pair"
-    col = {k: [row[k] for row in pairs] for k in ("ball", "bat_a", "bat_b", "d", "stat", "syst", "se", "z", "p")}
+    keys = ("ball", "bat_a", "bat_b", "d", "stat", "syst", "se", "dof", "z", "p")
+    col = {k: [row[k] for row in pairs] for k in keys}
     col["p_holm"] = [row["p_holm"] for row in pairs]
     return {
         "pair_ball": variable(p, np.array(col["ball"], dtype=str), None, "ball type of the pair"),
@@ -452,8 +462,13 @@ def _pair_vars(pairs: list[dict], settings: LeagueSettings) -> dict[str, tuple]:
             p, np.array(col["syst"], dtype=float), "1", "systematic error of it (shared calibrations cancel)"
         ),
         "pair_se": variable(p, np.array(col["se"], dtype=float), "1", "standard error of it, stat. and syst."),
-        "pair_z": variable(p, np.array(col["z"], dtype=float), "1", "difference over its standard error"),
-        "pair_p": variable(p, np.array(col["p"], dtype=float), "1", "two-sided p-value of no difference (normal)"),
+        "pair_dof": variable(
+            p, np.array(col["dof"], dtype=float), "1", "Welch-Satterthwaite degrees of freedom of pair_se"
+        ),
+        "pair_t": variable(p, np.array(col["z"], dtype=float), "1", "difference over its standard error"),
+        "pair_p": variable(
+            p, np.array(col["p"], dtype=float), "1", "two-sided p-value of no difference (Student t on pair_dof)"
+        ),
         "pair_p_holm": variable(
             p, np.array(col["p_holm"], dtype=float), "1", "pair_p adjusted by Holm over every pair of the table"
         ),
