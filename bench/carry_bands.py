@@ -63,6 +63,7 @@ def rate(k: int, n: int) -> str:
 
 
 def main(n: int = 400, impacts: int = 30, seed0: int = 20261128) -> None:
+    """Run ``n`` replicates and print the bands' coverage."""
     tables = (load_balls(ROOT / "config" / "balls.csv"), load_bats(ROOT / "config" / "examples" / "hickory_bats.csv"))
     imp = checked_block({"scenarios": {"s": {"ball": "baseball", "bat": "hickory", "sweep": SWEEP}}}, "implications")
     settings = stage.ImplicationsSettings(scenario=imp["scenarios"]["s"], air=imp["air"])

@@ -1,5 +1,6 @@
-"""A synthetic season of the bats league table (issue 37): are the bats that truly differ found, and the
-pairs that truly agree not, at the stated error rates?
+"""A synthetic season of the bats league table (issue 37): the error rates of its tests.
+
+Are the bats that truly differ found, and the pairs that truly agree not, at the stated error rates?
 
 Each season is three test sessions of synthetic impacts (direct-noise mode, the default's noise) of
 bats with known e_x, run through the chain (:func:`ballbat.chain.run`) and the league
@@ -112,6 +113,7 @@ def rate(k: int, n: int) -> str:
 
 
 def main(n: int = 300, seed0: int = 20261127) -> None:
+    """Run ``n`` seasons and print the error rates and the power."""
     tables = (load_balls(ROOT / "config" / "balls.csv"), load_bats(ROOT / "config" / "bats.csv"))
     settings = league.LeagueSettings.from_config({"league": {"reference_bat": "wood", "margin": 0.02}})
     t0 = time.process_time()
