@@ -19,6 +19,8 @@ from .usage import UsageError
 if TYPE_CHECKING:
     from collections.abc import Callable
 
+    import xarray as xr
+
 EXAMPLE = """examples:
   ballbat hit --pitch-speed 90 --bat-speed 70 --bat hickory --results results/h01 --D 0.5
   ballbat hit --pitch-speed 85 --bat-speed 73 --bat wood --e-x 0.4 --D 0.5
@@ -129,7 +131,7 @@ def cmd_hit(args: argparse.Namespace) -> int:
     return 0
 
 
-def hit_lines(ds, sc: dict) -> list[str]:
+def hit_lines(ds: xr.Dataset, sc: dict) -> list[str]:
     """Return the batted ball in words: exit speed, launch angle, backspin and carry, with their bands."""
     import numpy as np
 

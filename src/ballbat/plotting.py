@@ -760,6 +760,15 @@ def design_figure(des: xr.Dataset) -> Figure:
         s = des["sigma_e_x"].values[:, j]
         ax1.errorbar(x, s, yerr=des["sigma_e_x_err"].values[:, j], label=f"{ball}, {bat}", **kw)
         ax2.plot(x, des["impacts_required"].values[:, j], **kw)
+        if "impacts_required_answer" in des:  # one answer over the sweep, with its interval (ballbat.pilot)
+            ax2.axhspan(
+                des["impacts_required_answer_low"].values[j],
+                des["impacts_required_answer_high"].values[j],
+                color=kw.get("color", "0.5"),
+                alpha=0.12,
+                lw=0,
+            )
+            ax2.axhline(des["impacts_required_answer"].values[j], color=kw.get("color", "0.5"), lw=1.2, ls="--")
     if param == "impacts_per_bat":
         ax1.set_xscale("log")
         ax1.set_yscale("log")
