@@ -227,6 +227,11 @@ def test_default_run_writes_the_league(default_run):
     assert float(row(ds, "wood")["e_x"]) in fit["e_x"].values  # one session: each bat's e_x is fit_ex.nc's
     assert (res / "league.csv").read_text().startswith("ball,bat,e_x,e_x_stat,e_x_syst,")
     assert (res / "figures" / "league_forest.png").stat().st_size > 10_000
+    import openpyxl
+
+    wb = openpyxl.load_workbook(res / "league.xlsx")
+    assert wb.sheetnames == ["league", "pairs", "sessions", "provenance"]
+    assert wb["pairs"].max_row == 2 + ds.sizes["pair"]  # names, units, one row per pair
     assert ds.sizes["pair"] == 3 + 6  # pairs of 3 baseball bats and of 4 softball bats
 
 

@@ -17,7 +17,9 @@ def league_wanted():
 
 
 LEAGUE_TARGETS = (
-    ["results/league.nc", "results/league.csv", "results/figures/league_forest.png"] if league_wanted() else []
+    ["results/league.nc", "results/league.csv", "results/league.xlsx", "results/figures/league_forest.png"]
+    if league_wanted()
+    else []
 )
 
 
@@ -30,6 +32,7 @@ rule league:
         nc="results/league.nc",
         csv="results/league.csv",
         prov="results/league.provenance.json",
+        xlsx="results/league.xlsx",
         forest=report(
             "results/figures/league_forest.png",
             caption="../report/league.rst",
