@@ -104,7 +104,8 @@ def test_across_sessions_systematics_add_in_quadrature(tmp_path):
     dof = p["se"] ** 4 / (0.006**4 / 19 + 0.008**4 / 19)
     assert p["dof"] == pytest.approx(dof, rel=1e-9)
     assert p["p"] == pytest.approx(2 * stats.t.sf(0.05 / p["se"], dof), rel=1e-9)
-    assert sorted(ds["entry_session"].values) == ["s1/d1", "s2/d2"]  # the session: folder/dataset
+    # the session: the dataset's folder as given
+    assert sorted(ds["entry_session"].values) == [str(tmp_path / "s1" / "d1"), str(tmp_path / "s2" / "d2")]
     # a source calibrated once for every session (sharing: lab) cancels across sessions too
     lab = table(tmp_path / "s1", tmp_path / "s2", sharing={"swing_m_per_px": "lab"})
     assert pair(lab, "A", "B")["syst"] == pytest.approx(0.001, rel=1e-9)
@@ -188,7 +189,7 @@ def test_ballbat_compare_prints_the_table_the_pairs_and_tost(tmp_path):
     fit_file(tmp_path / "s2", "m01", {"maple": (0.38, 0.006, 25, 0.004), "wood": (0.465, 0.006, 25, 0.004)})
     out = run_compare(str(tmp_path / "s1"), str(tmp_path / "s2"), "--reference-bat", "wood")
     assert out.returncode == 0, out.stderr
-    assert "2 test session(s): s1/h01, s2/m01" in out.stdout
+    assert f"2 test session(s): {tmp_path / 's1' / 'h01'}, {tmp_path / 's2' / 'm01'}" in out.stdout
     lines = out.stdout.splitlines()
     wood = next(line for line in lines if line.startswith("baseball  wood "))
     assert "(reference)" in wood and wood.split()[6] == "2"  # two sessions

@@ -110,7 +110,8 @@ def check_fit(ds: xr.Dataset, where: str) -> None:
 def read_folder(folder: str | os.PathLike[str], session: str | None = None) -> list[Session]:
     """Return the sessions of a results folder: its ``{dataset}/fit_ex.nc`` files, or its own fit_ex.nc.
 
-    Each dataset is a test session named ``folder/dataset`` unless ``session`` names them all.
+    Each dataset is a test session named by its folder as given (``results/synthetic``; two runs'
+    folders of the same dataset name stay apart) unless ``session`` names them all.
     Raises :class:`LeagueInputError` naming the folder when it holds no fit_ex.nc or one the
     league cannot read.
     """
@@ -130,7 +131,8 @@ def read_folder(folder: str | os.PathLike[str], session: str | None = None) -> l
             raise LeagueInputError(f"{folder}: {path.name} cannot be read: {exc}") from None
         check_fit(ds, str(path))
         dataset = path.parent.name
-        out.append(Session(session or f"{root.name}/{dataset}", str(root), dataset, ds))
+        name = str(path.parent) if path.parent != root else str(folder).rstrip("/") or str(root)
+        out.append(Session(session or name, str(root), dataset, ds))
     return out
 
 
