@@ -1,8 +1,9 @@
+from ballbat.pipeline.config import scenario_tables as _scenario_tables
+
+
 def scenario_tables(wildcards):
-    """The property tables of a scenario: those of its e_x_from_dataset dataset (a lab's own bat), else tables."""
-    name = get_scenario(wildcards).get("e_x_from_dataset")
-    block = config["datasets"][name] if name else {}
-    return {k: block.get(k, config["tables"][k]) for k in ("balls", "bats")}
+    """The property tables of a scenario: its e_x_from_dataset dataset's where they hold its bat (ball), else tables."""
+    return _scenario_tables(config, get_scenario(wildcards))
 
 
 rule implications:

@@ -619,7 +619,7 @@ def scenario_problems(config: dict) -> list[str]:
     problems = []
     for name, sc in scenarios.items():
         where = f"implications.scenarios.{name}"
-        tables = _scenario_tables(config, sc)
+        tables = scenario_tables(config, sc)
         for key, table in (("ball", "balls"), ("bat", "bats")):
             names = _table_names(tables[table], load_bats if key == "bat" else load_balls)
             if key in sc and names is not None and sc[key] not in names:
@@ -632,10 +632,22 @@ def scenario_problems(config: dict) -> list[str]:
     return problems
 
 
-def _scenario_tables(config: dict, scenario: dict) -> dict[str, str]:
-    """Return a scenario's property tables: its ``e_x_from_dataset`` dataset's own (a lab's bat), else ``tables``."""
+def scenario_tables(config: dict, scenario: dict) -> dict[str, str]:
+    """Return a scenario's property tables (``balls``, ``bats``): its dataset's where they hold its ball (bat).
+
+    For each, the ``e_x_from_dataset`` dataset's own table when that holds the scenario's ball
+    (bat), else the config's ``tables``. A lab's own bat needs no extra config: a bat only its
+    dataset's table knows is found there.
+    """
+    from ..properties import load_balls, load_bats
+
     block = (config.get("datasets") or {}).get(scenario.get("e_x_from_dataset")) or {}
-    return {k: block.get(k, config["tables"][k]) for k in ("balls", "bats")}
+    out = {}
+    for key, table, loader in (("ball", "balls", load_balls), ("bat", "bats", load_bats)):
+        own = block.get(table)
+        names = _table_names(own, loader) if own else None
+        out[table] = own if names is not None and scenario.get(key) in names else config["tables"][table]
+    return out
 
 
 def _e_x_source_problems(config: dict, where: str, scenario: dict) -> list[str]:
