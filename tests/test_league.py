@@ -111,6 +111,15 @@ def test_across_sessions_systematics_add_in_quadrature(tmp_path):
     assert pair(lab, "A", "B")["syst"] == pytest.approx(0.001, rel=1e-9)
 
 
+def test_a_session_label_joins_datasets_into_one_session(tmp_path):
+    """Two datasets labelled one test session (config datasets.<name>.session) share its calibrations."""
+    fit_file(tmp_path / "a", "d1", {"A": (0.45, 0.006, 20, 0.005)})
+    fit_file(tmp_path / "b", "d2", {"B": (0.40, 0.008, 20, 0.004)})
+    sessions = league.read_folder(tmp_path / "a", session="day1") + league.read_folder(tmp_path / "b", session="day1")
+    p = pair(league.league(sessions, settings()), "A", "B")
+    assert p["syst"] == pytest.approx(0.001, rel=1e-9)
+
+
 # ---------------------------------------------------------------------------------------
 # Holm, consistency, TOST
 
