@@ -32,6 +32,8 @@ localrules:
     all,
     compare,
     league,
+    plot_league,
+    league_workbook,
     comparison_html,
     implications_compare,
     workbook,

@@ -121,6 +121,17 @@ def scenario_with_bands(
     scenario has no e_x in it, so it gets no bands either.
     """
     ds = stage.run(settings, balls, bats, e_x=None if ex is None else ex.value)
+    return with_bands(ds, settings, balls, bats, ex)
+
+
+def with_bands(
+    ds: xr.Dataset,
+    settings: stage.ImplicationsSettings,
+    balls: dict[str, Ball],
+    bats: dict[str, Bat],
+    ex: DatasetEx | None = None,
+) -> xr.Dataset:
+    """Return a scenario's Dataset (run at ``ex``'s e_x) with its case attributes and, with ``ex``, its bands."""
     ds.attrs.update(case_attrs(settings.scenario))
     if ex is None:
         return ds

@@ -1,16 +1,11 @@
-from ballbat.pipeline.config import scenario_tables as _scenario_tables
-
-
-def scenario_tables(wildcards):
-    """The property tables of a scenario: its e_x_from_dataset dataset's where they hold its bat (ball), else tables."""
-    return _scenario_tables(config, get_scenario(wildcards))
+from ballbat.pipeline.config import scenario_tables
 
 
 rule implications:
     """Collide a pitched ball with a bat and fly it, or fly given launch conditions (Sec. V.B)."""
     input:
         unpack(get_scenario_fit),
-        unpack(scenario_tables),
+        unpack(lambda w: scenario_tables(config, get_scenario(w))),
         code=code("implications.py"),
     output:
         scenario="results/implications/{scenario}.nc",
@@ -27,7 +22,7 @@ rule implications:
     params:
         scenario=get_scenario,
         air=config["implications"]["air"],
-        sha256=lambda w: file_hashes(scenario_tables(w)),
+        sha256=lambda w: file_hashes(scenario_tables(config, get_scenario(w))),
     script:
         "../scripts/implications.py"
 
