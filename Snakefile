@@ -19,6 +19,7 @@ include: "workflow/rules/reconstruct.smk"
 include: "workflow/rules/fit_ex.smk"
 include: "workflow/rules/stronge.smk"
 include: "workflow/rules/compare.smk"
+include: "workflow/rules/league.smk"
 include: "workflow/rules/implications.smk"
 include: "workflow/rules/plots.smk"
 include: "workflow/rules/workbook.smk"
@@ -30,6 +31,9 @@ include: "workflow/rules/report.smk"
 localrules:
     all,
     compare,
+    league,
+    plot_league,
+    league_workbook,
     comparison_html,
     implications_compare,
     workbook,
@@ -71,4 +75,5 @@ rule all:
     default_target: True
     input:
         final_targets(),
+        LEAGUE_TARGETS,
         "results/report/front.rst",

@@ -19,9 +19,9 @@ from __future__ import annotations
 import argparse
 import time
 
+from ballbat import study_batch
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat import study_batch
 from ballbat.studies import StudySettings, combine, coverage, population_truth
 
 QUANTITIES = ("e_x", "e_x_pooled", "e_y_implied")

@@ -25,10 +25,9 @@ from unittest import mock
 
 import numpy as np
 
-from ballbat import chain, fitting, studies
+from ballbat import chain, fitting, studies, study_batch
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat import study_batch
 
 #: name -> (replicates, [(sweep parameter, value), ...])
 SETUPS = {

@@ -17,10 +17,9 @@ import sys
 import time
 import traceback
 
-from ballbat import studies
+from ballbat import studies, study_batch
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat import study_batch
 from ballbat.stronge import analysis, fit, model
 
 CALLS: collections.Counter[str] = collections.Counter()

@@ -21,10 +21,9 @@ import sys
 import time
 from unittest import mock
 
-from ballbat import fitting, linefit, studies
+from ballbat import fitting, linefit, studies, study_batch
 from ballbat.pipeline.config import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat import study_batch
 
 
 def _cameras(ds: dict, swing: float, spin: float) -> dict:

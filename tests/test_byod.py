@@ -101,13 +101,13 @@ def _restoring(path, new_text):
 
 def _one_dataset(wd, name):
     """The rules of the planned jobs, all of dataset ``name`` (or of what follows every dataset:
-    the scenarios that use its fits, the report's front page): no other dataset's job is planned.
+    the scenarios that use its fits, the report's front page, the bats league table): no other
+    dataset's job is planned.
     """
     logs = planned_logs(wd)
     assert logs, "nothing planned"
-    others = {
-        log for log in logs if not log.startswith((f"results/{name}/", "results/implications/", "results/report/"))
-    }
+    follows_all = (f"results/{name}/", "results/implications/", "results/report/", "results/logs/")
+    others = {log for log in logs if not log.startswith(follows_all)}
     assert not others, others
     return {rule for log, rule in logs.items() if log.startswith(f"results/{name}/")}
 

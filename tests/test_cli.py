@@ -54,6 +54,9 @@ COMMANDS = {
     "track-video": "track high-speed clips into ballbat's long tracks CSV",
     "summary": "a dataset's headline numbers",
     "bat": "a lab's bat measurements (ASTM F2398) as a bat-table row",
+    "compare": "the bats league table of results folders: e_x per bat, pairwise tests, equivalence",
+    "hit": "a pitch and a swing into a batted ball and its carry, with bands from e_x",
+    "design": "impacts per bat to tell two bats apart, from a pilot dataset's measured scatter",
 }
 
 
@@ -65,7 +68,10 @@ def test_entry_point_is_installed():
     out = ballbat_process("--help")
     assert out.returncode == 0, out.stderr
     lines = out.stdout.splitlines()
-    assert lines[0] == "usage: ballbat [-h] [--version] {check,fly,import-tracks,track-video,summary,bat} ..."
+    assert (
+        lines[0]
+        == "usage: ballbat [-h] [--version] {check,fly,import-tracks,track-video,summary,bat,compare,hit,design} ..."
+    )
     listed = dict(line.split(None, 1) for line in lines if line.startswith("    ") and not line.startswith("     "))
     assert listed == COMMANDS  # every command, each with its one-line help
     out = ballbat_process("fly", "--speed", "fast", "--angle", "20")
@@ -109,6 +115,10 @@ EXAMPLE_OUTPUT = {
     # a results folder exists only after a run: what is printed depends on that run
     "ballbat summary results/synthetic": "synthetic: 108 impacts,",
     "ballbat summary results/maple": "maple: ",
+    "ballbat hit --pitch-speed 85 --bat-speed 73 --bat wood --e-x 0.4 --D 0.5": "carry         381.9 ft",
+    "ballbat design results/synthetic --delta 0.02": "baseball, pooled over 3 bat(s): ",
+    "ballbat compare results/": "League table (e_x per bat; reference bats: ",
+    "ballbat compare results/ --reference-bat wood --margin 0.02 --alpha 0.05": "TOST margin +-0.02, alpha 0.05",
 }
 
 

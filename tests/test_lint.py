@@ -14,7 +14,7 @@ import yaml
 import ballbat
 
 #: The plotting layer: the only modules of the package that may import matplotlib (issue 20).
-PLOTTING_LAYER = {"ballbat.plotting", "ballbat.plotting_tracks"}
+PLOTTING_LAYER = {"ballbat.plotting", "ballbat.plotting_tracks", "ballbat.plotting_league"}
 
 
 def _imported_top_packages(source: str) -> set[str]:

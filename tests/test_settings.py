@@ -25,6 +25,7 @@ import pytest
 import ballbat
 from ballbat import studies
 from ballbat.chain import DatasetSettings
+from ballbat.league import LeagueSettings
 from ballbat.pipeline.config import block_schema, checked_block, packaged_schema, validate_config
 from ballbat.properties import InputError
 from ballbat.stages.fit_ex import FitExSettings
@@ -57,6 +58,7 @@ _mm = lambda v: float(v) * 1e-3  # noqa: E731
 #: the block) and the conversion from the config's units. A field not named here has no key of
 #: its own in the block (a nested dataclass, a required key, the study's sweep).
 SETTINGS = {
+    LeagueSettings: ("league", {}),  # every field required: the schema gives the defaults
     Camera: (
         "render_camera",
         {"fps": (("fps",), _same), "m_per_px": (("m_per_px",), _same), "mirror": (("mirror",), _same)}

@@ -91,8 +91,12 @@ def test_implications_outputs(run_dir):
     imp = run_dir / "results" / "implications"
     paper = xr.open_dataset(imp / "paper.nc")
     fit = xr.open_dataset(run_dir / "results" / "small" / "fit_ex.nc")
-    # e_x taken from the dataset's pooled baseball fit, recorded in the file and its inputs
-    assert paper.attrs["e_x"] == pytest.approx(float(fit.e_x_pooled.sel(ball="baseball")), rel=1e-12)
+    # e_x taken from the dataset's fit of the scenario's bat (wood) with its ball (issue 37: the bat's own
+    # e_x, no longer the pooled one), recorded in the file and its inputs, with its bands
+    assert paper.attrs["e_x"] == pytest.approx(float(fit.e_x.sel(ball="baseball", bat="wood")), rel=1e-12)
+    assert paper.attrs["e_x_source"] == "bat e_x of dataset small"
+    assert paper.attrs["e_x_stat"] == pytest.approx(float(fit.e_x_err.sel(ball="baseball", bat="wood")), rel=1e-12)
+    assert (paper.carry_low95 <= paper.carry_low68).all() and (paper.carry_high68 <= paper.carry_high95).all()
     assert any(r["name"] == "fit" for r in json.loads(paper.attrs["provenance_inputs"]))
     assert paper.sizes["case"] == 26 and paper.D.attrs["units"] == "m"
     assert set(np.unique(paper.exceeds_mu.values)) <= {0, 1}
@@ -107,7 +111,7 @@ def test_implications_outputs(run_dir):
 #: Two datasets (small and maple) draw the paper's figures; the scenarios draw Fig. 11 (paper) and
 #: the launch figure (flyballs); small's tracks have their QA figures.
 DATASET_PLOTS = {f"plot_fig{n}": 2 for n in (3, 4, 5, 6, 9, 10)}
-ALL_PLOTS = {**DATASET_PLOTS, "plot_fig11": 1, "plot_launch": 1, "tracks_qa": 1}
+ALL_PLOTS = {**DATASET_PLOTS, "plot_fig11": 1, "plot_launch": 1, "tracks_qa": 1, "plot_league": 1}
 #: The report's front page follows every product of the run (its warnings are every job's).
 FRONT = {"report_front": 1}
 #: What follows a fit of both datasets: comparisons (HTML: both datasets' and the scenarios'),
@@ -120,6 +124,9 @@ AFTER_FIT = {
     "implications_compare": 1,
     "implications_workbook": 1,
     "plot_fig11": 1,
+    "league": 1,  # the bats league table over both datasets (issue 37), its forest plot and workbook
+    "plot_league": 1,
+    "league_workbook": 1,
 }
 #: What follows a new reduction of both datasets (small's tracks, maple's ingest) up to the fits.
 REDUCED = {"reduce": 1, "tracks_qa": 1, "ingest": 1, "normalize": 2, "reconstruct": 2, "fit_ex": 2, "fit_stronge": 2}
@@ -168,7 +175,12 @@ def test_code_edit_reruns_only_dependents(run_dir):
         "comparison_html": 1,
         "implications_workbook": 1,
     }
-    assert _jobs_after_edit(run_dir, pkg / "workbook.py") == {"workbook": 2, "implications_workbook": 1, **FRONT}
+    assert _jobs_after_edit(run_dir, pkg / "workbook.py") == {
+        "workbook": 2,
+        "implications_workbook": 1,
+        "league_workbook": 1,
+        **FRONT,
+    }
     assert planned_jobs(run_dir) == {}  # restoring the text restores the state
     (run_dir / "README.md").write_text("an unrelated edit\n")
     assert planned_jobs(run_dir) == {}
@@ -349,7 +361,10 @@ def test_report_builds(run_dir):
     for d in ("small", "maple", "implications"):  # the config's (not the tool files' datasets of tools.yaml)
         for pattern in ("figures/*.png", "paper_comparison.html", "results.xlsx"):
             products += [str(p.relative_to(run_dir)) for p in run_dir.glob(f"results/{d}/{pattern}")]
-    assert len(products) == 9 + 7 + 3 + 3 + 3  # small 9, maple 7, implications 3 figures; a table and a workbook each
+    products.append("results/figures/league_forest.png")  # the league table's forest plot (issue 37)
+    assert (
+        len(products) == 9 + 7 + 3 + 3 + 3 + 1
+    )  # small 9, maple 7, implications 3 figures; a table and a workbook each
     assert sorted(results) == sorted(products)
     for path in products:
         head, data = results[path]["data_uri"].split(",", 1)

@@ -5,7 +5,10 @@ rule does (the same function, :func:`ballbat.stages.ingest.run`); ``ballbat fly`
 balls with Nathan's trajectory model (:func:`ballbat.flight.fly`), one from options or many
 from a CSV file; ``ballbat summary results/{dataset}`` prints a dataset's headline numbers; ``ballbat import-tracks``
 reads Tracker or Kinovea files into the long tracks CSV (:mod:`ballbat.tracks.formats`); ``ballbat
-bat`` turns a lab's bat measurements into a bat-table row (:mod:`ballbat.batcli`).
+bat`` turns a lab's bat measurements into a bat-table row (:mod:`ballbat.batcli`); ``ballbat compare
+FOLDER...`` prints the bats league table of results folders (:mod:`ballbat.league_cli`); ``ballbat hit``
+turns a pitch and a swing into a batted ball with bands from a dataset's e_x (:mod:`ballbat.hit_cli`);
+``ballbat design`` gives the impacts per bat a lab needs from a pilot dataset (:mod:`ballbat.design_cli`).
 Defaults (air, spin decay, integrator, property tables) are the config schema's, the one
 place the workflow's defaults live. Errors are one line naming the bad argument (exit 2);
 ``check`` exits 1 when the file is not usable.
@@ -27,7 +30,7 @@ import sys
 from pathlib import Path
 from typing import TYPE_CHECKING, NoReturn
 
-from . import __version__
+from . import __version__, design_cli, hit_cli, league_cli
 from .usage import UsageError
 from .video import cli as video_cli
 from .writer import OutputFailed, OutputRefused
@@ -70,6 +73,9 @@ measured value's uncertainty does to e_x; exits 1 when the values fail a bat row
   ballbat summary results/maple""",
 }
 EXAMPLES["track-video"] = video_cli.EXAMPLE
+EXAMPLES["compare"] = league_cli.EXAMPLE
+EXAMPLES["hit"] = hit_cli.EXAMPLE
+EXAMPLES["design"] = design_cli.EXAMPLE
 
 
 class _Parser(argparse.ArgumentParser):
@@ -788,6 +794,7 @@ def parser() -> argparse.ArgumentParser:
     p.add_argument("folder", help="a results folder, e.g. results/synthetic")
     p.set_defaults(func=cmd_summary)
     _add_bat(sub, Path(d["tables"]["balls"]))
+    _add_lab_commands(sub, d["tables"])
     return top
 
 
@@ -796,6 +803,13 @@ def _add_bat(sub: argparse._SubParsersAction, balls: Path) -> None:
     from .batcli import register
 
     register(sub, _finite, balls, EXAMPLES["bat"])
+
+
+def _add_lab_commands(sub: argparse._SubParsersAction, tables: dict) -> None:
+    """Add a lab's season commands (issue 37): ``compare``, ``hit`` and ``design``."""
+    league_cli.register(sub, _finite)
+    hit_cli.register(sub, _finite, tables)
+    design_cli.register(sub, _finite)
 
 
 def main(argv: Sequence[str] | None = None) -> int:

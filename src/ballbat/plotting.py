@@ -479,6 +479,7 @@ def fig11a_exit_vs_D(scenario: xr.Dataset) -> Figure:
     l2 = right.plot(D, from_si(scenario["backspin"].values, "rpm"), "--", color="#c0392b", lw=1.8, label="backspin")
     right.axhline(0, color="0.6", lw=0.6)
     handles = l1 + l2
+    handles += _e_x_bands(ax, right, D, scenario)
     if "exceeds_mu" in scenario and np.any(scenario["exceeds_mu"].values == 1):
         bad = scenario["exceeds_mu"].values == 1
         ax.fill_between(D, 0, 1, where=bad, transform=ax.get_xaxis_transform(), color="0.85", step="mid", lw=0)
@@ -497,6 +498,17 @@ def fig11a_exit_vs_D(scenario: xr.Dataset) -> Figure:
     ax.legend(handles=handles, fontsize=7, frameon=False, loc="center left")
     ax.set_title(f"Fig. 11a: {scenario.attrs.get('ball', '')} on the {scenario.attrs.get('bat', '')} bat", fontsize=10)
     return fig
+
+
+def _e_x_bands(ax, right, D, scenario: xr.Dataset) -> list:
+    """Shade exit speed's and backspin's 68 % and 95 % bands from e_x's uncertainty, where the file has them."""
+    if "exit_speed_low68" not in scenario:
+        return []
+    for axis, q, unit, color in ((ax, "exit_speed", "mph", "#1f3b73"), (right, "backspin", "rpm", "#c0392b")):
+        for tag, alpha in (("95", 0.12), ("68", 0.25)):
+            lo, hi = (from_si(scenario[f"{q}_{s}{tag}"].values, unit) for s in ("low", "high"))
+            axis.fill_between(D, lo, hi, color=color, alpha=alpha, lw=0)
+    return [Rectangle((0, 0), 1, 1, color="#1f3b73", alpha=0.3, label="68 % / 95 % bands from e_x")]
 
 
 def _pick_offsets(D_in, targets=(0.0, 0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 2.0)):
@@ -748,6 +760,15 @@ def design_figure(des: xr.Dataset) -> Figure:
         s = des["sigma_e_x"].values[:, j]
         ax1.errorbar(x, s, yerr=des["sigma_e_x_err"].values[:, j], label=f"{ball}, {bat}", **kw)
         ax2.plot(x, des["impacts_required"].values[:, j], **kw)
+        if "impacts_required_answer" in des:  # one answer over the sweep, with its interval (ballbat.pilot)
+            ax2.axhspan(
+                des["impacts_required_answer_low"].values[j],
+                des["impacts_required_answer_high"].values[j],
+                color=kw.get("color", "0.5"),
+                alpha=0.12,
+                lw=0,
+            )
+            ax2.axhline(des["impacts_required_answer"].values[j], color=kw.get("color", "0.5"), lw=1.2, ls="--")
     if param == "impacts_per_bat":
         ax1.set_xscale("log")
         ax1.set_yscale("log")

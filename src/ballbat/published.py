@@ -87,6 +87,17 @@ PUBLISHED_IMPLICATIONS: tuple[Published, ...] = (
     Published("D_at_exit_speed_max", _BASE, "wood", 0.0, None, "in", "Sec. V.B: exit speed peaks at D ~ 0, Fig. 11a"),
 )
 
+#: Sec. V.B's case, the one PUBLISHED_IMPLICATIONS describe: an 85 mph fastball descending at 6 deg with
+#: 2000 rpm backspin, a 73 mph swing at 6 deg attack, a baseball. A caption compares with the paper only here.
+PAPER_IMPLICATIONS_CASE = {
+    "ball": "baseball",
+    "pitch_mph": 85.0,
+    "pitch_descent_deg": 6.0,
+    "pitch_backspin_rpm": 2000.0,
+    "bat_mph": 73.0,
+    "attack_deg": 6.0,
+}
+
 #: Sec. V.A: the fixed normal COR and friction coefficient with which the paper fitted eta^2
 #: (4.75 baseball, 6.30 softball) and drew Figs. 9-10 ("e_y = mu = 0.5 was assumed").
 STRONGE_E_Y = 0.5

@@ -212,25 +212,56 @@ def stick_period(t: ArrayLike, stick: ArrayLike) -> tuple[float | None, float | 
     return float(t[i0]), float(t[i1])
 
 
+def _case_note(scenario: xr.Dataset) -> str:
+    """Return a note on a D sweep that is not Sec. V.B's case (empty for the paper's case)."""
+    a = scenario.attrs
+    if "pitch_mph" not in a:
+        return "The pitch and swing are not recorded: the paper's Sec. V.B numbers are not quoted."
+    case = f"{_f(a['pitch_mph'], '.0f')} mph pitch, {_f(a['bat_mph'], '.0f')} mph swing"
+    if int(a.get("paper_case", 0)):
+        return ""
+    return f"Not the paper's case ({case}; Sec. V.B: 85 mph pitch, 73 mph swing): its numbers are not compared."
+
+
+def _band_text(scenario: xr.Dataset, q: str, i: int, unit: str, fmt: str) -> str:
+    if f"{q}_low68" not in scenario:
+        return ""
+    v = {t: from_si(scenario[f"{q}_{t}"].values[i], unit) for t in ("low68", "high68", "low95", "high95")}
+    return (
+        f" (68 %: {_f(v['low68'], fmt)} to {_f(v['high68'], fmt)}, 95 %: {_f(v['low95'], fmt)} to"
+        f" {_f(v['high95'], fmt)} {unit} from e_x's uncertainty)"
+    )
+
+
 def fig11_numbers(scenario: xr.Dataset) -> str:
-    """Exit speed, spin and carry of a D sweep (Fig. 11, Sec. V.B)."""
+    """Exit speed, spin and carry of a D sweep (Fig. 11, Sec. V.B); the paper's words only for its own case."""
     D = from_si(scenario["D"].values, "in")
     speed = from_si(scenario["exit_speed"].values, "mph")
     carry = from_si(scenario["carry"].values, "ft")
     spin = from_si(scenario["backspin"].values, "rpm")
     i_v, i_c, i_0 = int(np.nanargmax(speed)), int(np.nanargmax(carry)), int(np.argmin(np.abs(D)))
+    note = _case_note(scenario)
+    paper = not note
     lines = [
         f"Ball {scenario.attrs.get('ball', '?')}, bat {scenario.attrs.get('bat', '?')},"
         f" e_x = {_f(scenario.attrs.get('e_x', np.nan))}:",
         "",
-        f"- Largest exit speed {_f(speed[i_v], '.1f')} mph at D = {_f(D[i_v], '.2f')} in (paper: peaks near D = 0).",
+        f"- Largest exit speed {_f(speed[i_v], '.1f')} mph"
+        + _band_text(scenario, "exit_speed", i_v, "mph", ".1f")
+        + f" at D = {_f(D[i_v], '.2f')} in"
+        + (" (paper: peaks near D = 0)." if paper else "."),
         f"- Spin at D = {_f(D[i_0], '.2f')} in: {_f(spin[i_0], '.0f')} rpm (negative: topspin).",
-        f"- Longest carry {_f(carry[i_c], '.0f')} ft at D = {_f(D[i_c], '.2f')} in,"
-        f" launch angle {_f(np.degrees(scenario['launch_angle'].values[i_c]), '.1f')}° (paper: about 400 ft).",
+        f"- Longest carry {_f(carry[i_c], '.0f')} ft"
+        + _band_text(scenario, "carry", i_c, "ft", ".0f")
+        + f" at D = {_f(D[i_c], '.2f')} in,"
+        f" launch angle {_f(np.degrees(scenario['launch_angle'].values[i_c]), '.1f')}°"
+        + (" (paper: about 400 ft)." if paper else "."),
     ]
     if "exceeds_mu" in scenario:
         n = int(np.count_nonzero(scenario["exceeds_mu"].values == 1))
         lines.append(f"- {n} of {scenario.sizes['case']} offsets would need more friction than μ allows (shaded).")
+    if note:
+        lines += ["", note]
     return "\n".join(lines)
 
 

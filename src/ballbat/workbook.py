@@ -167,17 +167,34 @@ STRONGE_COLUMNS = (
     Column("psi_gross_slip_boundary", "deg"),
 )
 
-#: A batted-ball scenario's cases (implications/{scenario}.nc).
+#: A batted-ball scenario's cases (implications/{scenario}.nc); the 68 % and 95 % bands from e_x's
+#: uncertainty where the scenario takes e_x from a dataset (:mod:`ballbat.scenario_bands`).
 SCENARIO_COLUMNS = (
     Column("case", "1"),
     Column("D", "in"),
     Column("psi", "deg"),
     Column("exit_speed", "mph"),
+    Column("exit_speed_low68", "mph"),
+    Column("exit_speed_high68", "mph"),
+    Column("exit_speed_low95", "mph"),
+    Column("exit_speed_high95", "mph"),
     Column("launch_angle", "deg"),
+    Column("launch_angle_low68", "deg"),
+    Column("launch_angle_high68", "deg"),
+    Column("launch_angle_low95", "deg"),
+    Column("launch_angle_high95", "deg"),
     Column("spray_angle", "deg"),
     Column("backspin", "rpm"),
+    Column("backspin_low68", "rpm"),
+    Column("backspin_high68", "rpm"),
+    Column("backspin_low95", "rpm"),
+    Column("backspin_high95", "rpm"),
     Column("sidespin", "rpm"),
     Column("carry", "ft"),
+    Column("carry_low68", "ft"),
+    Column("carry_high68", "ft"),
+    Column("carry_low95", "ft"),
+    Column("carry_high95", "ft"),
     Column("apex", "ft"),
     Column("hang_time", "s"),
     Column("landing_x", "ft"),
@@ -507,3 +524,86 @@ def implications_workbook(
     _provenance_sheet(wb, {f"{name}.nc": ds for name, ds in sorted(scenarios.items())})
     first = scenarios[sorted(scenarios)[0]].attrs if scenarios else {}
     _write(wb, path, document_time(first), properties)
+
+
+#: The league table's sheets (results/league.nc; :mod:`ballbat.league`): sheet -> (dimension, columns).
+LEAGUE_SHEETS = {
+    "league": (
+        "row",
+        tuple(
+            Column(v, "1")
+            for v in (
+                "ball",
+                "bat",
+                "e_x",
+                "e_x_stat",
+                "e_x_syst",
+                "e_x_err_total",
+                "n",
+                "n_sessions",
+                "sessions",
+                "consistency_chi2",
+                "consistency_dof",
+                "consistency_p",
+                "tost_difference",
+                "tost_se",
+                "tost_dof",
+                "tost_p",
+                "tost_equivalent",
+            )
+        ),
+    ),
+    "pairs": (
+        "pair",
+        tuple(
+            Column(v, "1")
+            for v in (
+                "pair_ball",
+                "pair_bat_a",
+                "pair_bat_b",
+                "pair_difference",
+                "pair_stat",
+                "pair_syst",
+                "pair_se",
+                "pair_dof",
+                "pair_t",
+                "pair_p",
+                "pair_p_holm",
+                "pair_differs",
+            )
+        ),
+    ),
+    "sessions": (
+        "entry",
+        tuple(
+            Column(v, "1")
+            for v in (
+                "entry_ball",
+                "entry_bat",
+                "entry_session",
+                "entry_dataset",
+                "entry_folder",
+                "entry_e_x",
+                "entry_e_x_stat",
+                "entry_e_x_syst",
+                "entry_e_x_scatter",
+                "entry_n",
+                "entry_status",
+            )
+        ),
+    ),
+}
+
+
+def league_workbook(
+    path: str | os.PathLike[str], league: xr.Dataset, properties: Mapping[str, str] | None = None
+) -> None:
+    """Write the bats league table's workbook: the table, the pairs, the sessions' entries, the provenance."""
+    from openpyxl import Workbook
+
+    wb = Workbook()
+    wb.remove(wb.active)
+    for title, (dim, columns) in LEAGUE_SHEETS.items():
+        _table_sheet(wb, title, league, columns, dim)
+    _provenance_sheet(wb, {"league.nc": league})
+    _write(wb, path, document_time(league.attrs), properties)

@@ -15,7 +15,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .pipeline.codedeps import module_files
-from .pipeline.config import BYTES_PER_CASE, STUDY_BYTES_PER_REPLICATE, impact_bytes, study_impacts
+from .pipeline.config import BYTES_PER_CASE, STUDY_BYTES_PER_REPLICATE, impact_bytes, scenario_tables, study_impacts
 from .pipeline.provenance import sha256_file
 from .sweeps import renders
 from .tracks.data import camera_block, tool_file_extensions
@@ -211,6 +211,14 @@ class WorkflowInputs:
     def get_scenario(self, wildcards: Namespace) -> dict:
         """Return the scenario's config block."""
         return self.config["implications"]["scenarios"][wildcards.scenario]
+
+    def get_scenario_tables(self, wildcards: Namespace) -> dict[str, str]:
+        """Return the scenario's property tables: its dataset's where they hold its bat and ball, else ``tables``."""
+        return scenario_tables(self.config, self.get_scenario(wildcards))
+
+    def scenario_hashes(self, wildcards: Namespace) -> dict[str, str]:
+        """Return the sha256 of the scenario's property tables (:func:`file_hashes`)."""
+        return file_hashes(self.get_scenario_tables(wildcards))
 
     def get_scenario_fit(self, wildcards: Namespace) -> dict:
         """Return fit_ex.nc of the dataset whose e_x the scenario uses (none by default)."""

@@ -2,8 +2,7 @@ rule implications:
     """Collide a pitched ball with a bat and fly it, or fly given launch conditions (Sec. V.B)."""
     input:
         unpack(get_scenario_fit),
-        balls=config["tables"]["balls"],
-        bats=config["tables"]["bats"],
+        unpack(get_scenario_tables),
         code=code("implications.py"),
     output:
         scenario="results/implications/{scenario}.nc",
@@ -20,7 +19,7 @@ rule implications:
     params:
         scenario=get_scenario,
         air=config["implications"]["air"],
-        sha256=tables_hashes,
+        sha256=scenario_hashes,
     script:
         "../scripts/implications.py"
 

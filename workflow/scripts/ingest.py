@@ -6,9 +6,7 @@ from ballbat.stages import ingest
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     files = snakemake.params.files  # as the config names them: a missing one is reported by the ingest
-    ds = ingest.run(
-        ingest.IngestSettings(), files["impacts"], balls=files["balls"], bats=files["bats"]
-    )
+    ds = ingest.run(ingest.IngestSettings(), files["impacts"], balls=files["balls"], bats=files["bats"])
     for text in ingest.warnings(ds):
         log.warning(text)
     log_exclusions(log, ingest.excluded_listing(ds), ds.sizes["impact"])

@@ -1,9 +1,9 @@
 """Rule study_batch: adapter around ballbat.study_batch.run."""
 
+from ballbat import study_batch
 from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
-from ballbat import study_batch
 from ballbat.studies import StudySettings
 
 with logged(snakemake.log[0], snakemake.rule) as log:

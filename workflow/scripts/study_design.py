@@ -1,5 +1,6 @@
 """Rule study_design: adapter around ballbat.studies.design."""
 
+from ballbat.pilot import with_sweep_answer
 from ballbat.pipeline.ncio import atomic_write_text, read_dataset, write_job_output
 from ballbat.pipeline.provenance import job_provenance, png_text
 from ballbat.pipeline.runlog import logged
@@ -10,7 +11,7 @@ with logged(snakemake.log[0], snakemake.rule):
     study = snakemake.wildcards.study
     settings = StudySettings.from_block(snakemake.params.study)
     cov = read_dataset(snakemake.input.coverage)
-    des = design(cov, settings)
+    des = with_sweep_answer(design(cov, settings))  # one answer over a sweep of impacts per bat (issue 37)
     write_job_output(des, snakemake, "design", f"Study {study}: spread of e_x and impacts per bat needed")
     atomic_write_text(snakemake.output.csv, design_csv(des))
     save_figure(design_figure(des), snakemake.output.png, png_text(*job_provenance(snakemake)))

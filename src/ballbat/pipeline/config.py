@@ -517,6 +517,7 @@ SCHEMA_BLOCKS = {
     "normalize": ("properties", "normalize"),
     "analysis": ("properties", "analysis"),
     "implications": ("properties", "implications"),
+    "league": ("properties", "league"),
 }
 
 
@@ -606,7 +607,8 @@ def _table_names(path: str, loader) -> set[str] | None:
 def scenario_problems(config: dict) -> list[str]:
     """Check each scenario of a validated config against the files it needs, before any job runs.
 
-    Its ball and (sweep) bat must be in the property tables of config ``tables``, and the dataset of
+    Its ball and (sweep) bat must be in the property tables of config ``tables`` (of its ``e_x_from_dataset``
+    dataset when that has its own), and the dataset of
     ``e_x_from_dataset`` must exist and have impacts of its ball. Each problem names the scenario's key.
     """
     from ..properties import load_balls, load_bats
@@ -614,20 +616,38 @@ def scenario_problems(config: dict) -> list[str]:
     scenarios = (config.get("implications") or {}).get("scenarios") or {}
     if not scenarios:
         return []
-    tables = config["tables"]
-    known = {"ball": _table_names(tables["balls"], load_balls), "bat": _table_names(tables["bats"], load_bats)}
     problems = []
     for name, sc in scenarios.items():
         where = f"implications.scenarios.{name}"
+        tables = scenario_tables(config, sc)
         for key, table in (("ball", "balls"), ("bat", "bats")):
-            names = known[key]
+            names = _table_names(tables[table], load_bats if key == "bat" else load_balls)
             if key in sc and names is not None and sc[key] not in names:
                 problems.append(
                     f"{where}.{key}: {sc[key]!r} is not in the {key} table {tables[table]} "
-                    f"({', '.join(sorted(names))}); a misspelt name?"
+                    f"({', '.join(sorted(names))}); a misspelt name? A lab's own {key}: add it to "
+                    f"tables.{table}, or name its dataset in e_x_from_dataset (its {table} table is used)"
                 )
         problems += _e_x_source_problems(config, where, sc)
     return problems
+
+
+def scenario_tables(config: dict, scenario: dict) -> dict[str, str]:
+    """Return a scenario's property tables (``balls``, ``bats``): its dataset's where they hold its ball (bat).
+
+    For each, the ``e_x_from_dataset`` dataset's own table when that holds the scenario's ball
+    (bat), else the config's ``tables``. A lab's own bat needs no extra config: a bat only its
+    dataset's table knows is found there.
+    """
+    from ..properties import load_balls, load_bats
+
+    block = (config.get("datasets") or {}).get(scenario.get("e_x_from_dataset")) or {}
+    out = {}
+    for key, table, loader in (("ball", "balls", load_balls), ("bat", "bats", load_bats)):
+        own = block.get(table)
+        names = _table_names(own, loader) if own else None
+        out[table] = own if names is not None and scenario.get(key) in names else config["tables"][table]
+    return out
 
 
 def _e_x_source_problems(config: dict, where: str, scenario: dict) -> list[str]:
