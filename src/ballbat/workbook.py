@@ -474,9 +474,9 @@ def _systematics_sheet(wb: object, fit: xr.Dataset, stronge: xr.Dataset) -> None
             for idx in np.ndindex(per.shape[1:]):
                 where = {d: str(ds[d].values[i]) for d, i in zip(per.dims[1:], idx, strict=True)}
                 for k, src in enumerate(sources):
-                    if not rel[src] > 0 or not np.isfinite(per.values[(k, *idx)]):
-                        continue
-                    row = [q, where.get("ball", ""), where.get("bat", ""), src, rel[src]]
+                    if rel[src] == 0 or not np.isfinite(per.values[(k, *idx)]):
+                        continue  # (a NaN relative sigma, an absolute one such as angle_offset, is kept)
+                    row = [q, where.get("ball", ""), where.get("bat", ""), src, _cell(rel[src], "1")]
                     row += [_cell(per.values[(k, *idx)], unit), _unit_label(unit)]
                     _format_row(ws, row, ["", "", "", "", "1", unit, ""], [([5], [5])])
 

@@ -7,7 +7,10 @@ from ballbat.stages import ingest
 with logged(snakemake.log[0], snakemake.rule) as log:
     files = snakemake.params.files  # as the config names them: a missing one is reported by the ingest
     ds = ingest.run(
-        ingest.IngestSettings.from_config(snakemake.config), files["impacts"], balls=files["balls"], bats=files["bats"]
+        ingest.IngestSettings.from_config(snakemake.config, snakemake.wildcards.dataset),
+        files["impacts"],
+        balls=files["balls"],
+        bats=files["bats"],
     )
     for text in ingest.warnings(ds):
         log.warning(text)
@@ -17,5 +20,8 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         snakemake,
         "impacts",
         f"Measured ball-bat impacts of dataset {snakemake.wildcards.dataset}, checked and in SI",
-        config={"sha256": snakemake.params.sha256},
+        config={
+            "sha256": snakemake.params.sha256,
+            **({"calibration": cal} if (cal := snakemake.params.calibration) else {}),
+        },
     )
