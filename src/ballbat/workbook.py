@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .compare import systematic_var, total_uncertainty
+from .compare import NO_SYSTEMATIC_NOTE, systematic_var, total_uncertainty
 from .pipeline.atomic import atomic_target
 from .units import from_si
 
@@ -457,11 +457,14 @@ def _systematics_sheet(wb: object, fit: xr.Dataset, stronge: xr.Dataset) -> None
     """Add the ``systematics`` sheet: each quantity's systematic from each calibration source (tracked data).
 
     One row per quantity, ball (and bat), and source with a stated uncertainty, with its
-    relative standard uncertainty; the sheet has its header rows only when the dataset has none.
+    relative standard uncertainty (empty for an absolute one, the angle offset); a dataset with
+    none has one row saying so (source ``none stated``, the reason in the unit column's place).
     """
     ws = wb.create_sheet("systematics")
     ws.append(["quantity", "ball", "bat", "source", "source_rel_sigma", "systematic", "unit"])
     ws.append(["", "", "", "", "", "", ""])
+    if not any("systematic" in ds.coords for ds in (fit, stronge)):  # "syst. —", and why
+        ws.append(["e_x", "", "", "none stated", None, None, NO_SYSTEMATIC_NOTE])
     for ds in (fit, stronge):
         if "systematic" not in ds.coords:
             continue
