@@ -227,3 +227,105 @@ def test_eta2_gets_the_property_systematic(tmp_path):
     per = st["eta2_syst_by_source"].sel(systematic="bat:maple:M_oz").values
     assert np.all(np.isfinite(per[np.isfinite(st["eta2"].values)])) and np.nanmax(per) > 0
     assert math.isfinite(float(np.nanmax(st["eta2_syst"].values)))
+
+
+# ---------------------------------------------------------------------------------------
+# replicate studies that draw the bat's properties (docs/studies.md)
+
+
+def _study(tmp_path):
+    import yaml
+
+    from ballbat.pipeline.config import validate_config
+    from ballbat.study_settings import StudySettings
+
+    base = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
+    over = yaml.safe_load((EX / "property_study.yaml").read_text())
+    ds = over["datasets"]["hickory_study"]
+    ds["synthetic"]["impacts"] = {"baseball": {"hickory": 40}, "softball": {"hickory": 40}}  # small and quick
+    ds["bats"] = str(EX / "property_study_bats.csv")
+    base["datasets"].update(over["datasets"])
+    base["studies"].update(over["studies"])
+    schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
+    return StudySettings.from_config(validate_config(base, schema), "properties")
+
+
+def test_drawn_properties_scatter_by_the_stated_sigma():
+    """The truth a replicate is drawn with differs from the sheet by N(0, sigma) in each measured value."""
+    from ballbat.properties import drawn_properties
+
+    bats = load_bats(EX / "property_study_bats.csv")
+    balls = load_balls(BALLS)
+    rng = np.random.default_rng(1)
+    n = 2000
+    draws = [drawn_properties(bats, balls, rng) for _ in range(n)]
+    z = np.array([[d[2][k] for k in sorted(d[2])] for d in draws])
+    assert sorted(draws[0][2]) == [
+        f"bat:hickory:{c}" for c in ("balance_in", "impact_from_tip_in", "moi_oz_in2", "weight_oz")
+    ]
+    # z is standard normal: mean 0 and sd 1 within 4 standard errors of n draws
+    assert np.all(np.abs(z.mean(axis=0)) < 4 / np.sqrt(n))
+    assert np.all(np.abs(z.std(axis=0, ddof=1) - 1) < 4 / np.sqrt(2 * n))
+    # the bat's mass is the drawn weight: (M - M_sheet) / sigma is that z exactly
+    mass = np.array([d[0]["hickory"].M for d in draws]) / OUNCE
+    assert np.allclose((mass - 32.0) / 0.1, z[:, 3], atol=1e-9)
+    # the MOI's 3 % moves I0 by 336 oz in^2 per z (I0 = I_p - M d^2), with the others' draws on top
+    i0 = np.array([d[0]["hickory"].I0 for d in draws]) / OZ_IN2
+    lab = {"length_in": 34, "weight_oz": 32, "balance_in": 23.0, "pivot_in": 6, "moi_oz_in2": 11200}
+    lab |= {"impact_from_tip_in": 6, "diameter_in": 2.6, "Iz_oz_in2": 11.0}
+    order = ("balance_in", "impact_from_tip_in", "moi_oz_in2", "weight_oz")
+    sig = {"balance_in": 0.1, "impact_from_tip_in": 0.25, "moi_oz_in2": 336.0, "weight_oz": 0.1}
+    expect = [batlab.moved_row(lab, {c: zz * sig[c] for c, zz in zip(order, row, strict=True)}, "lab") for row in z[:5]]
+    assert np.allclose(i0[:5], [e["I0_oz_in2"] for e in expect], rtol=1e-12)
+    assert np.std(i0, ddof=1) == pytest.approx(
+        np.sqrt(336.0**2 + (2 * 32 * 17 * 0.1) ** 2 + (17**2 * 0.1) ** 2), rel=0.08
+    )
+    # no stated uncertainty: nothing drawn, the tables as they are
+    plain = load_bats(ROOT / "config" / "bats.csv")
+    assert drawn_properties(plain, balls, rng)[2] == {}
+
+
+def test_study_replicate_draws_and_its_systematic_is_the_finite_difference(tmp_path):
+    """One replicate: its truth is its drawn bat's, its systematic the +-1 sigma refit's, its effect first order."""
+    from dataclasses import replace
+
+    from ballbat import studies
+
+    st = _study(tmp_path)
+    bats, balls = load_bats(EX / "property_study_bats.csv"), load_balls(BALLS)
+    dataset = st.point_dataset(0)
+    rows = {(r["quantity"], r["ball"], r["bat"]): r for r in studies.run_replicate(st, dataset, 3, balls, bats)}
+    # the same draw, by hand
+    true_balls, true_bats, z = studies.drawn_tables(st, 3, balls, bats)
+    assert true_bats["hickory"].M != bats["hickory"].M and set(z) == {
+        f"bat:hickory:{c}" for c in ("balance_in", "impact_from_tip_in", "moi_oz_in2", "weight_oz")
+    }
+    seeds = studies.replicate_seeds(st.seed, 3)
+    cs = studies.chain_settings(st, dataset, seeds)
+    src = chain.source(cs, true_balls, true_bats)
+    quiet = replace(cs, fit_ex=replace(cs.fit_ex, systematic=False))
+    # finite differences: the sheet with one value moved by +-sigma, every other as the sheet says
+    row = {"length_in": 34, "weight_oz": 32, "balance_in": 23.0, "pivot_in": 6, "moi_oz_in2": 11200}
+    row |= {"impact_from_tip_in": 6, "diameter_in": 2.6, "Iz_oz_in2": 11.0}
+    sig = {"balance_in": 0.1, "impact_from_tip_in": 0.25, "moi_oz_in2": 336.0, "weight_oz": 0.1}
+    parts, effect = [], 0.0
+    from ballbat.properties import _bat_from_paper_row
+
+    for col, s in sorted(sig.items()):
+        e = []
+        for side in (1, -1):
+            moved = {"hickory": _bat_from_paper_row(bats["hickory"], batlab.moved_row(row, {col: side * s}, "lab"))}
+            e.append(float(chain.run(quiet, src, balls, moved).fit_ex["e_x"].sel(ball="baseball", bat="hickory")))
+        parts.append(0.5 * (e[0] - e[1]))
+        effect += z[f"bat:hickory:{col}"] * parts[-1]
+    r = rows[("e_x", "baseball", "hickory")]
+    assert r["systematic"] == pytest.approx(float(np.sqrt(np.sum(np.square(parts)))), rel=1e-9)
+    assert r["systematic"] > 0.3 * r["uncertainty"]  # of the size the study is for: not negligible
+    assert r["calibration_effect"] == pytest.approx(effect, rel=1e-9)
+    # the truth: the estimator on the noise-free values with the true bat (the drawn one), near the bat's e_x
+    truth = chain.run(quiet, studies._truth_source(src), true_balls, true_bats).fit_ex
+    assert r["truth"] == pytest.approx(float(truth["e_x"].sel(ball="baseball", bat="hickory")), rel=1e-12)
+    assert r["truth"] == pytest.approx(0.455, abs=0.002)
+    # analysed with the sheet, value + effect is, to first order, the analysis with the true bat
+    with_true = float(chain.run(quiet, src, true_balls, true_bats).fit_ex["e_x"].sel(ball="baseball", bat="hickory"))
+    assert r["value"] + r["calibration_effect"] == pytest.approx(with_true, abs=0.1 * r["systematic"])

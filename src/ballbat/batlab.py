@@ -350,22 +350,27 @@ def err_problems(at: str, row: dict) -> list[str]:
     return problems
 
 
+def moved_row(row: dict, deltas: dict[str, float], convention: str) -> dict[str, float]:
+    """Return a row (``<column>_err`` ignored) with each column of ``deltas`` moved by it, in the paper's convention.
+
+    A lab row is converted again (:func:`paper_row`), so the moves carry the conversion's
+    correlations exactly (e.g. the balance point moves both I0 and b).
+    """
+    moved = {k: v for k, v in row.items() if not k.endswith(ERR)}
+    for col, delta in deltas.items():
+        moved[col] = row[col] + delta
+    return paper_row(moved) if convention == "lab" else {c: moved[c] for c in PAPER}
+
+
 def shifted_rows(row: dict, convention: str) -> list[tuple[str, float, dict, dict]]:
     """Per stated uncertainty (``<column>_err`` > 0): (column, sigma, paper row at +1 sigma, at -1 sigma).
 
-    The measured value alone is moved by one standard uncertainty and the row converted again
-    (:func:`paper_row` for a lab row), so the paper-convention shifts carry the conversion's
-    correlations exactly (e.g. the balance point moves both I0 and b).
+    The measured value alone is moved by one standard uncertainty (:func:`moved_row`).
     """
     out = []
     for col in sorted(c for c in row if c.endswith(ERR)):
         sigma, base = row[col], col.removesuffix(ERR)
-        if not sigma:
-            continue
-        sides = []
-        for side in (1.0, -1.0):
-            shifted = {k: v for k, v in row.items() if not k.endswith(ERR)}
-            shifted[base] = row[base] + side * sigma
-            sides.append(paper_row(shifted) if convention == "lab" else {c: shifted[c] for c in PAPER})
-        out.append((base, sigma, sides[0], sides[1]))
+        if sigma:
+            sides = [moved_row(row, {base: side * sigma}, convention) for side in (1.0, -1.0)]
+            out.append((base, sigma, sides[0], sides[1]))
     return out

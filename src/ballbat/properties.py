@@ -515,13 +515,55 @@ def bat_variants(bat: Bat) -> list[tuple[str, float, float, Bat, Bat]]:
     """
     if not bat.err:
         return []
-    given = json.loads(bat.given)
-    row = {c: float(v) for c, v in given.items() if c != "convention" and not c.endswith(batlab.ERR) and v != ""}
-    row.update({f"{c}{batlab.ERR}": s for c, s in json.loads(bat.err).items()})
+    row = _table_row(bat)
     return [
         (col, row[col], sigma, _bat_from_paper_row(bat, plus), _bat_from_paper_row(bat, minus))
         for col, sigma, plus, minus in batlab.shifted_rows(row, bat.convention)
     ]
+
+
+def _table_row(bat: Bat) -> dict[str, float]:
+    """Return a bat's row as its table gave it (tables' units), with its uncertainties as ``<column>_err``."""
+    given = json.loads(bat.given)
+    row = {c: float(v) for c, v in given.items() if c != "convention" and not c.endswith(batlab.ERR) and v != ""}
+    row.update({f"{c}{batlab.ERR}": s for c, s in json.loads(bat.err).items()})
+    return row
+
+
+def drawn_properties(
+    bats: dict[str, Bat], balls: dict[str, Ball], rng: np.random.Generator
+) -> tuple[dict[str, Bat], dict[str, Ball], dict[str, float]]:
+    """Return bats and balls whose measured values are drawn from their stated uncertainties (a replicate's truth).
+
+    Every stated ``<column>_err`` of every bat (then ball), in sorted order, draws z ~ N(0, 1) and
+    the column becomes value + z sigma; a lab row is converted again with all its columns moved
+    (:func:`ballbat.batlab.moved_row`). Returns the drawn tables and each source's z, by the
+    source's name (``bat:<bat>:<column>``, ``ball:<ball>:<column>``, as reconstruct names them).
+    """
+    from dataclasses import replace
+
+    z: dict[str, float] = {}
+    out_bats = dict(bats)
+    for key in sorted(bats):
+        bat = bats[key]
+        if not bat.err:
+            continue
+        row = _table_row(bat)
+        deltas = {}
+        for col, sigma in sorted(json.loads(bat.err).items()):
+            z[f"bat:{key}:{col}"] = float(rng.standard_normal())
+            deltas[col] = z[f"bat:{key}:{col}"] * sigma
+        out_bats[key] = _bat_from_paper_row(bat, batlab.moved_row(row, deltas, bat.convention))
+    out_balls = dict(balls)
+    for key in sorted(balls):
+        ball = balls[key]
+        moved = {}
+        for col, (value, sigma) in sorted(json.loads(ball.err).items()) if ball.err else ():
+            z[f"ball:{key}:{col}"] = float(rng.standard_normal())
+            field, factor = BALL_ERR_FIELDS[col]
+            moved[field] = (value + z[f"ball:{key}:{col}"] * sigma) * factor
+        out_balls[key] = replace(ball, **moved)
+    return out_bats, out_balls, z
 
 
 def bat_record(bats: dict[str, Bat]) -> str:
