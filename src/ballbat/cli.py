@@ -159,7 +159,10 @@ def cmd_check(args: argparse.Namespace) -> int:
         raise UsageError("argument --impacts: only with --kind tracks (the impact table of a tracks file)")
     try:
         ds = ingest.run(
-            ingest.IngestSettings(calibration={}), path, balls=args.balls or defaults["balls"], bats=args.bats or defaults["bats"]
+            ingest.IngestSettings(calibration={}),
+            path,
+            balls=args.balls or defaults["balls"],
+            bats=args.bats or defaults["bats"],
         )
         warnings = ingest.warnings(ds)
     except InputError as exc:
