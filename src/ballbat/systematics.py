@@ -22,9 +22,9 @@ relative; ``pivot_to_tip_err_in`` and ``pivot_to_impact_err_in`` of the rig, inc
    systematic in quadrature ``<q>_err_total``. A source whose uncertainty is 0 costs nothing
    and gives 0.
 
-The same machinery carries two more kinds of source (docs/model.md, "Property and instrument
-systematics"), each appended to the ``systematic`` dimension only where an uncertainty is stated,
-so a dataset without any keeps its sources as they were:
+The same machinery carries two more kinds of source, each appended to the ``systematic``
+dimension only where an uncertainty is stated, so a dataset without any keeps its sources as
+they were (docs/model.md, "Property and instrument systematics"):
 
 * **instrument calibrations of a measured impacts file** (:data:`INSTRUMENT_SOURCES`, config
   ``datasets.<name>.calibration``): a speed scale and a spin scale (relative) and an angle
