@@ -575,9 +575,9 @@ def _population_rows(settings: StudySettings, point: int, balls: dict[str, Ball]
     """
     ds = settings.point_dataset(point)
     ds["synthetic"]["impacts"] = settings.truth_counts(point)[1]
-    big = replace(
-        settings, seed=int(np.random.SeedSequence(settings.seed, spawn_key=(2**31 - 1, point)).generate_state(1)[0])
-    )
+    # the design's truth is the tables' bat (a drawn one's e_x is the same: drawing moves the analysis, not e_x)
+    seed = int(np.random.SeedSequence(settings.seed, spawn_key=(2**31 - 1, point)).generate_state(1)[0])
+    big = replace(settings, seed=seed, draw_properties=False)
     return run_replicate(big, ds, 0, balls, bats, check=False)
 
 
