@@ -674,7 +674,7 @@ def _systematic_lines(fit, st) -> list[str]:
             lines.append(f"{ball:<10} {var:<18} " + " ".join(f"{c:>8}" for c in cells) + f"  {unit}")
     per_source = (
         [
-            f"{src} ({float(r):g})"
+            f"{src} ({float(r):g})" if math.isfinite(r) else f"{src} (absolute: fit_ex.nc's systematic coordinate)"
             for src, r in zip(fit["systematic"].values.astype(str), fit["systematic_rel_sigma"].values, strict=True)
             if r != 0
         ]

@@ -132,6 +132,8 @@ def fig5_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     syst_var = systematic_var(fit, "e_x")
     tracked = syst_var is not None and bool(np.isfinite(fit[syst_var].values).any())
     what = "standard errors and the calibration systematic" if tracked else "standard errors"
+    if tracked and systematic_note(fit) != SYSTEMATIC_NOTE:
+        what = "standard errors and the systematic"
     lines = [f"Slopes 1 + e_x of the pooled fits through the origin ({what}):", ""]
     for ball in fit["ball"].values.astype(str):
         v = float(fit["e_x_pooled"].sel(ball=ball))
