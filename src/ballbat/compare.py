@@ -72,7 +72,7 @@ _SOURCE_KINDS = (
 
 
 def _source_kind(name: str) -> str:
-    from .systematics import INSTRUMENT_SOURCES
+    from .instruments import INSTRUMENT_SOURCES
 
     if name.startswith(("bat:", "ball:")):
         return "properties"

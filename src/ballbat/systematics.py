@@ -49,6 +49,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import xarray as xr
 
+from .instruments import INSTRUMENT_SOURCES
+
 if TYPE_CHECKING:
     from .tracks.data import Camera, Rig, Tracks
     from .tracks.reduce import ReduceOptions, Reduction
@@ -71,14 +73,6 @@ SHIFT_UNITS = {"v_bat": "m s-1", "v_ball": "m s-1", "theta": "rad", "omega": "ra
 #: Per-impact properties that reconstruct stores and a property source shifts (:mod:`ballbat.stages.reconstruct`).
 PROPERTY_SHIFTED = ("r", "m", "alpha", "R_bat", "r_x", "r_y")
 PROPERTY_UNITS = {"r": "m", "m": "kg", "alpha": "1", "R_bat": "m", "r_x": "1", "r_y": "1"}
-
-#: The instrument calibrations a measured impacts file can state (config ``datasets.<name>.calibration``):
-#: source -> (config key, what; the key's unit).
-INSTRUMENT_SOURCES = {
-    "speed_scale": ("speed_scale_pct", "scale of the bat and ball speeds (calibration.speed_scale_pct, %)"),
-    "spin_scale": ("spin_scale_pct", "scale of the spin (calibration.spin_scale_pct, %)"),
-    "angle_offset": ("angle_offset_deg", "offset of the launch angle theta (calibration.angle_offset_deg, deg)"),
-}
 
 #: Quantities of fit_ex.nc that get systematics.
 FIT_QUANTITIES = (
