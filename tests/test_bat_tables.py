@@ -124,7 +124,7 @@ def test_hickory_in_the_lab_convention_gives_e_x_within_one_standard_error(confi
     balls = load_balls(ROOT / "config" / "balls.csv")
     bats = load_bats(EXAMPLES / "hickory_bats.csv")
     ds = ingest.run(
-        ingest.IngestSettings(),
+        ingest.IngestSettings(calibration={}),
         EXAMPLES / "hickory_impacts.csv",
         ROOT / "config" / "balls.csv",
         EXAMPLES / "hickory_bats.csv",

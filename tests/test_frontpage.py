@@ -179,7 +179,9 @@ def test_front_page_renders_numbers_before_warnings():
 def test_notes_follow_the_columns():
     text = "\n".join(fp.dataset_section("lab", fit(systematic=False, truth=False), stronge()))
     assert (
-        "syst. —: none is estimated here" in text and "truth:" not in text and "not in the standard error" not in text
+        "syst. —: no calibration uncertainty stated" in text
+        and "truth:" not in text
+        and "not in the standard error" not in text
     )
 
 

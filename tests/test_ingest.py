@@ -44,7 +44,7 @@ FIT = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=Tru
 
 def ingested(path, balls=BALLS, bats=BATS):
     """The ingest stage's file of ``path`` and its warnings."""
-    ds = ingest_stage.run(ingest_stage.IngestSettings(), path, balls, bats)
+    ds = ingest_stage.run(ingest_stage.IngestSettings(calibration={}), path, balls, bats)
     return ds, ingest_stage.warnings(ds)
 
 

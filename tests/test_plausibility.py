@@ -29,7 +29,7 @@ RPM_PER_RAD_S = 2 * math.pi / 60
 
 def ingest(path, balls, bats):
     """The ingest stage's file of ``path`` and its warnings."""
-    ds = ingest_stage.run(ingest_stage.IngestSettings(), path, balls, bats)
+    ds = ingest_stage.run(ingest_stage.IngestSettings(calibration={}), path, balls, bats)
     return ds, ingest_stage.warnings(ds)
 
 

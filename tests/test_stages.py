@@ -54,7 +54,7 @@ def chain(config, balls, bats):
 
 def test_impacts_table_is_what_every_source_stage_writes(chain, balls, bats):
     """simulate.nc, ingest.nc and reduce.nc declare their measurements from the one IMPACTS table."""
-    ing = ingest.run(ingest.IngestSettings(), MAPLE, ROOT / "config" / "balls.csv", MAPLE_BATS)
+    ing = ingest.run(ingest.IngestSettings(calibration={}), MAPLE, ROOT / "config" / "balls.csv", MAPLE_BATS)
     for name, ds in (("simulate", chain["sim"]), ("ingest", ing), ("reduce", chain["red"])):
         for k in QUANTITIES:
             for var in (k, f"{k}_err"):
@@ -106,7 +106,7 @@ def test_each_stage_writes_exactly_its_table(chain, config, balls, bats):
     st = stronge.run(stronge.StrongeSettings(**{**config["stronge"], "n_time": 40}), rec)
     assert set(st.data_vars) == set(stronge.stronge_variables())
     assert set(st.coords) == set(stronge.STRONGE_COORDS)
-    ing = ingest.run(ingest.IngestSettings(), MAPLE, ROOT / "config" / "balls.csv", MAPLE_BATS)
+    ing = ingest.run(ingest.IngestSettings(calibration={}), MAPLE, ROOT / "config" / "balls.csv", MAPLE_BATS)
     assert set(ing.data_vars) <= set(ingest.INGEST_TABLE)
     assert set(ingest.INGEST_TABLE) - set(ing.data_vars) == {"theta_err", "v_bat_err", "v_ball_err"} - set(ing)
     sc = implications.ImplicationsSettings.from_config(config, "paper")
@@ -177,7 +177,7 @@ def test_reduce_stage_is_the_reduction_and_its_cross_checks(chain, config):
 
 
 def test_ingest_stage_keeps_warnings_and_exclusions():
-    ds = ingest.run(ingest.IngestSettings(), MAPLE, ROOT / "config" / "balls.csv", MAPLE_BATS)
+    ds = ingest.run(ingest.IngestSettings(calibration={}), MAPLE, ROOT / "config" / "balls.csv", MAPLE_BATS)
     assert ds.attrs["n_warnings"] == len(ingest.warnings(ds)) == 0
     assert ds.attrs["n_excluded"] == 1 and ds.sizes["impact"] == 31
     assert ingest.excluded_listing(ds)[0].startswith("impact MP31 (row 32):")

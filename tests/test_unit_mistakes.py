@@ -38,7 +38,7 @@ def rewritten(tmp_path, column, factor, rows, keep_err=True):
 
 
 def ingested(path):
-    ds = ingest_stage.run(ingest_stage.IngestSettings(), path, BALLS, MAPLE_BATS)
+    ds = ingest_stage.run(ingest_stage.IngestSettings(calibration={}), path, BALLS, MAPLE_BATS)
     return ds, ingest_stage.warnings(ds)
 
 
@@ -83,6 +83,6 @@ def test_a_kept_row_that_fits_another_unit_is_a_warning(tmp_path):
 def test_clean_files_name_no_unit_mistake():
     for path, bats in ((MAPLE, MAPLE_BATS), (ROOT / "config" / "examples" / "hickory_impacts.csv", None)):
         bats = bats or ROOT / "config" / "examples" / "hickory_bats.csv"
-        ds = ingest_stage.run(ingest_stage.IngestSettings(), path, BALLS, bats)
+        ds = ingest_stage.run(ingest_stage.IngestSettings(calibration={}), path, BALLS, bats)
         assert not any("unit mistake" in w for w in ingest_stage.warnings(ds))
         assert not any("unit mistake" in str(r) for r in ds.ingest_flag_reason.values)

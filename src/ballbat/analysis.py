@@ -76,32 +76,32 @@ def reconstruct_values(ds: xr.Dataset, balls: dict[str, Ball], bats: dict[str, B
     )
     if missing:
         raise ValueError("reconstruct: not in the property tables: " + ", ".join(missing))
-    pairs = {(b, t): recoil_factors(balls[b], bats[t]) for b, t in set(zip(ball_ids, bat_ids, strict=True))}
-    r = np.array([balls[b].r for b in ball_ids])
-    alpha = np.array([balls[b].alpha for b in ball_ids])
-    r_x = np.array([pairs[(b, t)][0] for b, t in zip(ball_ids, bat_ids, strict=True)])
-    R = np.array([bats[t].R for t in bat_ids])
-
-    psi, flag, geometry = _geometry(ds, r, alpha, r_x, R)
+    values = property_values(ball_ids, bat_ids, balls, bats)
+    psi, flag, geometry = _geometry(ds, values["r"], values["alpha"], values["r_x"], values["R_bat"])
     reasons = np.array([FLAG_TEXT[ImpactFlag(int(f))] for f in flag], dtype=object).astype(str)
     if "ingest_flag" in ds:  # measured data: keep the ingest's exclusions out of every fit
         excluded = ds["ingest_flag"].values != 0
         flag = np.where(excluded, ImpactFlag.EXCLUDED_AT_INGEST, flag).astype(np.int8)
         ingest_reasons = ds["ingest_flag_reason"].values.astype(str)
         reasons = np.where(excluded, np.char.add("excluded at ingest: ", ingest_reasons), reasons)
-    values = {
-        "r": r,
-        "m": np.array([balls[b].m for b in ball_ids]),
-        "alpha": alpha,
-        "R_bat": R,
-        "r_x": r_x,
-        "r_y": np.array([pairs[(b, t)][1] for b, t in zip(ball_ids, bat_ids, strict=True)]),
-        "psi": psi,
-        "flag": flag,
-        "flag_reason": reasons,
-    }
+    values.update({"psi": psi, "flag": flag, "flag_reason": reasons})
     values.update(geometry)
     return values
+
+
+def property_values(
+    ball_ids: np.ndarray, bat_ids: np.ndarray, balls: dict[str, Ball], bats: dict[str, Bat]
+) -> dict[str, np.ndarray]:
+    """Each impact's ball and bat properties: r, m, alpha, R_bat and the recoil factors r_x, r_y (Eqs. rx, ry)."""
+    pairs = {(b, t): recoil_factors(balls[b], bats[t]) for b, t in set(zip(ball_ids, bat_ids, strict=True))}
+    return {
+        "r": np.array([balls[b].r for b in ball_ids]),
+        "m": np.array([balls[b].m for b in ball_ids]),
+        "alpha": np.array([balls[b].alpha for b in ball_ids]),
+        "R_bat": np.array([bats[t].R for t in bat_ids]),
+        "r_x": np.array([pairs[(b, t)][0] for b, t in zip(ball_ids, bat_ids, strict=True)]),
+        "r_y": np.array([pairs[(b, t)][1] for b, t in zip(ball_ids, bat_ids, strict=True)]),
+    }
 
 
 def _geometry(ds: xr.Dataset, r, alpha, r_x, R) -> tuple[np.ndarray, np.ndarray, dict[str, np.ndarray]]:

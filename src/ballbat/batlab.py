@@ -316,3 +316,61 @@ def lab_problems(at: str, row: dict) -> list[str]:
 def row_problems(at: str, row: dict, convention: str) -> list[str]:
     """Problems of one bat row of either convention (``row``: column -> number in the tables' units)."""
     return lab_problems(at, row) if convention == "lab" else paper_problems(at, row)
+
+
+# ---------------------------------------------------------------------------------------
+# Uncertainties: an optional ``<column>_err`` beside a numeric column, in the column's unit.
+
+#: Suffix of a column's standard uncertainty (same unit as the column).
+ERR = "_err"
+#: Largest relative uncertainty accepted: a larger one is a unit mistake or a percentage, not a measurement.
+MAX_REL_ERR = 0.5
+
+
+def err_columns(header: list[str], numeric: tuple[str, ...] | list[str]) -> list[str]:
+    """Return the ``<column>_err`` columns of ``header`` that belong to a numeric column of the table."""
+    return [f"{c}{ERR}" for c in numeric if f"{c}{ERR}" in header]
+
+
+def err_problems(at: str, row: dict) -> list[str]:
+    """Problems of a row's uncertainties (``<column>_err``): negative, or larger than half the value."""
+    problems = []
+    for col, sigma in row.items():
+        if not col.endswith(ERR) or sigma is None:
+            continue
+        base = col.removesuffix(ERR)
+        value = row.get(base)
+        if sigma < 0:
+            problems.append(f"{at}, column {col}: {sigma:g} is negative (a standard uncertainty is 0 or more)")
+        elif value is not None and value != 0 and sigma > MAX_REL_ERR * abs(value):
+            problems.append(
+                f"{at}, column {col}: {sigma:g} is {sigma / abs(value):.0%} of {base} = {value:g}, more than "
+                f"{MAX_REL_ERR:.0%}: the uncertainty in another unit, or a percentage? Give it in {base}'s unit"
+            )
+    return problems
+
+
+def moved_row(row: dict, deltas: dict[str, float], convention: str) -> dict[str, float]:
+    """Return a row (``<column>_err`` ignored) with each column of ``deltas`` moved by it, in the paper's convention.
+
+    A lab row is converted again (:func:`paper_row`), so the moves carry the conversion's
+    correlations exactly (e.g. the balance point moves both I0 and b).
+    """
+    moved = {k: v for k, v in row.items() if not k.endswith(ERR)}
+    for col, delta in deltas.items():
+        moved[col] = row[col] + delta
+    return paper_row(moved) if convention == "lab" else {c: moved[c] for c in PAPER}
+
+
+def shifted_rows(row: dict, convention: str) -> list[tuple[str, float, dict, dict]]:
+    """Per stated uncertainty (``<column>_err`` > 0): (column, sigma, paper row at +1 sigma, at -1 sigma).
+
+    The measured value alone is moved by one standard uncertainty (:func:`moved_row`).
+    """
+    out = []
+    for col in sorted(c for c in row if c.endswith(ERR)):
+        sigma, base = row[col], col.removesuffix(ERR)
+        if sigma:
+            sides = [moved_row(row, {base: side * sigma}, convention) for side in (1.0, -1.0)]
+            out.append((base, sigma, sides[0], sides[1]))
+    return out

@@ -167,11 +167,21 @@ def source(
     return reduce.run(settings.reduce, render.render(settings.render, sim, balls), balls, bats)
 
 
-def ingest(impacts: str | os.PathLike[str], balls: str | os.PathLike[str], bats: str | os.PathLike[str]) -> xr.Dataset:
-    """Return a measured impacts file read and checked as the ingest rule does (the property tables by path)."""
+def ingest(
+    impacts: str | os.PathLike[str],
+    balls: str | os.PathLike[str],
+    bats: str | os.PathLike[str],
+    calibration: Mapping[str, float] | None = None,
+) -> xr.Dataset:
+    """Return a measured impacts file read and checked as the ingest rule does (the property tables by path).
+
+    ``calibration``: the dataset's stated instrument calibration uncertainties (config
+    ``datasets.<name>.calibration``), each a systematic source.
+    """
     from .stages import ingest as ingest_stage
 
-    return ingest_stage.run(ingest_stage.IngestSettings(), impacts, balls=balls, bats=bats)
+    settings = ingest_stage.IngestSettings(calibration=dict(calibration or {}))
+    return ingest_stage.run(settings, impacts, balls=balls, bats=bats)
 
 
 @dataclass(frozen=True)

@@ -165,7 +165,10 @@ def cmd_check(args: argparse.Namespace) -> int:
         raise UsageError("argument --impacts: only with --kind tracks (the impact table of a tracks file)")
     try:
         ds = ingest.run(
-            ingest.IngestSettings(), path, balls=args.balls or defaults["balls"], bats=args.bats or defaults["bats"]
+            ingest.IngestSettings(calibration={}),
+            path,
+            balls=args.balls or defaults["balls"],
+            bats=args.bats or defaults["bats"],
         )
         warnings = ingest.warnings(ds)
     except InputError as exc:
@@ -581,7 +584,7 @@ def summary_lines(folder: Path) -> list[str]:
         raise UsageError(f"argument folder: {exc}") from None
     rec, fit, st = read
     lines = [f"{folder.name}: {rec.sizes['impact']} impacts, {int((rec['flag'].values != 0).sum())} not used (flagged)"]
-    from .compare import SYSTEMATIC_NOTE, format_measurement, systematic_var, total_uncertainty
+    from .compare import format_measurement, systematic_var, total_uncertainty
 
     scale = systematic_var(fit, "e_x") is not None
     head = f"{'ball':<10} {'bat':<20} {'e_x':>8} {'± stat':>8}"
@@ -606,8 +609,7 @@ def summary_lines(folder: Path) -> list[str]:
             lines.append(
                 f"{ball:<10} {bat:<20} " + " ".join(f"{c:>8}" for c in cells) + f" {f'[{lo}, {hi}]':>22} {n:4d}"
             )
-    if scale:
-        lines += [f"syst: {SYSTEMATIC_NOTE}; total: both in quadrature."]
+    lines += _e_x_source_lines(fit, scale)
     lines += ["", f"{'ball':<10} {'eta^2':>7} {'± se':>7} {'95 % interval':>17} {'n':>4}"]
     for ball in st["ball"].values.astype(str):
         s = st.sel(ball=ball)
@@ -622,6 +624,25 @@ def summary_lines(folder: Path) -> list[str]:
     if reasons.size:
         labels = impact_labels(rec)[bad]
         lines += ["", "not used:"] + [f"  {lab}: {r}" for lab, r in zip(labels, reasons, strict=True)]
+    return lines
+
+
+def _e_x_source_lines(fit, scale: bool) -> list[str]:
+    """Return what e_x's systematic holds and its split by source (per bat and ball, pooled), or why there is none."""
+    from .compare import NO_SYSTEMATIC_NOTE, source_parts, systematic_note
+
+    if not scale:
+        return [f"syst. —: {NO_SYSTEMATIC_NOTE}."]
+    lines = [f"syst: {systematic_note(fit)}; total: both in quadrature."]
+    if "e_x_syst_by_source" not in fit:
+        return lines
+    lines.append("e_x syst by source (largest first):")
+    for ball in fit["ball"].values.astype(str):
+        for bat in [*fit["bat"].values.astype(str), "pooled"]:
+            f = fit.sel(ball=ball) if bat == "pooled" else fit.sel(ball=ball, bat=bat)
+            parts = source_parts(f, "e_x_pooled" if bat == "pooled" else "e_x")
+            if parts:
+                lines.append(f"  {ball:<10} {bat:<20} " + ", ".join(f"{n} {v:.2g}" for n, v in parts))
     return lines
 
 
@@ -659,14 +680,14 @@ def _systematic_lines(fit, st) -> list[str]:
             lines.append(f"{ball:<10} {var:<18} " + " ".join(f"{c:>8}" for c in cells) + f"  {unit}")
     per_source = (
         [
-            f"{src} ({float(r):g})"
+            f"{src} ({float(r):g})" if math.isfinite(r) else f"{src} (absolute: fit_ex.nc's systematic coordinate)"
             for src, r in zip(fit["systematic"].values.astype(str), fit["systematic_rel_sigma"].values, strict=True)
-            if r > 0
+            if r != 0
         ]
         if "systematic_rel_sigma" in fit
         else []
     )
-    lines.append("calibration sources (relative sigma): " + (", ".join(per_source) or "none stated"))
+    lines.append("systematic sources (relative sigma): " + (", ".join(per_source) or "none stated"))
     return lines
 
 

@@ -52,6 +52,63 @@ SYSTEMATIC_NOTE = (
     "each propagated by reducing the tracks again at ± one standard uncertainty, combined in quadrature; "
     "shared by every impact, apart from the standard error"
 )
+#: What a dataset without any systematic says in place of one ("syst. —").
+NO_SYSTEMATIC_NOTE = (
+    "no calibration uncertainty stated (no camera tracks, no datasets.<name>.calibration of the instruments) and "
+    "no property uncertainty (no *_err column in the bat and ball tables), so no systematic is estimated"
+)
+#: The kinds of systematic source (ballbat.systematics): a source name's prefix or set -> what, for the notes.
+_SOURCE_KINDS = (
+    (
+        "cameras",
+        "the cameras' and rig's calibrations (pixel scale, frame rate, the rig's lengths; tracks reduced again)",
+    ),
+    (
+        "instruments",
+        "the instruments' calibrations (datasets.<name>.calibration: speed scale, spin scale, angle offset)",
+    ),
+    ("properties", "the bat and ball properties' uncertainties (the tables' *_err columns, tables converted again)"),
+)
+
+
+def _source_kind(name: str) -> str:
+    from .instruments import INSTRUMENT_SOURCES
+
+    if name.startswith(("bat:", "ball:")):
+        return "properties"
+    return "instruments" if name in INSTRUMENT_SOURCES else "cameras"
+
+
+def systematic_note(ds: xr.Dataset) -> str:
+    """Return what the combined systematic of ``ds`` holds (:data:`SYSTEMATIC_NOTE` for camera-tracked data alone).
+
+    Only the kinds of source with a stated uncertainty are named; :data:`NO_SYSTEMATIC_NOTE` when none is.
+    """
+    if "systematic" not in ds.coords:
+        return SYSTEMATIC_NOTE if "e_x_err_scale" in ds else NO_SYSTEMATIC_NOTE
+    names = ds["systematic"].values.astype(str)
+    stated = [n for n, r in zip(names, ds["systematic_rel_sigma"].values, strict=True) if r != 0]
+    kinds = {_source_kind(n) for n in stated}
+    if kinds <= {"cameras"}:
+        return SYSTEMATIC_NOTE
+    parts = [what for kind, what in _SOURCE_KINDS if kind in kinds]
+    return (
+        "every stated uncertainty: "
+        + "; ".join(parts)
+        + "; each propagated by refitting at ± one standard uncertainty of that one source (shared by every "
+        "impact of its bat or ball, or by every impact), combined in quadrature; apart from the standard error"
+    )
+
+
+def source_parts(ds: xr.Dataset, var: str) -> list[tuple[str, float]]:
+    """Each stated source's part of ``var``'s systematic in ``ds`` (a selection of one cell), largest first."""
+    if f"{var}_syst_by_source" not in ds:
+        return []
+    per = ds[f"{var}_syst_by_source"].values
+    rel = ds["systematic_rel_sigma"].values
+    names = ds["systematic"].values.astype(str)
+    parts = [(str(n), float(v)) for n, r, v in zip(names, rel, per, strict=True) if r != 0 and math.isfinite(v)]
+    return sorted(parts, key=lambda nv: -nv[1])
 
 
 COLUMNS = (

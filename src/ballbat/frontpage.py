@@ -26,7 +26,7 @@ from urllib.parse import quote
 
 import numpy as np
 
-from .compare import SYSTEMATIC_NOTE, systematic_var
+from .compare import NO_SYSTEMATIC_NOTE, SYSTEMATIC_NOTE, source_parts, systematic_note, systematic_var
 from .published import PUBLISHED, per_ball
 
 if TYPE_CHECKING:
@@ -315,6 +315,19 @@ def provenance_line(git: Mapping[str, object], date: str | None) -> str:
     )
 
 
+def source_note(fit: xr.Dataset) -> list[str]:
+    """Return the pooled e_x's systematic split by source, one sentence per ball (none for tracked data alone)."""
+    if systematic_note(fit) == SYSTEMATIC_NOTE:  # the default run's front page as it was
+        return []
+    out = []
+    for ball in fit["ball"].values.astype(str):
+        parts = source_parts(fit.sel(ball=ball), "e_x_pooled")
+        if parts:
+            split = ", ".join(f"{escape(n)} {v:.2g}" for n, v in parts)
+            out.append(f"By source, pooled e_x of the {escape(ball)}: {split}.")
+    return out
+
+
 def dataset_section(
     name: str,
     fit: xr.Dataset,
@@ -335,9 +348,11 @@ def dataset_section(
     has_syst = any(r[4] != "—" for r in e_x_rows(fit))
     note = ["stat.: the standard error."]
     if has_syst:
-        note.append(f"syst.: the calibration systematic, {SYSTEMATIC_NOTE}.")
+        what = "calibration systematic" if systematic_note(fit) == SYSTEMATIC_NOTE else "systematic"
+        note.append(f"syst.: the {what}, {systematic_note(fit)}.")
+        note += source_note(fit)
     else:
-        note.append("syst. —: none is estimated here (the calibration systematics come with camera tracks).")
+        note.append(f"syst. —: {NO_SYSTEMATIC_NOTE}.")
     if "truth_e_x" in fit:
         note.append("truth: the value the synthetic experiment was drawn with.")
     lines += [" ".join(note), ""]

@@ -57,6 +57,7 @@ class Ball:
     alpha: float = 0.4
     psi_max: float = math.nan  # rad, Table I (experiment's range, not a property)
     D_max: float = math.nan  # m, Table I
+    err: str = ""  # JSON {column: [value, standard uncertainty]}, tables' units, of each stated *_err (empty: none)
 
 
 @dataclass(frozen=True)
@@ -72,6 +73,7 @@ class Bat:
     R: float  # m, bat radius at the impact location
     convention: str = "paper"  # the table's convention (ballbat.batlab.CONVENTIONS)
     given: str = ""  # JSON of the row's cells as given in its table (empty: not from a table)
+    err: str = ""  # JSON {column: standard uncertainty}, tables' units, of each stated *_err (empty: none)
 
 
 #: Columns of the ball table: name -> (unit factor to SI, required, must be positive).
@@ -85,7 +87,13 @@ BALL_COLUMNS = {
     "alpha": (1.0, False, True),
     "psi_max_deg": (math.pi / 180, False, True),
     "D_max_in": (INCH, False, True),
+    # standard uncertainties of the table's values (not the ball-to-ball spread *_sd): optional, >= 0
+    "m_oz_err": (OUNCE, False, False),
+    "r_in_err": (INCH, False, False),
+    "alpha_err": (1.0, False, False),
 }
+#: A ball's uncertain properties: table column -> (Ball field, unit factor to SI).
+BALL_ERR_FIELDS = {"m_oz": ("m", OUNCE), "r_in": ("r", INCH), "alpha": ("alpha", 1.0)}
 
 
 #: A number written with a decimal comma (European spreadsheets), e.g. ``68,7`` or ``-1,5e3``.
@@ -373,10 +381,30 @@ def _cell(raw: str, at: str, factor: float | None, req: bool, positive: bool, pr
     return val * factor
 
 
+def _ball_err(path: object, rec: dict, problems: list[str]) -> str:
+    """JSON {column: [value, sigma]} (tables' units) of a ball row's stated uncertainties; bad ones to ``problems``."""
+    row = {c: rec[c] / f for c, (_, f) in BALL_ERR_FIELDS.items() if rec[c] is not None}
+    row.update(
+        {f"{c}_err": rec[f"{c}_err"] / f for c, (_, f) in BALL_ERR_FIELDS.items() if rec[f"{c}_err"] is not None}
+    )
+    problems += batlab.err_problems(f"{path}: {rec[ROW]}", row)
+    alpha = rec["alpha"] if rec["alpha"] is not None else 0.4
+    row.setdefault("alpha", alpha)
+    err = {c: [row[c], row[f"{c}_err"]] for c in BALL_ERR_FIELDS if row.get(f"{c}_err")}
+    return json.dumps(err, sort_keys=True) if err else ""
+
+
 def load_balls(path: str | os.PathLike[str]) -> dict[str, Ball]:
-    """Read a ball table (Table I layout, paper units) into SI :class:`Ball` records."""
+    """Read a ball table (Table I layout, paper units) into SI :class:`Ball` records.
+
+    Optional ``m_oz_err``, ``r_in_err`` and ``alpha_err`` are the standard uncertainties of the
+    table's values (their systematics: :func:`ball_variants`); Table I's ``*_sd`` is the spread
+    from ball to ball, not an uncertainty of the values used, and gives no systematic.
+    """
     balls = {}
+    problems: list[str] = []
     for rec in _read_table(path, BALL_COLUMNS, "ball"):
+        err = _ball_err(path, rec, problems)
         balls[rec["ball"]] = Ball(
             ball=rec["ball"],
             name=rec["name"] or rec["ball"],
@@ -385,8 +413,23 @@ def load_balls(path: str | os.PathLike[str]) -> dict[str, Ball]:
             alpha=rec["alpha"] if rec["alpha"] is not None else 0.4,
             psi_max=rec["psi_max_deg"] if rec["psi_max_deg"] is not None else math.nan,
             D_max=rec["D_max_in"] if rec["D_max_in"] is not None else math.nan,
+            err=err,
         )
+    if problems:
+        raise InputError(problems)
     return balls
+
+
+def ball_variants(ball: Ball) -> list[tuple[str, float, float, Ball, Ball]]:
+    """Per stated uncertainty: (column, value, sigma, the ball at +1 sigma, at -1 sigma), tables' units."""
+    from dataclasses import replace
+
+    out = []
+    for col, (value, sigma) in sorted(json.loads(ball.err).items()) if ball.err else ():
+        field, factor = BALL_ERR_FIELDS[col]
+        sides = [replace(ball, **{field: (value + s * sigma) * factor}) for s in (1.0, -1.0)]
+        out.append((col, value, sigma, sides[0], sides[1]))
+    return out
 
 
 def _bat_columns(path: Path, header: list[str], lines: list) -> tuple[str, dict]:
@@ -403,10 +446,13 @@ def _bat_columns(path: Path, header: list[str], lines: list) -> tuple[str, dict]
         raise InputError(problems)
     text = {"bat": (None, True, False), "name": (None, False, False), "convention": (None, False, False)}
     if convention == "paper":
-        return convention, {**text, **{c: (1.0, True, c != "b_in") for c in batlab.PAPER}}
-    chosen = [c for pair in batlab.LAB_EITHER for c in pair if c in header]
-    cols = {c: (1.0, True, c != "pivot_in") for c in (*batlab.LAB_REQUIRED, *chosen)}
-    return convention, {**text, **cols, **{c: (1.0, False, True) for c in batlab.LAB_OPTIONAL}}
+        cols = {c: (1.0, True, c != "b_in") for c in batlab.PAPER}
+    else:
+        chosen = [c for pair in batlab.LAB_EITHER for c in pair if c in header]
+        cols = {c: (1.0, True, c != "pivot_in") for c in (*batlab.LAB_REQUIRED, *chosen)}
+        cols.update({c: (1.0, False, True) for c in batlab.LAB_OPTIONAL})
+    errs = {c: (1.0, False, False) for c in batlab.err_columns(header, list(cols))}
+    return convention, {**text, **cols, **errs}
 
 
 def load_bats(path: str | os.PathLike[str]) -> dict[str, Bat]:
@@ -424,11 +470,13 @@ def load_bats(path: str | os.PathLike[str]) -> dict[str, Bat]:
     for rec in _read_table(path, columns, "bat"):
         nums = {c: v for c, v in rec.items() if isinstance(v, float)}
         found = batlab.row_problems(f"{path}: {rec[ROW]}", nums, convention)
+        found += batlab.err_problems(f"{path}: {rec[ROW]}", nums)
         problems += found
         if found:
             continue
         used = batlab.paper_row(nums) if convention == "lab" else {c: nums[c] for c in batlab.PAPER}
         given = {c: v for c, v in rec[GIVEN].items() if c not in ("bat", "name")}
+        err = {c.removesuffix(batlab.ERR): v for c, v in nums.items() if c.endswith(batlab.ERR) and v > 0}
         bats[rec["bat"]] = Bat(
             bat=rec["bat"],
             name=rec["name"] or rec["bat"],
@@ -439,10 +487,83 @@ def load_bats(path: str | os.PathLike[str]) -> dict[str, Bat]:
             R=used["R_in"] * INCH,
             convention=convention,
             given=json.dumps(given),
+            err=json.dumps(err, sort_keys=True) if err else "",
         )
     if problems:
         raise InputError(problems)
     return bats
+
+
+def _bat_from_paper_row(bat: Bat, used: dict[str, float]) -> Bat:
+    from dataclasses import replace
+
+    return replace(
+        bat,
+        M=used["M_oz"] * OUNCE,
+        I0=used["I0_oz_in2"] * OZ_IN2,
+        Iz=used["Iz_oz_in2"] * OZ_IN2,
+        b=used["b_in"] * INCH,
+        R=used["R_in"] * INCH,
+    )
+
+
+def bat_variants(bat: Bat) -> list[tuple[str, float, float, Bat, Bat]]:
+    """Per stated uncertainty (``<column>_err``): (column, value, sigma, the bat at +1 sigma, at -1 sigma).
+
+    The measured value of that column alone moves by one standard uncertainty, and a lab row is
+    converted again (:func:`ballbat.batlab.shifted_rows`); tables' units for value and sigma.
+    """
+    if not bat.err:
+        return []
+    row = _table_row(bat)
+    return [
+        (col, row[col], sigma, _bat_from_paper_row(bat, plus), _bat_from_paper_row(bat, minus))
+        for col, sigma, plus, minus in batlab.shifted_rows(row, bat.convention)
+    ]
+
+
+def _table_row(bat: Bat) -> dict[str, float]:
+    """Return a bat's row as its table gave it (tables' units), with its uncertainties as ``<column>_err``."""
+    given = json.loads(bat.given)
+    row = {c: float(v) for c, v in given.items() if c != "convention" and not c.endswith(batlab.ERR) and v != ""}
+    row.update({f"{c}{batlab.ERR}": s for c, s in json.loads(bat.err).items()})
+    return row
+
+
+def drawn_properties(
+    bats: dict[str, Bat], balls: dict[str, Ball], rng: np.random.Generator
+) -> tuple[dict[str, Bat], dict[str, Ball], dict[str, float]]:
+    """Return bats and balls whose measured values are drawn from their stated uncertainties (a replicate's truth).
+
+    Every stated ``<column>_err`` of every bat (then ball), in sorted order, draws z ~ N(0, 1) and
+    the column becomes value + z sigma; a lab row is converted again with all its columns moved
+    (:func:`ballbat.batlab.moved_row`). Returns the drawn tables and each source's z, by the
+    source's name (``bat:<bat>:<column>``, ``ball:<ball>:<column>``, as reconstruct names them).
+    """
+    from dataclasses import replace
+
+    z: dict[str, float] = {}
+    out_bats = dict(bats)
+    for key in sorted(bats):
+        bat = bats[key]
+        if not bat.err:
+            continue
+        row = _table_row(bat)
+        deltas = {}
+        for col, sigma in sorted(json.loads(bat.err).items()):
+            z[f"bat:{key}:{col}"] = float(rng.standard_normal())
+            deltas[col] = z[f"bat:{key}:{col}"] * sigma
+        out_bats[key] = _bat_from_paper_row(bat, batlab.moved_row(row, deltas, bat.convention))
+    out_balls = dict(balls)
+    for key in sorted(balls):
+        ball = balls[key]
+        moved = {}
+        for col, (value, sigma) in sorted(json.loads(ball.err).items()) if ball.err else ():
+            z[f"ball:{key}:{col}"] = float(rng.standard_normal())
+            field, factor = BALL_ERR_FIELDS[col]
+            moved[field] = (value + z[f"ball:{key}:{col}"] * sigma) * factor
+        out_balls[key] = replace(ball, **moved)
+    return out_bats, out_balls, z
 
 
 def bat_record(bats: dict[str, Bat]) -> str:
@@ -460,6 +581,7 @@ def bat_record(bats: dict[str, Bat]) -> str:
                 "convention": t.convention,
                 "as_given": json.loads(t.given) if t.given else {},
                 "used": {c: round(f(t), 6) for c, f in used.items()},
+                **({"uncertainty": json.loads(t.err)} if t.err else {}),
             }
             for k, t in sorted(bats.items())
         },

@@ -18,7 +18,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .compare import COLUMNS, SYSTEMATIC_NOTE, format_measurement, read_csv, systematic_var, total_uncertainty
+from .compare import (
+    COLUMNS,
+    NO_SYSTEMATIC_NOTE,
+    SYSTEMATIC_NOTE,
+    format_measurement,
+    read_csv,
+    source_parts,
+    systematic_note,
+    systematic_var,
+    total_uncertainty,
+)
 from .pipeline.ncio import atomic_write_text
 from .published import per_ball
 from .units import from_si
@@ -122,6 +132,8 @@ def fig5_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
     syst_var = systematic_var(fit, "e_x")
     tracked = syst_var is not None and bool(np.isfinite(fit[syst_var].values).any())
     what = "standard errors and the calibration systematic" if tracked else "standard errors"
+    if tracked and systematic_note(fit) != SYSTEMATIC_NOTE:
+        what = "standard errors and the systematic"
     lines = [f"Slopes 1 + e_x of the pooled fits through the origin ({what}):", ""]
     for ball in fit["ball"].values.astype(str):
         v = float(fit["e_x_pooled"].sel(ball=ball))
@@ -142,11 +154,23 @@ def fig5_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:
                     f" (n = {int(fit['e_x_n'].sel(ball=ball, bat=bat))})"
                 )
     if tracked:
-        lines += [
-            "",
-            f"The systematic is {SYSTEMATIC_NOTE}; the two add in quadrature to the total.",
-        ]
+        lines += ["", f"The systematic is {systematic_note(fit)}; the two add in quadrature to the total."]
+        lines += _source_lines(fit)
+    else:
+        lines += ["", f"syst. —: {NO_SYSTEMATIC_NOTE}."]
     return "\n".join([*lines, "", *_header(impacts)])
+
+
+def _source_lines(fit: xr.Dataset) -> list[str]:
+    """Return the pooled e_x's systematic split by source, one line per ball (none for camera-tracked data alone)."""
+    if systematic_note(fit) == SYSTEMATIC_NOTE:  # the default run's caption as it was
+        return []
+    lines = []
+    for ball in fit["ball"].values.astype(str):
+        parts = source_parts(fit.sel(ball=ball), "e_x_pooled")
+        if parts:
+            lines.append(f"- by source, pooled e_x of the {ball}: " + ", ".join(f"{n} {v:.2g}" for n, v in parts))
+    return ["", *lines] if lines else []
 
 
 def fig6_numbers(impacts: xr.Dataset, fit: xr.Dataset) -> str:

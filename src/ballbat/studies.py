@@ -189,20 +189,23 @@ def run_replicate(
     """
     from . import chain
     from .systematics import has_shifts
-    from .tracks.render import calibration_draws
 
     seeds = replicate_seeds(settings.seed, replicate)
     cs = chain_settings(settings, dataset, seeds, f"render (replicate {replicate})", check)
-    src = chain.source(cs, balls, bats)
-    # the calibration systematics where the replicate draws its calibration (the combined interval's
-    # coverage); every replicate's numbers are recorded as they come
-    drawn = has_shifts(src)
+    # the true properties: the tables' (or, with draw_properties, drawn from their stated uncertainties)
+    true_balls, true_bats, z_props = drawn_tables(settings, replicate, balls, bats)
+    src = chain.source(cs, true_balls, true_bats)
+    # the systematics where the replicate draws its calibration or its properties (the combined
+    # interval's coverage); every replicate's numbers are recorded as they come
+    drawn = has_shifts(src) or bool(z_props)
     run = chain.run(replace(cs, fit_ex=replace(cs.fit_ex, systematic=drawn)), src, balls, bats)
     rec, fit, fs = run.reconstruct, run.fit_ex, run.fit_systematics
-    z = calibration_draws({**dataset["render"], "seed": seeds[1]}) if drawn else None
+    z = source_draws(rec, dataset, seeds, z_props) if drawn else None
+    if z_props:  # the truth: the same estimator on the noise-free values with the true properties
+        fit = with_true_truth(fit, cs, src, true_balls, true_bats)
     rows = fit_quantity_rows(fit, None if fs is None else _calibration_effect(fit, fs.signed, z))
     if "eta2" in STUDY_QUANTITIES:
-        rec_truth = chain.reconstructed(cs, _truth_source(src), balls, bats)
+        rec_truth = chain.reconstructed(cs, _truth_source(src), true_balls, true_bats)
         balls_fitted = fit["ball"].values.astype(str)
         nan = np.full(balls_fitted.size, np.nan)
         syst, effect = _eta2_systematic(rec, balls_fitted, settings.stronge, z) if drawn else (nan, nan)
@@ -223,6 +226,62 @@ def run_replicate(
                 }
             )
     return rows
+
+
+#: spawn_key tail of a replicate's stream of drawn properties (independent of its experiment's and tracks').
+PROPERTY_STREAM = 1
+
+
+def drawn_tables(
+    settings: StudySettings, replicate: int, balls: dict[str, Ball], bats: dict[str, Bat]
+) -> tuple[dict[str, Ball], dict[str, Bat], dict[str, float]]:
+    """Return a replicate's true balls and bats and each property source's draw z (empty: the tables as they are).
+
+    With ``settings.draw_properties`` every stated uncertainty of the tables is drawn
+    (:func:`ballbat.properties.drawn_properties`) from ``SeedSequence(seed, spawn_key=(replicate,
+    PROPERTY_STREAM))``; a table without any is a ValueError (nothing to draw).
+    """
+    from .properties import drawn_properties
+
+    if not settings.draw_properties:
+        return balls, bats, {}
+    rng = np.random.default_rng(np.random.SeedSequence(settings.seed, spawn_key=(replicate, PROPERTY_STREAM)))
+    true_bats, true_balls, z = drawn_properties(bats, balls, rng)
+    if not z:
+        raise ValueError("draw_properties: the bat and ball tables state no uncertainty (no *_err column)")
+    return true_balls, true_bats, z
+
+
+def source_draws(rec: xr.Dataset, dataset: dict, seeds: tuple[int, int], z_props: dict[str, float]) -> np.ndarray:
+    """Return each systematic source's draw in standard uncertainties, in the order of ``rec``'s sources.
+
+    The cameras' from the drawn calibration (:func:`ballbat.tracks.render.calibration_draws`; 0 where
+    the calibration is not drawn), the properties' from ``z_props``.
+    """
+    from .systematics import SOURCES, source_names
+    from .tracks.render import calibration_draws
+
+    names = source_names(rec)
+    calib = {}
+    if renders(dataset) and dataset["render"]["draw_calibration"]:
+        calib = dict(zip(SOURCES, calibration_draws({**dataset["render"], "seed": seeds[1]}), strict=True))
+    return np.array([z_props.get(n, calib.get(n, 0.0)) for n in names], dtype=float)
+
+
+def with_true_truth(
+    fit: xr.Dataset, cs: DatasetSettings, src: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]
+) -> xr.Dataset:
+    """Return ``fit`` with its ``truth_*`` the estimator's on the noise-free values analysed with the true tables.
+
+    fit_ex's own ``truth_*`` analyse the noise-free values with the tables' (nominal) properties,
+    so they share the estimate's property error; the truth of a replicate whose properties are
+    drawn is the analysis with the properties it was drawn with.
+    """
+    from . import chain
+
+    quiet = replace(cs, fit_ex=replace(cs.fit_ex, systematic=False))
+    true = chain.run(quiet, _truth_source(src), balls, bats).fit_ex
+    return fit.assign({k: true[k.removeprefix("truth_")] for k in fit.data_vars if k.startswith("truth_")})
 
 
 def _calibration_effect(fit: xr.Dataset, signed: dict[str, np.ndarray], z: np.ndarray) -> xr.Dataset:
@@ -516,9 +575,9 @@ def _population_rows(settings: StudySettings, point: int, balls: dict[str, Ball]
     """
     ds = settings.point_dataset(point)
     ds["synthetic"]["impacts"] = settings.truth_counts(point)[1]
-    big = replace(
-        settings, seed=int(np.random.SeedSequence(settings.seed, spawn_key=(2**31 - 1, point)).generate_state(1)[0])
-    )
+    # the design's truth is the tables' bat (a drawn one's e_x is the same: drawing moves the analysis, not e_x)
+    seed = int(np.random.SeedSequence(settings.seed, spawn_key=(2**31 - 1, point)).generate_state(1)[0])
+    big = replace(settings, seed=seed, draw_properties=False)
     return run_replicate(big, ds, 0, balls, bats, check=False)
 
 

@@ -46,6 +46,10 @@ class StudySettings:
         that gives the design's truth (:meth:`truth_counts`).
     delta_e_x, confidence, power : float
         The design table's difference in e_x to detect and its test's confidence and power.
+    draw_properties : bool
+        Every replicate draws its true bat and ball properties from the tables' stated
+        uncertainties (``<column>_err``) and is analysed with the tables' values
+        (:func:`ballbat.studies.run_replicate`; config ``studies.<name>.draw_properties``).
     """
 
     dataset: dict
@@ -61,6 +65,7 @@ class StudySettings:
     delta_e_x: float
     confidence: float
     power: float
+    draw_properties: bool
 
     @classmethod
     def from_config(cls, config: dict, name: str) -> StudySettings:
@@ -88,6 +93,7 @@ class StudySettings:
             delta_e_x=float(s["delta_e_x"]),
             confidence=float(s["confidence"]),
             power=float(s["power"]),
+            draw_properties=bool(s["draw_properties"]),
         )
 
     @property

@@ -22,6 +22,19 @@ relative; ``pivot_to_tip_err_in`` and ``pivot_to_impact_err_in`` of the rig, inc
    systematic in quadrature ``<q>_err_total``. A source whose uncertainty is 0 costs nothing
    and gives 0.
 
+The same machinery carries two more kinds of source, each appended to the ``systematic``
+dimension only where an uncertainty is stated, so a dataset without any keeps its sources as
+they were (docs/model.md, "Property and instrument systematics"):
+
+* **instrument calibrations of a measured impacts file** (:data:`INSTRUMENT_SOURCES`, config
+  ``datasets.<name>.calibration``): a speed scale and a spin scale (relative) and an angle
+  offset (absolute), each a shift of every impact's measured values (:func:`instrument_shifts`);
+* **bat and ball properties** (a ``<column>_err`` in the property tables): one source per
+  property and bat (``bat:<bat>:<column>``) or ball (``ball:<ball>:<column>``), the property
+  moved by +-1 sigma for every impact of that bat (ball) and the per-impact properties that
+  reconstruct stored (``r``, ``m``, ``alpha``, ``R_bat``, ``r_x``, ``r_y``: :data:`PROPERTY_SHIFTED`)
+  shifted accordingly (``<name>_shift``, reconstruct.nc; :func:`ballbat.stages.reconstruct.property_shifts`).
+
 ``e_x_err_scale`` and ``e_x_pooled_err_scale`` keep their meaning: the systematic of e_x from
 the swing camera's pixel scale (now the ``swing_m_per_px`` source, by the exact rerun; it was
 a linear rescale of v_bat and v_ball).
@@ -29,11 +42,14 @@ a linear rescale of v_bat and v_ball).
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 import xarray as xr
+
+from .instruments import INSTRUMENT_SOURCES
 
 if TYPE_CHECKING:
     from .tracks.data import Camera, Rig, Tracks
@@ -53,6 +69,10 @@ SIDES = (1, -1)
 #: The measured quantities (and uncertainties) whose shifts reduce.nc keeps: what later stages read.
 SHIFTED = ("v_bat", "v_ball", "theta", "omega", "v_bat_err", "v_ball_err", "theta_err", "omega_err")
 SHIFT_UNITS = {"v_bat": "m s-1", "v_ball": "m s-1", "theta": "rad", "omega": "rad s-1"}
+
+#: Per-impact properties that reconstruct stores and a property source shifts (:mod:`ballbat.stages.reconstruct`).
+PROPERTY_SHIFTED = ("r", "m", "alpha", "R_bat", "r_x", "r_y")
+PROPERTY_UNITS = {"r": "m", "m": "kg", "alpha": "1", "R_bat": "m", "r_x": "1", "r_y": "1"}
 
 #: Quantities of fit_ex.nc that get systematics.
 FIT_QUANTITIES = (
@@ -102,6 +122,7 @@ class Shifts:
 
     rel_sigma: np.ndarray  # (source,)
     shift: dict[str, np.ndarray]  # name -> (source, side, impact)
+    names: list[str] | None = None  # the sources (None: the calibration ones, :data:`SOURCES`)
 
 
 def reduce_shifts(
@@ -161,13 +182,15 @@ def shifted_impacts(rec: xr.Dataset, source: int, side: int) -> xr.Dataset:
     -------
     xarray.Dataset
         The same impacts and flags, without the ``truth_*`` variables (the estimators' truth
-        is no systematic).
+        is no systematic). The per-impact properties move too where the dataset has property
+        sources (:data:`PROPERTY_SHIFTED`).
     """
     from .analysis import normalize_values, reconstruct_again_values
 
     out = rec.drop_vars([k for k in rec.data_vars if k.startswith("truth_")])
-    for k in SHIFTED:
-        out[k] = (rec[k].dims, rec[k].values + rec[f"{k}_shift"].values[source, side], rec[k].attrs)
+    for k in (*SHIFTED, *PROPERTY_SHIFTED):
+        if f"{k}_shift" in rec:  # the properties: only where a property source is stated
+            out[k] = (rec[k].dims, rec[k].values + rec[f"{k}_shift"].values[source, side], rec[k].attrs)
     # the normalize and reconstruct stages' steps, at the nominal reference speed and properties
     out = out.assign({k: ("impact", v) for k, v in normalize_values(out, float(rec.attrs["v_ref"])).items()})
     return out.assign({k: ("impact", v) for k, v in reconstruct_again_values(out).items()})
@@ -183,3 +206,53 @@ class FitSystematics:
     #: ``by_source == abs(signed)``; a quantity's first-order change when source k is off by z_k sigma
     #: is sum_k z_k signed[k] (:func:`ballbat.studies.run_replicate`).
     signed: dict[str, np.ndarray]
+    #: The sources, in the order of the first axis (the dataset's ``systematic`` coordinate), and its long name.
+    names: list[str] | None = None
+    long_name: str | None = None
+
+
+def source_names(ds: xr.Dataset) -> list[str]:
+    """Return the systematic sources of a dataset carrying shifts (its ``systematic`` coordinate), in order."""
+    return [str(v) for v in ds["systematic"].values]
+
+
+def instrument_shifts(values: dict[str, np.ndarray], calibration: dict[str, float]) -> Shifts | None:
+    """Return the shifts of every impact's measured values at +-1 sigma of each stated instrument calibration.
+
+    Parameters
+    ----------
+    values : dict
+        The measured values in SI (v_bat, v_ball, theta, omega; ``*_err`` where given).
+    calibration : dict
+        Config ``calibration``: ``speed_scale_pct`` and ``spin_scale_pct`` (relative standard
+        uncertainties in %: every speed, or every spin, times 1 +- sigma; their standard
+        uncertainties scale alike) and ``angle_offset_deg`` (every theta +- sigma). Absent or 0: no source.
+
+    Returns
+    -------
+    Shifts or None
+        Only the stated sources (:attr:`Shifts.names`), None when none is stated; rel_sigma is
+        NaN for the angle offset (an absolute uncertainty; its sigma is in the source's long name).
+    """
+    names, rel, shift = [], [], {k: [] for k in SHIFTED}
+    n = len(values["v_bat"])
+    for source, (key, _) in INSTRUMENT_SOURCES.items():
+        sigma = float(calibration.get(key, 0.0) or 0.0)
+        if sigma == 0:
+            continue
+        scaled = {"speed_scale": ("v_bat", "v_ball"), "spin_scale": ("omega",)}.get(source, ())
+        per = {k: np.zeros((len(SIDES), n)) for k in SHIFTED}
+        for j, side in enumerate(SIDES):
+            for k in scaled:
+                per[k][j] = side * sigma / 100.0 * values[k]
+                if f"{k}_err" in values:
+                    per[f"{k}_err"][j] = side * sigma / 100.0 * values[f"{k}_err"]
+            if source == "angle_offset":
+                per["theta"][j] = side * np.deg2rad(sigma)
+        names.append(source)
+        rel.append(math.nan if source == "angle_offset" else sigma / 100.0)
+        for k in SHIFTED:
+            shift[k].append(per[k])
+    if not names:
+        return None
+    return Shifts(np.array(rel), {k: np.array(v) for k, v in shift.items()}, names)

@@ -38,7 +38,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .compare import systematic_var, total_uncertainty
+from .compare import NO_SYSTEMATIC_NOTE, systematic_var, total_uncertainty
 from .pipeline.atomic import atomic_target
 from .units import from_si
 
@@ -474,11 +474,14 @@ def _systematics_sheet(wb: object, fit: xr.Dataset, stronge: xr.Dataset) -> None
     """Add the ``systematics`` sheet: each quantity's systematic from each calibration source (tracked data).
 
     One row per quantity, ball (and bat), and source with a stated uncertainty, with its
-    relative standard uncertainty; the sheet has its header rows only when the dataset has none.
+    relative standard uncertainty (empty for an absolute one, the angle offset); a dataset with
+    none has one row saying so (source ``none stated``, the reason in the unit column's place).
     """
     ws = wb.create_sheet("systematics")
     ws.append(["quantity", "ball", "bat", "source", "source_rel_sigma", "systematic", "unit"])
     ws.append(["", "", "", "", "", "", ""])
+    if not any("systematic" in ds.coords for ds in (fit, stronge)):  # "syst. —", and why
+        ws.append(["e_x", "", "", "none stated", None, None, NO_SYSTEMATIC_NOTE])
     for ds in (fit, stronge):
         if "systematic" not in ds.coords:
             continue
@@ -491,9 +494,9 @@ def _systematics_sheet(wb: object, fit: xr.Dataset, stronge: xr.Dataset) -> None
             for idx in np.ndindex(per.shape[1:]):
                 where = {d: str(ds[d].values[i]) for d, i in zip(per.dims[1:], idx, strict=True)}
                 for k, src in enumerate(sources):
-                    if not rel[src] > 0 or not np.isfinite(per.values[(k, *idx)]):
-                        continue
-                    row = [q, where.get("ball", ""), where.get("bat", ""), src, rel[src]]
+                    if rel[src] == 0 or not np.isfinite(per.values[(k, *idx)]):
+                        continue  # (a NaN relative sigma, an absolute one such as angle_offset, is kept)
+                    row = [q, where.get("ball", ""), where.get("bat", ""), src, _cell(rel[src], "1")]
                     row += [_cell(per.values[(k, *idx)], unit), _unit_label(unit)]
                     _format_row(ws, row, ["", "", "", "", "1", unit, ""], [([5], [5])])
 

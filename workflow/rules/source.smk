@@ -50,5 +50,6 @@ rule ingest:
     params:
         files=data_files,
         sha256=data_hashes,
+        calibration=lambda w: dataset_config(w).get("calibration", {}),
     script:
         "../scripts/ingest.py"

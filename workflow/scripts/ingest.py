@@ -6,7 +6,12 @@ from ballbat.stages import ingest
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     files = snakemake.params.files  # as the config names them: a missing one is reported by the ingest
-    ds = ingest.run(ingest.IngestSettings(), files["impacts"], balls=files["balls"], bats=files["bats"])
+    ds = ingest.run(
+        ingest.IngestSettings.from_params(dict(snakemake.params)),
+        files["impacts"],
+        balls=files["balls"],
+        bats=files["bats"],
+    )
     for text in ingest.warnings(ds):
         log.warning(text)
     log_exclusions(log, ingest.excluded_listing(ds), ds.sizes["impact"])
@@ -15,5 +20,8 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         snakemake,
         "impacts",
         f"Measured ball-bat impacts of dataset {snakemake.wildcards.dataset}, checked and in SI",
-        config={"sha256": snakemake.params.sha256},
+        config={
+            "sha256": snakemake.params.sha256,
+            **({"calibration": cal} if (cal := snakemake.params.calibration) else {}),
+        },
     )

@@ -11,16 +11,15 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 import numpy as np
+import xarray as xr
 
 from ..fitting import FitGrid, FitStatus, Sec4, analyze_impacts, check_physical, fit_status
 from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
-from ..systematics import FIT_QUANTITIES, SIDES, SOURCES, FitSystematics, has_shifts, shifted_impacts
+from ..systematics import FIT_QUANTITIES, SIDES, SOURCES, FitSystematics, has_shifts, shifted_impacts, source_names
 from .systematics import systematic_vars
 
 if TYPE_CHECKING:
     from collections.abc import Mapping
-
-    import xarray as xr
 
 
 @dataclass(frozen=True)
@@ -250,10 +249,11 @@ def fit_systematics(rec: xr.Dataset, res: Sec4) -> FitSystematics:
     """
     nominal = results_dataset(res)
     rel = rec["systematic_rel_sigma"].values
-    out = {q: np.zeros((len(SOURCES), *nominal[q].shape)) for q in FIT_QUANTITIES}
+    names = source_names(rec)
+    out = {q: np.zeros((len(names), *nominal[q].shape)) for q in FIT_QUANTITIES}
     for q in FIT_QUANTITIES:  # no value, no systematic
         out[q][:, ~np.isfinite(nominal[q].values)] = np.nan
-    for i in range(len(SOURCES)):
+    for i in range(len(names)):
         if rel[i] == 0:
             continue
         fits = [
@@ -262,12 +262,17 @@ def fit_systematics(rec: xr.Dataset, res: Sec4) -> FitSystematics:
         ]
         for q in FIT_QUANTITIES:
             out[q][i] = 0.5 * (fits[0][q].values - fits[1][q].values)
-    return FitSystematics({q: np.abs(v) for q, v in out.items()}, rel, out)
+    return FitSystematics({q: np.abs(v) for q, v in out.items()}, rel, out, names, rec["systematic"].attrs["long_name"])
 
 
-def scale_entries(fs: FitSystematics) -> dict[str, np.ndarray]:
-    """``e_x_err_scale`` and ``e_x_pooled_err_scale``: the swing camera's pixel-scale systematic of e_x."""
-    i = list(SOURCES).index("swing_m_per_px")
+def scale_entries(fs: FitSystematics) -> dict[str, np.ndarray] | None:
+    """``e_x_err_scale`` and ``e_x_pooled_err_scale``: the swing camera's pixel-scale systematic of e_x.
+
+    None for a dataset without camera tracks (its sources are an instrument's or properties').
+    """
+    if fs.names is not None and "swing_m_per_px" not in fs.names:
+        return None
+    i = (fs.names or list(SOURCES)).index("swing_m_per_px")
     return {"e_x_err_scale": fs.by_source["e_x"][i], "e_x_pooled_err_scale": fs.by_source["e_x_pooled"][i]}
 
 
@@ -276,4 +281,9 @@ def add_fit_systematics(ds: xr.Dataset, fs: FitSystematics | None) -> xr.Dataset
     if fs is None:
         return ds
     what = "the tracks reduced again, then normalize, reconstruct and the fit"
-    return systematic_vars(ds, fs.by_source, what, fs.rel_sigma)
+    if fs.names is None:
+        return systematic_vars(ds, fs.by_source, what, fs.rel_sigma)
+    if fs.names != list(SOURCES):
+        what = "that source's shift of the measured values or properties, then normalize, reconstruct and the fit"
+    coord = xr.DataArray(np.array(fs.names, dtype=str), dims="systematic", attrs={"long_name": fs.long_name})
+    return systematic_vars(ds, fs.by_source, what, fs.rel_sigma, coord)

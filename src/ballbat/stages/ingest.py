@@ -16,10 +16,13 @@ import xarray as xr
 from ..ingest import MEASURED_COLUMNS, read_measured
 from ..kinematics import ImpactFlag
 from ..pipeline.products import Var, build_dataset, flag_attrs
+from ..systematics import INSTRUMENT_SOURCES, instrument_shifts
 from .impacts import IMPACTS, impact_coords
+from .systematics import add_shifts
 
 if TYPE_CHECKING:
     import os
+    from collections.abc import Mapping
 
 #: The variables of ingest.nc, in order (``*_err`` only where the file has the column).
 INGEST_TABLE = {
@@ -37,12 +40,29 @@ INGEST_TABLE = {
 
 @dataclass(frozen=True)
 class IngestSettings:
-    """Settings of the ingest stage: none (the impacts file and the property tables are inputs)."""
+    """Settings of the ingest stage (the impacts file and the property tables are inputs).
+
+    Attributes
+    ----------
+    calibration : dict
+        The instruments' calibration uncertainties the dataset states (config
+        ``datasets.<name>.calibration``: ``speed_scale_pct``, ``spin_scale_pct``,
+        ``angle_offset_deg``; :func:`ballbat.systematics.instrument_shifts`); empty: none stated.
+    """
+
+    calibration: dict
 
     @classmethod
-    def from_config(cls, config: dict) -> IngestSettings:
-        """Return the workflow's settings from the validated config."""
-        return cls()
+    def from_config(cls, config: dict, dataset: str | None = None) -> IngestSettings:
+        """Return the workflow's settings from the validated config (``dataset``: whose calibration)."""
+        if dataset is None:
+            return cls(calibration={})
+        return cls.from_params({"calibration": config["datasets"][dataset].get("calibration", {})})
+
+    @classmethod
+    def from_params(cls, params: Mapping) -> IngestSettings:
+        """Return the workflow's settings from the ingest rule's params (``calibration``)."""
+        return cls(calibration=dict(params["calibration"]))
 
 
 def run(
@@ -77,7 +97,18 @@ def run(
         "n_warnings": len(got.warnings),
         "ingest_warnings": "\n".join(got.warnings),
     }
-    return build_dataset(given, values, coords=impact_coords(got.ball, got.bat), attrs=attrs)
+    ds = build_dataset(given, values, coords=impact_coords(got.ball, got.bat), attrs=attrs)
+    return add_shifts(ds, instrument_shifts(values, settings.calibration), calibration_what(settings.calibration))
+
+
+def calibration_what(calibration: dict) -> dict[str, str]:
+    """Each stated instrument source's description with its stated uncertainty (the coordinate's long name)."""
+    out = {}
+    for source, (key, what) in INSTRUMENT_SOURCES.items():
+        if calibration.get(key):
+            unit = "deg" if key.endswith("_deg") else "%"
+            out[source] = what.split(" (")[0] + f" (calibration.{key} = {calibration[key]:g} {unit})"
+    return out
 
 
 def warnings(ds: xr.Dataset) -> list[str]:

@@ -5,13 +5,18 @@ The normalised impacts with :data:`RECONSTRUCT_TABLE` added (:func:`ballbat.anal
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-from ..analysis import reconstruct_values
+import numpy as np
+
+from ..analysis import property_values, reconstruct_values
 from ..kinematics import ImpactFlag
 from ..pipeline.products import Var, add_variables, flag_attrs
-from ..properties import bat_record
+from ..properties import ball_variants, bat_record, bat_variants
+from ..systematics import PROPERTY_SHIFTED
+from .systematics import append_sources
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -67,4 +72,40 @@ def run(settings: ReconstructSettings, impacts: xr.Dataset, balls: dict[str, Bal
     out = add_variables(impacts, RECONSTRUCT_TABLE, reconstruct_values(impacts, balls, bats))
     used = sorted(set(impacts["bat"].values.astype(str)))
     out.attrs["bat_properties"] = bat_record({k: bats[k] for k in used})
-    return out
+    return append_sources(out, *property_shifts(out, balls, bats))
+
+
+def property_shifts(
+    rec: xr.Dataset, balls: dict[str, Ball], bats: dict[str, Bat]
+) -> tuple[list[str], np.ndarray, dict[str, np.ndarray], dict[str, str]]:
+    """Return the property sources of a dataset: one per stated uncertainty (``<column>_err``) of a bat or ball it uses.
+
+    Returns the sources' names (``bat:<bat>:<column>``, ``ball:<ball>:<column>``), their
+    relative standard uncertainties, per :data:`~ballbat.systematics.PROPERTY_SHIFTED` name the
+    shifts of every impact's properties at +1 and -1 sigma (source, side, impact: nonzero only for
+    that bat's, or ball's, impacts) and each source's description. Empty when none is stated.
+    """
+    ball_ids, bat_ids = rec["ball"].values.astype(str), rec["bat"].values.astype(str)
+    nominal = {k: rec[k].values for k in PROPERTY_SHIFTED}
+    names, rel, what = [], [], {}
+    shifts: dict[str, list[np.ndarray]] = {k: [] for k in PROPERTY_SHIFTED}
+    variants = [("bat", k, v, bats) for k in sorted(set(bat_ids)) for v in bat_variants(bats[k])]
+    variants += [("ball", k, v, balls) for k in sorted(set(ball_ids)) for v in ball_variants(balls[k])]
+    for kind, key, (col, value, sigma, plus, minus), _ in variants:
+        sides = []
+        for moved in (plus, minus):
+            sides.append(property_values(ball_ids, bat_ids, *_with(kind, key, moved, balls, bats)))
+        name = f"{kind}:{key}:{col}"
+        names.append(name)
+        rel.append(sigma / abs(value) if value else math.nan)
+        what[name] = f"{kind} {key}'s {col} = {value:g} +- {sigma:g} (the {kind} table's {col}_err)"
+        for k in PROPERTY_SHIFTED:
+            shifts[k].append(np.stack([side[k] - nominal[k] for side in sides]))
+    return names, np.array(rel, dtype=float), {k: np.array(v) for k, v in shifts.items()}, what
+
+
+def _with(kind: str, key: str, moved: Ball | Bat, balls: dict, bats: dict) -> tuple[dict, dict]:
+    """Return the tables with one bat (or ball) replaced by ``moved``."""
+    if kind == "bat":
+        return balls, {**bats, key: moved}
+    return {**balls, key: moved}, bats

@@ -25,7 +25,7 @@ from ..stronge.analysis import (
     vtf_data,
 )
 from ..stronge.regimes import Regime
-from ..systematics import SIDES, SOURCES, has_shifts, shifted_impacts
+from ..systematics import SIDES, SOURCES, has_shifts, shifted_impacts, source_names
 from .systematics import systematic_vars
 
 if TYPE_CHECKING:
@@ -308,7 +308,9 @@ def stronge_systematics(
         out[q][:, ~np.isfinite(ds[q].values)] = np.nan
     rel = rec["systematic_rel_sigma"].values
     what = "the tracks reduced again, then normalize, reconstruct and the eta^2 fit"
-    return systematic_vars(ds, out, what, rel)
+    if source_names(rec) != list(SOURCES):
+        what = "that source's shift of the measured values or properties, then normalize, reconstruct and the eta^2 fit"
+    return systematic_vars(ds, out, what, rel, rec["systematic"])
 
 
 def stronge_by_source(
@@ -332,11 +334,11 @@ def stronge_shifts(
     source without uncertainty. ``rec`` carries the shifts (:func:`has_shifts`).
     """
     rel = rec["systematic_rel_sigma"].values
-    out = {q: np.zeros((len(SOURCES), len(balls))) for q in names}
+    out = {q: np.zeros((rec.sizes["systematic"], len(balls))) for q in names}
     usable = rec["flag"].values == 0
     ball_of = rec["ball"].values.astype(str)
     kw = {"e_y": e_y, "mu": mu, "vary_e_y": vary_e_y, "vary_mu": vary_mu, "interval": False}
-    for i in range(len(SOURCES)):
+    for i in range(rec.sizes["systematic"]):
         if rel[i] == 0:
             continue
         fits = []
