@@ -27,12 +27,14 @@ BALLBAT = Path(sys.executable).parent / "ballbat"
 SOURCES = list(league.SHARING)
 
 
-def fit_file(folder: Path, dataset: str, bats: dict, ball: str = "baseball", older: bool = False) -> Path:
-    """Write ``folder/dataset/fit_ex.nc`` with ``bats``: name -> (e_x, stat, n, swing-scale systematic)."""
+def fit_file(
+    folder: Path, dataset: str, bats: dict, ball: str = "baseball", older: bool = False, sources: list = SOURCES
+) -> Path:
+    """Write ``folder/dataset/fit_ex.nc`` with ``bats``: name -> (e_x, stat, n, systematic of ``sources[0]``)."""
     names = list(bats)
     shape = (1, len(names))
     val = {k: np.array([[bats[b][i] for b in names]], dtype=float) for i, k in enumerate(("e_x", "err", "n", "s"))}
-    per = np.zeros((len(SOURCES), *shape))
+    per = np.zeros((len(sources), *shape))
     per[0] = val["s"]
     one = {"units": "1", "long_name": "x"}
     ds = xr.Dataset(
@@ -47,7 +49,7 @@ def fit_file(folder: Path, dataset: str, bats: dict, ball: str = "baseball", old
         coords={
             "ball": ("ball", np.array([ball]), {"long_name": "ball"}),
             "bat": ("bat", np.array(names), {"long_name": "bat"}),
-            "systematic": ("systematic", np.array(SOURCES), {"long_name": "source"}),
+            "systematic": ("systematic", np.array(sources), {"long_name": "source"}),
         },
     )
     if older:  # fit_ex.nc before the intrinsic scatter (issue 36) and the systematics by source
@@ -109,6 +111,20 @@ def test_across_sessions_systematics_add_in_quadrature(tmp_path):
     # a source calibrated once for every session (sharing: lab) cancels across sessions too
     lab = table(tmp_path / "s1", tmp_path / "s2", sharing={"swing_m_per_px": "lab"})
     assert pair(lab, "A", "B")["syst"] == pytest.approx(0.001, rel=1e-9)
+
+
+def test_a_property_tables_uncertainty_is_shared_by_every_session(tmp_path):
+    """A bat's property uncertainty (issue 35: ``bat:<bat>:<column>``) is the same table's in every
+    session: it does not average down over sessions, and a ball's is shared by every entry of it.
+    """
+    assert settings().kind("bat:A:M_oz") == "bat" and settings().kind("ball:baseball:m_oz") == "lab"
+    assert settings().kind("swing_m_per_px") == "session"
+    sources = ["bat:A:M_oz"]
+    fit_file(tmp_path / "s1", "d1", {"A": (0.45, 0.006, 20, 0.004)}, sources=sources)
+    fit_file(tmp_path / "s2", "d2", {"A": (0.46, 0.006, 20, 0.004)}, sources=sources)
+    r = row(table(tmp_path / "s1", tmp_path / "s2"), "A")
+    assert r["e_x_syst"] == pytest.approx(0.004, rel=1e-9)  # not 0.004 / sqrt(2)
+    assert r["e_x_stat"] == pytest.approx(0.006 / math.sqrt(2), rel=1e-9)
 
 
 def test_a_session_label_joins_datasets_into_one_session(tmp_path):

@@ -78,8 +78,17 @@ class LeagueSettings:
         return cls(block["reference_bat"], float(block["margin"]), float(block["alpha"]), dict(block["sharing"]))
 
     def kind(self, source: str) -> str:
-        """How ``source``'s systematic is shared (``session``, ``lab`` or ``bat``)."""
-        return self.sharing.get(source, SHARING.get(source, "session"))
+        """How ``source``'s systematic is shared (``session``, ``lab`` or ``bat``).
+
+        A property table's uncertainty (source ``bat:<bat>:<column>``, ``ball:<ball>:<column>``)
+        is the same table's in every session: ``bat`` for a bat's (its entries in every session),
+        ``lab`` for a ball's (every entry of that ball; the others' shift is 0).
+        """
+        if source in self.sharing:
+            return self.sharing[source]
+        if source.startswith("bat:"):
+            return "bat"
+        return "lab" if source.startswith("ball:") else SHARING.get(source, "session")
 
 
 @dataclass(frozen=True)
