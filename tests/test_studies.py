@@ -100,6 +100,21 @@ def test_dropping_a_dataset_drops_its_studies(raw, schema):
     assert list(drop_nulls(raw2)["studies"]) == ["design"]
 
 
+def test_drawing_properties_from_tables_without_uncertainties_is_refused_before_the_dag(raw, schema):
+    """draw_properties with tables that state no *_err: one line at the config check, not a failed job."""
+    raw["studies"]["calibration"]["draw_properties"] = True
+    with pytest.raises(ConfigError, match=r"studies.calibration.draw_properties: the tables .* state no uncertainty"):
+        validate_config(raw, schema, available=24 * 2**30)
+    raw["datasets"]["synthetic"]["bats"] = "config/examples/property_study_bats.csv"
+    raw["datasets"]["synthetic"]["synthetic"]["impacts"] = {"baseball": {"hickory": 10}}
+    raw["datasets"]["synthetic"]["synthetic"]["e_x"] = {"baseball": {"hickory": 0.455}}
+    raw["datasets"]["synthetic"]["synthetic"]["e_y"] = {"baseball": 0.45}
+    raw["datasets"]["synthetic"]["synthetic"]["psi_deg"] = {"baseball": [0.0, 30.0]}
+    raw["studies"] = {"calibration": raw["studies"]["calibration"]}
+    raw["implications"]["scenarios"] = {}
+    assert validate_config(raw, schema, available=24 * 2**30)["studies"]["calibration"]["draw_properties"]
+
+
 def test_a_study_of_a_measured_dataset_is_refused(raw, schema):
     raw["datasets"]["lab"] = {"impacts": "x.csv"}
     raw["studies"]["calibration"]["dataset"] = "lab"

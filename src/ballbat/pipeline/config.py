@@ -178,7 +178,28 @@ def _studies(config: dict, schema: dict | None = None) -> list[str]:
         else:
             found = check_study_sweep(ds, study, where)
             problems += found or _sweep_point_problems(ds, study, where, schema)
+            problems += _draw_properties_problems(config, ds, study, where)
     return problems
+
+
+def _draw_properties_problems(config: dict, dataset: dict, study: dict, where: str) -> list[str]:
+    """Return the problem of a study that draws properties from tables that state no uncertainty (no ``*_err``)."""
+    from ..properties import InputError, load_balls, load_bats
+
+    if not study.get("draw_properties"):
+        return []
+    tables = config.get("tables") or {}
+    paths = {k: dataset.get(k, tables.get(k)) for k in ("bats", "balls")}
+    try:
+        rows = [*load_bats(paths["bats"]).values(), *load_balls(paths["balls"]).values()]
+    except (InputError, OSError, ValueError, TypeError, UnicodeDecodeError):
+        return []  # a table that cannot be read: the jobs that read it say why
+    if any(r.err for r in rows):
+        return []
+    return [
+        f"{where}.draw_properties: the tables {paths['bats']} and {paths['balls']} state no uncertainty "
+        "(no *_err column): there is nothing to draw; add <column>_err beside the measured values, or set it false"
+    ]
 
 
 def _sweep_point_problems(dataset: dict, study: dict, where: str, schema: dict | None = None) -> list[str]:
