@@ -89,3 +89,13 @@ def test_code_lists_the_modules_a_script_imports(inputs):
     files = inputs.code("simulate.py")
     assert any(f.endswith("src/ballbat/stages/simulate.py") for f in files)
     assert not any(f.endswith("src/ballbat/plotting.py") for f in files)
+
+
+def test_league_targets(config):
+    """The league is made when there is something to compare: several datasets, or several bats of a ball."""
+    cfg = copy.deepcopy(config)
+    assert "results/league.nc" in WorkflowInputs(cfg, ROOT).league_targets()  # 3 baseball, 4 softball bats
+    cfg["datasets"]["synthetic"]["synthetic"]["impacts"] = {"baseball": {"wood": 20}}
+    assert WorkflowInputs(cfg, ROOT).league_targets() == []
+    cfg["datasets"]["lab"] = {"impacts": "lab.csv"}
+    assert len(WorkflowInputs(cfg, ROOT).league_targets()) == 4

@@ -589,21 +589,3 @@ def pair_lines(ds: xr.Dataset) -> list[str]:
             f"{'yes' if g['pair_differs'] else 'no'}"
         )
     return out
-
-
-def league_targets(config: dict) -> list[str]:
-    """Return the league products of a run (rule all), none unless it has something to compare.
-
-    Something to compare: more than one dataset, or a dataset with more than one bat of a ball
-    (a synthetic dataset's ``impacts`` say; a measured one's file is read only by its jobs, so it counts).
-    """
-    datasets = config["datasets"]
-
-    def several_bats(block: dict) -> bool:
-        if "synthetic" not in block:
-            return True
-        return max(sum(1 for n in per.values() if n) for per in block["synthetic"]["impacts"].values()) > 1
-
-    if len(datasets) > 1 or any(several_bats(b) for b in datasets.values()):
-        return ["results/league.nc", "results/league.csv", "results/league.xlsx", "results/figures/league_forest.png"]
-    return []

@@ -104,10 +104,6 @@ class WorkflowInputs:
         """Return the sha256 of each data file of a dataset (:func:`file_hashes`)."""
         return file_hashes(self.data_files(wildcards))
 
-    def tables_hashes(self, wildcards: Namespace) -> dict[str, str]:
-        """Return the sha256 of the property tables of config ``tables`` (the implications' balls and bats)."""
-        return file_hashes(self.config["tables"])
-
     def is_measured(self, name: str) -> bool:
         """Return whether a dataset is measured (it names its impacts file; a synthetic one has ``synthetic``)."""
         return "impacts" in self.config["datasets"][name]
@@ -244,6 +240,30 @@ class WorkflowInputs:
         if "paper" in self.sweep_scenarios:  # the paper's own scenario is compared with Sec. V.B
             targets += ["results/implications/paper_comparison.csv", "results/implications/paper_comparison.html"]
         return targets
+
+    def league_targets(self) -> list[str]:
+        """Return the league products of a run (rule all), none unless it has something to compare.
+
+        Something to compare: more than one dataset, or a dataset with more than one bat of a ball
+        (a synthetic dataset's ``impacts`` say; a measured one's file is read only by its jobs, so
+        it counts). Here, not in :mod:`ballbat.league`, so that Snakemake's start does not import
+        the statistics (scipy.stats: 1.4 s a start).
+        """
+
+        def several_bats(block: dict) -> bool:
+            if "synthetic" not in block:
+                return True
+            return max(sum(1 for n in per.values() if n) for per in block["synthetic"]["impacts"].values()) > 1
+
+        datasets = self.config["datasets"]
+        if len(datasets) > 1 or any(several_bats(b) for b in datasets.values()):
+            return [
+                "results/league.nc",
+                "results/league.csv",
+                "results/league.xlsx",
+                "results/figures/league_forest.png",
+            ]
+        return []
 
     # -- replicate studies ----------------------------------------------------------------
 

@@ -61,7 +61,6 @@ get_synthetic_settings = INPUTS.get_synthetic_settings
 get_measured_impacts = INPUTS.get_measured_impacts
 get_balls_table = INPUTS.get_balls_table
 get_bats_table = INPUTS.get_bats_table
-tables_hashes = INPUTS.tables_hashes
 dataset_kind = INPUTS.dataset_kind
 get_source = INPUTS.get_source
 final_targets = INPUTS.final_targets

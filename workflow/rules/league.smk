@@ -1,8 +1,6 @@
 # The bats league table (docs/league.md): every bat's e_x over the run's datasets, when there is
 # anything to compare (more than one dataset, or more than one bat of a ball in a dataset).
-from ballbat.league import league_targets
-
-LEAGUE_TARGETS = league_targets(config)
+LEAGUE_TARGETS = INPUTS.league_targets()
 
 
 rule league:
