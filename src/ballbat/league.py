@@ -124,8 +124,6 @@ def read_folder(folder: str | os.PathLike[str], session: str | None = None) -> l
     Raises :class:`LeagueInputError` naming the folder when it holds no fit_ex.nc or one the
     league cannot read.
     """
-    from .pipeline.ncio import read_dataset
-
     root = Path(folder)
     if not root.is_dir():
         raise LeagueInputError(f"{folder}: no such folder")
@@ -134,15 +132,26 @@ def read_folder(folder: str | os.PathLike[str], session: str | None = None) -> l
         raise LeagueInputError(f"{folder}: no fit_ex.nc in it or in its dataset folders (run the workflow first)")
     out = []
     for path in files:
-        try:
-            ds = read_dataset(path)
-        except (OSError, ValueError) as exc:
-            raise LeagueInputError(f"{folder}: {path.name} cannot be read: {exc}") from None
-        check_fit(ds, str(path))
-        dataset = path.parent.name
         name = str(path.parent) if path.parent != root else str(folder).rstrip("/") or str(root)
-        out.append(Session(session or name, str(root), dataset, ds))
+        out.append(read_session(path, session or name, str(root), where=str(folder)))
     return out
+
+
+def read_session(path: str | os.PathLike[str], label: str, folder: str, where: str | None = None) -> Session:
+    """Return the session of one fit_ex.nc (its dataset: the file's folder), named ``label``.
+
+    Raises :class:`LeagueInputError` when the file cannot be read (named after ``where``, default
+    the file) or lacks what the league reads (:func:`check_fit`).
+    """
+    from .pipeline.ncio import read_dataset
+
+    path = Path(path)
+    try:
+        ds = read_dataset(path)
+    except (OSError, ValueError) as exc:
+        raise LeagueInputError(f"{where or path.parent}: {path.name} cannot be read: {exc}") from None
+    check_fit(ds, str(path))
+    return Session(label, folder, path.parent.name, ds)
 
 
 def _by_source(ds: xr.Dataset, sources: list[str]) -> np.ndarray:
