@@ -6,6 +6,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import forked
 import pytest
 
 from ballbat.properties import load_balls, recoil_factors
@@ -16,13 +17,16 @@ BALLBAT = Path(sys.executable).parent / "ballbat"
 HICKORY = "--length 34 --weight 32 --balance-point 23.0 --moi-6in 11200 --impact-from-tip 6 --diameter 2.6 --iz 11"
 
 
-def ballbat(*args: str) -> subprocess.CompletedProcess:
+def ballbat(*args: str, installed: bool = False) -> subprocess.CompletedProcess:
+    """Run `ballbat ARGS`: the installed command, or (the default) a process forked with its libraries loaded."""
+    if not installed:
+        return forked.ballbat(*args, cwd=ROOT, timeout=120)
     assert BALLBAT.is_file(), f"{BALLBAT}: the entry point is not installed"
     return subprocess.run([str(BALLBAT), *args], capture_output=True, text=True, cwd=ROOT, timeout=120)
 
 
 def test_bat_prints_the_paper_row_and_the_centre_of_percussion():
-    got = ballbat("bat", *HICKORY.split(), "--name", "hickory")
+    got = ballbat("bat", *HICKORY.split(), "--name", "hickory", installed=True)
     assert got.returncode == 0, got.stderr
     lines = got.stdout.splitlines()
     # I0 = 11200 - 32 (23 - 6)^2 = 1952; b = 34 - 6 - 23 = 5; R = 1.3 (parallel-axis theorem)

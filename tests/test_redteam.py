@@ -17,6 +17,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import forked
 import numpy as np
 import pytest
 import yaml
@@ -32,10 +33,8 @@ RPM_PER_RAD_S = 60 / (2 * math.pi)
 
 
 def ballbat(*args: str, cwd: Path = ROOT) -> subprocess.CompletedProcess:
-    """Run the command line in this interpreter."""
-    return subprocess.run(
-        [sys.executable, "-m", "ballbat.cli", *map(str, args)], capture_output=True, text=True, timeout=120, cwd=cwd
-    )
+    """Run the command line in a process of its own (forked: :mod:`forked`)."""
+    return forked.ballbat(*args, cwd=cwd, timeout=120)
 
 
 # ---------------------------------------------------------------------------------------

@@ -12,7 +12,6 @@ from __future__ import annotations
 import errno
 import os
 import re
-import resource
 import shutil
 import stat
 import subprocess
@@ -26,6 +25,7 @@ import xarray as xr
 import yaml
 
 sys.path.insert(0, str(Path(__file__).parent))
+import forked
 from track_files import TOOL_NAMES, kva_text, read_long_csv, trk_text, write_lab_folder, write_trz
 
 from ballbat import cli
@@ -128,21 +128,8 @@ def test_every_case_has_its_tests():
 
 
 def ballbat(*args, cwd: Path = ROOT, mem_gib: float | None = None) -> subprocess.CompletedProcess:
-    """Run the command line in this interpreter (under a memory limit of ``mem_gib``, if given)."""
-
-    def limit():
-        if mem_gib:
-            cap = int(mem_gib * 2**30)
-            resource.setrlimit(resource.RLIMIT_AS, (cap, cap))
-
-    return subprocess.run(
-        [sys.executable, "-m", "ballbat.cli", *map(str, args)],
-        capture_output=True,
-        text=True,
-        timeout=300,
-        cwd=cwd,
-        preexec_fn=limit,
-    )
+    """Run the command line in a process of its own (forked: :mod:`forked`), under a memory limit of ``mem_gib``."""
+    return forked.ballbat(*args, cwd=cwd, timeout=300, mem_gib=mem_gib)
 
 
 def one_line(out: subprocess.CompletedProcess, status: int, text: str) -> None:

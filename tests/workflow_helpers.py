@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import forked
+
 ROOT = Path(__file__).resolve().parents[1]
 
 
@@ -80,79 +82,16 @@ def copy_run(finished: Path, dest: Path) -> Path:
     return dest
 
 
-#: Imported once per test process by a fork server (:mod:`snakemake_preload`: Snakemake, the
-#: third-party libraries its start imports, its plugin registries): every run of :func:`snakemake`
-#: is a child forked from it (the real ``snakemake`` command line, ``main``), so that the suite's
-#: many short runs do not each pay the interpreter's start and those imports.
-PRELOAD = ["snakemake_preload"]
-_CONTEXT = None
-
-
-def _context():
-    global _CONTEXT
-    if _CONTEXT is None:
-        import multiprocessing
-        from multiprocessing import forkserver
-
-        _CONTEXT = multiprocessing.get_context("forkserver")
-        _CONTEXT.set_forkserver_preload(PRELOAD)
-        # The server starts with this folder on its path, so that it finds the preload module
-        # (Python 3.11's fork server ignores the parent's sys.path, and skips a preload it
-        # cannot import without a word); the runs it forks set their own environment.
-        saved = os.environ.get("PYTHONPATH")
-        os.environ["PYTHONPATH"] = os.pathsep.join(p for p in (str(Path(__file__).parent), saved) if p)
-        try:
-            forkserver.ensure_running()
-        finally:
-            if saved is None:
-                del os.environ["PYTHONPATH"]
-            else:
-                os.environ["PYTHONPATH"] = saved
-    return _CONTEXT
-
-
-def _snakemake_main(workdir: str, args: list[str], env: dict, out: str, err: str) -> None:
-    """The child: ``python -m snakemake ARGS`` in ``workdir`` with ``env``, its output in two files."""
-    if PRELOAD[0] not in sys.modules:  # the server skips a preload it cannot import, silently
-        raise RuntimeError(f"the fork server did not preload {PRELOAD[0]}: see workflow_helpers._context")
-    os.chdir(workdir)
-    os.environ.clear()
-    os.environ.update(env)
-    sys.path[:0] = [p for p in env.get("PYTHONPATH", "").split(os.pathsep) if p]
-    for fd, path in ((1, out), (2, err)):
-        handle = os.open(path, os.O_WRONLY | os.O_CREAT | os.O_TRUNC, 0o644)
-        os.dup2(handle, fd)
-        os.close(handle)
-    sys.stdout = open(1, "w", closefd=False)  # the child's own streams, left open for its exit
-    sys.stderr = open(2, "w", closefd=False)
-    sys.argv = ["snakemake", *args]
-    from snakemake.cli import main
-
-    main()
-
-
 def snakemake(workdir: Path, *args: str, check: bool = True, timeout: int = 600) -> subprocess.CompletedProcess:
     """Run ``python -m snakemake ARGS`` in ``workdir`` (with workdir/src first on the path if present).
 
-    The run is a child of a fork server that has Snakemake imported (:data:`PRELOAD`); its exit
+    The run is a child of a fork server that has Snakemake imported (:mod:`forked`); its exit
     status, standard output and standard error come back as those of a subprocess.
     """
-    import tempfile
-
     env = dict(os.environ)
     if (workdir / "src").is_dir():
         env["PYTHONPATH"] = os.pathsep.join([str(workdir / "src"), env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
-    with tempfile.TemporaryDirectory() as tmp:
-        out, err = os.path.join(tmp, "stdout"), os.path.join(tmp, "stderr")
-        child = _context().Process(target=_snakemake_main, args=(str(workdir), list(args), env, out, err))
-        child.start()
-        child.join(timeout)
-        if child.exitcode is None:
-            child.kill()
-            child.join()
-            raise subprocess.TimeoutExpired(["snakemake", *args], timeout)
-        with open(out) as fh_out, open(err) as fh_err:
-            proc = subprocess.CompletedProcess(["snakemake", *args], child.exitcode, fh_out.read(), fh_err.read())
+    proc = forked.run("snakemake", workdir, list(args), env=env, timeout=timeout)
     if check and proc.returncode != 0:
         raise AssertionError(f"snakemake {' '.join(args)} failed:\n{proc.stdout[-4000:]}\n{proc.stderr[-4000:]}")
     return proc
