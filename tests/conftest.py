@@ -55,12 +55,17 @@ def _shared_run(tmp_path_factory, name: str, build) -> Path:
     a worker that needs it while another builds it waits, and a finished build is marked
     (``.built``) so that no one builds it twice. A failed build is marked too, with its error,
     so that the other worker fails at once instead of building it again.
+
+    ``BALLBAT_TEST_SHARED_RUNS`` names a folder to keep the runs in between sessions (for work on
+    one test; a run built by other code is not rebuilt: remove its ``.built`` mark).
     """
     import fcntl
 
     base = tmp_path_factory.getbasetemp()
     if os.environ.get("PYTEST_XDIST_WORKER"):
         base = base.parent  # shared by the session's workers
+    if os.environ.get("BALLBAT_TEST_SHARED_RUNS"):  # a developer's folder of runs kept between sessions
+        base = Path(os.environ["BALLBAT_TEST_SHARED_RUNS"])
     work, done, failed = base / name, base / f"{name}.built", base / f"{name}.failed"
     with open(base / f"{name}.lock", "w") as lock:  # closing the file releases the lock
         fcntl.flock(lock, fcntl.LOCK_EX)

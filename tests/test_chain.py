@@ -4,13 +4,14 @@
 what the studies and ``ballbat check`` run; the workflow's rules run the same stages one by one
 through their files. Every variable of reduce.nc / ingest.nc and fit_ex.nc must agree, value for
 value (a rendered dataset's at round-off: its tracks make a round trip through tracks.nc): a
-rendered dataset (the default run's), a measured impacts file (maple) and a tracks file (tracked,
-of the lab run).
+rendered dataset (the default run's), a measured impacts file (maple), a tracks file (tracked,
+of the lab run) and a folder of Tracker projects (trk, of the lab run; ``ballbat check``'s reduction too).
 """
 
 from __future__ import annotations
 
 import copy
+import dataclasses
 
 import numpy as np
 import pytest
@@ -105,3 +106,36 @@ def test_check_uses_the_workflows_defaults(config):
     workflow = chain.DatasetSettings.from_config(config, "synthetic")
     assert check.normalize == workflow.normalize and check.fit_ex == workflow.fit_ex
     assert copy.deepcopy(check.block) == {"impacts": "x.csv"}
+
+
+@pytest.mark.slow
+def test_a_folder_of_tracker_files(lab_run, monkeypatch):
+    """The lab run's ``trk`` dataset (a folder of Tracker projects): the chain in memory, and ``ballbat check``'s
+    reduction of the same block, give the workflow's reduce.nc (import_tracks, then reduce) and fit_ex.nc.
+    """
+    from ballbat.stages import reduce
+    from ballbat.tracks.data import camera_block, with_found_settings
+    from ballbat.tracks.formats.layout import import_block
+
+    monkeypatch.chdir(lab_run)
+    cfg = _config(lab_run, "tools.yaml")
+    balls, bats = load_balls(cfg["tables"]["balls"]), load_bats(cfg["tables"]["bats"])
+    block = cfg["datasets"]["trk"]["tracks"]
+    res = lab_run / "results" / "trk"
+    tracks, imported = import_block(block, "datasets.trk.tracks", balls, bats)
+    found = with_found_settings(camera_block(block), imported.settings_yaml())
+    settings = chain.DatasetSettings.from_config(cfg, "trk")
+    settings = dataclasses.replace(
+        settings, reduce=reduce.ReduceSettings.from_config(found, "datasets.trk.tracks", systematics=True)
+    )
+    # exactly: the import's tracks file keeps every digit of the pixels
+    src = chain.source(settings, balls, bats, tracks=tracks)
+    _same(src, res / "reduce.nc")
+    _same(chain.run(settings, src, balls, bats).fit_ex, res / "fit_ex.nc")
+    red, verdict = chain.reduce_tracks_block(block, "datasets.trk.tracks", balls, bats)  # ballbat check's
+    checked = reduce.reduction_dataset(red)
+    with xr.open_dataset(res / "reduce.nc") as ds:  # a check runs no calibration reruns: no systematic's variables
+        syst = {k for k in ds.data_vars if "systematic" in ds[k].dims or k.startswith("systematic")}
+    assert syst and not syst & set(checked.data_vars)
+    _same(checked.assign({k: src[k] for k in syst}), res / "reduce.nc")
+    assert verdict.lines and "\n".join(verdict.lines) == src.attrs["reduce_checks"]
