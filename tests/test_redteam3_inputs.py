@@ -29,8 +29,9 @@ sys.path.insert(0, str(Path(__file__).parent))
 from track_files import TOOL_NAMES, kva_text, read_long_csv, trk_text, write_lab_folder, write_trz
 
 from ballbat import cli
+from ballbat.config_checks import validate_config
 from ballbat.pipeline.checked import DamagedFileError
-from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.pipeline.config import ConfigError
 from ballbat.pipeline.ncio import read_dataset, write_dataset
 from ballbat.pipeline.provenance import sha256_file
 from ballbat.pipeline.runlog import logged
@@ -430,7 +431,7 @@ def test_yaml_alias_bomb(tmp_path, raw):
     bomb = tmp_path / "bomb.yaml"
     bomb.write_text("\n".join(lines) + "\n")
     code = (
-        "import sys, yaml; from ballbat.pipeline.config import ConfigError, validate_config\n"
+        "import sys, yaml; from ballbat.config_checks import ConfigError, validate_config\n"
         "cfg = yaml.safe_load(open(sys.argv[2])); cfg['datasets']['synthetic']['extra'] = yaml.safe_load("
         "open(sys.argv[1]))\n"
         "schema = yaml.safe_load(open('workflow/schemas/config.schema.yaml'))\n"
