@@ -109,8 +109,6 @@ ORCHESTRATION = (
     "ballbat.chain",
     "ballbat.studies",
     "ballbat.cli",
-    "ballbat.batcli",
-    "ballbat.video.cli",
 )
 
 #: Layers that import nothing of the orchestration (issue 33: no upward imports).

@@ -9,7 +9,7 @@ dataset block), and :func:`run` runs the stages in the workflow's order on it:
 * :mod:`~ballbat.stages.normalize`, :mod:`~ballbat.stages.reconstruct` and
   :mod:`~ballbat.stages.fit_ex` (:func:`run`).
 
-The replicate studies (:mod:`ballbat.studies`), ``ballbat check`` (:mod:`ballbat.cli`) and the
+The replicate studies (:mod:`ballbat.studies`), ``ballbat check`` (:mod:`ballbat.cli.check`) and the
 tests call these; the workflow's rules call the same stages one by one, each writing its file.
 No other module chains stages.
 """
