@@ -25,7 +25,8 @@ from collections import defaultdict
 
 from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.stages import fit_ex, normalize, reconstruct, reduce, render, simulate, study_batch
+from ballbat.stages import fit_ex, normalize, reconstruct, reduce, render, simulate
+from ballbat.studies import batch as study_batch
 from ballbat.studies import replicates
 from ballbat.studies.settings import StudySettings
 

@@ -30,7 +30,7 @@ sys.path.insert(0, str(ROOT / "src"))
 
 from ballbat.config_checks import validate_config  # noqa: E402
 from ballbat.properties import load_balls, load_bats  # noqa: E402
-from ballbat.stages import study_batch  # noqa: E402
+from ballbat.studies import batch as study_batch  # noqa: E402
 from ballbat.studies.coverage import combine, coverage  # noqa: E402
 from ballbat.studies.settings import StudySettings  # noqa: E402
 
