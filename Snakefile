@@ -49,6 +49,8 @@ localrules:
     tracks_qa,
     studies,
     study_design,
+    plot_study_coverage,
+    plot_study_design,
     report_front,
     report_front_studies,
 

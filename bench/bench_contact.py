@@ -2,7 +2,7 @@
 
 The default ``synthetic`` dataset (108 impacts rendered as camera tracks and reduced) with the
 renderer's contact time drawn from a chosen range, ``N`` replicates per range through the
-study's own in-memory functions (``ballbat.study_batch.run``, the design's truth from
+study's own in-memory functions (``ballbat.studies.batch.run``, the design's truth from
 ``population_truth``, ``coverage``), in one process. Prints, per quantity (e_x per bat and
 pooled, the implied e_y), the bias over the standard error and the 95 % coverage, each with
 its binomial or standard error. Targets: |bias| <= 0.25 SE, coverage 93-97 %.
@@ -19,10 +19,12 @@ from __future__ import annotations
 import argparse
 import time
 
-from ballbat import study_batch
-from ballbat.pipeline.config import load_config
+from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.studies import StudySettings, combine, coverage, population_truth
+from ballbat.studies import batch as study_batch
+from ballbat.studies.coverage import combine, coverage
+from ballbat.studies.settings import StudySettings
+from ballbat.studies.truth import population_truth
 
 QUANTITIES = ("e_x", "e_x_pooled", "e_y_implied")
 

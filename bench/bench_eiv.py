@@ -2,11 +2,11 @@
 
 For each set-up (the shipped calibration; 5 px tracking noise at the paper's size; 3.5 px
 with 60 impacts per bat) it runs replicate experiments through the study's chain
-(:func:`ballbat.study_batch.run`) twice on the same replicates: with the fits as they
+(:func:`ballbat.studies.batch.run`) twice on the same replicates: with the fits as they
 were (weighted least squares, which the abscissa's noise attenuates) and with the
 moment-corrected fits (``linefit.eiv_line``, ``fitting.implied_e_y``). Each replicate's
 experiment and tracks are simulated once and reused by the second pass. The design's truth
-(:func:`ballbat.studies.population_truth`) is computed once per set-up, with
+(:func:`ballbat.studies.truth.population_truth`) is computed once per set-up, with
 ``truth_impacts`` noise-free impacts per ball and bat (3000 here: it scatters by about 0.1
 of a replicate's standard error, docs/studies.md).
 
@@ -21,13 +21,19 @@ from __future__ import annotations
 import sys
 import time
 from contextlib import contextmanager
+from dataclasses import replace
 from unittest import mock
 
 import numpy as np
 
-from ballbat import chain, fitting, studies, study_batch
-from ballbat.pipeline.config import load_config
+from ballbat import chain, fitting
+from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
+from ballbat.studies import batch as study_batch
+from ballbat.studies.coverage import coverage
+from ballbat.studies.settings import StudySettings
+from ballbat.studies.sweeps import point_dataset
+from ballbat.studies.truth import population_truth
 
 #: name -> (replicates, [(sweep parameter, value), ...])
 SETUPS = {
@@ -53,14 +59,14 @@ def plain_fits():
         yield
 
 
-def settings_for(cfg: dict, name: str) -> studies.StudySettings:
+def settings_for(cfg: dict, name: str) -> StudySettings:
     """The calibration study's settings at set-up ``name`` (one batch, 3000-impact truth)."""
     reps, sets = SETUPS[name]
-    s = studies.StudySettings.from_config(cfg, "calibration")
+    s = StudySettings.from_config(cfg, "calibration")
     ds = s.dataset
     for par, val in sets:
-        ds = studies.point_dataset(ds, par, val)
-    return studies.replace(s, dataset=ds, replicates=reps, batch_size=reps, truth_impacts=3000)
+        ds = point_dataset(ds, par, val)
+    return replace(s, dataset=ds, replicates=reps, batch_size=reps, truth_impacts=3000)
 
 
 def table(cov, label: str) -> list[str]:
@@ -100,10 +106,10 @@ def main() -> None:
     for name in names:
         s = settings_for(cfg, name)
         if reps:
-            s = studies.replace(s, replicates=reps, batch_size=reps)
+            s = replace(s, replicates=reps, batch_size=reps)
         cache.clear()
         t0 = time.perf_counter()
-        truth = [studies.population_truth(s, 0, balls, bats)]
+        truth = [population_truth(s, 0, balls, bats)]
         t_truth = time.perf_counter() - t0
         out = [f"{name}: {s.replicates} replicates (truth {t_truth:.0f} s)"]
         with mock.patch.object(chain, "source", cached_source):
@@ -115,7 +121,7 @@ def main() -> None:
                 else:
                     rep = study_batch.run(s, 0, balls, bats)
                 dt = time.perf_counter() - t0
-                cov = studies.coverage(rep, truth)
+                cov = coverage(rep, truth)
                 out += [*table(cov, label), f"  {label}: {dt:.0f} s"]
         print("\n".join(out), flush=True)
 

@@ -1,10 +1,10 @@
 """Calls of Stronge's model and CPU time of the eta^2 fits in calibration replicates (issue 39).
 
 Runs ``N`` replicates (default 5) of the calibration study as its batch job does
-(``ballbat.study_batch.run``, batch 1) after one warm-up replicate and prints, per
+(``ballbat.studies.batch.run``, batch 1) after one warm-up replicate and prints, per
 replicate, how many times :func:`ballbat.stronge.model.stronge_ex` is called and from where
 (the function that called it), and the CPU time (``time.process_time``) of the eta^2 fits
-(``studies._eta2``: the measured fit and the noise-free truth of each ball). Repeat the run
+(``_eta2``: the measured fit and the noise-free truth of each ball). Repeat the run
 and read the smallest time when the machine is shared.
 
 Run: ``.venv/bin/python bench/bench_eta2_calls.py [N]``.
@@ -17,10 +17,12 @@ import sys
 import time
 import traceback
 
-from ballbat import studies, study_batch
-from ballbat.pipeline.config import load_config
+from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
 from ballbat.stronge import analysis, fit, model
+from ballbat.studies import batch as study_batch
+from ballbat.studies import replicates
+from ballbat.studies.settings import StudySettings
 
 CALLS: collections.Counter[str] = collections.Counter()
 SPENT = [0.0]
@@ -50,12 +52,12 @@ def main(n: int = 5) -> None:
     cfg = load_config()
     balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
     cfg["studies"]["calibration"]["batch_size"] = 1
-    study_batch.run(studies.StudySettings.from_config(cfg, "calibration"), 0, balls, bats)  # warm-up
+    study_batch.run(StudySettings.from_config(cfg, "calibration"), 0, balls, bats)  # warm-up
     cfg["studies"]["calibration"]["batch_size"] = n
     counted = _counted(model.stronge_ex)
     fit.stronge_ex = analysis.stronge_ex = counted
-    studies._eta2 = _timed(studies._eta2)
-    study_batch.run(studies.StudySettings.from_config(cfg, "calibration"), 1, balls, bats)
+    replicates._eta2 = _timed(replicates._eta2)
+    study_batch.run(StudySettings.from_config(cfg, "calibration"), 1, balls, bats)
     print(f"{n} calibration replicates: stronge_ex calls per replicate, by caller")
     for name, k in CALLS.most_common():
         print(f"  {name:<24} {k / n:6.1f}")

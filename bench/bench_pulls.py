@@ -1,7 +1,7 @@
 """Per-impact pulls of the reduced quantities at one point of the robustness grid.
 
 Renders and reduces replicate experiments as a replicate study does
-(:func:`ballbat.studies.replicate_source`) and prints, per ball and quantity, the mean and spread of
+(:func:`ballbat.studies.replicates.replicate_source`) and prints, per ball and quantity, the mean and spread of
 (value − truth) / stated error over every impact the reduction keeps. A mean away from 0 is a
 bias of every impact. It becomes about mean * sqrt(n) standard errors on anything fitted to n
 impacts (docs/studies.md, "Where softballs' implied e_y goes wrong").
@@ -16,10 +16,11 @@ import argparse
 
 import numpy as np
 
-from ballbat import studies
-from ballbat.pipeline.config import load_config
+from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.sweeps import point_dataset
+from ballbat.studies.replicates import replicate_seeds, replicate_source
+from ballbat.studies.settings import StudySettings
+from ballbat.studies.sweeps import point_dataset
 
 QUANTITIES = ("v_bat", "v_ball", "theta", "omega")
 
@@ -31,11 +32,11 @@ def pulls(px: float, per_bat: int, contact_ms: float, replicates: int, draw: boo
     block = cfg["studies"]["robustness"]
     block["sweep"] = {"grid": {"pixel_noise_px": [px], "impacts_per_bat": [per_bat], "contact_ms": [contact_ms]}}
     block["draw_calibration"] = draw
-    s = studies.StudySettings.from_config(cfg, "robustness")
+    s = StudySettings.from_config(cfg, "robustness")
     dataset = point_dataset(s.dataset, s.parameter, s.values[0])
     out: dict = {}
     for rep in range(replicates):
-        src = studies.replicate_source(dataset, studies.replicate_seeds(s.seed, rep), balls, bats, check=False)
+        src = replicate_source(dataset, replicate_seeds(s.seed, rep), balls, bats, check=False)
         kept = src["ingest_flag"].values == 0
         ball = src["ball"].values.astype(str)
         for b in np.unique(ball):

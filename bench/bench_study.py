@@ -27,10 +27,10 @@ from ballbat.pipeline.ncio import read_table_csv
 
 CHILD = """
 import resource, sys, time
-from ballbat.pipeline.config import load_config
+from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat import study_batch
-from ballbat.studies import StudySettings
+from ballbat.studies import batch as study_batch
+from ballbat.studies.settings import StudySettings
 n = int(sys.argv[1])
 cfg = load_config()
 cfg["studies"]["calibration"]["batch_size"] = n

@@ -23,7 +23,7 @@ from pathlib import Path
 
 import numpy as np
 
-from ballbat.pipeline.config import load_config
+from ballbat.config_checks import load_config
 from ballbat.properties import InputError, load_balls, load_bats
 from ballbat.stages import simulate
 from ballbat.stages.impacts import SIMULATED_TRUTH

@@ -1,7 +1,7 @@
 """Benchmark: a study's truth job, its memory plan against its measured peak (issue 40).
 
 The truth job of one sweep point holds the design's large noise-free experiment; its size is
-``StudySettings.truth_counts`` (``ballbat.sweeps.truth_counts``) and its memory plan, what
+``StudySettings.truth_counts`` (``ballbat.studies.sweeps.truth_counts``) and its memory plan, what
 Snakemake schedules it with, ``StudySettings.truth_mem_mb``. For each design below a child
 process runs the truth job's code (``studies.truth_dataset`` of one point) and reports its peak
 resident memory. Target: the plan covers the peak and is within 1.5 times it.
@@ -42,9 +42,10 @@ DESIGNS = {
 }
 CHILD = """
 import json, resource, sys, time
-from ballbat.pipeline.config import load_config
+from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.studies import StudySettings, truth_dataset
+from ballbat.studies.settings import StudySettings
+from ballbat.studies.truth import truth_dataset
 impacts, truth_impacts = json.loads(sys.argv[1])
 cfg = load_config()
 if impacts is not None:

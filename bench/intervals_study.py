@@ -1,7 +1,7 @@
 """Issue 36: coverage of implied e_y's interval forms and of e_x with intrinsic scatter, per set-up.
 
 Each set-up's replicate experiments are simulated, rendered and reduced once
-(:func:`ballbat.studies._source`, cached) and fitted once per estimator variant on the same
+(:func:`ballbat.studies.replicates._source`, cached) and fitted once per estimator variant on the same
 replicates: implied e_y's sandwich form (:data:`ballbat.fitting.E_Y_SANDWICH`: ``hc0k``, the
 first version; ``hc2``, shipped; ``hc3``) and the e_x fits with or without the intrinsic-scatter
 term (:data:`ballbat.linefit.SCATTER_TERM`). Variants: ``before`` (hc0k, no term), ``hc2`` (no
@@ -19,11 +19,18 @@ from __future__ import annotations
 
 import sys
 import time
+from dataclasses import replace
 from unittest import mock
 
-from ballbat import fitting, linefit, studies, study_batch
-from ballbat.pipeline.config import load_config
+from ballbat import fitting, linefit
+from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
+from ballbat.studies import batch as study_batch
+from ballbat.studies import replicates
+from ballbat.studies.coverage import coverage
+from ballbat.studies.replicates import STUDY_QUANTITIES
+from ballbat.studies.settings import StudySettings
+from ballbat.studies.truth import population_truth
 
 
 def _cameras(ds: dict, swing: float, spin: float) -> dict:
@@ -77,24 +84,24 @@ def main() -> None:
     cfg = load_config()
     balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
     cache: dict = {}
-    real_source = studies._source
+    real_source = replicates._source
 
     def cached_source(dataset, seeds, *rest):
         if seeds not in cache:
             cache[seeds] = real_source(dataset, seeds, *rest)
         return cache[seeds]
 
-    quantities = tuple(q for q in studies.STUDY_QUANTITIES if q != "eta2")
+    quantities = tuple(q for q in STUDY_QUANTITIES if q != "eta2")
     for name in names:
-        s = studies.StudySettings.from_config(cfg, "calibration")
-        s = studies.replace(s, dataset=SETUPS[name](s.dataset), replicates=reps, batch_size=reps, truth_impacts=2000)
+        s = StudySettings.from_config(cfg, "calibration")
+        s = replace(s, dataset=SETUPS[name](s.dataset), replicates=reps, batch_size=reps, truth_impacts=2000)
         cache.clear()
         t0 = time.perf_counter()
-        truth = [studies.population_truth(s, 0, balls, bats)]
+        truth = [population_truth(s, 0, balls, bats)]
         out = [f"{name}: {reps} replicates (truth {time.perf_counter() - t0:.0f} s)"]
         with (
-            mock.patch.object(studies, "_source", cached_source),
-            mock.patch.object(studies, "STUDY_QUANTITIES", quantities),
+            mock.patch.object(replicates, "_source", cached_source),
+            mock.patch.object(replicates, "STUDY_QUANTITIES", quantities),
         ):
             for label in variants:
                 form, term = VARIANTS[label]
@@ -104,8 +111,8 @@ def main() -> None:
                     mock.patch.object(linefit, "SCATTER_TERM", term),
                 ):
                     rep = study_batch.run(s, 0, balls, bats)
-                    truth_v = [studies.population_truth(s, 0, balls, bats)] if term else truth
-                out += [*table(studies.coverage(rep, truth_v), label), f"  {label}: {time.perf_counter() - t0:.0f} s"]
+                    truth_v = [population_truth(s, 0, balls, bats)] if term else truth
+                out += [*table(coverage(rep, truth_v), label), f"  {label}: {time.perf_counter() - t0:.0f} s"]
         print("\n".join(out), flush=True)
 
 

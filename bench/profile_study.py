@@ -1,7 +1,7 @@
 """Profile of a replicate study: where one replicate's time goes, by stage and by function (issue 39).
 
 Runs ``N`` replicates (default 10) of a shipped study (default ``calibration``) in this
-process, exactly as its batch job does (``ballbat.study_batch.run``), after one warm-up
+process, exactly as its batch job does (``ballbat.studies.batch.run``), after one warm-up
 replicate, and prints:
 
 1. CPU time per replicate of each stage of the chain (simulate, render, reduce with its
@@ -23,10 +23,12 @@ import sys
 import time
 from collections import defaultdict
 
-from ballbat import studies
-from ballbat.pipeline.config import load_config
+from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.stages import fit_ex, normalize, reconstruct, reduce, render, simulate, study_batch
+from ballbat.stages import fit_ex, normalize, reconstruct, reduce, render, simulate
+from ballbat.studies import batch as study_batch
+from ballbat.studies import replicates
+from ballbat.studies.settings import StudySettings
 
 #: (module, function name, label): the stage functions a replicate calls, timed where they are looked up.
 STAGES = [
@@ -38,8 +40,8 @@ STAGES = [
     (normalize, "run", "normalize"),
     (reconstruct, "run", "reconstruct (x2: measured, truth)"),
     (fit_ex, "fit", "fit_ex (Sec. IV fits)"),
-    (studies, "_eta2", "eta^2 fits (value and truth)"),
-    (studies, "_eta2_systematic", "eta^2 systematics"),
+    (replicates, "_eta2", "eta^2 fits (value and truth)"),
+    (replicates, "_eta2_systematic", "eta^2 systematics"),
 ]
 
 SPENT: dict[str, float] = defaultdict(float)
@@ -68,9 +70,9 @@ def main(n: int = 10, study: str = "calibration") -> None:
     """Profile ``n`` replicates of ``study``; print the stage table and the top functions."""
     cfg = load_config()
     cfg["studies"][study]["batch_size"] = n
-    s = studies.StudySettings.from_config(cfg, study)
+    s = StudySettings.from_config(cfg, study)
     balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
-    warm = studies.StudySettings.from_config(
+    warm = StudySettings.from_config(
         {**cfg, "studies": {**cfg["studies"], study: {**cfg["studies"][study], "batch_size": 1}}}, study
     )
     study_batch.run(warm, 0, balls, bats)  # imports and caches

@@ -28,11 +28,11 @@ import yaml
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "src"))
 
-from ballbat.pipeline.config import validate_config  # noqa: E402
+from ballbat.config_checks import validate_config  # noqa: E402
 from ballbat.properties import load_balls, load_bats  # noqa: E402
-from ballbat.stages import study_batch  # noqa: E402
-from ballbat.studies import combine, coverage  # noqa: E402
-from ballbat.study_settings import StudySettings  # noqa: E402
+from ballbat.studies import batch as study_batch  # noqa: E402
+from ballbat.studies.coverage import combine, coverage  # noqa: E402
+from ballbat.studies.settings import StudySettings  # noqa: E402
 
 EXAMPLE = ROOT / "config" / "examples" / "property_study.yaml"
 COLUMNS = (

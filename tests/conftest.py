@@ -9,7 +9,7 @@ from pathlib import Path
 import pytest
 import yaml
 
-from ballbat.pipeline.config import load_config
+from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
 
 ROOT = Path(__file__).resolve().parents[1]

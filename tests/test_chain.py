@@ -19,7 +19,8 @@ import xarray as xr
 import yaml
 
 from ballbat import chain
-from ballbat.pipeline.config import packaged_schema, validate_config
+from ballbat.config_checks import validate_config
+from ballbat.pipeline.config import packaged_schema
 from ballbat.properties import load_balls, load_bats
 from ballbat.tracks.io import load_tracks
 

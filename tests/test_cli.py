@@ -14,6 +14,7 @@ import pytest
 from conftest import ROOT
 
 from ballbat import __version__, cli
+from ballbat.cli.common import EXAMPLES
 
 BALLBAT = Path(sys.executable).parent / "ballbat"
 MAPLE = ROOT / "config" / "examples" / "maple_impacts.csv"
@@ -84,12 +85,12 @@ def test_help_ends_with_its_examples(command):
     out = ballbat(command, "--help")
     assert out.returncode == 0 and out.stderr == ""
     assert out.stdout.startswith(f"usage: ballbat {command} ")
-    assert out.stdout.endswith("\n\n" + cli.EXAMPLES[command] + "\n")
+    assert out.stdout.endswith("\n\n" + EXAMPLES[command] + "\n")
 
 
 def _examples() -> list[str]:
     """The one-line examples of every command's help (a continued line or one with '...' is a sketch)."""
-    lines = [line.strip() for text in cli.EXAMPLES.values() for line in text.splitlines()]
+    lines = [line.strip() for text in EXAMPLES.values() for line in text.splitlines()]
     return [line.split("  (")[0].strip() for line in lines if line.startswith("ballbat ") and "\\" not in line]
 
 

@@ -5,7 +5,8 @@ import copy
 import pytest
 import yaml
 
-from ballbat.pipeline.config import ConfigError, drop_nulls, validate_config
+from ballbat.config_checks import validate_config
+from ballbat.pipeline.config import ConfigError, drop_nulls
 
 
 @pytest.fixture

@@ -6,8 +6,8 @@ import numpy as np
 import pytest
 import yaml
 
+from ballbat.config_checks import validate_config
 from ballbat.implications import comparison_rows, density_from_conditions, launch_conditions
-from ballbat.pipeline.config import validate_config
 from ballbat.stages.implications import ImplicationsSettings
 from ballbat.stages.implications import run as run_scenario
 from ballbat.units import DEGREE, FOOT, INCH, MPH, RPM

@@ -13,9 +13,10 @@ import xarray as xr
 import yaml
 
 from ballbat import ingest
+from ballbat.config_checks import validate_config
 from ballbat.fitting import FitStatus
 from ballbat.kinematics import ImpactFlag
-from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.pipeline.config import ConfigError
 from ballbat.pipeline.ncio import check_metadata
 from ballbat.properties import InputError, load_balls, load_bats
 from ballbat.stages import fit_ex, normalize, reconstruct

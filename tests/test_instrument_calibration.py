@@ -17,7 +17,8 @@ import yaml
 
 from ballbat import chain
 from ballbat.compare import NO_SYSTEMATIC_NOTE, SYSTEMATIC_NOTE, systematic_note
-from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.config_checks import validate_config
+from ballbat.pipeline.config import ConfigError
 from ballbat.properties import load_balls, load_bats
 
 ROOT = Path(__file__).resolve().parents[1]

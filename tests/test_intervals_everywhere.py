@@ -107,13 +107,13 @@ def test_the_switch_turns_the_term_off(monkeypatch):
 
 
 def _dataset():
-    from ballbat.pipeline.config import load_config
+    from ballbat.config_checks import load_config
 
     return load_config()["datasets"]["synthetic"]
 
 
 def test_sweep_sets_scatter_psi_range_and_spin_noise():
-    from ballbat.sweeps import point_dataset
+    from ballbat.studies.sweeps import point_dataset
 
     base = _dataset()
     ds = point_dataset(base, ["e_x_scatter", "psi_max_scale", "spin_pixel_noise_px"], [0.02, 0.4, 3.5])
@@ -133,7 +133,7 @@ def test_sweep_sets_scatter_psi_range_and_spin_noise():
     ],
 )
 def test_sweep_refuses_bad_values(parameter, value, words):
-    from ballbat.sweeps import check_sweep
+    from ballbat.studies.sweeps import check_sweep
 
     problems = check_sweep(_dataset(), parameter, [value], "studies.x")
     assert any(words in p for p in problems)

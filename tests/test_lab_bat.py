@@ -18,7 +18,8 @@ import yaml
 from conftest import ROOT
 
 from ballbat import reporting, scenario_bands
-from ballbat.pipeline.config import checked_block, scenario_problems, validate_config
+from ballbat.config_checks import scenario_problems, validate_config
+from ballbat.pipeline.config import checked_block
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.properties import bat_record, load_balls, load_bats
 from ballbat.stages import implications as stage

@@ -6,7 +6,8 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.config_checks import validate_config
+from ballbat.pipeline.config import ConfigError
 from ballbat.pipeline.ncio import MetadataError, read_dataset, write_dataset
 from ballbat.pipeline.provenance import package_source_hash, sha256_file
 

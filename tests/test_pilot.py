@@ -17,7 +17,7 @@ from scipy import stats
 
 from ballbat import pilot
 from ballbat.pipeline.ncio import write_dataset
-from ballbat.studies import impacts_required
+from ballbat.studies.design import impacts_required
 
 BALLBAT = Path(sys.executable).parent / "ballbat"
 

@@ -236,8 +236,8 @@ def test_eta2_gets_the_property_systematic(tmp_path):
 def _study(tmp_path):
     import yaml
 
-    from ballbat.pipeline.config import validate_config
-    from ballbat.study_settings import StudySettings
+    from ballbat.config_checks import validate_config
+    from ballbat.studies.settings import StudySettings
 
     base = yaml.safe_load((ROOT / "config" / "config.yaml").read_text())
     over = yaml.safe_load((EX / "property_study.yaml").read_text())
@@ -289,19 +289,19 @@ def test_study_replicate_draws_and_its_systematic_is_the_finite_difference(tmp_p
     """One replicate: its truth is its drawn bat's, its systematic the +-1 sigma refit's, its effect first order."""
     from dataclasses import replace
 
-    from ballbat import studies
+    from ballbat.studies.replicates import _truth_source, chain_settings, drawn_tables, replicate_seeds, run_replicate
 
     st = _study(tmp_path)
     bats, balls = load_bats(EX / "property_study_bats.csv"), load_balls(BALLS)
     dataset = st.point_dataset(0)
-    rows = {(r["quantity"], r["ball"], r["bat"]): r for r in studies.run_replicate(st, dataset, 3, balls, bats)}
+    rows = {(r["quantity"], r["ball"], r["bat"]): r for r in run_replicate(st, dataset, 3, balls, bats)}
     # the same draw, by hand
-    true_balls, true_bats, z = studies.drawn_tables(st, 3, balls, bats)
+    true_balls, true_bats, z = drawn_tables(st, 3, balls, bats)
     assert true_bats["hickory"].M != bats["hickory"].M and set(z) == {
         f"bat:hickory:{c}" for c in ("balance_in", "impact_from_tip_in", "moi_oz_in2", "weight_oz")
     }
-    seeds = studies.replicate_seeds(st.seed, 3)
-    cs = studies.chain_settings(st, dataset, seeds)
+    seeds = replicate_seeds(st.seed, 3)
+    cs = chain_settings(st, dataset, seeds)
     src = chain.source(cs, true_balls, true_bats)
     quiet = replace(cs, fit_ex=replace(cs.fit_ex, systematic=False))
     # finite differences: the sheet with one value moved by +-sigma, every other as the sheet says
@@ -323,7 +323,7 @@ def test_study_replicate_draws_and_its_systematic_is_the_finite_difference(tmp_p
     assert r["systematic"] > 0.3 * r["uncertainty"]  # of the size the study is for: not negligible
     assert r["calibration_effect"] == pytest.approx(effect, rel=1e-9)
     # the truth: the estimator on the noise-free values with the true bat (the drawn one), near the bat's e_x
-    truth = chain.run(quiet, studies._truth_source(src), true_balls, true_bats).fit_ex
+    truth = chain.run(quiet, _truth_source(src), true_balls, true_bats).fit_ex
     assert r["truth"] == pytest.approx(float(truth["e_x"].sel(ball="baseball", bat="hickory")), rel=1e-12)
     assert r["truth"] == pytest.approx(0.455, abs=0.002)
     # analysed with the sheet, value + effect is, to first order, the analysis with the true bat

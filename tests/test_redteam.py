@@ -23,8 +23,9 @@ import pytest
 import yaml
 from conftest import ROOT
 
-from ballbat import studies
-from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.config_checks import validate_config
+from ballbat.pipeline.config import ConfigError
+from ballbat.studies.coverage import MIN_COVERAGE_REPLICATES, EmptySweepPoint, coverage, coverage_csv
 
 MAPLE = ROOT / "config" / "examples" / "maple_impacts.csv"
 MAPLE_BATS = ROOT / "config" / "examples" / "maple_bats.csv"
@@ -162,18 +163,18 @@ def _replicates(n, value=np.nan, parameter=""):
 
 
 def test_study_of_4_replicates_warns_in_its_table():
-    cov = studies.coverage(_replicates(4))
-    text = studies.coverage_csv(cov)
+    cov = coverage(_replicates(4))
+    text = coverage_csv(cov)
     assert "only 4 replicates: a 95 % coverage is known to +-10.9 points" in text
     assert text.splitlines()[0].endswith(",warning")
-    assert studies.coverage(_replicates(studies.MIN_COVERAGE_REPLICATES))["warning"].values[0, 0] == ""
+    assert coverage(_replicates(MIN_COVERAGE_REPLICATES))["warning"].values[0, 0] == ""
 
 
 def test_sweep_point_without_replicates_is_an_error_naming_it():
     rep = _replicates(6, value=7.0, parameter="impacts_per_bat")
     rep["value"][:] = np.nan
-    with pytest.raises(studies.EmptySweepPoint, match=r"sweep point 0 \(impacts_per_bat = 7\): none of its 6"):
-        studies.coverage(rep)
+    with pytest.raises(EmptySweepPoint, match=r"sweep point 0 \(impacts_per_bat = 7\): none of its 6"):
+        coverage(rep)
 
 
 # ---------------------------------------------------------------------------------------

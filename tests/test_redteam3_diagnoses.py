@@ -17,7 +17,8 @@ import pytest
 import yaml
 from conftest import ROOT
 
-from ballbat.pipeline.config import ConfigError, drop_nulls, validate_config
+from ballbat.config_checks import validate_config
+from ballbat.pipeline.config import ConfigError, drop_nulls
 
 MAPLE = ROOT / "config" / "examples" / "maple_impacts.csv"
 MAPLE_BATS = ROOT / "config" / "examples" / "maple_bats.csv"
@@ -71,7 +72,7 @@ EARLY_CASES = [
 
 def _early_problems(cfg, schema) -> list[str]:
     """What common.smk says before the DAG: the schema's lines, else the scenarios' (scenario_problems)."""
-    from ballbat.pipeline.config import scenario_problems
+    from ballbat.config_checks import scenario_problems
 
     try:
         validate_config(drop_nulls(cfg), schema, available=24 * 2**30)

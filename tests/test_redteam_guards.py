@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ballbat import compare, studies
+from ballbat import compare
 from ballbat.pipeline import guards
 from ballbat.pipeline.atomic import atomic_target, hostname, temporary_owner
 from ballbat.pipeline.checked import (
@@ -32,6 +32,8 @@ from ballbat.pipeline.checked import (
 )
 from ballbat.pipeline.ncio import read_dataset, write_dataset
 from ballbat.pipeline.runlog import logged
+from ballbat.studies.coverage import COVERAGE_COLUMNS
+from ballbat.studies.design import DESIGN_COLUMNS
 from workflow_helpers import copy_run, planned_jobs, snakemake
 
 #: case -> (expected outcome, tests)
@@ -135,8 +137,8 @@ def test_sealed_csv_refuses_a_truncated_table(tmp_path):
 def test_table_headers_are_the_writers(tmp_path):
     """The headers that recognise an unsealed table as the workflow's are those its writers write."""
     assert ",".join(compare.COLUMNS).startswith(guards.TABLE_HEADERS[0])
-    assert ",".join(studies.COVERAGE_COLUMNS).startswith(guards.TABLE_HEADERS[1])
-    assert ",".join(studies.DESIGN_COLUMNS).startswith(guards.TABLE_HEADERS[2])
+    assert ",".join(COVERAGE_COLUMNS).startswith(guards.TABLE_HEADERS[1])
+    assert ",".join(DESIGN_COLUMNS).startswith(guards.TABLE_HEADERS[2])
 
 
 def test_damaged_products_only_reads(tmp_path):

@@ -4,7 +4,7 @@ Every settings dataclass is checked against the schema: a field default that dif
 schema's, or that the schema does not give, fails; every default the schema gives a render,
 reduce, camera, synthetic or study setting arrives in the settings built from a block that
 leaves it out; no code restates a schema default through ``.get(key, default)``. And a
-replicate of a study (``studies.replicate_source``) and the workflow's rule functions give the same
+replicate of a study (``replicate_source``) and the workflow's rule functions give the same
 reduced impacts whichever render or reduce setting is changed, one at a time.
 """
 
@@ -23,10 +23,11 @@ import numpy as np
 import pytest
 
 import ballbat
-from ballbat import studies
 from ballbat.chain import DatasetSettings
+from ballbat.config_checks import validate_config
+from ballbat.datasets import renders
 from ballbat.league import LeagueSettings
-from ballbat.pipeline.config import block_schema, checked_block, packaged_schema, validate_config
+from ballbat.pipeline.config import block_schema, checked_block, packaged_schema
 from ballbat.properties import InputError
 from ballbat.stages.fit_ex import FitExSettings
 from ballbat.stages.implications import ImplicationsSettings
@@ -35,8 +36,9 @@ from ballbat.stages.normalize import NormalizeSettings
 from ballbat.stages.reconstruct import ReconstructSettings
 from ballbat.stages.reduce import ReduceSettings, reduce_options
 from ballbat.stages.stronge import StrongeSettings
-from ballbat.studies import StudySettings
-from ballbat.sweeps import renders
+from ballbat.studies.coverage import COVERAGE_COLUMNS, coverage, coverage_csv
+from ballbat.studies.replicates import replicate_source
+from ballbat.studies.settings import StudySettings
 from ballbat.synthetic import SyntheticSettings
 from ballbat.tracks.data import Camera, Rig, camera_block
 from ballbat.tracks.formats.layout import DEFAULT_PATTERN
@@ -463,9 +465,9 @@ SEEDS = (11, 12)
 
 
 def _replicate(ds: dict, balls, bats):
-    """The study's replicate (studies.replicate_source): the reduced impacts, or the problems that stop it."""
+    """The study's replicate (replicate_source): the reduced impacts, or the problems that stop it."""
     try:
-        return studies.replicate_source(ds, SEEDS, balls, bats)
+        return replicate_source(ds, SEEDS, balls, bats)
     except InputError as exc:
         return exc.problems
 
@@ -570,7 +572,7 @@ def test_enabled_and_seed(config, small, balls, bats, baselines, tmp_path):
     ds = copy.deepcopy(small)
     ds["render"]["enabled"] = False
     ds = _validated(config, ds)
-    replicate = studies.replicate_source(ds, SEEDS, balls, bats)
+    replicate = replicate_source(ds, SEEDS, balls, bats)
     from ballbat.stages import simulate
 
     sim = simulate.run(SyntheticSettings(**{**ds["synthetic"], "seed": SEEDS[0]}), balls, bats)
@@ -603,12 +605,12 @@ def test_study_files_hold_si_and_the_table_prints_paper_units():
         bat=("quantity", [""]),
     )
     rep = rep.assign_coords(units=("quantity", ["rad s-1 rad-1"]))
-    cov = studies.coverage(rep)
+    cov = coverage(rep)
     assert cov["mean_uncertainty"].values[0, 0] == pytest.approx(2.0)  # SI, as the batches hold it
     assert cov["units"].values[0] == "rad s-1 rad-1" and cov["mean_uncertainty"].attrs["units_from"] == "units"
     assert "units" not in cov["mean_uncertainty"].attrs
     check_metadata(cov, "coverage")  # units_from names a text coordinate along quantity
-    row = dict(zip(studies.COVERAGE_COLUMNS, studies.coverage_csv(cov).splitlines()[1].split(","), strict=False))
+    row = dict(zip(COVERAGE_COLUMNS, coverage_csv(cov).splitlines()[1].split(","), strict=False))
     assert row["unit"] == "rpm/deg"
     assert float(row["mean_uncertainty"]) == pytest.approx(2.0 / (RPM / DEGREE), rel=1e-5)  # 0.349 rpm/deg
     assert float(row["coverage_95"]) == pytest.approx(float(cov["coverage_95"].values[0, 0]), rel=1e-5)

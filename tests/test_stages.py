@@ -17,9 +17,12 @@ import numpy as np
 import pytest
 from helpers import SMALL
 
-from ballbat import fitting, studies
+from ballbat import fitting
 from ballbat.stages import fit_ex, implications, ingest, normalize, reconstruct, reduce, render, simulate, stronge
 from ballbat.stages.impacts import IMPACT_COORDS, IMPACTS, QUANTITIES, SIMULATED_TRUTH, truth_var
+from ballbat.studies import replicates
+from ballbat.studies.replicates import STUDY_QUANTITIES, run_replicate
+from ballbat.studies.settings import StudySettings
 from ballbat.synthetic import SyntheticSettings
 from ballbat.tracks.data import camera_block
 from ballbat.tracks.render import settings_from_config
@@ -246,14 +249,14 @@ SCRIPTS = {
     "fit_ex": "fit_ex",
     "fit_stronge": "stronge",
     "implications": "implications",
-    "study_batch": "study_batch",  # beside the studies (ballbat.study_batch), not a stage of the chain
+    "study_batch": "batch",  # beside the studies (ballbat.studies.batch), not a stage of the chain
 }
 
 
 @pytest.mark.parametrize(("script", "stage"), SCRIPTS.items())
 def test_rule_script_is_one_call_of_its_stage(script, stage):
     text = (ROOT / "workflow" / "scripts" / f"{script}.py").read_text()
-    package = "ballbat" if stage == "study_batch" else "ballbat.stages"
+    package = "ballbat.studies" if script == "study_batch" else "ballbat.stages"
     assert f"from {package} import {stage}" in text
     assert len(re.findall(rf"\b{stage}\.run\(", text)) == 1
     assert "build_dataset" not in text and "xr.Dataset(" not in text
@@ -275,13 +278,13 @@ def test_a_replicate_is_the_stages_in_memory(config, balls, bats, monkeypatch):
         monkeypatch.setattr(mod, entry, counted)
     orig_render = render.render
     monkeypatch.setattr(render, "render", lambda *a, **k: calls.append("render") or orig_render(*a, **k))
-    monkeypatch.setattr(studies, "STUDY_QUANTITIES", tuple(q for q in studies.STUDY_QUANTITIES if q != "eta2"))
+    monkeypatch.setattr(replicates, "STUDY_QUANTITIES", tuple(q for q in STUDY_QUANTITIES if q != "eta2"))
     dataset = copy.deepcopy(config["datasets"]["synthetic"])
     dataset["synthetic"]["impacts"] = SMALL
-    settings = studies.StudySettings.from_config(
+    settings = StudySettings.from_config(
         {**config, "studies": {"s": {**config["studies"]["calibration"], "dataset": "synthetic"}}}, "s"
     )
-    rows = studies.run_replicate(settings, dataset, 0, balls, bats)
+    rows = run_replicate(settings, dataset, 0, balls, bats)
     assert calls == ["simulate", "render", "reduce", "normalize", "reconstruct", "fit_ex"]
     e_x = [r for r in rows if r["quantity"] == "e_x_pooled" and r["ball"] == "baseball"]
     assert len(e_x) == 1 and np.isfinite(e_x[0]["value"]) and e_x[0]["uncertainty"] > 0

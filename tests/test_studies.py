@@ -14,23 +14,31 @@ import yaml
 from helpers import fake_replicates
 from scipy import stats
 
-from ballbat import studies, study_batch
-from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.config_checks import validate_config
+from ballbat.pipeline.config import ConfigError
 from ballbat.pipeline.ncio import read_table_csv
+from ballbat.studies import batch as study_batch
+from ballbat.studies import replicates
+from ballbat.studies.coverage import COVERAGE_COLUMNS, combine, coverage, coverage_csv
+from ballbat.studies.design import impacts_required
+from ballbat.studies.replicates import STUDY_QUANTITIES, TooManyRefused, replicate_seeds, replicate_source
+from ballbat.studies.settings import StudySettings
+from ballbat.studies.sweeps import point_dataset
+from ballbat.studies.truth import population_truth
 
 
 def settings(config, name="calibration", **over):
     cfg = copy.deepcopy(config)
     cfg["studies"][name].update(over)
-    return studies.StudySettings.from_config(cfg, name)
+    return StudySettings.from_config(cfg, name)
 
 
 def test_seeds_are_reproducible_and_independent():
-    a = [studies.replicate_seeds(7, k) for k in range(200)]
-    assert a == [studies.replicate_seeds(7, k) for k in range(200)]
+    a = [replicate_seeds(7, k) for k in range(200)]
+    assert a == [replicate_seeds(7, k) for k in range(200)]
     flat = [s for pair in a for s in pair]
     assert len(set(flat)) == len(flat)  # every experiment and every rendering has its own stream
-    assert studies.replicate_seeds(8, 0) != a[0]
+    assert replicate_seeds(8, 0) != a[0]
 
 
 def test_batches_cover_every_replicate_once(config):
@@ -54,7 +62,7 @@ def test_batches_cover_every_replicate_once(config):
 def test_sweep_sets_the_dataset(config, parameter, value, check):
     base = config["datasets"]["synthetic"]
     before = copy.deepcopy(base)
-    assert check(studies.point_dataset(base, parameter, value))
+    assert check(point_dataset(base, parameter, value))
     assert base == before  # a copy: the config is untouched
 
 
@@ -131,18 +139,18 @@ def test_a_frame_rate_sweep_needs_rendered_tracks(raw, schema):
 
 def test_coverage_arithmetic():
     """Honest errors cover 68 % / 95 %; errors half the truth's spread cover far less, as the normal law says."""
-    good = studies.coverage(fake_replicates(20000, 0.01, 0.01)).isel(point=0, quantity=0)
+    good = coverage(fake_replicates(20000, 0.01, 0.01)).isel(point=0, quantity=0)
     assert good.coverage_95 == pytest.approx(0.95, abs=4 * float(good.coverage_95_err))
     assert good.coverage_68 == pytest.approx(0.6827, abs=4 * float(good.coverage_68_err))
     assert good.spread_over_se == pytest.approx(1.0, abs=0.03)
     assert abs(float(good.bias_over_se)) < 4 * float(good.bias_over_se_err)
-    bad = studies.coverage(fake_replicates(20000, 0.005, 0.01)).isel(point=0, quantity=0)
+    bad = coverage(fake_replicates(20000, 0.005, 0.01)).isel(point=0, quantity=0)
     assert bad.coverage_95 == pytest.approx(2 * stats.norm.cdf(0.98) - 1, abs=0.01)
     assert bad.spread_over_se == pytest.approx(2.0, abs=0.05)
     # Student's t: with 5 degrees of freedom the 95 % interval is 2.571 SE wide on each side
     t = fake_replicates(20000, 0.01, 0.01 * math.sqrt(5 / 3), dof=5, seed=1)
     t["value"][:] = 1.0 + 0.01 * np.random.default_rng(2).standard_t(5, (20000, 1))
-    cov_t = studies.coverage(t).isel(point=0, quantity=0)
+    cov_t = coverage(t).isel(point=0, quantity=0)
     assert cov_t.coverage_95 == pytest.approx(0.95, abs=0.01)
 
 
@@ -164,8 +172,8 @@ def test_the_truths_own_sampling_error_goes_into_the_bias_error():
     rep["truth"][:] = own
     rep["value"][:] = own + 0.01 * rng.standard_normal((n, 2))
     truths = [{"e_x:baseball:wood": 1.0, "mu_k_lower_bound:baseball:": 1.0}]
-    cov = studies.coverage(rep, truths, [100.0]).isel(point=0)
-    plain = studies.coverage(rep, truths).isel(point=0)
+    cov = coverage(rep, truths, [100.0]).isel(point=0)
+    plain = coverage(rep, truths).isel(point=0)
     te = cov.truth_error_over_se.values
     assert te[0] == pytest.approx(0.1, rel=0.1)
     assert np.isnan(te[1]) and np.isnan(plain.truth_error_over_se.values).all()
@@ -173,7 +181,7 @@ def test_the_truths_own_sampling_error_goes_into_the_bias_error():
     assert cov.bias_over_se_err.values[0] == pytest.approx(math.hypot(stat[0], te[0]), rel=1e-12)
     assert cov.bias_over_se_err.values[1] == stat[1]
     assert cov.bias_over_se.values == pytest.approx(plain.bias_over_se.values)
-    text = studies.coverage_csv(studies.coverage(rep, truths, [100.0]))
+    text = coverage_csv(coverage(rep, truths, [100.0]))
     assert "truth_error_over_se" in text.splitlines()[0].split(",")
 
 
@@ -181,12 +189,12 @@ def test_impacts_required_matches_the_normal_formula_for_many_impacts():
     # sigma with n_at impacts -> single-impact sigma s1; large n: n = 2 (z_a + z_b)^2 s1^2 / delta^2
     s1, delta = 0.1, 0.02
     n_normal = 2 * (stats.norm.ppf(0.975) + stats.norm.ppf(0.8)) ** 2 * s1**2 / delta**2
-    n = studies.impacts_required(s1 / math.sqrt(20), 20, delta)
+    n = impacts_required(s1 / math.sqrt(20), 20, delta)
     assert n_normal < n < n_normal * 1.03  # t quantiles: a little more than the normal answer
-    assert studies.impacts_required(s1 / math.sqrt(20), 20, 2 * delta) < n
-    assert studies.impacts_required(1e-6, 20, delta) == 3
-    assert math.isnan(studies.impacts_required(math.nan, 20, delta))
-    assert studies.impacts_required(1.0, 20, 1e-6) == math.inf
+    assert impacts_required(s1 / math.sqrt(20), 20, 2 * delta) < n
+    assert impacts_required(1e-6, 20, delta) == 3
+    assert math.isnan(impacts_required(math.nan, 20, delta))
+    assert impacts_required(1.0, 20, 1e-6) == math.inf
 
 
 @pytest.mark.slow  # seconds (quiet machine): more than a unit test may take
@@ -200,8 +208,8 @@ def test_replicates_cover_the_truth(config, balls, bats):
     s = settings(config, replicates=40, batch_size=40, truth_impacts=400)
     batch = study_batch.run(s, 0, balls, bats)
     assert batch.sizes == {"replicate": 40, "quantity": 21}
-    truths = [studies.population_truth(s, 0, balls, bats)]
-    cov = studies.coverage(studies.combine([batch]), truths).isel(point=0)
+    truths = [population_truth(s, 0, balls, bats)]
+    cov = coverage(combine([batch]), truths).isel(point=0)
     ex = cov.where(cov.quantity_name == "e_x", drop=True)
     n = int(ex.n_replicates.sum())
     assert n == 280
@@ -210,7 +218,7 @@ def test_replicates_cover_the_truth(config, balls, bats):
     ratio = float(ex.spread_over_se.mean())
     assert 0.85 <= ratio <= 1.15, ratio
     # every recorded quantity has its truth and an honest label of its uncertainty
-    assert set(cov.quantity_name.values) == set(studies.STUDY_QUANTITIES)
+    assert set(cov.quantity_name.values) == set(STUDY_QUANTITIES)
     assert np.all(cov.n_replicates.values == 40)
     assert all(cov.error_kind.values)
     # eta^2's interval uses the Bell-McCaffrey degrees of freedom of its bat-stratified sandwich
@@ -249,7 +257,7 @@ def test_study_rules_through_snakemake(lab_run, tmp_path):
     )
     assert int(cov.n_replicates.max()) == 4
     rows = list(csv.DictReader(io.StringIO(read_table_csv(res / "calibration" / "coverage.csv"))))
-    assert len(rows) == n_q and set(rows[0]) == set(studies.COVERAGE_COLUMNS)
+    assert len(rows) == n_q and set(rows[0]) == set(COVERAGE_COLUMNS)
     design = list(csv.DictReader(io.StringIO(read_table_csv(res / "design" / "design.csv"))))
     per_size = len(design) // 2
     assert per_size >= 3 and [r["setting"] for r in design] == ["5"] * per_size + ["8"] * per_size
@@ -333,7 +341,7 @@ def test_a_replicate_and_the_workflow_reduce_alike(config, balls, bats, root, tm
     schema = yaml.safe_load((root / "workflow" / "schemas" / "config.schema.yaml").read_text())
     ds = validate_config(raw, schema)["datasets"]["synthetic"]
     seeds = (11, 12)
-    replicate = studies.replicate_source(ds, seeds, balls, bats)
+    replicate = replicate_source(ds, seeds, balls, bats)
     sim = simulate.run(SyntheticSettings(**{**ds["synthetic"], "seed": seeds[0]}), balls, bats)
     cfg = {**ds["render"], "seed": seeds[1]}
     tracks_nc = tmp_path / "tracks.nc"
@@ -370,7 +378,8 @@ def test_combined_interval_takes_welch_satterthwaite_degrees_of_freedom():
     99-100 % at 12-30 impacts per bat (docs/studies.md). With nu_eff = nu (u^2 + s^2)^2 / u^4
     (GUM G.4) it covers 95 %.
     """
-    from ballbat.studies import _t, combined_dof
+    from ballbat.studies.coverage import _t
+    from ballbat.studies.records import combined_dof
 
     assert combined_dof(1.0, 0.0, 10.0) == 10.0
     assert combined_dof(1.0, 1.0, 10.0) == 40.0
@@ -403,16 +412,16 @@ def test_a_refused_replicate_is_counted_and_the_batch_goes_on(config, balls, bat
             raise InputError(["render (replicate 3).cameras.spin: g is negative: y points up"])
         return _fake_rows(0.35 + 0.01 * (replicate - 5) / 5)
 
-    monkeypatch.setattr(studies, "run_replicate", fake)
+    monkeypatch.setattr(replicates, "run_replicate", fake)
     s = settings(config, replicates=20, batch_size=20)
     batch = study_batch.run(s, 0, balls, bats)
     why = batch["refusal"].values.astype(str)
     assert [i for i, w in enumerate(why) if w] == [3]
     assert "replicate 3" in why[3] and "y points up" in why[3]
     assert np.isnan(batch["value"].values[3]).all() and np.isfinite(batch["value"].values[:3]).all()
-    cov = studies.coverage(studies.combine([batch]))
+    cov = coverage(combine([batch]))
     assert int(cov["n_refused"].values[0, 0]) == 1 and int(cov["n_replicates"].values[0, 0]) == 19
-    header = studies.coverage_csv(cov).splitlines()[0].split(",")
+    header = coverage_csv(cov).splitlines()[0].split(",")
     assert header[header.index("n_replicates") + 1] == "n_refused"
 
 
@@ -428,8 +437,8 @@ def test_a_batch_whose_data_are_refused_again_and_again_stops_with_the_first_rea
         calls.append(replicate)
         raise InputError([f"tracks.cameras.swing: fps wrong (replicate {replicate})"])
 
-    monkeypatch.setattr(studies, "run_replicate", fake)
+    monkeypatch.setattr(replicates, "run_replicate", fake)
     s = settings(config, replicates=40, batch_size=40)
-    with pytest.raises(studies.TooManyRefused, match=r"refused 3 of its first 3 replicates.*replicate 0\)"):
+    with pytest.raises(TooManyRefused, match=r"refused 3 of its first 3 replicates.*replicate 0\)"):
         study_batch.run(s, 0, balls, bats)
     assert len(calls) == 3  # 5 % of 40: two may be false alarms, the third stops it

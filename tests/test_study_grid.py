@@ -11,9 +11,15 @@ import numpy as np
 import pytest
 import xarray as xr
 
-from ballbat import studies, study_batch
-from ballbat.pipeline.config import ConfigError, validate_config
-from ballbat.sweeps import CONTACT_HALF_WIDTH_MS, point_dataset, sweep_points
+from ballbat.config_checks import validate_config
+from ballbat.pipeline.config import ConfigError
+from ballbat.studies import batch as study_batch
+from ballbat.studies.coverage import EmptySweepPoint, coverage, coverage_csv
+from ballbat.studies.records import row_labels
+from ballbat.studies.replicates import replicate_seeds, run_replicate
+from ballbat.studies.settings import StudySettings
+from ballbat.studies.sweeps import CONTACT_HALF_WIDTH_MS, point_dataset, sweep_points
+from ballbat.studies.truth import merge_truths, truth_dataset, truth_scales_from_dataset, truths_from_dataset
 from ballbat.tracks.data import camera_block
 from ballbat.tracks.render import calibration_draws, drawn_calibration, settings_from_config
 
@@ -23,7 +29,7 @@ from ballbat.tracks.render import calibration_draws, drawn_calibration, settings
 
 def test_the_shipped_robustness_grid_expands_to_the_product(config):
     """27 points, the first setting slowest; each point's dataset has its noise, impacts and contact range."""
-    s = studies.StudySettings.from_config(config, "robustness")
+    s = StudySettings.from_config(config, "robustness")
     grid = config["studies"]["robustness"]["sweep"]["grid"]
     assert s.parameters == ("pixel_noise_px", "impacts_per_bat", "contact_ms") and s.is_grid
     assert s.values == tuple(itertools.product(*grid.values()))
@@ -39,10 +45,10 @@ def test_the_shipped_robustness_grid_expands_to_the_product(config):
     seen = [divmod(g, s.replicates) for b in range(s.n_batches) for g in s.batch_range(b)]
     assert len(set(seen)) == s.total and max(p for p, _ in seen) == 26
     # one-parameter sweeps are as they were (the shipped design study)
-    d = studies.StudySettings.from_config(config, "design")
+    d = StudySettings.from_config(config, "design")
     assert d.parameter == "impacts_per_bat" and d.values == (5.0, 10.0, 20.0, 30.0, 50.0, 75.0, 100.0)
     assert not d.is_grid and d.point_settings()[:, 0].tolist() == list(d.values)
-    assert studies.StudySettings.from_config(config, "calibration").parameters == ()
+    assert StudySettings.from_config(config, "calibration").parameters == ()
 
 
 def test_sweep_points_of_one_parameter_and_of_a_grid():
@@ -239,7 +245,7 @@ def _with_systematic(n=4000, se=0.01, syst=0.02, seed=0):
 
 
 def test_the_combined_interval_covers_what_the_statistical_one_misses():
-    cov = studies.coverage(_with_systematic()).isel(point=0)
+    cov = coverage(_with_systematic()).isel(point=0)
     a, b = cov.isel(quantity=0), cov.isel(quantity=1)
     # statistical only: the interval is sqrt(5) too narrow -> 2 Phi(1.96 / sqrt(5)) - 1 = 62 %
     assert float(a.coverage_95) == pytest.approx(0.62, abs=0.03)
@@ -250,7 +256,7 @@ def test_the_combined_interval_covers_what_the_statistical_one_misses():
     # no systematic: no combined coverage (not the statistical one again)
     assert np.isnan(float(b.coverage_95_combined)) and int(b.n_systematic) == 0
     assert float(b.coverage_95) == pytest.approx(0.95, abs=0.015)
-    text = studies.coverage_csv(studies.coverage(_with_systematic(n=200)))
+    text = coverage_csv(coverage(_with_systematic(n=200)))
     rows = list(csv.DictReader(io.StringIO(text.split("# ballbat table:")[0])))
     assert rows[1]["coverage_95_combined"] == "" and rows[0]["coverage_95_combined"] != ""
 
@@ -270,7 +276,7 @@ def test_the_calibration_effect_takes_the_draw_out_of_bias_spread_and_statistica
     a["value"] = a["value"] + bias * se + shift
     a["systematic"] = (("replicate", "quantity"), np.full((n, 1), syst))
     a["calibration_effect"] = (("replicate", "quantity"), -shift)
-    c = studies.coverage(a).isel(point=0, quantity=0)
+    c = coverage(a).isel(point=0, quantity=0)
     assert float(c.bias_over_se_calibrated) == pytest.approx(bias, abs=4 * float(c.bias_over_se_calibrated_err))
     assert float(c.bias_over_se_calibrated_err) == pytest.approx(1 / np.sqrt(n), rel=0.1)
     assert float(c.bias_over_se_err) > 3.5 * float(c.bias_over_se_calibrated_err)  # the draw's spread
@@ -283,10 +289,10 @@ def test_the_calibration_effect_takes_the_draw_out_of_bias_spread_and_statistica
     assert float(c.coverage_95_calibrated) == pytest.approx(expected, abs=4 * float(c.coverage_95_calibrated_err))
     assert float(c.coverage_95) < 0.5  # the raw statistical interval does not cover the draw
     assert int(c.n_calibrated) == n
-    plain = studies.coverage(fake_replicates(200, 0.01, 0.01)).isel(point=0, quantity=0)
+    plain = coverage(fake_replicates(200, 0.01, 0.01)).isel(point=0, quantity=0)
     assert int(plain.n_calibrated) == 0 and np.isnan(float(plain.bias_over_se_calibrated))
     assert np.isnan(float(plain.coverage_95_calibrated))
-    text = studies.coverage_csv(studies.coverage(a))
+    text = coverage_csv(coverage(a))
     header = text.splitlines()[0].split(",")
     assert {"bias_over_se_calibrated", "coverage_95_calibrated", "spread_over_se_calibrated"} <= set(header)
 
@@ -294,7 +300,7 @@ def test_the_calibration_effect_takes_the_draw_out_of_bias_spread_and_statistica
 def test_batches_without_a_systematic_still_aggregate():
     from helpers import fake_replicates
 
-    cov = studies.coverage(fake_replicates(200, 0.01, 0.01)).isel(point=0, quantity=0)
+    cov = coverage(fake_replicates(200, 0.01, 0.01)).isel(point=0, quantity=0)
     assert np.isnan(float(cov.coverage_95_combined)) and int(cov.n_systematic) == 0
 
 
@@ -315,12 +321,12 @@ def test_grid_coverage_table_and_figure(tmp_path):
     from workflow_helpers import assert_not_blank
 
     rep, table = _grid_replicates()
-    cov = studies.coverage(rep)
+    cov = coverage(rep)
     assert cov.sizes["point"] == 8
     np.testing.assert_array_equal(cov.grid_setting.values, table)
     assert list(cov.parameter.values) == ["pixel_noise_px", "impacts_per_bat", "contact_ms"]
     assert np.all(np.isnan(cov.setting.values))
-    text = studies.coverage_csv(cov)
+    text = coverage_csv(cov)
     header = text.splitlines()[0].split(",")
     assert header[:4] == ["setting", "quantity", "ball", "bat"]  # the header the damaged-product guards know
     assert header[-3:] == ["pixel_noise_px", "impacts_per_bat", "contact_ms"]
@@ -334,8 +340,8 @@ def test_grid_coverage_table_and_figure(tmp_path):
 def test_an_empty_grid_point_is_named():
     rep, _ = _grid_replicates(120)
     rep["value"][rep.point.values == 5] = np.nan
-    with pytest.raises(studies.EmptySweepPoint, match="pixel_noise_px = 5, impacts_per_bat = 12, contact_ms = 1"):
-        studies.coverage(rep)
+    with pytest.raises(EmptySweepPoint, match="pixel_noise_px = 5, impacts_per_bat = 12, contact_ms = 1"):
+        coverage(rep)
 
 
 def test_a_grid_replicate_records_a_systematic(config, balls, bats):
@@ -345,7 +351,7 @@ def test_a_grid_replicate_records_a_systematic(config, balls, bats):
     cfg = copy.deepcopy(config)
     cfg["studies"]["robustness"].update(replicates=1, batch_size=1)
     cfg["studies"]["robustness"]["sweep"] = {"grid": {"pixel_noise_px": [3.0], "contact_ms": [0.9]}}
-    s = studies.StudySettings.from_config(cfg, "robustness")
+    s = StudySettings.from_config(cfg, "robustness")
     batch = study_batch.run(s, 0, balls, bats)
     assert batch.attrs["sweep_parameter"] == "pixel_noise_px,contact_ms"
     names = batch.quantity_name.values
@@ -371,22 +377,22 @@ def test_truth_files_of_single_points_merge_into_the_study_truth(config, balls, 
     cfg = copy.deepcopy(config)
     cfg["studies"]["robustness"].update(truth_impacts=30)
     cfg["studies"]["robustness"]["sweep"] = {"grid": {"pixel_noise_px": [2.0], "impacts_per_bat": [6, 9]}}
-    s = studies.StudySettings.from_config(cfg, "robustness")
-    whole = studies.truth_dataset(s, balls, bats)
-    parts = [studies.truth_dataset(s, balls, bats, points=[p]) for p in (1, 0)]
+    s = StudySettings.from_config(cfg, "robustness")
+    whole = truth_dataset(s, balls, bats)
+    parts = [truth_dataset(s, balls, bats, points=[p]) for p in (1, 0)]
     assert [p.point.values.tolist() for p in parts] == [[1], [0]]
-    merged = studies.merge_truths(parts)
+    merged = merge_truths(parts)
     np.testing.assert_array_equal(merged.truth.values, whole.truth.values)
     np.testing.assert_array_equal(merged.grid_setting.values, whole.grid_setting.values)
     assert list(merged.quantity.values) == list(whole.quantity.values)
     assert merged.attrs["truth_impacts"] == 30 and merged.attrs["sweep_parameter"] == "pixel_noise_px,impacts_per_bat"
-    assert studies.truths_from_dataset(merged) == studies.truths_from_dataset(whole)
+    assert truths_from_dataset(merged) == truths_from_dataset(whole)
     # the truth's experiment repeats the design ceil(30 / 6) = 5 and ceil(30 / 9) = 4 times
-    np.testing.assert_array_equal(studies.truth_scales_from_dataset(merged), [5.0, 4.0])
+    np.testing.assert_array_equal(truth_scales_from_dataset(merged), [5.0, 4.0])
     with pytest.raises(ValueError, match="no truth_scale variable"):
-        studies.truth_scales_from_dataset(merged.drop_vars("truth_scale"))
+        truth_scales_from_dataset(merged.drop_vars("truth_scale"))
     with pytest.raises(ValueError, match=r"missing \[0\], repeated \[1\]"):
-        studies.merge_truths([parts[0], parts[0]])
+        merge_truths([parts[0], parts[0]])
 
 
 @pytest.mark.slow
@@ -416,7 +422,7 @@ def test_a_small_robustness_study_runs_through_snakemake(lab_run):
 
 def test_the_calibration_effect_is_what_the_true_calibration_would_have_given(config, balls, bats):
     """A replicate that draws its calibration reports, per quantity, the first-order change the draw made
-    (studies._calibration_effect). Reducing the same tracks with the drawn (true) calibration instead of
+    (_calibration_effect). Reducing the same tracks with the drawn (true) calibration instead of
     the declared one must give value + calibration_effect, up to second order: the study uses this to
     take the draw's spread out of a bias and to judge the statistical interval where calibration is drawn.
     """
@@ -428,13 +434,13 @@ def test_the_calibration_effect_is_what_the_true_calibration_would_have_given(co
     cams["swing"].update(m_per_px_err=0.01, fps_err=0.003)
     cams["spin"].update(m_per_px_err=0.01)
     dataset["render"]["draw_calibration"] = True
-    settings = studies.StudySettings.from_config(
+    settings = StudySettings.from_config(
         {**config, "studies": {"s": {**config["studies"]["calibration"], "dataset": "synthetic"}}}, "s"
     )
     replicate = 1
-    drawn = studies.run_replicate(settings, dataset, replicate, balls, bats)
+    drawn = run_replicate(settings, dataset, replicate, balls, bats)
     # the lab that knows its true calibration: the drawn one declared, nothing drawn (same seeds: same tracks)
-    seeds = studies.replicate_seeds(settings.seed, replicate)
+    seeds = replicate_seeds(settings.seed, replicate)
     z = calibration_draws({**dataset["render"], "seed": seeds[1]})
     assert np.all(np.abs(z[[0, 1, 2]]) > 0.2)  # swing and spin scale, swing frame rate: the draws this test needs
     known = copy.deepcopy(dataset)
@@ -442,11 +448,11 @@ def test_the_calibration_effect_is_what_the_true_calibration_would_have_given(co
     for name, cam in known["render"]["cameras"].items():
         cam.update(m_per_px=true_block["cameras"][name]["m_per_px"], fps=true_block["cameras"][name]["fps"])
     known["render"]["draw_calibration"] = False
-    plain = studies.run_replicate(settings, known, replicate, balls, bats)
-    exact = {studies.row_labels([r])[0]: r["value"] for r in plain}
+    plain = run_replicate(settings, known, replicate, balls, bats)
+    exact = {row_labels([r])[0]: r["value"] for r in plain}
     moved, missed = [], []
     for r in drawn:
-        label = studies.row_labels([r])[0]
+        label = row_labels([r])[0]
         if not np.isfinite(exact[label] - r["value"]):
             continue
         assert np.isfinite(r["calibration_effect"]), label

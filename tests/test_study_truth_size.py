@@ -8,8 +8,12 @@ import re
 
 import pytest
 
-from ballbat import studies, sweeps
-from ballbat.pipeline.config import MEMORY_SHARE, ConfigError, impact_bytes, study_impacts, validate_config
+from ballbat.config_checks import MEMORY_SHARE, impact_bytes, study_impacts, validate_config
+from ballbat.pipeline.config import ConfigError
+from ballbat.studies import truth as study_truth
+from ballbat.studies.settings import StudySettings
+from ballbat.studies.sweeps import truth_counts
+from ballbat.studies.truth import population_truth
 
 #: The unbalanced design of issue 40: 6 impacts on some bats and 60 on others, the softball bat
 #: swung with softballs only (102 of the 204 impacts on three pairs of 60).
@@ -27,7 +31,7 @@ def unbalanced(config, **over):
 
 
 def test_the_truth_keeps_the_designs_proportions_at_about_truth_impacts_a_pair(config):
-    s = studies.StudySettings.from_config(unbalanced(config), "calibration")
+    s = StudySettings.from_config(unbalanced(config), "calibration")
     k, counts = s.truth_counts(0)
     assert k == math.ceil(7 * 10_000 / 204) == 344
     assert counts == {b: {t: n * k for t, n in bats.items()} for b, bats in UNBALANCED.items()}
@@ -39,7 +43,7 @@ def test_the_truth_keeps_the_designs_proportions_at_about_truth_impacts_a_pair(c
 def test_a_balanced_design_keeps_the_old_scale(config):
     # every pair alike: ceil(P T / N) = ceil(T / n), the scale before issue 40 (the design and
     # robustness studies' truths are unchanged)
-    s = studies.StudySettings.from_config(config, "design")
+    s = StudySettings.from_config(config, "design")
     for p, n in enumerate(s.values):
         assert s.truth_counts(p)[0] == math.ceil(10_000 / n)
 
@@ -47,11 +51,11 @@ def test_a_balanced_design_keeps_the_old_scale(config):
 def test_a_pair_of_no_impacts_stays_empty(config):
     ds = copy.deepcopy(config["datasets"]["synthetic"])
     ds["synthetic"]["impacts"]["baseball"]["wood"] = 0
-    k, counts = sweeps.truth_counts(ds, 1000)
+    k, counts = truth_counts(ds, 1000)
     assert counts["baseball"]["wood"] == 0 and k == math.ceil(6 * 1000 / 88)
     ds["synthetic"]["impacts"] = {"baseball": {"wood": 0}}
     with pytest.raises(ValueError, match="no impacts"):
-        sweeps.truth_counts(ds, 1000)
+        truth_counts(ds, 1000)
 
 
 def test_the_truth_job_runs_the_size_its_plans_use(config, monkeypatch):
@@ -62,10 +66,10 @@ def test_the_truth_job_runs_the_size_its_plans_use(config, monkeypatch):
         seen["impacts"] = ds["synthetic"]["impacts"]
         return []
 
-    monkeypatch.setattr(studies, "run_replicate", fake_run_replicate)
+    monkeypatch.setattr(study_truth, "run_replicate", fake_run_replicate)  # where the truth job looks it up
     cfg = unbalanced(config)
-    s = studies.StudySettings.from_config(cfg, "calibration")
-    studies.population_truth(s, 0, {}, {})
+    s = StudySettings.from_config(cfg, "calibration")
+    population_truth(s, 0, {}, {})
     assert seen["impacts"] == s.truth_counts(0)[1]
     total = sum(n for bats in seen["impacts"].values() for n in bats.values())
     ds = cfg["datasets"]["synthetic"]
@@ -77,7 +81,7 @@ def test_the_unbalanced_design_runs_within_its_plan_on_this_machines_size(raw, s
     """At the default truth_impacts the 6-to-60 design is accepted on a 24 GiB machine (its plan: 4.0 GB)."""
     raw["datasets"]["synthetic"]["synthetic"]["impacts"] = copy.deepcopy(UNBALANCED)
     cfg = validate_config(raw, schema, available=23 * 2**30)
-    s = studies.StudySettings.from_config(cfg, "calibration")
+    s = StudySettings.from_config(cfg, "calibration")
     assert s.truth_mem_mb(0) * 1e6 <= MEMORY_SHARE * 23 * 2**30
     assert s.truth_mem_mb(0) == 500 + math.ceil(70_176 * 50_000 / 1e6)
 
@@ -92,7 +96,7 @@ def test_a_truth_the_machine_cannot_hold_is_refused_with_its_size(raw, schema):
 
 def test_the_workflow_schedules_each_truth_job_at_its_plan(tmp_path):
     """A dry run of the unbalanced design: every truth job is scheduled with StudySettings.truth_mem_mb of its point."""
-    from ballbat.pipeline.config import load_config
+    from ballbat.config_checks import load_config
     from workflow_helpers import make_workdir, snakemake, write_config
 
     wd = make_workdir(tmp_path)
@@ -109,7 +113,7 @@ def test_the_workflow_schedules_each_truth_job_at_its_plan(tmp_path):
     planned = {(study, int(point)): int(mem) for study, point, mem in jobs}
     cfg = load_config(wd / "config" / "config.yaml")
     expect = {
-        (name, p): studies.StudySettings.from_config(cfg, name).truth_mem_mb(p)
+        (name, p): StudySettings.from_config(cfg, name).truth_mem_mb(p)
         for name, p in [("calibration", 0), ("design", 0), ("design", 1)]
     }
     assert planned == expect

@@ -17,7 +17,8 @@ import numpy as np
 import pytest
 import yaml
 
-from ballbat.pipeline.config import ConfigError, checked_block, validate_config
+from ballbat.config_checks import validate_config
+from ballbat.pipeline.config import ConfigError, checked_block
 from ballbat.properties import InputError
 from ballbat.tracks.data import with_found_settings
 from ballbat.tracks.formats import FormatError

@@ -225,7 +225,7 @@ def test_shipped_example_reduces():
 
 def test_one_limit_for_a_calibration_uncertainty(schema, raw):
     """The schema and the tracks' own check refuse a relative fps or pixel-scale uncertainty at the same value."""
-    from ballbat.pipeline.config import validate_config
+    from ballbat.config_checks import validate_config
     from ballbat.tracks.checks import SCALE_ERR_MAX
 
     for camera in ("track_camera", "render_camera"):

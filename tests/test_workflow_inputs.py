@@ -7,7 +7,7 @@ from argparse import Namespace
 
 import pytest
 
-from ballbat.pipeline.config import impact_bytes
+from ballbat.config_checks import impact_bytes
 from ballbat.workflow_inputs import DATASET_FIGURES, WorkflowInputs, existing, file_hashes
 from workflow_helpers import ROOT
 

@@ -9,7 +9,7 @@ dataset block), and :func:`run` runs the stages in the workflow's order on it:
 * :mod:`~ballbat.stages.normalize`, :mod:`~ballbat.stages.reconstruct` and
   :mod:`~ballbat.stages.fit_ex` (:func:`run`).
 
-The replicate studies (:mod:`ballbat.studies`), ``ballbat check`` (:mod:`ballbat.cli`) and the
+The replicate studies (:mod:`ballbat.studies`), ``ballbat check`` (:mod:`ballbat.cli.check`) and the
 tests call these; the workflow's rules call the same stages one by one, each writing its file.
 No other module chains stages.
 """
@@ -20,8 +20,8 @@ import dataclasses
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+from .datasets import renders
 from .stages import fit_ex, normalize, reconstruct, reduce, render, simulate
-from .sweeps import renders
 from .synthetic import SyntheticSettings
 
 if TYPE_CHECKING:
@@ -90,7 +90,7 @@ class DatasetSettings:
         systematics: bool,
         where: str | None = None,
     ) -> DatasetSettings:
-        """Return the settings of one validated dataset block (a sweep point's: :func:`ballbat.sweeps.point_dataset`).
+        """Return the settings of one validated dataset block (a sweep point's: :func:`.studies.sweeps.point_dataset`).
 
         ``systematics``: reduce rendered or measured tracks again at +-1 sigma of each stated
         calibration uncertainty (the workflow: always; a study: where it draws its calibration).

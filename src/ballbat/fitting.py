@@ -420,8 +420,9 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
     bat speed (attribute ``v_ref``). When the dataset holds ``truth_*`` variables
     (synthetic), each quantity also gets a truth value: the same estimator applied to the
     noise-free truth with the same weights. ``systematic=False`` skips the pixel-scale
-    systematic (:func:`scale_systematic`, two more e_x fits), which the replicate studies do
-    not judge.
+    systematic (:func:`scale_systematic`, two more e_x fits): a replicate study asks for it only
+    where its replicates draw their calibration or their properties, the combined interval's
+    coverage (:func:`ballbat.studies.replicates.run_replicate`).
     """
     usable = ds["flag"].values == 0
     balls = ds["ball"].values.astype(str)

@@ -3,7 +3,7 @@
 A pilot session (a dataset's ``fit_ex.nc``) gives each bat's e_x with its standard error ``se``
 from ``n0`` impacts; the error of one impact is ``s1 = se sqrt(n0)`` (the intrinsic scatter of e_x
 is in ``se``: the random-effects fit). With n impacts per bat, e_x of each bat has error
-``s1 / sqrt(n)``, and :func:`ballbat.studies.impacts_required` gives the smallest n at which a
+``s1 / sqrt(n)``, and :func:`ballbat.studies.design.impacts_required` gives the smallest n at which a
 two-sided test at ``confidence`` finds two bats ``delta`` apart with probability ``power``. The
 interval: ``s1`` is estimated on ``n0 - 1`` degrees of freedom, so its ``level`` interval is
 ``s1 sqrt(dof / chi2_{(1 +- level)/2, dof})``, and n is monotone in s1. Per ball, the bats'
@@ -28,7 +28,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 from scipy import stats
 
-from .studies import impacts_required
+from .studies.design import impacts_required
 
 if TYPE_CHECKING:
     import xarray as xr

@@ -24,7 +24,7 @@ class SyntheticSettings:
     """Settings of a synthetic experiment, in the paper's units (as in the config).
 
     Every field is required: the defaults live in the config schema alone (the workflow
-    passes the validated config; :func:`ballbat.pipeline.config.load_config` gives it to
+    passes the validated config; :func:`ballbat.config_checks.load_config` gives it to
     other callers).
 
     ``impacts[ball][bat]`` is the number of impacts; ``e_x[ball][bat]`` the true tangential

@@ -204,7 +204,7 @@ class FitSystematics:
     rel_sigma: np.ndarray
     #: The same with its sign: half of (the estimate at +1 sigma) - (the estimate at -1 sigma), so that
     #: ``by_source == abs(signed)``; a quantity's first-order change when source k is off by z_k sigma
-    #: is sum_k z_k signed[k] (:func:`ballbat.studies.run_replicate`).
+    #: is sum_k z_k signed[k] (:func:`ballbat.studies.replicates.run_replicate`).
     signed: dict[str, np.ndarray]
     #: The sources, in the order of the first axis (the dataset's ``systematic`` coordinate), and its long name.
     names: list[str] | None = None

@@ -14,14 +14,14 @@ from argparse import Namespace
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from .config_checks import BYTES_PER_CASE, STUDY_BYTES_PER_REPLICATE, impact_bytes, scenario_tables, study_impacts
+from .datasets import renders
 from .pipeline.codedeps import module_files
-from .pipeline.config import BYTES_PER_CASE, STUDY_BYTES_PER_REPLICATE, impact_bytes, scenario_tables, study_impacts
 from .pipeline.provenance import sha256_file
-from .sweeps import renders
 from .tracks.data import camera_block, tool_file_extensions
 
 if TYPE_CHECKING:
-    from .study_settings import StudySettings
+    from .studies.settings import StudySettings
 
 #: Every figure of a dataset (results/{dataset}/figures/).
 DATASET_FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig9a", "fig9b", "fig10")
@@ -269,13 +269,13 @@ class WorkflowInputs:
 
     def study_settings(self, name: str) -> StudySettings:
         """Return study ``name``'s settings."""
-        from .study_settings import StudySettings
+        from .studies.settings import StudySettings
 
         return StudySettings.from_config(self.config, name)
 
     def get_study_config(self, wildcards: Namespace) -> dict:
         """Return everything a study's results depend on (its, its dataset's and the chain's settings)."""
-        from .study_settings import study_block
+        from .studies.settings import study_block
 
         return study_block(self.config, wildcards.study)
 

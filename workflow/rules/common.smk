@@ -7,7 +7,8 @@ from pathlib import Path
 import yaml
 from snakemake.exceptions import WorkflowError
 
-from ballbat.pipeline.config import ConfigError, drop_nulls, scenario_problems, validate_config
+from ballbat.config_checks import scenario_problems, validate_config
+from ballbat.pipeline.config import ConfigError, drop_nulls
 from ballbat.pipeline.guards import (
     damaged_products,
     foreign_outputs,

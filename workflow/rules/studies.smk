@@ -1,6 +1,6 @@
 # Replicate studies (docs/studies.md): the whole chain on many replicates of a synthetic
 # dataset, one job per batch of replicates, then the coverage of every uncertainty and, for a
-# sweep, the design table; a grid's coverage figure. Not part of `rule all`: `make study` (or `snakemake
+# sweep, the design table; each figure a job of its own (plot_study_*, study_grid), drawn from its file. Not part of `rule all`: `make study` (or `snakemake
 # studies`); the studies marked on_request: `make study-robustness` (`snakemake studies_on_request`).
 
 
@@ -76,7 +76,7 @@ rule study_truth:
 
 
 rule study_aggregate:
-    """Coverage of every quantity with an uncertainty and a truth, over all batches of a study."""
+    """Coverage of every quantity with an uncertainty and a truth, over all batches of a study (file and table)."""
     input:
         batches=get_study_batches,
         truth=rules.study_truth.output.truth,
@@ -84,13 +84,6 @@ rule study_aggregate:
     output:
         coverage="results/studies/{study}/coverage.nc",
         csv="results/studies/{study}/coverage.csv",
-        png=report(
-            "results/studies/{study}/coverage.png",
-            caption="../report/study_coverage.rst",
-            category="Studies",
-            subcategory="{study}",
-            labels={"figure": "coverage", "shows": "coverage of every reported uncertainty"},
-        ),
     log:
         "results/studies/{study}/logs/aggregate.log",
     benchmark:
@@ -107,21 +100,38 @@ rule study_aggregate:
         "../scripts/study_aggregate.py"
 
 
+rule plot_study_coverage:
+    """A study's coverage figure, drawn from its coverage file (a job of its own: drawing apart from computing)."""
+    input:
+        coverage=rules.study_aggregate.output.coverage,
+        code=code("plot_study_coverage.py"),
+    output:
+        png=report(
+            "results/studies/{study}/coverage.png",
+            caption="../report/study_coverage.rst",
+            category="Studies",
+            subcategory="{study}",
+            labels={"figure": "coverage", "shows": "coverage of every reported uncertainty"},
+        ),
+    log:
+        "results/studies/{study}/logs/plot_coverage.log",
+    conda:
+        ENV
+    threads: 1
+    resources:
+        runtime=10,
+    script:
+        "../scripts/plot_study_coverage.py"
+
+
 rule study_design:
-    """A sweep's spread of e_x and the impacts per bat an experiment needs (table and figure)."""
+    """A sweep's spread of e_x and the impacts per bat an experiment needs (file and table)."""
     input:
         coverage=rules.study_aggregate.output.coverage,
         code=code("study_design.py"),
     output:
         design="results/studies/{study}/design.nc",
         csv="results/studies/{study}/design.csv",
-        png=report(
-            "results/studies/{study}/design.png",
-            caption="../report/study_design.rst",
-            category="Studies",
-            subcategory="{study}",
-            labels={"figure": "design", "shows": "spread of e_x and impacts needed"},
-        ),
     log:
         "results/studies/{study}/logs/design.log",
     conda:
@@ -130,6 +140,27 @@ rule study_design:
         study=get_study_config,
     script:
         "../scripts/study_design.py"
+
+
+rule plot_study_design:
+    """A sweep's design figure, drawn from its design file (a job of its own: drawing apart from computing)."""
+    input:
+        design=rules.study_design.output.design,
+        code=code("plot_study_design.py"),
+    output:
+        png=report(
+            "results/studies/{study}/design.png",
+            caption="../report/study_design.rst",
+            category="Studies",
+            subcategory="{study}",
+            labels={"figure": "design", "shows": "spread of e_x and impacts needed"},
+        ),
+    log:
+        "results/studies/{study}/logs/plot_design.log",
+    conda:
+        ENV
+    script:
+        "../scripts/plot_study_design.py"
 
 
 rule study_grid:

@@ -1,10 +1,9 @@
 """Rule study_aggregate: adapter around ballbat.studies (combine, coverage)."""
 
 from ballbat.pipeline.ncio import atomic_write_text, read_dataset, write_job_output
-from ballbat.pipeline.provenance import job_provenance, png_text
 from ballbat.pipeline.runlog import logged
-from ballbat.plotting import coverage_figure, save_figure
-from ballbat.studies import combine, coverage, coverage_csv, truth_scales_from_dataset, truths_from_dataset
+from ballbat.studies.coverage import combine, coverage, coverage_csv
+from ballbat.studies.truth import truth_scales_from_dataset, truths_from_dataset
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     study = snakemake.wildcards.study
@@ -15,4 +14,3 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         log.info("%s", line)
     write_job_output(cov, snakemake, "coverage", f"Study {study}: coverage of every reported uncertainty")
     atomic_write_text(snakemake.output.csv, coverage_csv(cov))
-    save_figure(coverage_figure(cov, point=0), snakemake.output.png, png_text(*job_provenance(snakemake)))

@@ -1,13 +1,13 @@
-"""Rule study_batch: adapter around ballbat.study_batch.run."""
+"""Rule study_batch: adapter around ballbat.studies.batch.run."""
 
-from ballbat import study_batch
 from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
-from ballbat.studies import StudySettings
+from ballbat.studies import batch
+from ballbat.studies.settings import StudySettings
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    study, batch = snakemake.wildcards.study, int(snakemake.wildcards.batch)
+    study, number = snakemake.wildcards.study, int(snakemake.wildcards.batch)
     settings = StudySettings.from_block(snakemake.params.study)
     step = max(1, settings.batch_size // 10)
 
@@ -16,8 +16,8 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         if done % step == 0 or done == n:
             log.info("%d of %d replicates", done, n)
 
-    ds = study_batch.run(settings, batch, load_balls(snakemake.input.balls), load_bats(snakemake.input.bats), progress)
+    ds = batch.run(settings, number, load_balls(snakemake.input.balls), load_bats(snakemake.input.bats), progress)
     for why in ds["refusal"].values.astype(str):
         if why:
             log.warning("data refused, counted in the coverage table's n_refused: %s", why)
-    write_job_output(ds, snakemake, "batch", f"Study {study}, batch {batch}: replicate estimates, errors and truths")
+    write_job_output(ds, snakemake, "batch", f"Study {study}, batch {number}: replicate estimates, errors and truths")

@@ -1,11 +1,10 @@
-"""Rule study_design: adapter around ballbat.studies.design."""
+"""Rule study_design: adapter around ballbat.studies.design.design."""
 
 from ballbat.pilot import with_sweep_answer
 from ballbat.pipeline.ncio import atomic_write_text, read_dataset, write_job_output
-from ballbat.pipeline.provenance import job_provenance, png_text
 from ballbat.pipeline.runlog import logged
-from ballbat.plotting import design_figure, save_figure
-from ballbat.studies import StudySettings, design, design_csv
+from ballbat.studies.design import design, design_csv
+from ballbat.studies.settings import StudySettings
 
 with logged(snakemake.log[0], snakemake.rule):
     study = snakemake.wildcards.study
@@ -14,4 +13,3 @@ with logged(snakemake.log[0], snakemake.rule):
     des = with_sweep_answer(design(cov, settings))  # one answer over a sweep of impacts per bat (issue 37)
     write_job_output(des, snakemake, "design", f"Study {study}: spread of e_x and impacts per bat needed")
     atomic_write_text(snakemake.output.csv, design_csv(des))
-    save_figure(design_figure(des), snakemake.output.png, png_text(*job_provenance(snakemake)))

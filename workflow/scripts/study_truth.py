@@ -1,9 +1,10 @@
-"""Rule study_truth_point: adapter around ballbat.studies.truth_dataset (one sweep point, or every point)."""
+"""Rule study_truth_point: adapter around ballbat.studies.truth.truth_dataset (one sweep point, or every point)."""
 
 from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
-from ballbat.studies import StudySettings, truth_dataset
+from ballbat.studies.settings import StudySettings
+from ballbat.studies.truth import truth_dataset
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     study = snakemake.wildcards.study

@@ -1,8 +1,8 @@
-"""Rule study_truth: adapter around ballbat.studies.merge_truths (the truth files of every sweep point)."""
+"""Rule study_truth: adapter around ballbat.studies.truth.merge_truths (the truth files of every sweep point)."""
 
 from ballbat.pipeline.ncio import read_dataset, write_job_output
 from ballbat.pipeline.runlog import logged
-from ballbat.studies import merge_truths
+from ballbat.studies.truth import merge_truths
 
 with logged(snakemake.log[0], snakemake.rule):
     study = snakemake.wildcards.study

@@ -31,8 +31,9 @@ class FitExSettings:
     mu_k_example : float
         Friction of the Sec. IV gross-slip example (config ``analysis.mu_k_example``).
     systematic : bool
-        Fit the pixel-scale systematic of e_x (:func:`ballbat.fitting.scale_systematic`; the
-        replicate studies judge no systematic and skip it).
+        Fit the pixel-scale systematic of e_x (:func:`ballbat.fitting.scale_systematic`; a
+        replicate of a study fits it where it draws its calibration or its properties,
+        :func:`ballbat.studies.replicates.run_replicate`, and skips it elsewhere).
     check_physical : bool
         Refuse a fitted e_x outside [-1, 1] (:class:`ballbat.fitting.ImplausibleFit`); the
         replicate studies record every replicate's numbers as they come.

@@ -519,7 +519,7 @@ def weighted_mean(x: ArrayLike, err: ArrayLike) -> tuple[float, float, int]:
 def hypotheses(cameras: dict, steps: dict | None = None) -> list[tuple[str, dict]]:
     """Single mistakes and what they scale (config value over true value), most specific first.
 
-    Keys: ``m_swing``, ``fps_swing``, ``m_spin``, ``fps_spin``, ``rig``, ``y_swing``, ``y_spin``,
+    Keys: ``swing_m_per_px``, ``swing_fps``, ``spin_m_per_px``, ``spin_fps``, ``rig``, ``y_swing``, ``y_spin``,
     ``x_swing``, ``x_spin`` (signs). ``steps``: the step every impact's frames share in a camera
     (:func:`frame_steps`); a step d > 1 adds the mistake "frame numbers d x the video's", which
     scales time as fps d x too low does and comes first (the frames show it).
@@ -527,10 +527,10 @@ def hypotheses(cameras: dict, steps: dict | None = None) -> list[tuple[str, dict
     out = _frame_step_hypotheses(steps or {})
     for c in ("swing", "spin"):
         out += [
-            (f"cameras.{c}.fps is 2x too high", {f"fps_{c}": 2.0}),
-            (f"cameras.{c}.fps is 2x too low", {f"fps_{c}": 0.5}),
-            (f"cameras.{c}.m_per_px is in mm per pixel, not m", {f"m_{c}": 1000.0}),
-            (f"cameras.{c}.m_per_px is in cm per pixel, not m", {f"m_{c}": 100.0}),
+            (f"cameras.{c}.fps is 2x too high", {f"{c}_fps": 2.0}),
+            (f"cameras.{c}.fps is 2x too low", {f"{c}_fps": 0.5}),
+            (f"cameras.{c}.m_per_px is in mm per pixel, not m", {f"{c}_m_per_px": 1000.0}),
+            (f"cameras.{c}.m_per_px is in cm per pixel, not m", {f"{c}_m_per_px": 100.0}),
             (
                 f"y points up in the {c} camera's rows (Tracker and Kinovea export y up; ballbat's pixels have y down)",
                 {f"y_{c}": -1.0},
@@ -542,7 +542,7 @@ def hypotheses(cameras: dict, steps: dict | None = None) -> list[tuple[str, dict
         ("the rig lengths are in metres, not inches", {"rig": 1 / 39.37}),
         ("the rig lengths are in cm, not inches", {"rig": 2.54}),
     ]
-    mm = {f"m_{c}": cameras[c].m_per_px / 1e-3 for c in ("swing", "spin")}
+    mm = {f"{c}_m_per_px": cameras[c].m_per_px / 1e-3 for c in ("swing", "spin")}
     out += [
         ("x_px and y_px are millimetres, not pixels (a world-unit export)", mm),
         (
@@ -554,10 +554,14 @@ def hypotheses(cameras: dict, steps: dict | None = None) -> list[tuple[str, dict
     out.append(
         (
             "the swing and spin camera settings are swapped",
-            {"m_swing": sw.m_per_px / sp.m_per_px, "fps_swing": sw.fps / sp.fps, "m_spin": sp.m_per_px / sw.m_per_px},
+            {
+                "swing_m_per_px": sw.m_per_px / sp.m_per_px,
+                "swing_fps": sw.fps / sp.fps,
+                "spin_m_per_px": sp.m_per_px / sw.m_per_px,
+            },
         )
     )
-    out[-1][1]["fps_spin"] = sp.fps / sw.fps
+    out[-1][1]["spin_fps"] = sp.fps / sw.fps
     return out
 
 
@@ -572,15 +576,20 @@ def _frame_step_hypotheses(steps: dict) -> list[tuple[str, dict]]:
         f"the frame numbers of the {which} are {d}x the video's: every impact's tracked frames step by {d} "
         f"(number the video's frames 0, 1, 2, ..., or divide them by {d})"
     )
-    return [(name, {f"fps_{c}": 1.0 / steps[c] for c in cams})]
+    return [(name, {f"{c}_fps": 1.0 / steps[c] for c in cams})]
 
 
 def _both_camera_hypotheses() -> list[tuple[str, dict]]:
     """Mistakes made alike in both cameras: a scale or frame rate off by 2, the axes turned 180 deg, a mirror."""
     out: list[tuple[str, dict]] = []
     for k, how in ((2.0, "2x too high"), (0.5, "2x too low (half the true value)")):
-        out.append((f"cameras.swing.m_per_px and cameras.spin.m_per_px are both {how}", {"m_swing": k, "m_spin": k}))
-        out.append((f"cameras.swing.fps and cameras.spin.fps are both {how}", {"fps_swing": k, "fps_spin": k}))
+        out.append(
+            (
+                f"cameras.swing.m_per_px and cameras.spin.m_per_px are both {how}",
+                {"swing_m_per_px": k, "spin_m_per_px": k},
+            )
+        )
+        out.append((f"cameras.swing.fps and cameras.spin.fps are both {how}", {"swing_fps": k, "spin_fps": k}))
     out += _length_unit_hypotheses()
     turned = "x points left and y up: Tracker's coordinate axes turned 180 deg, or the video upside down"
     for c in ("swing", "spin"):
@@ -606,7 +615,7 @@ def _length_unit_hypotheses() -> list[tuple[str, dict]]:
                     (
                         f"units.length says {said!r} but the exported tables are in {true} (both cameras' lengths "
                         f"{k:.4g}x the true ones; or both cameras' m_per_px off by that factor)",
-                        {"m_swing": k, "m_spin": k},
+                        {"swing_m_per_px": k, "spin_m_per_px": k},
                     )
                 )
     return out
@@ -637,15 +646,15 @@ def frame_steps(tracks: Tracks, largest: int = 10) -> dict[str, int]:
 
 def predict(h: dict) -> dict:
     """Observables a mistake predicts: g over its value per camera, L_arc / L_cfg, v_swing / v_spin."""
-    keys = ("m_swing", "fps_swing", "m_spin", "fps_spin", "rig", "y_swing", "y_spin", "x_swing", "x_spin")
+    keys = ("swing_m_per_px", "swing_fps", "spin_m_per_px", "spin_fps", "rig", "y_swing", "y_spin", "x_swing", "x_spin")
     f = {k: h.get(k, 1.0) for k in keys}
     return {
         "dir_swing": f["x_swing"],
         "dir_spin": f["x_spin"],
-        "g_swing": f["y_swing"] * f["m_swing"] * f["fps_swing"] ** 2,
-        "g_spin": f["y_spin"] * f["m_spin"] * f["fps_spin"] ** 2,
-        "arc": f["m_swing"] / f["rig"],
-        "speed": f["m_swing"] * f["fps_swing"] / (f["m_spin"] * f["fps_spin"]),
+        "g_swing": f["y_swing"] * f["swing_m_per_px"] * f["swing_fps"] ** 2,
+        "g_spin": f["y_spin"] * f["spin_m_per_px"] * f["spin_fps"] ** 2,
+        "arc": f["swing_m_per_px"] / f["rig"],
+        "speed": f["swing_m_per_px"] * f["swing_fps"] / (f["spin_m_per_px"] * f["spin_fps"]),
     }
 
 

@@ -137,7 +137,7 @@ def calibration_draws(cfg: dict) -> np.ndarray:
     the declared one moved by ``z[k]`` of its stated uncertainty, so a quantity's change under
     the draw is, to first order, the sum of ``z[k]`` times its change per +1 sigma of source k
     (what a replicate study uses to take the draw's spread out of a bias,
-    :func:`ballbat.studies.run_replicate`). Drawn whether or not a source's uncertainty is stated.
+    :func:`ballbat.studies.replicates.run_replicate`). Drawn whether or not a source's uncertainty is stated.
     """
     rng = np.random.default_rng(np.random.SeedSequence(int(cfg["seed"]), spawn_key=(CALIBRATION_SPAWN_KEY,)))
     return rng.standard_normal(len(_calibration_entries(cfg)))

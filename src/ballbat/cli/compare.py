@@ -12,7 +12,7 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
-from .usage import UsageError
+from ..usage import UsageError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -26,7 +26,7 @@ Folders hold {dataset}/fit_ex.nc (or fit_ex.nc itself); each dataset is a test s
 
 def register(sub: argparse._SubParsersAction, number: Callable[[str], float]) -> None:
     """Add the ``compare`` command to ``sub`` (``number`` parses a finite number)."""
-    from .league import LeagueSettings
+    from ..league import LeagueSettings
 
     d = LeagueSettings.from_config({})
     p = sub.add_parser(
@@ -44,7 +44,7 @@ def register(sub: argparse._SubParsersAction, number: Callable[[str], float]) ->
 
 def cmd_compare(args: argparse.Namespace) -> int:
     """Print the league table of ``args.folders``; a folder the league cannot read is a usage error."""
-    from .league import LeagueInputError, LeagueSettings, league, pair_lines, read_folder, table_lines
+    from ..league import LeagueInputError, LeagueSettings, league, pair_lines, read_folder, table_lines
 
     if not 0 < args.alpha < 0.5:
         raise UsageError(f"--alpha {args.alpha}: must lie between 0 and 0.5")

@@ -17,16 +17,16 @@ import math
 import sys
 from typing import TYPE_CHECKING
 
-from . import batlab
-from .properties import recoil_factors
-from .units import INCH, OUNCE, OZ_IN2
+from .. import batlab
+from ..properties import recoil_factors
+from ..units import INCH, OUNCE, OZ_IN2
 
 if TYPE_CHECKING:
     import argparse
     from collections.abc import Callable
     from pathlib import Path
 
-    from .properties import Ball
+    from ..properties import Ball
 
 #: Measured values: option -> (lab column, help, unit, default standard uncertainty, relative?).
 MEASURED = {
@@ -110,7 +110,7 @@ def e_x_shift(row: dict, ball: Ball, e_x: float) -> Callable[[dict], float]:
 
 def _bat(row: dict):
     """Return a lab row as an SI :class:`~ballbat.properties.Bat`."""
-    from .properties import Bat
+    from ..properties import Bat
 
     p = batlab.paper_row(row)
     return Bat(
@@ -141,8 +141,8 @@ def uncertainty_lines(row: dict, args: argparse.Namespace, ball: Ball) -> list[s
 
 def cmd_bat(args: argparse.Namespace) -> int:
     """Print the bat's rows, centre of percussion, recoil factors and e_x uncertainties; 1 when it fails the checks."""
-    from .properties import load_balls
-    from .usage import UsageError
+    from ..properties import load_balls
+    from ..usage import UsageError
 
     try:
         row = lab_row(args)

@@ -14,7 +14,7 @@ import json
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-from .usage import UsageError
+from ..usage import UsageError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -59,10 +59,10 @@ def register(sub: argparse._SubParsersAction, number: Callable[[str], float], ta
 
 def _dataset(folder: str, bat: str, ball: str):
     """Return the bat of a results folder (its fit_ex.nc's ``bat_properties``) and the e_x of it there."""
-    from .league import LeagueInputError, read_folder
-    from .properties import Bat
-    from .scenario_bands import dataset_e_x
-    from .units import INCH, OUNCE, OZ_IN2
+    from ..league import LeagueInputError, read_folder
+    from ..properties import Bat
+    from ..scenario_bands import dataset_e_x
+    from ..units import INCH, OUNCE, OZ_IN2
 
     try:
         sessions = read_folder(folder)
@@ -94,7 +94,7 @@ def _dataset(folder: str, bat: str, ball: str):
 
 def scenario(args: argparse.Namespace, e_x: float | None) -> tuple[dict, dict]:
     """Return the one-offset D sweep of ``args`` as a checked scenario block, and the air (the schema's defaults)."""
-    from .pipeline.config import ConfigError, checked_block
+    from ..pipeline.config import ConfigError, checked_block
 
     sweep = {key: getattr(args, opt.replace("-", "_")) for opt, (key, *_) in SWING.items()}
     sweep["D_in"] = {"start": args.D, "stop": args.D, "num": 1}
@@ -108,9 +108,9 @@ def scenario(args: argparse.Namespace, e_x: float | None) -> tuple[dict, dict]:
 
 def cmd_hit(args: argparse.Namespace) -> int:
     """Print the batted ball of a pitch and a swing, and its bands when e_x comes from a dataset."""
-    from .properties import InputError, load_balls, load_bats
-    from .scenario_bands import scenario_with_bands
-    from .stages.implications import ImplicationsSettings
+    from ..properties import InputError, load_balls, load_bats
+    from ..scenario_bands import scenario_with_bands
+    from ..stages.implications import ImplicationsSettings
 
     if args.results is not None and args.e_x is not None:
         raise UsageError("--e-x: not with --results (the dataset gives e_x)")
@@ -135,7 +135,7 @@ def hit_lines(ds: xr.Dataset, sc: dict) -> list[str]:
     """Return the batted ball in words: exit speed, launch angle, backspin and carry, with their bands."""
     import numpy as np
 
-    from .units import from_si
+    from ..units import from_si
 
     sw = sc["sweep"]
     out = [

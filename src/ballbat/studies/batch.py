@@ -1,8 +1,8 @@
 """Stage study_batch: ``results/studies/{study}/batches/batch{n}.nc``, the replicates of one batch job.
 
-Each replicate is the workflow's own stages in memory (:func:`ballbat.studies.run_replicate`:
+Each replicate is the workflow's own stages in memory (:func:`ballbat.studies.replicates.run_replicate`:
 simulate, render, reduce, normalize, reconstruct, fit_ex and eta^2); this stage runs a batch
-of them (:func:`ballbat.studies.run_replicates`) and writes their estimates, uncertainties,
+of them (:func:`ballbat.studies.replicates.run_replicates`) and writes their estimates, uncertainties,
 systematics and truths on :data:`BATCH_TABLE` (dims replicate x quantity; SI, each quantity's
 unit in the coordinate ``units``).
 """
@@ -13,15 +13,17 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from .pipeline.products import Var, build_dataset
-from .studies import PER_QUANTITY_UNITS, StudySettings, quantity_coords, row_labels, run_replicates, study_attrs
+from ..pipeline.products import Var, build_dataset
+from .records import PER_QUANTITY_UNITS, quantity_coords, row_labels, study_attrs
+from .replicates import run_replicates
+from .settings import StudySettings
 
 if TYPE_CHECKING:
     from collections.abc import Callable
 
     import xarray as xr
 
-    from .properties import Ball, Bat
+    from ..properties import Ball, Bat
 
 __all__ = ["BATCH_TABLE", "StudySettings", "run"]
 

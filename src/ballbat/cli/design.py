@@ -10,7 +10,7 @@ from __future__ import annotations
 import argparse
 from typing import TYPE_CHECKING
 
-from .usage import UsageError
+from ..usage import UsageError
 
 if TYPE_CHECKING:
     from collections.abc import Callable
@@ -37,8 +37,8 @@ def register(sub: argparse._SubParsersAction, number: Callable[[str], float]) ->
 
 def cmd_design(args: argparse.Namespace) -> int:
     """Print the impacts per bat of the pilot ``args.folder``."""
-    from .league import LeagueInputError, read_folder
-    from .pilot import pilot_design, requirement_lines
+    from ..league import LeagueInputError, read_folder
+    from ..pilot import pilot_design, requirement_lines
 
     for name, value, low, high in (("delta", args.delta, 0, 2), ("confidence", args.confidence, 0, 1)):
         if not low < value < high:

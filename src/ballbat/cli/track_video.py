@@ -56,8 +56,8 @@ def _radii(text: str) -> dict[str, float]:
 
 
 def _track_one(path: Path, radii: dict, args) -> tuple[dict, dict, dict]:
-    from .io import open_clip
-    from .track import TrackOptions, found_columns, require_ball, track_clip
+    from ..video.io import open_clip
+    from ..video.track import TrackOptions, found_columns, require_ball, track_clip
 
     m = _NAME.match(path.stem)
     if not m:
@@ -93,9 +93,9 @@ def cmd_track_video(args: argparse.Namespace) -> int:
 
     from ..pipeline.checked import sealed_csv
     from ..tracks.io import long_csv_text
+    from ..video.clip import VideoError
+    from ..video.track import QUALITY_COLUMNS
     from ..writer import OutputRefused, output_problem, write_output
-    from .clip import VideoError
-    from .track import QUALITY_COLUMNS
 
     if args.output == "-":
         raise OutputRefused("-o -: track-video writes two tables (the tracks and their quality); name a file")

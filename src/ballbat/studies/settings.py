@@ -32,11 +32,11 @@ class StudySettings:
     batch_size : int
         Replicates per batch job.
     parameter : str, tuple of str or None
-        Swept setting (a key of :data:`ballbat.sweeps.SWEEP_PARAMETERS`), None for no sweep;
+        Swept setting (a key of :data:`ballbat.studies.sweeps.SWEEP_PARAMETERS`), None for no sweep;
         for a grid sweep the tuple of its settings.
     values : tuple
         Its values (one point, NaN, without a sweep); for a grid one tuple per point, every
-        combination of the settings' values (:func:`ballbat.sweeps.sweep_points`).
+        combination of the settings' values (:func:`ballbat.studies.sweeps.sweep_points`).
     v_ref_mph, mu_k_example : float
         The workflow's ``normalize.v_ref_mph`` and ``analysis.mu_k_example``.
     stronge : dict
@@ -49,7 +49,7 @@ class StudySettings:
     draw_properties : bool
         Every replicate draws its true bat and ball properties from the tables' stated
         uncertainties (``<column>_err``) and is analysed with the tables' values
-        (:func:`ballbat.studies.run_replicate`; config ``studies.<name>.draw_properties``).
+        (:func:`ballbat.studies.replicates.run_replicate`; config ``studies.<name>.draw_properties``).
     """
 
     dataset: dict
@@ -134,7 +134,7 @@ class StudySettings:
     def truth_counts(self, point: int) -> tuple[int, dict[str, dict[str, int]]]:
         """Return the truth job's scale and impacts per ball and bat at sweep point ``point``.
 
-        The one rule for the truth's size: :func:`ballbat.sweeps.truth_counts`.
+        The one rule for the truth's size: :func:`ballbat.studies.sweeps.truth_counts`.
         """
         return truth_counts(self.point_dataset(point), self.truth_impacts)
 
@@ -144,7 +144,7 @@ class StudySettings:
 
     def truth_mem_mb(self, point: int) -> int:
         """Return the truth job's memory plan at sweep point ``point`` (MB): 500 MB and the chain's per impact."""
-        from .pipeline.config import impact_bytes
+        from ..config_checks import impact_bytes
 
         return 500 + math.ceil(self.truth_size(point) * impact_bytes(self.dataset) / 1e6)
 

@@ -13,6 +13,8 @@ import itertools
 import math
 from typing import TYPE_CHECKING
 
+from ..datasets import renders
+
 if TYPE_CHECKING:
     from collections.abc import Sequence
 
@@ -22,16 +24,10 @@ __all__ = [
     "check_study_sweep",
     "check_sweep",
     "point_dataset",
-    "renders",
     "study_dataset",
     "sweep_points",
     "truth_counts",
 ]
-
-
-def renders(dataset: dict) -> bool:
-    """Whether a validated dataset renders camera tracks (its render block's ``enabled``, default filled)."""
-    return "render" in dataset and bool(dataset["render"]["enabled"])
 
 
 #: What a sweep may vary: name -> what it sets in the dataset's settings.
@@ -98,7 +94,7 @@ def _value_problem(parameter: str, v: float) -> str | None:
         return f"psi_max_scale must lie in (0, 2], not {v:g}"
     if parameter == "e_x" and not -1.0 < v < 1.0:
         return f"e_x must lie in (-1, 1), not {v:g}"
-    from .tracks.data import CONTACT_PRIOR  # the reduction's prior: the renderer's contacts must lie in it
+    from ..tracks.data import CONTACT_PRIOR  # the reduction's prior: the renderer's contacts must lie in it
 
     lo, hi = (1e3 * v for v in CONTACT_PRIOR)
     h = CONTACT_HALF_WIDTH_MS
