@@ -26,9 +26,9 @@ Folders hold {dataset}/fit_ex.nc (or fit_ex.nc itself); each dataset is a test s
 
 def register(sub: argparse._SubParsersAction, number: Callable[[str], float]) -> None:
     """Add the ``compare`` command to ``sub`` (``number`` parses a finite number)."""
-    from ..league import LeagueSettings
+    from ..pipeline.config import checked_block  # the schema's defaults, without the league's scipy and xarray
 
-    d = LeagueSettings.from_config({})
+    d = checked_block({}, "league")
     p = sub.add_parser(
         "compare",
         help="the bats league table of results folders: e_x per bat, pairwise tests, equivalence",
@@ -37,8 +37,8 @@ def register(sub: argparse._SubParsersAction, number: Callable[[str], float]) ->
     )
     p.add_argument("folders", nargs="+", metavar="FOLDER", help="results folders (or dataset folders)")
     p.add_argument("--reference-bat", help="bat of the equivalence test (default: per ball, the most impacts)")
-    p.add_argument("--margin", type=number, default=d.margin, help="equivalence margin in e_x (default %(default)s)")
-    p.add_argument("--alpha", type=number, default=d.alpha, help="level of every test (default %(default)s)")
+    p.add_argument("--margin", type=number, default=d["margin"], help="equivalence margin in e_x (default %(default)s)")
+    p.add_argument("--alpha", type=number, default=d["alpha"], help="level of every test (default %(default)s)")
     p.set_defaults(func=cmd_compare)
 
 
