@@ -7,6 +7,12 @@ mirrored, 0.5 px tracking noise; true e_x = 0.464, e_y = 0.45, bat speed 63-88 m
 axis: its dots do not rotate about the ball's centre and the reduction excludes it.
 
     .venv/bin/python config/examples/make_tracked.py
+
+The committed files came from the renderer of their time (commit 7c246cf). The renderer has
+changed since (its tracking-noise and camera defaults, now the config schema's), so this script
+no longer gives them byte for byte: run today it writes a dataset of the same design (the
+first seed with one tilted axis is 8, 2754 rows against the committed 2743). The example is an
+input the tests pin, so it is kept as committed, not regenerated.
 """
 
 import csv
@@ -14,8 +20,10 @@ from pathlib import Path
 
 import numpy as np
 
+from ballbat.pipeline.config import checked_block
 from ballbat.properties import load_balls, load_bats
-from ballbat.synthetic import SyntheticSettings, simulate_experiment
+from ballbat.stages import simulate
+from ballbat.synthetic import SyntheticSettings
 from ballbat.tracks.data import to_long
 from ballbat.tracks.render import render_tracks, settings_from_config
 
@@ -41,13 +49,18 @@ settings = SyntheticSettings(
     e_x_scatter=0.0,
     noise={"v_bat_mph": 0.5, "v_ball_mph": 0.5, "theta_deg": 0.5, "omega_rpm": 75.0},
 )
-ds = simulate_experiment(settings, balls, load_bats(ROOT / "config" / "bats.csv"))
+ds = simulate.run(settings, balls, load_bats(ROOT / "config" / "bats.csv"))
 truth = {k: ds[f"truth_{k}"].values for k in ("v_bat", "v_ball", "theta", "omega", "psi")}
 r = np.array([balls[b].r for b in ds["ball"].values])
 ids = np.array([f"W{i + 1:02d}" for i in range(ds.sizes["impact"])])
 for seed in range(100):  # the first rendering seed with exactly one tilted spin axis
     tracks = render_tracks(
-        truth, r, settings_from_config({**RENDER, "seed": seed}), ids, ds["ball"].values, ds["bat"].values
+        truth,
+        r,
+        settings_from_config(checked_block({**RENDER, "seed": seed}, "render")),
+        ids,
+        ds["ball"].values,
+        ds["bat"].values,
     )
     if int((tracks.truth["truth_spin_axis_tilt"] > 0).sum()) == 1:
         break
