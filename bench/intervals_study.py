@@ -1,7 +1,7 @@
 """Issue 36: coverage of implied e_y's interval forms and of e_x with intrinsic scatter, per set-up.
 
 Each set-up's replicate experiments are simulated, rendered and reduced once
-(:func:`ballbat.studies.replicates._source`, cached) and fitted once per estimator variant on the same
+(:func:`ballbat.chain.source`, cached per seeds) and fitted once per estimator variant on the same
 replicates: implied e_y's sandwich form (:data:`ballbat.fitting.E_Y_SANDWICH`: ``hc0k``, the
 first version; ``hc2``, shipped; ``hc3``) and the e_x fits with or without the intrinsic-scatter
 term (:data:`ballbat.linefit.SCATTER_TERM`). Variants: ``before`` (hc0k, no term), ``hc2`` (no
@@ -22,7 +22,7 @@ import time
 from dataclasses import replace
 from unittest import mock
 
-from ballbat import fitting, linefit
+from ballbat import chain, fitting, linefit
 from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
 from ballbat.studies import batch as study_batch
@@ -84,11 +84,12 @@ def main() -> None:
     cfg = load_config()
     balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
     cache: dict = {}
-    real_source = replicates._source
+    real_source = chain.source
 
-    def cached_source(dataset, seeds, *rest):
+    def cached_source(settings, *rest, **kw):
+        seeds = (settings.synthetic.seed, settings.render.seed if settings.render else None)
         if seeds not in cache:
-            cache[seeds] = real_source(dataset, seeds, *rest)
+            cache[seeds] = real_source(settings, *rest, **kw)
         return cache[seeds]
 
     quantities = tuple(q for q in STUDY_QUANTITIES if q != "eta2")
@@ -100,7 +101,7 @@ def main() -> None:
         truth = [population_truth(s, 0, balls, bats)]
         out = [f"{name}: {reps} replicates (truth {time.perf_counter() - t0:.0f} s)"]
         with (
-            mock.patch.object(replicates, "_source", cached_source),
+            mock.patch.object(chain, "source", cached_source),
             mock.patch.object(replicates, "STUDY_QUANTITIES", quantities),
         ):
             for label in variants:
