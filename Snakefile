@@ -61,14 +61,14 @@ onstart:
 
 
 # Every warning of the run's jobs, printed at its end, success or not; then the run's Provenance Run
-# Crate (results/ro-crate-metadata.json; common.smk: write_crate), marked failed after a failure.
+# Crate ({R}/ro-crate-metadata.json; common.smk: write_crate), marked failed after a failure.
 onsuccess:
-    print_warnings("results", DATASETS, SCENARIOS)
+    print_warnings(R, DATASETS, SCENARIOS)
     write_crate()
 
 
 onerror:
-    print_warnings("results", DATASETS, SCENARIOS)
+    print_warnings(R, DATASETS, SCENARIOS)
     write_crate(failed=True)
 
 
@@ -78,4 +78,4 @@ rule all:
     input:
         final_targets(),
         LEAGUE_TARGETS,
-        "results/report/front.rst",
+        f"{R}/report/front.rst",

@@ -299,7 +299,7 @@ def commit_date(commit: str, repo: str | os.PathLike[str] = ".") -> str | None:
     return text if out.returncode == 0 and text else None
 
 
-def provenance_line(git: Mapping[str, object], date: str | None) -> str:
+def provenance_line(git: Mapping[str, object], date: str | None, results: str = "results") -> str:
     """One line: the commit the results were made from, clean or not, its date, and where the full record is."""
     commit = str(git.get("commit") or "unknown")
     if commit == "unknown":
@@ -311,7 +311,8 @@ def provenance_line(git: Mapping[str, object], date: str | None) -> str:
         f"**Provenance:** commit ``{commit[:12]}`` ({state}). The full record (every input with its sha256,"
         " the config values each job used, the software versions) is in the ``provenance_*`` attributes of"
         " every NetCDF file and in each workbook's provenance sheet; the run as a whole, every job with its"
-        " inputs, config values and outputs, is the Provenance Run Crate ``results/ro-crate-metadata.json``."
+        " inputs, config values and outputs, is the Provenance Run Crate "
+        f"``{results}/ro-crate-metadata.json``."
     )
 
 
@@ -380,11 +381,13 @@ def front_page(
     warnings: Sequence[str],
     git: Mapping[str, object],
     date: str | None,
+    results: str = "results",
 ) -> str:
     """Return the front page's reStructuredText.
 
     ``datasets``: name -> {"kind": str, "impacts": reconstruct.nc, "fit": fit_ex.nc,
     "stronge": stronge.nc, and optionally "fig5": the figure's path and "thumbnail": its data URI}.
+    ``results``: the run's results folder (config ``results``).
     """
     lines = ["What was run", "-" * 12, ""]
     for name, d in datasets.items():
@@ -407,7 +410,7 @@ def front_page(
         lines += [f"- {escape(w)}" for w in dict.fromkeys(all_warnings)]
     else:
         lines.append("No warnings in this run.")
-    lines += ["", provenance_line(git, date), ""]
+    lines += ["", provenance_line(git, date, results), ""]
     return "\n".join(lines).rstrip("\n") + "\n"
 
 

@@ -23,7 +23,7 @@ from .tracks.data import camera_block, tool_file_extensions
 if TYPE_CHECKING:
     from .studies.settings import StudySettings
 
-#: Every figure of a dataset (results/{dataset}/figures/).
+#: Every figure of a dataset ({results}/{dataset}/figures/).
 DATASET_FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig9a", "fig9b", "fig10")
 
 
@@ -44,6 +44,11 @@ def file_hashes(files: dict[str, str]) -> dict[str, str]:
     return {k: sha256_file(v) if Path(v).is_file() else "not a file" for k, v in files.items()}
 
 
+def results_root(config: dict) -> str:
+    """Return the run's results folder (config ``results``, default ``results``), without a trailing slash."""
+    return str(config.get("results") or "results").rstrip("/") or "results"
+
+
 class WorkflowInputs:
     """The rules' view of one validated config (``basedir``: the workflow's folder, for its scripts).
 
@@ -54,6 +59,8 @@ class WorkflowInputs:
     def __init__(self, config: dict, basedir: str | Path) -> None:
         self.config = config
         self.scripts = Path(basedir) / "workflow" / "scripts"
+        #: The run's results folder (config ``results``; default ``results``): every product's path starts with it.
+        self.results = results_root(config)
         self.datasets = sorted(config["datasets"])
         self.tracked = [d for d in self.datasets if self.uses_tracks(d)]
         self.scenarios = sorted(config.get("implications", {}).get("scenarios", {}))
@@ -126,9 +133,9 @@ class WorkflowInputs:
     def get_source(self, wildcards: Namespace) -> str:
         """Return the first product of a dataset: its experiment, its measured impacts or its reduced tracks."""
         if self.uses_tracks(wildcards.dataset):  # raw camera tracks: workflow/rules/tracks.smk
-            return f"results/{wildcards.dataset}/reduce.nc"
+            return f"{self.results}/{wildcards.dataset}/reduce.nc"
         stage = "ingest" if self.is_measured(wildcards.dataset) else "simulate"
-        return f"results/{wildcards.dataset}/{stage}.nc"
+        return f"{self.results}/{wildcards.dataset}/{stage}.nc"
 
     # -- camera tracks --------------------------------------------------------------------
 
@@ -144,11 +151,11 @@ class WorkflowInputs:
         """
         d = self.dataset_config(wildcards)
         if "tracks" in d and "dir" in d["tracks"]:
-            out = f"results/{wildcards.dataset}/imported"
+            out = f"{self.results}/{wildcards.dataset}/imported"
             return {"tracks": f"{out}_tracks.nc", "cameras": f"{out}_cameras.yaml"}
         if "tracks" in d:  # a missing file fails this dataset's reduce job only (existing), not the DAG
             return {"tracks": existing(d["tracks"]["file"]), "impacts": existing(d["tracks"]["impacts"])}
-        return {"tracks": f"results/{wildcards.dataset}/tracks.nc"}
+        return {"tracks": f"{self.results}/{wildcards.dataset}/tracks.nc"}
 
     def get_tool_files(self, wildcards: Namespace) -> dict:
         """Return the tool files of a dataset whose tracks block names a folder (dir), and its impacts file."""
@@ -216,10 +223,28 @@ class WorkflowInputs:
         """Return the sha256 of the scenario's property tables (:func:`file_hashes`)."""
         return file_hashes(self.get_scenario_tables(wildcards))
 
+    def workbook_scenarios(self) -> list[str]:
+        """Return the scenario files of the implications workbook: this run's, and the earlier ones of its folder.
+
+        An earlier run of the same results folder with another config (a lab's own scenario) left its
+        ``implications/{name}.nc``; the workbook keeps its sheet (a scenario file the workflow wrote,
+        :func:`.pipeline.guards.written_by_workflow`; not one put there by hand, nor a damaged one).
+        """
+        from .pipeline.guards import product_problem, written_by_workflow
+
+        folder = Path(self.results) / "implications"
+        ours = [f"{folder.as_posix()}/{s}.nc" for s in self.scenarios]
+        earlier = [
+            p.as_posix()
+            for p in sorted(folder.glob("*.nc"))
+            if p.stem not in self.scenarios and written_by_workflow(p) and product_problem(p) is None
+        ]
+        return sorted(ours + earlier, key=lambda f: Path(f).stem)
+
     def get_scenario_fit(self, wildcards: Namespace) -> dict:
         """Return fit_ex.nc of the dataset whose e_x the scenario uses (none by default)."""
         name = self.get_scenario(wildcards).get("e_x_from_dataset")
-        return {"fit": f"results/{name}/fit_ex.nc"} if name else {}
+        return {"fit": f"{self.results}/{name}/fit_ex.nc"} if name else {}
 
     def final_targets(self) -> list[str]:
         """Return everything a default run makes.
@@ -230,15 +255,16 @@ class WorkflowInputs:
         per_dataset = ["normalize.nc", "reconstruct.nc", "fit_ex.nc", "stronge.nc"]
         per_dataset += ["paper_comparison.csv", "paper_comparison.html", "results.xlsx"]
         per_dataset += [f"figures/{fig}.png" for fig in DATASET_FIGURES]
+        r, imp = self.results, f"{self.results}/implications"
         targets = [self.get_source(Namespace(dataset=d)) for d in self.datasets]
-        targets += [f"results/{d}/figures/tracks_{fig}.png" for d in self.tracked for fig in ("impacts", "summary")]
-        targets += [f"results/{d}/{f}" for d in self.datasets for f in per_dataset]
-        targets += [f"results/implications/{s}.nc" for s in self.scenarios]
-        targets += ["results/implications/results.xlsx"] if self.scenarios else []
-        targets += [f"results/implications/figures/{s}_fig11{p}.png" for s in self.sweep_scenarios for p in "ab"]
-        targets += [f"results/implications/figures/{s}_launch.png" for s in self.launch_scenarios]
+        targets += [f"{r}/{d}/figures/tracks_{fig}.png" for d in self.tracked for fig in ("impacts", "summary")]
+        targets += [f"{r}/{d}/{f}" for d in self.datasets for f in per_dataset]
+        targets += [f"{imp}/{s}.nc" for s in self.scenarios]
+        targets += [f"{imp}/results.xlsx"] if self.scenarios else []
+        targets += [f"{imp}/figures/{s}_fig11{p}.png" for s in self.sweep_scenarios for p in "ab"]
+        targets += [f"{imp}/figures/{s}_launch.png" for s in self.launch_scenarios]
         if "paper" in self.sweep_scenarios:  # the paper's own scenario is compared with Sec. V.B
-            targets += ["results/implications/paper_comparison.csv", "results/implications/paper_comparison.html"]
+            targets += [f"{imp}/paper_comparison.csv", f"{imp}/paper_comparison.html"]
         return targets
 
     def league_targets(self) -> list[str]:
@@ -258,10 +284,10 @@ class WorkflowInputs:
         datasets = self.config["datasets"]
         if len(datasets) > 1 or any(several_bats(b) for b in datasets.values()):
             return [
-                "results/league.nc",
-                "results/league.csv",
-                "results/league.xlsx",
-                "results/figures/league_forest.png",
+                f"{self.results}/league.nc",
+                f"{self.results}/league.csv",
+                f"{self.results}/league.xlsx",
+                f"{self.results}/figures/league_forest.png",
             ]
         return []
 
@@ -297,7 +323,7 @@ class WorkflowInputs:
     def get_study_batches(self, wildcards: Namespace) -> list[str]:
         """Return the study's batch files."""
         n = self.study_settings(wildcards.study).n_batches
-        return [f"results/studies/{wildcards.study}/batches/batch{b}.nc" for b in range(n)]
+        return [f"{self.results}/studies/{wildcards.study}/batches/batch{b}.nc" for b in range(n)]
 
     def study_batch_mem_mb(self, wildcards: Namespace) -> int:
         """Return a batch job's memory, MB: one replicate at a time (measured ~180 MB at the paper's size)."""
@@ -322,7 +348,7 @@ class WorkflowInputs:
     def get_study_truth_points(self, wildcards: Namespace) -> list[str]:
         """Return the study's truth files, one per sweep point."""
         n = self.study_settings(wildcards.study).n_points
-        return [f"results/studies/{wildcards.study}/truth/point{p}.nc" for p in range(n)]
+        return [f"{self.results}/studies/{wildcards.study}/truth/point{p}.nc" for p in range(n)]
 
     def study_truth_runtime(self, wildcards: Namespace) -> int:
         """Return a truth job's time, minutes (StudySettings.truth_runtime_min)."""
@@ -337,12 +363,12 @@ class WorkflowInputs:
         """
         targets = []
         for name in self.studies if not on_request else sorted(set(self.all_studies) - set(self.studies)):
-            targets += [f"results/studies/{name}/coverage.{ext}" for ext in ("nc", "csv", "png")]
+            targets += [f"{self.results}/studies/{name}/coverage.{ext}" for ext in ("nc", "csv", "png")]
             sweep = self.config["studies"][name].get("sweep") or {}
             if "grid" in sweep:
-                targets += [f"results/studies/{name}/grid.png"]
+                targets += [f"{self.results}/studies/{name}/grid.png"]
             elif sweep:
-                targets += [f"results/studies/{name}/design.{ext}" for ext in ("nc", "csv", "png")]
-            targets += [f"results/studies/{name}/truth.nc", *self.get_study_truth_points(Namespace(study=name))]
+                targets += [f"{self.results}/studies/{name}/design.{ext}" for ext in ("nc", "csv", "png")]
+            targets += [f"{self.results}/studies/{name}/truth.nc", *self.get_study_truth_points(Namespace(study=name))]
             targets += self.get_study_batches(Namespace(study=name))
         return targets

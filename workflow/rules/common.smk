@@ -19,10 +19,6 @@ from ballbat.pipeline.guards import (
 )
 from ballbat.workflow_inputs import WorkflowInputs
 
-# A folder the run cannot write: one line naming it, for every invocation (a dry run, --unlock too).
-for _line in unwritable_folders(["results", ".snakemake"]):
-    sys.exit(f"ballbat: {_line}")
-
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 # A dataset or scenario set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.
 drop_nulls(config)
@@ -36,6 +32,12 @@ if _problems:
     raise ConfigError("config is not valid:\n  " + "\n  ".join(_problems))
 
 INPUTS = WorkflowInputs(config, workflow.basedir)
+#: The run's results folder (config `results`, default `results`): every rule's paths start with it, so a
+#: test session written to its own folder (`--config results=results/2026-11-h01`) touches no other.
+R = INPUTS.results
+# A folder the run cannot write: one line naming it, for every invocation (a dry run, --unlock too).
+for _line in unwritable_folders([R, ".snakemake"]):
+    sys.exit(f"ballbat: {_line}")
 DATASETS, TRACKED = INPUTS.datasets, INPUTS.tracked
 SCENARIOS, SWEEP_SCENARIOS, LAUNCH_SCENARIOS = INPUTS.scenarios, INPUTS.sweep_scenarios, INPUTS.launch_scenarios
 # Replicate studies (studies.smk). STUDIES: those of `snakemake studies` (`make study`); the studies marked
@@ -107,11 +109,12 @@ def start_run(dag):
     lines = foreign_outputs(f for job in dag.needrun_jobs() for f in job.output)
     if lines:
         raise WorkflowError("\n".join(f"ballbat: {line}" for line in lines))
-    for message in remove_temporaries("results"):
+    for message in remove_temporaries(R):
         print(f"ballbat: {message}", file=sys.stderr)
-    from ballbat.pipeline.crate import remove_crate
+    from ballbat.pipeline.crate import set_aside_crate
 
-    remove_crate("results")  # the run changes the folder: no crate until it ends (write_crate)
+    # the run changes the folder: no crate until it ends (write_crate), which carries over the earlier one's actions
+    set_aside_crate(R)
 
 
 #: When this run started (the crate's run action; no data file records a time).
@@ -119,7 +122,7 @@ RUN_STARTED = time.time()
 
 
 def write_crate(failed=False):
-    """Write the run's Provenance Run Crate, results/ro-crate-metadata.json (ballbat.pipeline.crate): after a
+    """Write the run's Provenance Run Crate, {R}/ro-crate-metadata.json (ballbat.pipeline.crate): after a
     success, or after a failure (the run marked failed; files it did not make listed with their staleness)."""
     from ballbat.pipeline.crate import write_crate_of_run
 

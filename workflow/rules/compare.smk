@@ -6,11 +6,11 @@ rule compare:
         stronge=rules.fit_stronge.output.stronge,
         code=code("compare.py"),
     output:
-        csv="results/{dataset}/paper_comparison.csv",
-        md="results/{dataset}/paper_comparison.md",
-        prov="results/{dataset}/paper_comparison.provenance.json",
+        csv=f"{R}/{{dataset}}/paper_comparison.csv",
+        md=f"{R}/{{dataset}}/paper_comparison.md",
+        prov=f"{R}/{{dataset}}/paper_comparison.provenance.json",
     log:
-        "results/{dataset}/logs/compare.log",
+        f"{R}/{{dataset}}/logs/compare.log",
     conda:
         ENV
     script:

@@ -4,11 +4,11 @@ rule fit_ex:
         impacts=rules.reconstruct.output.impacts,
         code=code("fit_ex.py"),
     output:
-        fit="results/{dataset}/fit_ex.nc",
+        fit=f"{R}/{{dataset}}/fit_ex.nc",
     log:
-        "results/{dataset}/logs/fit_ex.log",
+        f"{R}/{{dataset}}/logs/fit_ex.log",
     benchmark:
-        "results/{dataset}/benchmarks/fit_ex.tsv"
+        f"{R}/{{dataset}}/benchmarks/fit_ex.tsv"
     group:
         "dataset"
     conda:

@@ -5,11 +5,11 @@ rule implications:
         unpack(get_scenario_tables),
         code=code("implications.py"),
     output:
-        scenario="results/implications/{scenario}.nc",
+        scenario=f"{R}/implications/{{scenario}}.nc",
     log:
-        "results/implications/logs/{scenario}.log",
+        f"{R}/implications/logs/{{scenario}}.log",
     benchmark:
-        "results/implications/benchmarks/{scenario}.tsv"
+        f"{R}/implications/benchmarks/{{scenario}}.tsv"
     conda:
         ENV
     threads: 1
@@ -27,14 +27,14 @@ rule implications:
 rule implications_compare:
     """Compare the paper scenario's carry and exit speed with Sec. V.B's statements."""
     input:
-        scenario="results/implications/paper.nc",
+        scenario=f"{R}/implications/paper.nc",
         code=code("implications_compare.py"),
     output:
-        csv="results/implications/paper_comparison.csv",
-        md="results/implications/paper_comparison.md",
-        prov="results/implications/paper_comparison.provenance.json",
+        csv=f"{R}/implications/paper_comparison.csv",
+        md=f"{R}/implications/paper_comparison.md",
+        prov=f"{R}/implications/paper_comparison.provenance.json",
     log:
-        "results/implications/logs/paper_comparison.log",
+        f"{R}/implications/logs/paper_comparison.log",
     conda:
         ENV
     script:

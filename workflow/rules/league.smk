@@ -6,14 +6,14 @@ LEAGUE_TARGETS = INPUTS.league_targets()
 rule league:
     """The league table: e_x per bat and test session, pairwise tests (Holm), consistency, TOST."""
     input:
-        fits=expand("results/{dataset}/fit_ex.nc", dataset=DATASETS),
+        fits=expand(f"{R}/{{dataset}}/fit_ex.nc", dataset=DATASETS),
         code=code("league.py"),
     output:
-        nc="results/league.nc",
-        csv="results/league.csv",
-        prov="results/league.provenance.json",
+        nc=f"{R}/league.nc",
+        csv=f"{R}/league.csv",
+        prov=f"{R}/league.provenance.json",
     log:
-        "results/logs/league.log",
+        f"{R}/logs/league.log",
     conda:
         ENV
     params:
@@ -30,13 +30,13 @@ rule plot_league:
         code=code("plot_league.py"),
     output:
         png=report(
-            "results/figures/league_forest.png",
+            f"{R}/figures/league_forest.png",
             caption="../report/league.rst",
             category="League table",
             labels={"figure": "forest plot"},
         ),
     log:
-        "results/logs/plot_league.log",
+        f"{R}/logs/plot_league.log",
     conda:
         ENV
     script:
@@ -49,9 +49,9 @@ rule league_workbook:
         league=rules.league.output.nc,
         code=code("league_workbook.py"),
     output:
-        xlsx="results/league.xlsx",
+        xlsx=f"{R}/league.xlsx",
     log:
-        "results/logs/league_workbook.log",
+        f"{R}/logs/league_workbook.log",
     conda:
         ENV
     script:

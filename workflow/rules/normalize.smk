@@ -4,11 +4,11 @@ rule normalize:
         impacts=get_source,
         code=code("normalize.py"),
     output:
-        impacts="results/{dataset}/normalize.nc",
+        impacts=f"{R}/{{dataset}}/normalize.nc",
     log:
-        "results/{dataset}/logs/normalize.log",
+        f"{R}/{{dataset}}/logs/normalize.log",
     benchmark:
-        "results/{dataset}/benchmarks/normalize.tsv"
+        f"{R}/{{dataset}}/benchmarks/normalize.tsv"
     group:
         "dataset"
     conda:

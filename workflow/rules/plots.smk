@@ -19,15 +19,15 @@ for _fig, _shows in DATASET_FIGURES.items():
             code=code("plot.py"),
         output:
             png=report(
-                f"results/{{dataset}}/figures/{_fig}.png",
+                f"{R}/{{dataset}}/figures/{_fig}.png",
                 caption=f"../report/{_fig}.rst",
                 category="Dataset {dataset}",
                 subcategory="Figures",
                 labels={"figure": f"Fig. {_fig[3:]}", "shows": _shows},
             ),
-            numbers=f"results/{{dataset}}/figures/{_fig}.rst",
+            numbers=f"{R}/{{dataset}}/figures/{_fig}.rst",
         log:
-            f"results/{{dataset}}/logs/plot_{_fig}.log",
+            f"{R}/{{dataset}}/logs/plot_{_fig}.log",
         conda:
             ENV
         params:
@@ -43,22 +43,22 @@ rule plot_fig9:
         code=code("plot.py"),
     output:
         fig9a=report(
-            "results/{dataset}/figures/fig9a.png",
+            f"{R}/{{dataset}}/figures/fig9a.png",
             caption="../report/fig9a.rst",
             category="Dataset {dataset}",
             subcategory="Figures",
             labels={"figure": "Fig. 9a", "shows": "Stronge's model, fitted eta^2"},
         ),
         fig9b=report(
-            "results/{dataset}/figures/fig9b.png",
+            f"{R}/{{dataset}}/figures/fig9b.png",
             caption="../report/fig9b.rst",
             category="Dataset {dataset}",
             subcategory="Figures",
             labels={"figure": "Fig. 9b", "shows": "Stronge's model extrapolated"},
         ),
-        numbers="results/{dataset}/figures/fig9.rst",
+        numbers=f"{R}/{{dataset}}/figures/fig9.rst",
     log:
-        "results/{dataset}/logs/plot_fig9.log",
+        f"{R}/{{dataset}}/logs/plot_fig9.log",
     conda:
         ENV
     params:
@@ -74,15 +74,15 @@ rule plot_fig10:
         code=code("plot.py"),
     output:
         png=report(
-            "results/{dataset}/figures/fig10.png",
+            f"{R}/{{dataset}}/figures/fig10.png",
             caption="../report/fig10.rst",
             category="Dataset {dataset}",
             subcategory="Figures",
             labels={"figure": "Fig. 10", "shows": "time histories of Stronge's model"},
         ),
-        numbers="results/{dataset}/figures/fig10.rst",
+        numbers=f"{R}/{{dataset}}/figures/fig10.rst",
     log:
-        "results/{dataset}/logs/plot_fig10.log",
+        f"{R}/{{dataset}}/logs/plot_fig10.log",
     conda:
         ENV
     params:
@@ -98,22 +98,22 @@ rule plot_fig11:
         code=code("plot.py"),
     output:
         fig11a=report(
-            "results/implications/figures/{scenario}_fig11a.png",
+            f"{R}/implications/figures/{{scenario}}_fig11a.png",
             caption="../report/fig11a.rst",
             category="Implications",
             subcategory="{scenario}",
             labels={"figure": "Fig. 11a", "scenario": "{scenario}"},
         ),
         fig11b=report(
-            "results/implications/figures/{scenario}_fig11b.png",
+            f"{R}/implications/figures/{{scenario}}_fig11b.png",
             caption="../report/fig11b.rst",
             category="Implications",
             subcategory="{scenario}",
             labels={"figure": "Fig. 11b", "scenario": "{scenario}"},
         ),
-        numbers="results/implications/figures/{scenario}_fig11.rst",
+        numbers=f"{R}/implications/figures/{{scenario}}_fig11.rst",
     log:
-        "results/implications/logs/plot_fig11_{scenario}.log",
+        f"{R}/implications/logs/plot_fig11_{{scenario}}.log",
     conda:
         ENV
     params:
@@ -129,15 +129,15 @@ rule plot_launch:
         code=code("plot.py"),
     output:
         png=report(
-            "results/implications/figures/{scenario}_launch.png",
+            f"{R}/implications/figures/{{scenario}}_launch.png",
             caption="../report/launch.rst",
             category="Implications",
             subcategory="{scenario}",
             labels={"figure": "carry", "scenario": "{scenario}"},
         ),
-        numbers="results/implications/figures/{scenario}_launch.rst",
+        numbers=f"{R}/implications/figures/{{scenario}}_launch.rst",
     log:
-        "results/implications/logs/plot_launch_{scenario}.log",
+        f"{R}/implications/logs/plot_launch_{{scenario}}.log",
     conda:
         ENV
     params:
@@ -149,17 +149,17 @@ rule plot_launch:
 rule comparison_html:
     """Render a paper-comparison table as HTML for the report."""
     input:
-        csv="results/{source}/paper_comparison.csv",
+        csv=f"{R}/{{source}}/paper_comparison.csv",
         code=code("comparison_html.py"),
     output:
         html=report(
-            "results/{source}/paper_comparison.html",
+            f"{R}/{{source}}/paper_comparison.html",
             caption="../report/comparison.rst",
             category="Paper comparison",
             labels={"table": "{source}"},
         ),
     log:
-        "results/{source}/logs/comparison_html.log",
+        f"{R}/{{source}}/logs/comparison_html.log",
     wildcard_constraints:
         source="|".join(DATASETS + ["implications"]),
     conda:

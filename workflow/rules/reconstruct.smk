@@ -6,11 +6,11 @@ rule reconstruct:
         bats=get_bats_table,
         code=code("reconstruct.py"),
     output:
-        impacts="results/{dataset}/reconstruct.nc",
+        impacts=f"{R}/{{dataset}}/reconstruct.nc",
     log:
-        "results/{dataset}/logs/reconstruct.log",
+        f"{R}/{{dataset}}/logs/reconstruct.log",
     benchmark:
-        "results/{dataset}/benchmarks/reconstruct.tsv"
+        f"{R}/{{dataset}}/benchmarks/reconstruct.tsv"
     group:
         "dataset"
     conda:

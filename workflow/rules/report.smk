@@ -8,17 +8,17 @@ rule report_front:
     It comes last (every other product of the run is its input), so the warnings of every job are in.
     """
     input:
-        impacts=expand("results/{dataset}/reconstruct.nc", dataset=DATASETS),
-        fit=expand("results/{dataset}/fit_ex.nc", dataset=DATASETS),
-        stronge=expand("results/{dataset}/stronge.nc", dataset=DATASETS),
-        fig5=expand("results/{dataset}/figures/fig5.png", dataset=DATASETS),
-        scenarios=expand("results/implications/{scenario}.nc", scenario=SCENARIOS),
+        impacts=expand(f"{R}/{{dataset}}/reconstruct.nc", dataset=DATASETS),
+        fit=expand(f"{R}/{{dataset}}/fit_ex.nc", dataset=DATASETS),
+        stronge=expand(f"{R}/{{dataset}}/stronge.nc", dataset=DATASETS),
+        fig5=expand(f"{R}/{{dataset}}/figures/fig5.png", dataset=DATASETS),
+        scenarios=expand(f"{R}/implications/{{scenario}}.nc", scenario=SCENARIOS),
         rest=final_targets(),
         code=code("report_front.py"),
     output:
-        rst="results/report/front.rst",
+        rst=f"{R}/report/front.rst",
     log:
-        "results/report/logs/front.log",
+        f"{R}/report/logs/front.log",
     conda:
         ENV
     params:
@@ -31,13 +31,13 @@ rule report_front:
 rule report_front_studies:
     """Write the studies' lines of the report's front page: coverage range and a design's impacts per bat."""
     input:
-        coverage=expand("results/studies/{study}/coverage.nc", study=STUDIES),
+        coverage=expand(f"{R}/studies/{{study}}/coverage.nc", study=STUDIES),
         design=[t for t in study_targets() if t.endswith("design.nc")],
         code=code("report_front.py"),
     output:
-        rst="results/studies/front.rst",
+        rst=f"{R}/studies/front.rst",
     log:
-        "results/studies/logs/front.log",
+        f"{R}/studies/logs/front.log",
     conda:
         ENV
     params:

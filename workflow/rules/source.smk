@@ -5,11 +5,11 @@ rule simulate:
         bats=get_bats_table,
         code=code("simulate.py"),
     output:
-        impacts="results/{dataset}/simulate.nc",
+        impacts=f"{R}/{{dataset}}/simulate.nc",
     log:
-        "results/{dataset}/logs/simulate.log",
+        f"{R}/{{dataset}}/logs/simulate.log",
     benchmark:
-        "results/{dataset}/benchmarks/simulate.tsv"
+        f"{R}/{{dataset}}/benchmarks/simulate.tsv"
     group:
         "dataset"
     conda:
@@ -34,11 +34,11 @@ rule ingest:
         bats=get_bats_table,
         code=code("ingest.py"),
     output:
-        impacts="results/{dataset}/ingest.nc",
+        impacts=f"{R}/{{dataset}}/ingest.nc",
     log:
-        "results/{dataset}/logs/ingest.log",
+        f"{R}/{{dataset}}/logs/ingest.log",
     benchmark:
-        "results/{dataset}/benchmarks/ingest.tsv"
+        f"{R}/{{dataset}}/benchmarks/ingest.tsv"
     group:
         "dataset"
     conda:

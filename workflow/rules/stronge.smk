@@ -4,11 +4,11 @@ rule fit_stronge:
         impacts=rules.reconstruct.output.impacts,
         code=code("fit_stronge.py"),
     output:
-        stronge="results/{dataset}/stronge.nc",
+        stronge=f"{R}/{{dataset}}/stronge.nc",
     log:
-        "results/{dataset}/logs/fit_stronge.log",
+        f"{R}/{{dataset}}/logs/fit_stronge.log",
     benchmark:
-        "results/{dataset}/benchmarks/fit_stronge.tsv"
+        f"{R}/{{dataset}}/benchmarks/fit_stronge.tsv"
     group:
         "dataset"
     conda:

@@ -11,11 +11,11 @@ rule study_batch:
         bats=get_study_bats,
         code=code("study_batch.py"),
     output:
-        batch="results/studies/{study}/batches/batch{batch}.nc",
+        batch=f"{R}/studies/{{study}}/batches/batch{{batch}}.nc",
     log:
-        "results/studies/{study}/logs/batch{batch}.log",
+        f"{R}/studies/{{study}}/logs/batch{{batch}}.log",
     benchmark:
-        "results/studies/{study}/benchmarks/batch{batch}.tsv"
+        f"{R}/studies/{{study}}/benchmarks/batch{{batch}}.tsv"
     conda:
         ENV
     threads: 1
@@ -39,11 +39,11 @@ rule study_truth_point:
         bats=get_study_bats,
         code=code("study_truth.py"),
     output:
-        truth="results/studies/{study}/truth/point{point}.nc",
+        truth=f"{R}/studies/{{study}}/truth/point{{point}}.nc",
     log:
-        "results/studies/{study}/logs/truth_point{point}.log",
+        f"{R}/studies/{{study}}/logs/truth_point{{point}}.log",
     benchmark:
-        "results/studies/{study}/benchmarks/truth_point{point}.tsv"
+        f"{R}/studies/{{study}}/benchmarks/truth_point{{point}}.tsv"
     conda:
         ENV
     threads: 1
@@ -63,9 +63,9 @@ rule study_truth:
         points=get_study_truth_points,
         code=code("study_truth_merge.py"),
     output:
-        truth="results/studies/{study}/truth.nc",
+        truth=f"{R}/studies/{{study}}/truth.nc",
     log:
-        "results/studies/{study}/logs/truth.log",
+        f"{R}/studies/{{study}}/logs/truth.log",
     conda:
         ENV
     threads: 1
@@ -82,12 +82,12 @@ rule study_aggregate:
         truth=rules.study_truth.output.truth,
         code=code("study_aggregate.py"),
     output:
-        coverage="results/studies/{study}/coverage.nc",
-        csv="results/studies/{study}/coverage.csv",
+        coverage=f"{R}/studies/{{study}}/coverage.nc",
+        csv=f"{R}/studies/{{study}}/coverage.csv",
     log:
-        "results/studies/{study}/logs/aggregate.log",
+        f"{R}/studies/{{study}}/logs/aggregate.log",
     benchmark:
-        "results/studies/{study}/benchmarks/aggregate.tsv"
+        f"{R}/studies/{{study}}/benchmarks/aggregate.tsv"
     conda:
         ENV
     threads: 1
@@ -107,14 +107,14 @@ rule plot_study_coverage:
         code=code("plot_study_coverage.py"),
     output:
         png=report(
-            "results/studies/{study}/coverage.png",
+            f"{R}/studies/{{study}}/coverage.png",
             caption="../report/study_coverage.rst",
             category="Studies",
             subcategory="{study}",
             labels={"figure": "coverage", "shows": "coverage of every reported uncertainty"},
         ),
     log:
-        "results/studies/{study}/logs/plot_coverage.log",
+        f"{R}/studies/{{study}}/logs/plot_coverage.log",
     conda:
         ENV
     threads: 1
@@ -130,10 +130,10 @@ rule study_design:
         coverage=rules.study_aggregate.output.coverage,
         code=code("study_design.py"),
     output:
-        design="results/studies/{study}/design.nc",
-        csv="results/studies/{study}/design.csv",
+        design=f"{R}/studies/{{study}}/design.nc",
+        csv=f"{R}/studies/{{study}}/design.csv",
     log:
-        "results/studies/{study}/logs/design.log",
+        f"{R}/studies/{{study}}/logs/design.log",
     conda:
         ENV
     params:
@@ -149,14 +149,14 @@ rule plot_study_design:
         code=code("plot_study_design.py"),
     output:
         png=report(
-            "results/studies/{study}/design.png",
+            f"{R}/studies/{{study}}/design.png",
             caption="../report/study_design.rst",
             category="Studies",
             subcategory="{study}",
             labels={"figure": "design", "shows": "spread of e_x and impacts needed"},
         ),
     log:
-        "results/studies/{study}/logs/plot_design.log",
+        f"{R}/studies/{{study}}/logs/plot_design.log",
     conda:
         ENV
     script:
@@ -170,14 +170,14 @@ rule study_grid:
         code=code("study_grid.py"),
     output:
         png=report(
-            "results/studies/{study}/grid.png",
+            f"{R}/studies/{{study}}/grid.png",
             caption="../report/study_grid.rst",
             category="Studies",
             subcategory="{study}",
             labels={"figure": "grid", "shows": "95 % coverage at every grid point"},
         ),
     log:
-        "results/studies/{study}/logs/grid.log",
+        f"{R}/studies/{{study}}/logs/grid.log",
     conda:
         ENV
     script:
@@ -187,7 +187,7 @@ rule study_grid:
 rule studies:
     """Every study of the config but those on request (`make study`)."""
     input:
-        study_targets() + (["results/studies/front.rst"] if STUDIES else []),
+        study_targets() + ([f"{R}/studies/front.rst"] if STUDIES else []),
 
 
 rule studies_on_request:

@@ -6,15 +6,15 @@
 rule render_tracks:
     """Render both cameras' raw tracks of a synthetic experiment (Sec. II rig)."""
     input:
-        truth="results/{dataset}/simulate.nc",
+        truth=f"{R}/{{dataset}}/simulate.nc",
         balls=get_balls_table,
         code=code("render_tracks.py"),
     output:
-        tracks="results/{dataset}/tracks.nc",
+        tracks=f"{R}/{{dataset}}/tracks.nc",
     log:
-        "results/{dataset}/logs/render_tracks.log",
+        f"{R}/{{dataset}}/logs/render_tracks.log",
     benchmark:
-        "results/{dataset}/benchmarks/render_tracks.tsv"
+        f"{R}/{{dataset}}/benchmarks/render_tracks.tsv"
     group:
         "dataset"
     conda:
@@ -38,10 +38,10 @@ rule import_tracks:
         bats=get_bats_table,
         code=code("import_tracks.py"),
     output:
-        tracks="results/{dataset}/imported_tracks.nc",
-        cameras="results/{dataset}/imported_cameras.yaml",
+        tracks=f"{R}/{{dataset}}/imported_tracks.nc",
+        cameras=f"{R}/{{dataset}}/imported_cameras.yaml",
     log:
-        "results/{dataset}/logs/import_tracks.log",
+        f"{R}/{{dataset}}/logs/import_tracks.log",
     group:
         "dataset"
     conda:
@@ -66,11 +66,11 @@ rule reduce:
         bats=get_bats_table,
         code=code("reduce.py"),
     output:
-        impacts="results/{dataset}/reduce.nc",
+        impacts=f"{R}/{{dataset}}/reduce.nc",
     log:
-        "results/{dataset}/logs/reduce.log",
+        f"{R}/{{dataset}}/logs/reduce.log",
     benchmark:
-        "results/{dataset}/benchmarks/reduce.tsv"
+        f"{R}/{{dataset}}/benchmarks/reduce.tsv"
     group:
         "dataset"
     conda:
@@ -96,21 +96,21 @@ rule tracks_qa:
         code=code("tracks_qa.py"),
     output:
         impacts=report(
-            "results/{dataset}/figures/tracks_impacts.png",
+            f"{R}/{{dataset}}/figures/tracks_impacts.png",
             caption="../report/tracks_impacts.rst",
             category="Dataset {dataset}",
             subcategory="Camera tracks",
             labels={"figure": "tracks QA", "shows": "camera views and spin fits of a few impacts"},
         ),
         summary=report(
-            "results/{dataset}/figures/tracks_summary.png",
+            f"{R}/{{dataset}}/figures/tracks_summary.png",
             caption="../report/tracks_summary.rst",
             category="Dataset {dataset}",
             subcategory="Camera tracks",
             labels={"figure": "tracks summary", "shows": "fit residuals and exclusions"},
         ),
     log:
-        "results/{dataset}/logs/tracks_qa.log",
+        f"{R}/{{dataset}}/logs/tracks_qa.log",
     conda:
         ENV
     script:

@@ -8,14 +8,14 @@ rule workbook:
         code=code("workbook.py"),
     output:
         xlsx=report(
-            "results/{dataset}/results.xlsx",
+            f"{R}/{{dataset}}/results.xlsx",
             caption="../report/workbook.rst",
             category="Dataset {dataset}",
             subcategory="Workbook",
             labels={"table": "results.xlsx"},
         ),
     log:
-        "results/{dataset}/logs/workbook.log",
+        f"{R}/{{dataset}}/logs/workbook.log",
     conda:
         ENV
     script:
@@ -23,20 +23,23 @@ rule workbook:
 
 
 rule implications_workbook:
-    """Write every batted-ball scenario as a sheet of one spreadsheet (mph, deg, rpm, ft, s)."""
+    """Write every batted-ball scenario as a sheet of one spreadsheet (mph, deg, rpm, ft, s).
+
+    Every scenario of the folder: this run's and those an earlier run of the folder left (their sheets stay).
+    """
     input:
-        scenarios=expand("results/implications/{scenario}.nc", scenario=SCENARIOS),
+        scenarios=INPUTS.workbook_scenarios(),
         code=code("workbook.py"),
     output:
         xlsx=report(
-            "results/implications/results.xlsx",
+            f"{R}/implications/results.xlsx",
             caption="../report/workbook.rst",
             category="Implications",
             subcategory="Workbook",
             labels={"table": "results.xlsx"},
         ),
     log:
-        "results/implications/logs/workbook.log",
+        f"{R}/implications/logs/workbook.log",
     conda:
         ENV
     script:

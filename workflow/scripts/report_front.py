@@ -1,6 +1,7 @@
 """Rules report_front and report_front_studies: adapters around ballbat.frontpage."""
 
 import json
+from pathlib import Path
 
 from ballbat.frontpage import commit_date, front_page, studies_page, thumbnail_uri
 from ballbat.pipeline.guards import warnings_summary
@@ -24,8 +25,9 @@ with logged(snakemake.log[0], snakemake.rule):
         }
         scenarios = {name: read_dataset(p) for name, p in zip(snakemake.params.scenarios, inp.scenarios, strict=True)}
         git = json.loads(next(iter(datasets.values()))["fit"].attrs["provenance_git"]) if datasets else {}
-        logs = warnings_summary("results", list(kinds), ["implications"] if scenarios else [])
-        text = front_page(datasets, scenarios, logs, git, commit_date(str(git.get("commit", ""))))
+        results = Path(snakemake.output.rst).parent.parent.as_posix()  # {results}/report/front.rst
+        logs = warnings_summary(results, list(kinds), ["implications"] if scenarios else [])
+        text = front_page(datasets, scenarios, logs, git, commit_date(str(git.get("commit", ""))), results)
     else:
         designs = snakemake.params.designs
         studies = {

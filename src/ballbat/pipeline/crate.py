@@ -36,7 +36,7 @@ from typing import TYPE_CHECKING, Any
 
 from .. import __version__
 from .atomic import atomic_target
-from .cratefiles import METADATA_NAME, Staleness, folder_files
+from .cratefiles import EARLIER_NAME, METADATA_NAME, Staleness, folder_files
 from .guards import RECORDED_SUFFIXES, written_by_workflow
 from .provenance import (
     PACKAGE_DIR,
@@ -379,11 +379,14 @@ def build_crate(
     ended: float,
     record: Callable[[str], Any] | None = None,
     uncopied: Mapping[str, str] | None = None,
+    earlier: list[dict] | None = None,
 ) -> dict:
     """Return the crate's JSON-LD (a dict), the snapshot already in ``results/workflow.snapshot``.
 
     ``record`` returns Snakemake's metadata of an output (None: none): the staleness of the files of
     the folder that are not results of this run. ``uncopied``: input data left out of the snapshot.
+    ``earlier``: the graph of the folder's earlier crate, whose job actions this run did not redo are
+    carried over (:func:`_carry_earlier`).
     """
     b = _Builder(results, workdir)
     b.uncopied.update(uncopied or {})
@@ -396,12 +399,14 @@ def build_crate(
     done = [j for j in jobs if j.completed]
     tools, steps = _rules(b, done, soft_ids, main)
     job_actions, controls, all_results = _job_actions(b, done, workdir, tools, steps)
+    state = Staleness(workdir, record or (lambda path: None))
+    carried = _carry_earlier(b, earlier or [], {f"#job-{j.key}" for j in jobs}, (tools, steps, main, soft_ids), state)
     run = _run(b, config, configfiles, main, all_results, engine, controls, started, ended)
     if len(done) < len(jobs):
         _failed(run, [j for j in jobs if not j.completed])
     pending = {out: j.why for j in jobs if not j.completed for out in j.outputs}
-    others = _other_files(b, results, workdir, record, pending)
-    _root(b, main, run, job_actions, ended, others)
+    others = _other_files(b, results, workdir, state, pending)
+    _root(b, main, run, [*job_actions, *carried], ended, others)
     _ = package_source_hash, workflow_source_hash  # recorded through software_versions()
     return _single_values(b.crate.metadata.generate())
 
@@ -617,9 +622,7 @@ def _failed(run: Any, unfinished: list[JobRecord]) -> None:
     )
 
 
-def _other_files(
-    b: _Builder, results: Path, workdir: Path, record: Callable[[str], Any] | None, pending: Mapping[str, str]
-) -> list:
+def _other_files(b: _Builder, results: Path, workdir: Path, state: Staleness, pending: Mapping[str, str]) -> list:
     """Add every file of the folder that is not yet in the crate, each saying why and whether it is stale.
 
     ``pending``: the outputs of the jobs a failed run had to run and did not finish, with Snakemake's
@@ -627,7 +630,6 @@ def _other_files(
     """
     top = results.resolve()
     prefix = top.relative_to(workdir.resolve()).as_posix() if top.is_relative_to(workdir.resolve()) else str(results)
-    state = Staleness(workdir, record or (lambda path: None))
     paths = [f"{prefix}/{rel}" for rel in folder_files(results)]
     others = []
     for path in paths:
@@ -650,8 +652,9 @@ def _root(b: _Builder, main, run, job_actions: list, ended: float, others: list)
     root = b.crate.root_dataset
     root["name"] = "ballbat results"
     root["description"] = (
-        "The products of one run of the ballbat workflow (results/), described as a Provenance Run Crate: "
-        "the workflow, every job with its inputs, config values and outputs, every file's sha256."
+        "The products of the runs of the ballbat workflow in this results folder, described as a Provenance "
+        "Run Crate: the workflow, every job with its inputs, config values and outputs (the last run's, and "
+        "an earlier run's whose outputs are still here unchanged), every file's sha256."
     )
     if others:
         root["description"] += (
@@ -695,12 +698,13 @@ def write_run_crate(
 
     results = Path(results)
     work = Path(workdir or Path.cwd()).resolve()
+    earlier = earlier_graph(results)
     target = remove_crate(results)
     for stale in results.glob(f".{SNAPSHOT}.*"):  # left by a crate cut short (we hold Snakemake's lock)
         if stale.is_dir():
             shutil.rmtree(stale, ignore_errors=True)
     builder = _Builder(results, work)
-    extra = [*configfiles, *(p for j in jobs for p in j.inputs)]
+    extra = [*configfiles, *(p for j in jobs for p in j.inputs), *_earlier_inputs(earlier)]
     tmp = _copy_snapshot(results, work, extra, builder)
     try:
         _install_snapshot(results, tmp)
@@ -717,10 +721,176 @@ def write_run_crate(
         ended=time.time(),
         record=record,
         uncopied=builder.uncopied,
+        earlier=earlier,
     )
     with atomic_target(target) as out:
         out.write_text(json.dumps(doc, indent=1, sort_keys=True, ensure_ascii=False) + "\n", encoding="utf-8")
+    (results / EARLIER_NAME).unlink(missing_ok=True)  # its actions are in the new crate
     return target
+
+
+def set_aside_crate(results: str | os.PathLike[str]) -> Path:
+    """When a real run starts: move the folder's crate aside (``.ro-crate-metadata.earlier.json``); return its path.
+
+    The folder then holds no crate until the run ends (a run cut short leaves none rather than one that
+    lies), and the crate written then carries over the job actions of the earlier runs that this run did
+    not redo (:func:`_carry_earlier`). An earlier crate already set aside (a run cut short) is kept.
+    """
+    results = Path(results)
+    target = results / METADATA_NAME
+    if target.is_file():
+        os.replace(target, results / EARLIER_NAME)
+    return target
+
+
+def earlier_graph(results: str | os.PathLike[str]) -> list[dict]:
+    """Return the entities of the folder's earlier crate (set aside, else still in place); none if unreadable."""
+    for name in (EARLIER_NAME, METADATA_NAME):
+        path = Path(results) / name
+        if path.is_file():
+            try:
+                graph = json.loads(path.read_text(encoding="utf-8"))["@graph"]
+            except (ValueError, KeyError, TypeError):
+                return []
+            return [e for e in graph if isinstance(e, dict) and "@id" in e]
+    return []
+
+
+def _earlier_inputs(earlier: list[dict]) -> list[str]:
+    """Return the workdir paths of the snapshot copies the earlier crate's jobs read (copied again if still there)."""
+    prefix = f"{SNAPSHOT}/"
+    return [
+        e["@id"].removeprefix(prefix)
+        for e in earlier
+        if e["@id"].startswith(prefix) and not e["@id"].startswith(f"{prefix}external/") and "File" in _types(e)
+    ]
+
+
+def _types(entity: dict) -> list[str]:
+    t = entity.get("@type", [])
+    return t if isinstance(t, list) else [t]
+
+
+def _ids(value: Any) -> list[str]:
+    """Return the ``@id`` of each reference of a property (one reference or a list)."""
+    refs = value if isinstance(value, list) else [value] if value else []
+    return [r["@id"] for r in refs if isinstance(r, dict) and "@id" in r]
+
+
+def _carry_earlier(b: _Builder, earlier: list[dict], redone: set[str], run_parts: tuple, state: Staleness) -> list:
+    """Add the earlier crate's job actions that this run did not redo (``redone``: this run's job ids); return them.
+
+    A carried action keeps its times, config values and rule; its results are those of its outputs still
+    in the folder with the sha256 listed then (a file gone or changed since is not its result; a changed
+    one is listed among the files not made by this run). Each carried result says it was made by an
+    earlier run, with its staleness now. An action with no result left is dropped. An input file changed
+    or gone since is named with the sha256 it had (``#earlier-input-...``).
+    """
+    graph = {e["@id"]: e for e in earlier}
+    carried = []
+    for action in earlier:
+        ident = action["@id"]
+        if not ident.startswith("#job-") or "CreateAction" not in _types(action) or ident in redone:
+            continue
+        results = [cp for cp in _ids(action.get("result")) if _unchanged(b, graph.get(cp, {}), cp)]
+        if not results:
+            continue
+        tool, step = _earlier_rule(b, graph, action, run_parts)
+        for cp in results:
+            what = f"not made by this run: made by an earlier run's job ({action.get('name', ident)})"
+            b.file(cp, description=f"{what}; {state.describe(_workdir_path(b, cp), ())}")
+        props = {k: v for k, v in action.items() if k not in ("@id", "@type", "instrument", "object", "result")}
+        props["description"] = f"{action.get('description', '')} (an earlier run of this folder; not redone since)"
+        objects = [_earlier_object(b, graph, ref) for ref in _ids(action.get("object"))]
+        carried.append(
+            b.context(
+                ident,
+                {
+                    "@type": "CreateAction",
+                    **props,
+                    "instrument": tool,
+                    "object": [o for o in objects if o is not None],
+                    "result": [{"@id": cp} for cp in results],
+                },
+            )
+        )
+        key = ident.removeprefix("#job-")
+        b.context(
+            f"#control-{key}",
+            {"@type": "ControlAction", "name": f"orchestrate {key}", "instrument": step, "object": {"@id": ident}},
+        )
+    return carried
+
+
+def _workdir_path(b: _Builder, crate_path: str) -> str:
+    """Return a crate path of the results folder as a path from the working directory (Snakemake's records)."""
+    full = (b.results / crate_path).resolve()
+    work = b.workdir.resolve()
+    return full.relative_to(work).as_posix() if full.is_relative_to(work) else str(full)
+
+
+def _unchanged(b: _Builder, entity: dict, crate_path: str) -> bool:
+    """Whether an earlier result is still in the folder, unchanged (its sha256 then), and not this run's."""
+    path = b.results / crate_path
+    if crate_path in b.files or not path.is_file() or "sha256" not in entity:
+        return False
+    return entity["sha256"] == sha256_file(path) and _made_by_workflow(path)
+
+
+def _earlier_object(b: _Builder, graph: dict, ident: str) -> Any:
+    """Return an earlier action's object in the new crate: a file as it is now, else as it was, or a value."""
+    entity = graph.get(ident)
+    if entity is None:
+        return None
+    if "File" not in _types(entity):
+        props = {k: v for k, v in entity.items() if k != "@id"}
+        return b.context(ident, props) if b.crate.dereference(ident) is None else {"@id": ident}
+    path = b.results / ident
+    if path.is_file() and entity.get("sha256") == sha256_file(path):
+        b.file(ident)
+        return {"@id": ident}
+    digest = str(entity.get("sha256", ""))
+    return b.context(
+        f"#earlier-input-{digest[:16]}",
+        {
+            "@type": "CreativeWork",
+            "name": ident,
+            "sha256": digest,
+            "description": "an input of an earlier run's job, with the sha256 it had then; changed or gone since",
+        },
+    )
+
+
+def _earlier_rule(b: _Builder, graph: dict, action: dict, run_parts: tuple) -> tuple[Any, Any]:
+    """Return the tool and step of an earlier action's rule: this run's, else copied from the earlier crate."""
+    tools, steps, main, soft_ids = run_parts
+    tool_id = (_ids(action.get("instrument")) or ["#rule-unknown"])[0]
+    rule = tool_id.removeprefix("#rule-")
+    if rule not in tools:
+        old = graph.get(tool_id, {})
+        parts = [{"@id": cp} for cp in _ids(old.get("hasPart")) if cp in b.files]
+        tools[rule] = b.context(
+            tool_id,
+            {
+                "@type": "SoftwareApplication",
+                "name": old.get("name", f"rule {rule}"),
+                "description": f"{old.get('description', f'rule {rule}')} (as an earlier run of this folder ran it)",
+                "softwareVersion": old.get("softwareVersion", "unknown"),
+                "hasPart": parts,
+                "softwareRequirements": soft_ids,
+            },
+        )
+        steps[rule] = b.context(
+            f"#step-{rule}",
+            {"@type": "HowToStep", "name": f"rule {rule}", "position": str(len(steps)), "workExample": tools[rule]},
+        )
+        main["hasPart"] = [*_as_list(main.get("hasPart")), tools[rule]]
+        main["step"] = [*_as_list(main.get("step")), steps[rule]]
+    return tools[rule], steps[rule]
+
+
+def _as_list(value: Any) -> list:
+    return value if isinstance(value, list) else [value] if value else []
 
 
 def remove_crate(results: str | os.PathLike[str]) -> Path:
@@ -744,11 +914,13 @@ def write_crate_of_run(
     """
     from snakemake.io import IOFile
 
+    from ..workflow_inputs import results_root
+
     workdir = Path.cwd()
     jobs = jobs_from_dag(workflow.dag, workflow.persistence, workdir, failed=failed)
     configfiles = [str(f) for f in workflow.configfiles]
     return write_run_crate(
-        workdir / "results",
+        workdir / results_root(config),
         jobs,
         config=config,
         configfiles=configfiles,

@@ -13,27 +13,41 @@ its sha256 and size, and each file of the folder is listed.
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from .provenance import sha256_file
 
 if TYPE_CHECKING:
-    import os
     from collections.abc import Callable, Iterable
 
 #: The crate's metadata file, in the results folder (the crate's root).
 METADATA_NAME = "ro-crate-metadata.json"
+#: The folder's earlier crate while a run changes the folder (hidden; its actions go into the next crate).
+EARLIER_NAME = ".ro-crate-metadata.earlier.json"
+
+
+def is_results_folder(folder: Path) -> bool:
+    """Whether a folder is a results folder of its own (a run's crate, set-aside crate or snapshot is in it)."""
+    return any((folder / name).exists() for name in (METADATA_NAME, EARLIER_NAME, "workflow.snapshot"))
 
 
 def folder_files(results: Path) -> list[str]:
-    """Return every file of the results folder, as crate paths (the metadata file and hidden ones aside)."""
+    """Return every file of the results folder, as crate paths (the metadata file and hidden ones aside).
+
+    A results folder inside it (another test session's, e.g. ``results/2026-11-h01`` inside ``results``)
+    is that folder's crate's, not this one's: it is left out.
+    """
     out = []
-    for p in sorted(results.rglob("*")):
-        rel = p.relative_to(results)
-        if p.is_file() and rel.as_posix() != METADATA_NAME and not any(part.startswith(".") for part in rel.parts):
-            out.append(rel.as_posix())
-    return out
+    for dirpath, dirnames, filenames in os.walk(results):
+        here = Path(dirpath)
+        dirnames[:] = sorted(d for d in dirnames if not d.startswith(".") and not is_results_folder(here / d))
+        for name in sorted(filenames):
+            rel = (here / name).relative_to(results)
+            if rel.as_posix() != METADATA_NAME and not name.startswith("."):
+                out.append(rel.as_posix())
+    return sorted(out)
 
 
 def _record_value(record: Any, key: str) -> Any:
