@@ -400,7 +400,9 @@ def build_crate(
     tools, steps = _rules(b, done, soft_ids, main)
     job_actions, controls, all_results = _job_actions(b, done, workdir, tools, steps)
     state = Staleness(workdir, record or (lambda path: None))
-    carried = _carry_earlier(b, earlier or [], {f"#job-{j.key}" for j in jobs}, (tools, steps, main, soft_ids), state)
+    made = {r for action in job_actions for r in _ids(action["result"])}
+    parts = (tools, steps, main, soft_ids)
+    carried = _carry_earlier(b, earlier or [], ({f"#job-{j.key}" for j in jobs}, made), parts, state)
     run = _run(b, config, configfiles, main, all_results, engine, controls, started, ended)
     if len(done) < len(jobs):
         _failed(run, [j for j in jobs if not j.completed])
@@ -777,8 +779,10 @@ def _ids(value: Any) -> list[str]:
     return [r["@id"] for r in refs if isinstance(r, dict) and "@id" in r]
 
 
-def _carry_earlier(b: _Builder, earlier: list[dict], redone: set[str], run_parts: tuple, state: Staleness) -> list:
-    """Add the earlier crate's job actions that this run did not redo (``redone``: this run's job ids); return them.
+def _carry_earlier(b: _Builder, earlier: list[dict], this_run: tuple, run_parts: tuple, state: Staleness) -> list:
+    """Add the earlier crate's job actions that this run did not redo; return them.
+
+    ``this_run``: the ids of this run's jobs (finished or not) and the crate paths of their results.
 
     A carried action keeps its times, config values and rule; its results are those of its outputs still
     in the folder with the sha256 listed then (a file gone or changed since is not its result; a changed
@@ -787,18 +791,19 @@ def _carry_earlier(b: _Builder, earlier: list[dict], redone: set[str], run_parts
     or gone since is named with the sha256 it had (``#earlier-input-...``).
     """
     graph = {e["@id"]: e for e in earlier}
+    redone, made = this_run
     carried = []
     for action in earlier:
         ident = action["@id"]
         if not ident.startswith("#job-") or "CreateAction" not in _types(action) or ident in redone:
             continue
-        results = [cp for cp in _ids(action.get("result")) if _unchanged(b, graph.get(cp, {}), cp)]
+        results = [cp for cp in _ids(action.get("result")) if cp not in made and _unchanged(b, graph.get(cp, {}), cp)]
         if not results:
             continue
         tool, step = _earlier_rule(b, graph, action, run_parts)
         for cp in results:
             what = f"not made by this run: made by an earlier run's job ({action.get('name', ident)})"
-            b.file(cp, description=f"{what}; {state.describe(_workdir_path(b, cp), ())}")
+            b.file(cp)["description"] = f"{what}; {state.describe(_workdir_path(b, cp), ())}"
         props = {k: v for k, v in action.items() if k not in ("@id", "@type", "instrument", "object", "result")}
         props["description"] = f"{action.get('description', '')} (an earlier run of this folder; not redone since)"
         objects = [_earlier_object(b, graph, ref) for ref in _ids(action.get("object"))]
@@ -830,9 +835,9 @@ def _workdir_path(b: _Builder, crate_path: str) -> str:
 
 
 def _unchanged(b: _Builder, entity: dict, crate_path: str) -> bool:
-    """Whether an earlier result is still in the folder, unchanged (its sha256 then), and not this run's."""
+    """Whether an earlier result is still in the folder, unchanged (its sha256 then) and the workflow's."""
     path = b.results / crate_path
-    if crate_path in b.files or not path.is_file() or "sha256" not in entity:
+    if not path.is_file() or "sha256" not in entity:
         return False
     return entity["sha256"] == sha256_file(path) and _made_by_workflow(path)
 
