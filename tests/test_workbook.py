@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import datetime as dt
 import json
+import re
 import zipfile
 
 import numpy as np
@@ -128,6 +129,12 @@ def book(tmp_path, epoch):
     return path
 
 
+def unit_of(words: str | None) -> str | None:
+    """The unit a header in words states in its closing parentheses (None: no unit)."""
+    m = re.search(r"\(([^()]+)\)$", words or "")
+    return m.group(1) if m and m.group(1) in ("mph", "deg", "rpm", "in", "ft", "s", "mph/deg", "rpm/deg") else None
+
+
 def rows(ws) -> list[list]:
     return [[c.value for c in row] for row in ws.iter_rows()]
 
@@ -146,6 +153,7 @@ def test_sheets_and_header_rows(book):
         "systematics",
         "paper_comparison",
         "warnings",
+        "legend",
         "provenance",
     ]
     ws = wb["impacts"]
@@ -164,7 +172,7 @@ def test_sheets_and_header_rows(book):
         "flag_reason",
     ]  # the columns of IMPACT_COLUMNS present in the file, in their order
     assert rows(ws)[0] == names
-    assert rows(ws)[1] == [
+    assert [unit_of(w) for w in rows(ws)[1]] == [
         None,
         None,
         None,
@@ -177,7 +185,8 @@ def test_sheets_and_header_rows(book):
         None,
         None,
         None,
-    ]  # "1", text: blank
+    ]  # "1", text: none
+    assert rows(ws)[1][2] == "ball type" and rows(ws)[1][4].startswith("v bat")  # words (no long_name here)
     assert ws.freeze_panes == "A3"
     assert ws.max_row == 2 + 3
 
@@ -219,7 +228,8 @@ def test_e_x_sheet_rounds_to_the_finer_error(book):
         "e_x_redchi",
         "e_x_status",
     ]
-    assert table[1] == [None] * 11
+    assert [unit_of(w) for w in table[1]] == [None] * 11
+    assert table[1][0] == "ball type" and table[1][5].startswith("total error of e_x")
     # per bat, then pooled; softball x metal (no impacts) has no row
     assert [r[:2] for r in table[2:]] == [
         ["baseball", "wood"],
@@ -242,7 +252,7 @@ def test_e_x_sheet_rounds_to_the_finer_error(book):
 def test_sec4_sheet_in_rpm_and_mph_per_degree(book):
     ws = openpyxl.load_workbook(book)["sec4"]
     table = rows(ws)
-    head = dict(zip(table[0], table[1], strict=True))
+    head = dict(zip(table[0], map(unit_of, table[1]), strict=True))
     assert head["spin_theta_slope"] == "rpm/deg" and head["spin_theta_slope_err"] == "rpm/deg"
     assert head["speed_theta_slope"] == "mph/deg" and head["gross_slip_psi"] == "deg"
     assert head["gross_slip_omega"] == "rpm" and head["e_y_implied"] is None
@@ -264,7 +274,7 @@ def test_eta2_comparison_and_warnings_sheets(book):
     wb = openpyxl.load_workbook(book)
     eta = rows(wb["eta2"])
     assert eta[0] == ["ball", "eta2", "eta2_err", "eta2_n", "psi_stick_boundary"]
-    assert eta[1] == [None, None, None, None, "deg"]
+    assert [unit_of(w) for w in eta[1]] == [None, None, None, None, "deg"]
     assert eta[2][:4] == ["baseball", 4.9, 0.23, 58] and eta[3][:4] == ["softball", 6.1, 0.31, 50]
     assert eta[3][4] == pytest.approx(25.5, rel=1e-12)
     assert formats(wb["eta2"], 3)[1:3] == ["0.00", "0.00"]  # 0.23: two decimals for eta2 and its error
@@ -272,7 +282,12 @@ def test_eta2_comparison_and_warnings_sheets(book):
     assert comp[0] == ["quantity", "ball", "bat", "paper", "value", "unit"]
     assert comp[2] == ["e_x", "baseball", "wood", 0.464, 0.4641, 1.0]  # numbers as numbers
     assert comp[3][4] is None  # an empty value stays empty, not invented
-    assert rows(wb["warnings"]) == [["warning"], [None], ["first warning"], ["second warning"]]
+    assert rows(wb["warnings"]) == [
+        ["warning"],
+        ["warning of the measured file"],
+        ["first warning"],
+        ["second warning"],
+    ]
 
 
 def test_provenance_sheet(book):
@@ -354,13 +369,65 @@ def test_implications_workbook(tmp_path, epoch):
     path = tmp_path / "implications.xlsx"
     workbook.implications_workbook(path, {"paper": scenario([380.0, 400.5], "p"), long_name: scenario([350.25], "l")})
     wb = openpyxl.load_workbook(path)
-    assert wb.sheetnames == [long_name[:31], "paper", "provenance"]  # sorted; Excel's 31-character limit
+    assert wb.sheetnames == [long_name[:31], "paper", "legend", "provenance"]  # sorted; Excel's 31-character limit
     paper = rows(wb["paper"])
     assert paper[0] == ["case", "D", "exit_speed", "carry", "hang_time", "exceeds_mu"]
-    assert paper[1] == [None, "in", "mph", "ft", "s", None]
+    assert [unit_of(w) for w in paper[1]] == [None, "in", "mph", "ft", "s", None]
     assert [r[3] for r in paper[2:]] == pytest.approx([380.0, 400.5], rel=1e-12)
     assert paper[3][1] == pytest.approx(1.0, rel=1e-12) and paper[3][2] == pytest.approx(100.0, rel=1e-12)
     assert formats(wb["paper"], 3)[1:5] == ["0.00", "0.0", "0.0", "0.00"]  # in 2, mph 1, ft 1, s 2
     prov = {(r[0], r[1]) for r in rows(wb["provenance"])[2:]}
     assert ("paper.nc", "rule") in prov and (f"{long_name}.nc", "rule") in prov
     assert wb.properties.created == epoch
+
+
+# ---------------------------------------------------------------------------------------
+# Issue 37 §5: a workbook a lab reads (headers in words with units, legends, widths, frozen headers)
+
+
+def check_readable(path) -> dict[str, list]:
+    """Check every sheet of a real workbook; return the legend's rows by (sheet, column).
+
+    Every sheet: code names in row 1 (bold), each column in words in row 2 (with the unit where the
+    column has one), both rows frozen, every column's width set; every status and flag column's codes
+    that occur in the sheet explained in the legend sheet.
+    """
+    from openpyxl.utils import get_column_letter
+
+    wb = openpyxl.load_workbook(path)
+    legend = {}
+    for r in rows(wb["legend"])[2:]:
+        legend.setdefault((r[0], r[1]), {})[r[2]] = r[3]
+    for ws in wb.worksheets:
+        table = rows(ws)
+        if not table:
+            continue
+        names, words = table[0], table[1]
+        assert ws.freeze_panes == "A3", ws.title
+        for i, (name, word) in enumerate(zip(names, words, strict=True), start=1):
+            assert isinstance(name, str) and isinstance(word, str) and word, (ws.title, name)
+            assert word != name or "_" not in name, (ws.title, name)  # words, not the code name again
+            assert ws.cell(1, i).font.b, (ws.title, name)
+            width = ws.column_dimensions[get_column_letter(i)].width
+            assert workbook.COLUMN_WIDTH[0] <= width <= workbook.COLUMN_WIDTH[1], (ws.title, name, width)
+            if workbook.is_status_column(name):
+                codes = {r[i - 1] for r in table[2:] if r[i - 1] is not None}
+                assert codes and codes <= set(legend[(ws.title, name)]), (ws.title, name, codes)
+    return legend
+
+
+@pytest.mark.slow
+def test_the_default_runs_workbooks_read_in_words(default_run):
+    """Why (issue 37): headers were code names, e_x_status = 0 had no legend, no column widths were set."""
+    results = default_run / "results"
+    legend = check_readable(results / "synthetic" / "results.xlsx")
+    assert legend[("e_x", "e_x_status")] == {0: "ok", 1: "no impacts", 2: "too few impacts", 3: "fit failed"}
+    assert legend[("impacts", "flag")][0] == "ok" and legend[("impacts", "flag")][3] == "bat behind ball"
+    ws = openpyxl.load_workbook(results / "synthetic" / "results.xlsx")["impacts"]
+    head = dict(zip(rows(ws)[0], rows(ws)[1], strict=True))
+    assert head["v_bat"].endswith("(mph)") and "bat speed" in head["v_bat"]
+    assert head["omega"].endswith("(rpm)") and head["D"].endswith("(in)")
+    legend = check_readable(results / "implications" / "results.xlsx")
+    assert legend[("paper", "exceeds_mu")] == {0: "within friction", 1: "needs more friction than mu"}
+    legend = check_readable(results / "league.xlsx")
+    assert set(legend) >= {("league", "tost_equivalent"), ("pairs", "pair_differs"), ("sessions", "entry_status")}

@@ -4,8 +4,10 @@ A bat-testing lab writes its report in a spreadsheet, in mph, degrees, rpm, inch
 :func:`dataset_workbook` gathers the NetCDF results of one dataset (impacts, e_x per bat and
 ball, the Sec. IV quantities, eta^2) and its paper comparison into one ``.xlsx`` file, one sheet
 per table; :func:`implications_workbook` does the same for the batted-ball scenarios. Every
-sheet has the column names of ``docs/nomenclature.md`` in its first row and their units in the
-second; the last sheet records the provenance of every file it was made from.
+sheet has the column names of ``docs/nomenclature.md`` in its first row and, in the second, what
+each is in words with the unit it is shown in (both rows frozen, the columns sized); the
+``legend`` sheet explains every code of every status and flag column; the last sheet records the
+provenance of every file it was made from.
 
 Units ``1`` (dimensionless numbers) are shown as a blank unit cell. Cells keep the full
 precision of the NetCDF files; number formats show them as the field rounds them: an estimate
@@ -39,6 +41,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .compare import NO_SYSTEMATIC_NOTE, systematic_var, total_uncertainty
+from .fitting import FitStatus
+from .kinematics import ImpactFlag
 from .pipeline.atomic import atomic_target
 from .units import from_si
 
@@ -219,11 +223,62 @@ def _cell(value: object, unit: str) -> object:
     return float(from_si(v, unit))
 
 
-def _header(ws: object, names: Sequence[str], units: Sequence[str]) -> None:
-    """Write the two header rows: the column names, then their units (empty for text and for "1")."""
+#: Words for the columns that are no variable of the sheet's NetCDF source (a variable's long_name otherwise).
+WORDS = {
+    "ball": "ball type",
+    "bat": "bat",
+    "quantity": "quantity",
+    "paper": "the paper's value",
+    "paper_uncertainty": "the paper's uncertainty",
+    "value": "value",
+    "uncertainty": "our statistical standard error",
+    "systematic": "our calibration systematic",
+    "truth": "the true value (synthetic data)",
+    "unit": "unit of the row's numbers",
+    "source": "calibration source",
+    "source_rel_sigma": "relative standard uncertainty of the calibration source",
+    "warning": "warning of the measured file",
+    "file": "results file",
+    "record": "kind of record",
+    "key": "input, config key or software",
+    "sheet": "sheet",
+    "column": "column (code name)",
+    "meaning": "what the value means",
+    "e_x_err_total": "total error of e_x: statistical and systematic in quadrature",
+    "e_x_status": "why e_x has no value (0: it has one)",
+}
+#: Widest and narrowest column (characters); the words row wraps within it.
+COLUMN_WIDTH = (10, 32)
+
+
+def _words(name: str, unit: str, sources: Sequence[xr.Dataset] = ()) -> str:
+    """Return a column's header in words, with its unit: the long_name of its variable, else :data:`WORDS`."""
+    text = WORDS.get(name, name.replace("_", " "))
+    for ds in sources:
+        if name in ds.variables and "long_name" in ds[name].attrs:
+            text = str(ds[name].attrs["long_name"])
+            break
+    label = _unit_label(unit)
+    return f"{text} ({label})" if label else text
+
+
+def _header(ws: object, names: Sequence[str], units: Sequence[str], sources: Sequence[xr.Dataset] = ()) -> None:
+    """Write the two header rows, frozen: the code names, then each in words with its unit; set the widths.
+
+    The code names (``docs/nomenclature.md``) are the first row, so that a program finds a column by
+    name; the second says what it is, with the unit it is shown in (none for text and for "1").
+    """
+    from openpyxl.styles import Alignment, Font
+    from openpyxl.utils import get_column_letter
+
     ws.append(list(names))
-    ws.append([_unit_label(u) for u in units])
+    ws.append([_words(n, u, sources) for n, u in zip(names, units, strict=True)])
     ws.freeze_panes = "A3"
+    low, high = COLUMN_WIDTH
+    for i, name in enumerate(names, start=1):
+        ws.cell(1, i).font = Font(bold=True)
+        ws.cell(2, i).alignment = Alignment(wrap_text=True, vertical="top")
+        ws.column_dimensions[get_column_letter(i)].width = min(max(len(name) + 2, low), high)
 
 
 def _format_row(ws: object, row: Sequence[object], units: Sequence[str], groups: Sequence[Group]) -> None:
@@ -279,6 +334,9 @@ def _table_sheet(wb: object, title: str, ds: xr.Dataset, columns: Sequence[Colum
     ws = wb.create_sheet(title)
     names, units = [c.name for c in cols], [c.unit for c in cols]
     _header(ws, names, units)
+    for i, c in enumerate(cols, start=1):  # each column's words from its own variable's long_name
+        if "long_name" in ds[c.var].attrs:
+            ws.cell(2, i).value = _words(c.var, c.unit, [ds])
     groups = _error_groups(names)
     for i in range(ds.sizes[dim]):
         row = [_cell(ds[c.var].values[i] if ds[c.var].dims else ds[c.var].values, c.unit) for c in cols]
@@ -288,8 +346,7 @@ def _table_sheet(wb: object, title: str, ds: xr.Dataset, columns: Sequence[Colum
 def _provenance_sheet(wb: object, sources: dict[str, xr.Dataset]) -> None:
     """Add the provenance sheet: for every source file its rule, inputs (with sha256), config and software."""
     ws = wb.create_sheet("provenance")
-    ws.append(["file", "record", "key", "value"])
-    ws.append(["", "", "", ""])
+    _header(ws, ["file", "record", "key", "value"], ["", "", "", ""])
     for name, ds in sources.items():
         ws.append([name, "title", "", str(ds.attrs.get("title", ""))])
         ws.append([name, "rule", "", str(ds.attrs.get("provenance_rule", ""))])
@@ -401,7 +458,7 @@ def dataset_workbook(
     names = ["ball", "bat", *(c.name for c in FIT_FIELDS[:2]), "e_x_syst", "e_x_err_total"]
     names += [*(c.name for c in FIT_FIELDS[2:]), "e_x_status"]
     units = ["", "", *("1" for _ in names[2:])]
-    _header(ws, names, units)
+    _header(ws, names, units, [fit])
     # decimals from the statistical and systematic errors; value, errors and interval shown with them
     groups = [([3, 4], [2, 3, 4, 5, 6, 7])]
     for ball in fit["ball"].values.astype(str):
@@ -427,7 +484,7 @@ def dataset_workbook(
         cols += [(f"{var}{s}", unit) for s in ("_syst", "_err_total") if f"{var}{s}" in fit]
     names += [c for c, _ in cols]
     units += [u for _, u in cols]
-    _header(ws, names, units)
+    _header(ws, names, units, [fit])
     groups = _error_groups(names)
     for ball in fit["ball"].values.astype(str):
         f = fit.sel(ball=ball)
@@ -446,15 +503,14 @@ def dataset_workbook(
     ws = wb.create_sheet("paper_comparison")
     if comparison:
         keys = list(comparison[0])
-        ws.append(keys)
-        ws.append(["" for _ in keys])
+        _header(ws, keys, ["" for _ in keys])
         for row in comparison:
             ws.append([_number_or_text(row[k]) for k in keys])
     ws = wb.create_sheet("warnings")
-    ws.append(["warning"])
-    ws.append([""])
+    _header(ws, ["warning"], [""])
     for text in (w for w in impacts.attrs.get("ingest_warnings", "").split("\n") if w):
         ws.append([text])
+    _legend_sheet(wb, [impacts, fit, stronge])
     _provenance_sheet(wb, {"reconstruct.nc": impacts, "fit_ex.nc": fit, "stronge.nc": stronge})
     _write(wb, path, document_time(fit.attrs), properties)
 
@@ -478,8 +534,7 @@ def _systematics_sheet(wb: object, fit: xr.Dataset, stronge: xr.Dataset) -> None
     none has one row saying so (source ``none stated``, the reason in the unit column's place).
     """
     ws = wb.create_sheet("systematics")
-    ws.append(["quantity", "ball", "bat", "source", "source_rel_sigma", "systematic", "unit"])
-    ws.append(["", "", "", "", "", "", ""])
+    _header(ws, ["quantity", "ball", "bat", "source", "source_rel_sigma", "systematic", "unit"], [""] * 5 + ["1", ""])
     if not any("systematic" in ds.coords for ds in (fit, stronge)):  # "syst. —", and why
         ws.append(["e_x", "", "", "none stated", None, None, NO_SYSTEMATIC_NOTE])
     for ds in (fit, stronge):
@@ -499,6 +554,60 @@ def _systematics_sheet(wb: object, fit: xr.Dataset, stronge: xr.Dataset) -> None
                     row = [q, where.get("ball", ""), where.get("bat", ""), src, _cell(rel[src], "1")]
                     row += [_cell(per.values[(k, *idx)], unit), _unit_label(unit)]
                     _format_row(ws, row, ["", "", "", "", "1", unit, ""], [([5], [5])])
+
+
+def _enum_legend(flags: type) -> dict[int, str]:
+    return {int(m): m.name.lower().replace("_", " ") for m in flags}
+
+
+#: Legends of the status and flag columns whose variable states no CF ``flag_values``/``flag_meanings``
+#: (a file of an older format; the league's entry_status and pair_differs).
+LEGENDS = {
+    "flag": _enum_legend(ImpactFlag),
+    "e_x_status": _enum_legend(FitStatus),
+    "entry_status": _enum_legend(FitStatus),
+    "exceeds_mu": {0: "within friction", 1: "needs more friction than mu"},
+    "tost_equivalent": {-1: "not tested", 0: "not shown equivalent", 1: "equivalent"},
+    "pair_differs": {
+        0: "not shown to differ at the family-wise level alpha (pair_p_holm >= alpha)",
+        1: "the bats differ at the family-wise level alpha (pair_p_holm < alpha)",
+    },
+}
+
+
+def is_status_column(name: str) -> bool:
+    """Whether a column is a status or flag column (its values are codes, explained in the legend sheet)."""
+    return name in ("flag", "exceeds_mu") or name.endswith(("_status", "_flag", "_differs", "_equivalent"))
+
+
+def _legend(name: str, sources: Sequence[xr.Dataset]) -> dict[int, str]:
+    """Return a status column's codes and their meanings: its variable's flag_values/flag_meanings, else LEGENDS."""
+    for var in (name, name.replace("e_x_status", "e_x_pooled_status")):
+        for ds in sources:
+            attrs = ds[var].attrs if var in ds.variables else {}
+            if "flag_values" in attrs and "flag_meanings" in attrs:
+                values = np.atleast_1d(attrs["flag_values"]).astype(int)
+                meanings = str(attrs["flag_meanings"]).split()
+                return {int(v): m.replace("_", " ") for v, m in zip(values, meanings, strict=True)}
+    return LEGENDS.get(name, {})
+
+
+def _legend_sheet(wb: object, sources: Sequence[xr.Dataset]) -> None:
+    """Add the ``legend`` sheet: for every status and flag column of every sheet, each code and what it means.
+
+    A status column with no legend (no flag meanings in its file) is an error: its codes would be unexplained.
+    """
+    ws = wb.create_sheet("legend")
+    _header(ws, ["sheet", "column", "value", "meaning"], ["", "", "1", ""])
+    for sheet in wb.worksheets[:-1]:
+        for name in [c.value for c in sheet[1]] if sheet.max_row else []:
+            if not isinstance(name, str) or not is_status_column(name):
+                continue
+            legend = _legend(name, sources)
+            if not legend:
+                raise ValueError(f"workbook sheet {sheet.title}: column {name} has no legend of its codes")
+            for value, meaning in sorted(legend.items()):
+                ws.append([sheet.title, name, value, meaning])
 
 
 def _number_or_text(value: object) -> object:
@@ -524,6 +633,7 @@ def implications_workbook(
     wb.remove(wb.active)
     for name in sorted(scenarios):
         _table_sheet(wb, name[:31], scenarios[name], SCENARIO_COLUMNS, "case")
+    _legend_sheet(wb, [scenarios[name] for name in sorted(scenarios)])
     _provenance_sheet(wb, {f"{name}.nc": ds for name, ds in sorted(scenarios.items())})
     first = scenarios[sorted(scenarios)[0]].attrs if scenarios else {}
     _write(wb, path, document_time(first), properties)
@@ -608,5 +718,6 @@ def league_workbook(
     wb.remove(wb.active)
     for title, (dim, columns) in LEAGUE_SHEETS.items():
         _table_sheet(wb, title, league, columns, dim)
+    _legend_sheet(wb, [league])
     _provenance_sheet(wb, {"league.nc": league})
     _write(wb, path, document_time(league.attrs), properties)
