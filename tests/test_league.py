@@ -256,8 +256,8 @@ def test_default_run_writes_the_league(default_run):
     import openpyxl
 
     wb = openpyxl.load_workbook(res / "league.xlsx")
-    assert wb.sheetnames == ["league", "pairs", "sessions", "provenance"]
-    assert wb["pairs"].max_row == 2 + ds.sizes["pair"]  # names, units, one row per pair
+    assert wb.sheetnames == ["league", "pairs", "sessions", "legend", "provenance"]
+    assert wb["pairs"].max_row == 2 + ds.sizes["pair"]  # names, words, one row per pair
     assert ds.sizes["pair"] == 3 + 6  # pairs of 3 baseball bats and of 4 softball bats
 
 
