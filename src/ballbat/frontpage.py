@@ -375,6 +375,68 @@ def dataset_section(
     return lines
 
 
+def _league_rows(league: xr.Dataset) -> list[list[str]]:
+    """Rows of the league table: per ball, the bats from the highest e_x (those with a value)."""
+    from .league import ranked
+
+    rows = []
+    words = {1: "yes", 0: "not shown", -1: "reference"}
+    for i in ranked(league):
+        g = {k: league[k].values[i] for k in league.data_vars if league[k].dims == ("row",)}
+        if not math.isfinite(float(g["e_x"])):
+            continue
+        v, s, y = round_pm(float(g["e_x"]), float(g["e_x_stat"]), float(g["e_x_syst"]))
+        p_cons = float(g["consistency_p"])
+        cons = f"{p_cons:.2g}" if math.isfinite(p_cons) else "—"
+        n, sessions, eq = str(int(g["n"])), str(int(g["n_sessions"])), words[int(g["tost_equivalent"])]
+        bat = escape(_words(str(g["bat"])))
+        rows.append([escape(str(g["ball"])), bat, f"**{v}**", f"± {s}", f"± {y}", n, sessions, cons, eq])
+    return rows
+
+
+def _pair_rows(league: xr.Dataset) -> list[list[str]]:
+    """Rows of the pairs: ball, bats, difference ± its standard error, Holm-adjusted p, whether they differ."""
+    rows = []
+    for i in range(league.sizes["pair"]):
+        g = {k: league[k].values[i] for k in league.data_vars if league[k].dims == ("pair",)}
+        diff, se = float(g["pair_difference"]), float(g["pair_se"])
+        if not math.isfinite(diff):
+            continue
+        bats = f"{escape(_words(str(g['pair_bat_a'])))} − {escape(_words(str(g['pair_bat_b'])))}"
+        differs = "**yes**" if int(g["pair_differs"]) else "no"
+        rows.append([escape(str(g["pair_ball"])), bats, pm(diff, se), f"{float(g['pair_p_holm']):.2g}", differs])
+    return rows
+
+
+def league_section(league: xr.Dataset) -> list[str]:
+    """Return the bats league table (league.nc, :mod:`ballbat.league`): per bat, then every pair.
+
+    Per ball, the bats from the highest e_x: e_x with stat. and syst. over its test sessions, impacts,
+    sessions, the consistency p of a bat in several sessions and the equivalence test against the
+    reference bat; then each pair's difference with its standard error and Holm-adjusted p.
+    """
+    margin, alpha = float(league.attrs["league_margin"]), float(league.attrs["league_alpha"])
+    lines = ["Bats league table", "-" * 17, ""]
+    lines += _table(
+        ["ball", "bat", "e_x", "stat.", "syst.", "n", "sessions", "consistency p", f"within ±{margin:g} of ref."],
+        _league_rows(league),
+        "e_x per bat over the run's test sessions, highest first (league.nc, league.xlsx)",
+    )
+    lines += _table(
+        ["ball", "bats", "difference ± s.e.", "p (Holm)", "differ"],
+        _pair_rows(league),
+        f"every pair of bats of a ball: difference, its standard error (stat. and syst.), Holm-adjusted p at {alpha:g}",
+    )
+    refs = escape(str(league.attrs.get("league_reference_bats", "")))
+    lines += [
+        "A calibration systematic shared within a test session cancels in a difference of two bats of that"
+        " session and adds across sessions (docs/league.md); the equivalence test is TOST against the"
+        f" reference bat ({refs}).",
+        "",
+    ]
+    return lines
+
+
 def front_page(
     datasets: Mapping[str, Mapping[str, object]],
     scenarios: Mapping[str, xr.Dataset],
@@ -382,12 +444,14 @@ def front_page(
     git: Mapping[str, object],
     date: str | None,
     results: str = "results",
+    league: xr.Dataset | None = None,
 ) -> str:
     """Return the front page's reStructuredText.
 
     ``datasets``: name -> {"kind": str, "impacts": reconstruct.nc, "fit": fit_ex.nc,
     "stronge": stronge.nc, and optionally "fig5": the figure's path and "thumbnail": its data URI}.
-    ``results``: the run's results folder (config ``results``).
+    ``results``: the run's results folder (config ``results``); ``league``: the run's league table
+    (league.nc), shown when the run has one (more than one bat of a ball, or more than one dataset).
     """
     lines = ["What was run", "-" * 12, ""]
     for name, d in datasets.items():
@@ -397,6 +461,8 @@ def front_page(
     lines.append("")
     for name, d in datasets.items():
         lines += dataset_section(name, d["fit"], d["stronge"], d.get("fig5"), d.get("thumbnail"))
+    if league is not None:
+        lines += league_section(league)
     all_warnings = list(warnings)
     for name, d in datasets.items():
         impacts, fit = d["impacts"], d["fit"]

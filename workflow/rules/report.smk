@@ -13,6 +13,7 @@ rule report_front:
         stronge=expand(f"{R}/{{dataset}}/stronge.nc", dataset=DATASETS),
         fig5=expand(f"{R}/{{dataset}}/figures/fig5.png", dataset=DATASETS),
         scenarios=expand(f"{R}/implications/{{scenario}}.nc", scenario=SCENARIOS),
+        league=[t for t in LEAGUE_TARGETS if t.endswith(".nc")],
         rest=final_targets(),
         code=code("report_front.py"),
     output:

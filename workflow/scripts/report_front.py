@@ -27,7 +27,9 @@ with logged(snakemake.log[0], snakemake.rule):
         git = json.loads(next(iter(datasets.values()))["fit"].attrs["provenance_git"]) if datasets else {}
         results = Path(snakemake.output.rst).parent.parent.as_posix()  # {results}/report/front.rst
         logs = warnings_summary(results, list(kinds), ["implications"] if scenarios else [])
-        text = front_page(datasets, scenarios, logs, git, commit_date(str(git.get("commit", ""))), results)
+        league = read_dataset(inp.league[0]) if len(inp.league) else None
+        date = commit_date(str(git.get("commit", "")))
+        text = front_page(datasets, scenarios, logs, git, date, results, league)
     else:
         designs = snakemake.params.designs
         studies = {
