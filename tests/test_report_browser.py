@@ -165,3 +165,106 @@ def test_a_caption_shows_its_fitted_number(page, report_root):
     assert _close(shown[1], e_x) and _close(shown[3], 1 + e_x), (shown[0], e_x)
     prov = json.loads(fit.attrs["provenance_git"])
     assert prov["commit"][:12] in _front_text(page) or prov["commit"] == "unknown"
+
+
+#: The window sizes the front page must read at (issue 37: 1000-1920 px wide, any height).
+SIZES = ((1000, 900), (1400, 2000), (1920, 1080))
+
+#: The boxes of the front page, measured in the page (CSS pixels): the side menu, the scroll container,
+#: the text column, each of its blocks (headings, paragraphs, list items, tables, images), the workflow graph.
+BOXES_JS = """(() => {
+    const box = e => { const r = e.getBoundingClientRect(); return [r.left, r.top, r.right, r.bottom]; };
+    const prose = document.querySelector('.prose');
+    const scroller = prose.closest('.overflow-auto');
+    scroller.scrollTo(0, 0);
+    const blocks = Array.from(prose.querySelectorAll(
+        ':scope h1, :scope p, :scope li, :scope table, :scope img, :scope details'
+    )).filter(e => e.getClientRects().length > 0);
+    const graph = document.querySelector('.vega-embed canvas');
+    return {
+        width: window.innerWidth,
+        menu: box(document.querySelector('nav')),
+        scroller: [scroller.scrollWidth, scroller.clientWidth],
+        prose: box(prose),
+        graph: graph ? box(graph) : null,
+        blocks: blocks.map(e => [e.tagName + ' ' + (e.innerText || e.alt || '').slice(0, 40), ...box(e)]),
+    };
+})()"""
+
+
+def _overlap(a, b) -> float:
+    """The area two boxes (left, top, right, bottom) share."""
+    return max(0.0, min(a[2], b[2]) - max(a[0], b[0])) * max(0.0, min(a[3], b[3]) - max(a[1], b[1]))
+
+
+def layout_problems(boxes: dict) -> list[str]:
+    """What is clipped or overlapped on the front page, one line each (none: it reads).
+
+    Every block of the text column lies right of the side menu and inside the window's width, below
+    the window's top (the page scrolled to its top); no table runs out of the text column; nothing
+    needs a horizontal scroll; the workflow graph overlaps no block; no two tables overlap.
+    """
+    out = []
+    menu_right, width = boxes["menu"][2], boxes["width"]
+    scroll_width, client_width = boxes["scroller"]
+    if scroll_width > client_width + 1:
+        out.append(f"a horizontal scroll: content {scroll_width} px wide in {client_width} px")
+    for name, *b in boxes["blocks"]:
+        if b[0] < menu_right - 0.5:
+            out.append(f"{name!r}: under the side menu (left {b[0]:.0f} < {menu_right:.0f})")
+        if b[2] > width + 0.5:
+            out.append(f"{name!r}: past the window's right edge ({b[2]:.0f} > {width})")
+        if b[1] < -0.5:
+            out.append(f"{name!r}: above the window's top ({b[1]:.0f})")
+        if name.startswith("TABLE") and b[2] > boxes["prose"][2] + 0.5:
+            out.append(f"{name!r}: runs out of the text column ({b[2]:.0f} > {boxes['prose'][2]:.0f})")
+        if boxes["graph"] and _overlap(b, boxes["graph"]) > 0:
+            out.append(f"{name!r}: under the workflow graph")
+    tables = [b for b in boxes["blocks"] if b[0].startswith("TABLE")]
+    for i, a in enumerate(tables):
+        out += [f"{a[0]!r} and {b[0]!r} overlap" for b in tables[i + 1 :] if _overlap(a[1:], b[1:]) > 0]
+    g = boxes["graph"]
+    if g and (g[0] < menu_right - 0.5 or g[2] > width + 0.5):
+        out.append(f"the workflow graph is clipped ({g[0]:.0f}-{g[2]:.0f} in {menu_right:.0f}-{width})")
+    return out
+
+
+def test_layout_problems_are_found():
+    """The check finds what issue 37 saw at 1400 x 2000: the menu over the text, the eta^2 table under the graph."""
+    boxes = {
+        "width": 1400,
+        "menu": [0, 0, 251, 2000],
+        "scroller": [1283, 1149],
+        "prose": [196, 20, 1092, 1950],
+        "graph": [1104, 20, 1417, 1338],
+        "blocks": [
+            ["TABLE e_x", 196, 313, 1092, 581],
+            ["TABLE eta2", 196, 594, 1253, 688],
+            ["P text", 300, 700, 900, 720],
+        ],
+    }
+    problems = layout_problems(boxes)
+    assert any("under the side menu" in p and "e_x" in p for p in problems)
+    assert any("'TABLE eta2': under the workflow graph" in p for p in problems)
+    assert any("runs out of the text column" in p for p in problems) and any("horizontal scroll" in p for p in problems)
+    assert any("workflow graph is clipped" in p for p in problems) and not any("'P text'" in p for p in problems)
+
+
+@pytest.mark.parametrize(("width", "height"), SIZES)
+def test_front_page_reads_at_every_size(report_root, width, height):
+    """Issue 37: at 1400 x 2000 the side menu covered the front page's left edge and the eta^2 table ran
+    under the workflow graph. At 1000-1920 px wide and any height, nothing is clipped or overlapped.
+    The 1400 x 2000 view is docs/report-front.png's (BALLBAT_REPORT_ROOT: the repository's run).
+    """
+    if chromium_path() is None:
+        pytest.skip("no chromium (make test-report installs Debian's)")
+    with Browser(width=width, height=height) as b:
+        b.open((report_root / "results" / "report.html").resolve().as_uri())
+        b.wait_for("document.querySelector('.prose h1.title') !== null")
+        b.evaluate("app.setView({content: 'rulegraph', navbarMode: 'menu'})")
+        b.wait_for("document.querySelector('.vega-embed canvas') !== null")
+        boxes = b.evaluate(BOXES_JS)
+        assert len(boxes["blocks"]) >= 15 and boxes["graph"], boxes  # headings, text, 4 tables, Fig. 5
+        assert layout_problems(boxes) == []
+        if (width, height) == (1400, 2000):
+            assert_not_blank(b.screenshot(report_root / "results" / "report-front-1400x2000.png"))
