@@ -24,7 +24,7 @@ from .units import from_si
 
 if TYPE_CHECKING:
     import os
-    from collections.abc import Iterable, Sequence
+    from collections.abc import Iterable, Mapping, Sequence
 
     import xarray as xr
 
@@ -324,10 +324,60 @@ UNCERTAINTY_NOTES = {
 }
 
 
+def _has_value(row: Mapping[str, object]) -> bool:
+    return row.get("value") not in (None, "")
+
+
+def applicable_rows(table: Sequence[Mapping[str, object]]) -> tuple[list[Mapping[str, object]], list[str]]:
+    """Return the rows of a comparison that apply to the dataset, and a note on each kind left out.
+
+    The dataset's balls are those with a value of ours, its bats per ball those with an e_x of ours.
+    A published row of a ball the dataset has no impacts of, or of a bat it did not test, has no value
+    of ours to compare and is left out, with a note saying why. A per-ball quantity (e_x pooled, the
+    Figs. 3-6 slopes, ...) that the paper pooled over other bats than the dataset's stays, with a note
+    naming both sets of bats. A dataset of the paper's balls and bats keeps every row and gets no note.
+    """
+    balls = {str(r["ball"]) for r in table if _has_value(r) and r.get("ball")}
+    bats = {
+        b: {str(r["bat"]) for r in table if r["quantity"] == "e_x" and r["ball"] == b and _has_value(r)} for b in balls
+    }
+    paper_bats: dict[str, set[str]] = {}
+    for r in table:
+        if r["quantity"] == "e_x" and r.get("paper") not in (None, ""):
+            paper_bats.setdefault(str(r["ball"]), set()).add(str(r["bat"]))
+    kept, no_ball, no_bat = [], {}, {}
+    for r in table:
+        ball, bat = str(r.get("ball") or ""), str(r.get("bat") or "")
+        if _has_value(r) or not ball:
+            kept.append(r)
+        elif ball not in balls:
+            no_ball[ball] = no_ball.get(ball, 0) + 1
+        elif bat and bat not in bats[ball]:
+            no_bat.setdefault(ball, []).append(bat)
+        else:
+            kept.append(r)
+    notes = [
+        f"{ball}: this dataset has no impacts of it; the paper's {n} rows of it are left out"
+        for ball, n in sorted(no_ball.items())
+    ]
+    notes += [
+        f"e_x of {ball} on {', '.join(dict.fromkeys(missing))}: bats this dataset did not test; left out"
+        for ball, missing in sorted(no_bat.items())
+    ]
+    for ball in sorted(balls & set(paper_bats)):
+        if bats[ball] and bats[ball] != paper_bats[ball]:
+            notes.append(
+                f"{ball}'s per-ball quantities (e_x_pooled, the slopes, eta2, ...): ours pool the bats "
+                f"{', '.join(sorted(bats[ball]))}, the paper's {', '.join(sorted(paper_bats[ball]))}: not the same bats"
+            )
+    return kept, notes
+
+
 def to_markdown(table: list[dict], title: str) -> str:
     """Return the comparison table as a Markdown table under the heading ``title``, with notes on the uncertainties."""
+    shown, left_out = applicable_rows(table)
     lines = [f"# {title}", "", "| " + " | ".join(COLUMNS) + " |", "|" + "---|" * len(COLUMNS)]
-    for r in table:
+    for r in shown:
         cells = [r[c] or "" if c in ("quantity", "ball", "bat", "unit") else format_number(r[c]) for c in COLUMNS]
         if r.get("value") is not None and r.get("uncertainty") is not None:
             # rounded as the field does (the CSV keeps 6 significant digits)
@@ -350,6 +400,9 @@ def to_markdown(table: list[dict], title: str) -> str:
             "",
             *notes,
         ]
+    if left_out:  # a dataset of other balls or bats than the paper's (paper_comparison.csv keeps every row)
+        lines += ["", "Rows that do not apply to this dataset (paper_comparison.csv keeps them):", ""]
+        lines += [f"- {n}" for n in left_out]
     return "\n".join(lines) + "\n"
 
 

@@ -22,6 +22,7 @@ from .compare import (
     COLUMNS,
     NO_SYSTEMATIC_NOTE,
     SYSTEMATIC_NOTE,
+    applicable_rows,
     format_measurement,
     read_csv,
     source_parts,
@@ -305,7 +306,7 @@ def launch_numbers(scenario: xr.Dataset) -> str:
 
 def comparison_html(csv_path: str | os.PathLike[str], html_path: str | os.PathLike[str], title: str) -> str:
     """Write a paper-comparison CSV as a self-contained HTML table (for the report)."""
-    rows = read_csv(csv_path)
+    rows, left_out = applicable_rows(read_csv(csv_path))
     head = "".join(f"<th>{html.escape(c)}</th>" for c in COLUMNS)
     body = "\n".join(
         "<tr>" + "".join(f"<td>{html.escape(str(r.get(c, '')))}</td>" for c in COLUMNS) + "</tr>" for r in rows
@@ -321,7 +322,15 @@ def comparison_html(csv_path: str | os.PathLike[str], html_path: str | os.PathLi
         + head
         + "</tr>\n"
         + body
-        + "\n</table></body></html>\n"
+        + "\n</table>"
+        + (
+            "<p>Rows that do not apply to this dataset (paper_comparison.csv keeps them):</p><ul>"
+            + "".join(f"<li>{html.escape(n)}</li>" for n in left_out)
+            + "</ul>"
+            if left_out
+            else ""
+        )
+        + "</body></html>\n"
     )
     atomic_write_text(html_path, text)
     return text
