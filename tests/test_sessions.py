@@ -304,3 +304,44 @@ def test_rerunning_the_default_keeps_a_labs_scenario(default_run, tmp_path):
     assert graph["implications/mylab.nc"]["description"].startswith("not made by this run: made by an earlier run")
     assert "#job-plot_launch-scenario=mylab" in graph and "#job-report_front" in _ids(graph["./"]["mentions"])
     assert crate_file_problems(results) == [] and validate([str(results)]) == 0
+
+
+# -- a target after --configfile -------------------------------------------------------------------
+
+
+def test_a_results_file_given_as_a_config_file_is_named(tmp_path, monkeypatch):
+    """Why (issue 37): `snakemake -c2 --configfile my.yaml TARGET` reads TARGET as a config file. Snakemake
+    stops by itself when it is missing or not YAML (before the workflow is read); a results file it can
+    read (a provenance sidecar is JSON) is caught here: one line naming it and the right order.
+    """
+    from ballbat.pipeline.guards import configfile_targets
+
+    monkeypatch.chdir(tmp_path)
+    (tmp_path / "results" / "h01").mkdir(parents=True)
+    side = tmp_path / "results" / "h01" / "paper_comparison.provenance.json"
+    side.write_text("{}")
+    assert configfile_targets([str(tmp_path / "my.yaml"), str(tmp_path / "config" / "config.yaml")]) == []
+    (line,) = configfile_targets([str(tmp_path / "my.yaml"), str(side)])
+    assert line.startswith("--configfile results/h01/paper_comparison.provenance.json: a file of the results")
+    assert "snakemake -c2 results/h01/paper_comparison.provenance.json --configfile my.yaml" in line
+    session = tmp_path / "sessions" / "s1" / "a.json"  # a session's folder (config results)
+    assert configfile_targets([str(session)], "sessions/s1") and not configfile_targets([str(session)])
+
+
+@pytest.mark.slow
+def test_snakemake_names_a_target_after_configfile(tmp_path):
+    """The workflow stops with one line (main printed the sidecar's keys as unknown config keys)."""
+    from workflow_helpers import make_workdir, snakemake
+
+    work = make_workdir(tmp_path)
+    (work / "my.yaml").write_text("analysis: {mu_k_example: 0.4}\n")
+    (work / "results" / "synthetic").mkdir(parents=True)
+    (work / "results" / "synthetic" / "paper_comparison.provenance.json").write_text('{"rule": "compare"}')
+    out = snakemake(
+        work, "-n", "--configfile", "my.yaml", "results/synthetic/paper_comparison.provenance.json", check=False
+    )
+    assert out.returncode != 0
+    assert (
+        "ballbat: --configfile results/synthetic/paper_comparison.provenance.json: a file of the results" in out.stderr
+    )
+    assert "Traceback" not in out.stderr and "unknown key" not in out.stderr

@@ -10,6 +10,7 @@ from snakemake.exceptions import WorkflowError
 from ballbat.config_checks import scenario_problems, validate_config
 from ballbat.pipeline.config import ConfigError, drop_nulls
 from ballbat.pipeline.guards import (
+    configfile_targets,
     damaged_products,
     foreign_outputs,
     remove_temporaries,
@@ -18,6 +19,10 @@ from ballbat.pipeline.guards import (
     warnings_summary,
 )
 from ballbat.workflow_inputs import WorkflowInputs
+
+# A results file given to --configfile (a target put after it): one line, before the config is checked.
+for _line in configfile_targets(workflow.configfiles, config.get("results") or "results"):
+    sys.exit(f"ballbat: {_line}")
 
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 # A dataset or scenario set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.

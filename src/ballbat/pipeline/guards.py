@@ -247,3 +247,26 @@ def warnings_summary(
                 if " WARNING " in line or line.startswith("WARNING"):
                     lines.append(f"{log}: {line.split('WARNING', 1)[1].strip(' :')}")
     return lines
+
+
+def configfile_targets(configfiles: Iterable[str | os.PathLike[str]], results: str = "results") -> list[str]:
+    """Return a line for each ``--configfile`` that is a file of the results folder (a target put after it).
+
+    ``snakemake -c2 --configfile my.yaml results/lab/fit_ex.nc`` reads the target as a second config
+    file: Snakemake itself stops when it is missing or not YAML, but a results file it can read (a
+    provenance sidecar is JSON) would be merged into the config. A config file inside ``results`` (or
+    the default ``results/``) is such a target.
+    """
+    here = Path.cwd().resolve()
+    roots = {Path(results).resolve(), Path("results").resolve()}
+    lines = []
+    for f in configfiles:
+        path = Path(f).resolve()
+        if any(path == r or path.is_relative_to(r) for r in roots):
+            name = path.relative_to(here).as_posix() if path.is_relative_to(here) else str(f)
+            lines.append(
+                f"--configfile {name}: a file of the results folder, not a config file; a target goes before "
+                f"--configfile (snakemake -c2 {name} --configfile my.yaml): it takes every name after it as a "
+                "config file"
+            )
+    return lines
