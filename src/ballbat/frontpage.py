@@ -41,6 +41,9 @@ DASH = "\u2013"
 #: Excluded impacts named one by one on the front page; more are counted and left to the workbook.
 MAX_NAMED_EXCLUSIONS = 8
 
+#: The classes of a table whose number cells do not wrap (workflow/report/workflow.rst): its numbers are short.
+NUMBERS = "headline numbers"
+
 #: Width in pixels of the Fig. 5 thumbnail embedded in the front page.
 THUMBNAIL_WIDTH = 520
 
@@ -340,7 +343,7 @@ def dataset_section(
     title = f"Dataset {escape(name)}"
     lines = [title, "-" * len(title), ""]
     header = ["ball", "bat", "e_x", "stat.", "syst.", "paper"] + (["truth"] if "truth_e_x" in fit else [])
-    lines += _table(header, e_x_rows(fit), "e_x per bat and ball (Table II) and pooled (Eq. ex)")
+    lines += _table(header, e_x_rows(fit), "e_x per bat and ball (Table II) and pooled (Eq. ex)", NUMBERS)
     lines += _table(
         ["ball", "η²", "95 % interval", "paper", "e_y implied", "μ_k bound", "paper"],
         per_ball_rows(fit, stronge),
@@ -421,11 +424,13 @@ def league_section(league: xr.Dataset) -> list[str]:
         ["ball", "bat", "e_x", "stat.", "syst.", "n", "sessions", "consistency p", f"within ±{margin:g} of ref."],
         _league_rows(league),
         "e_x per bat over the run's test sessions, highest first (league.nc, league.xlsx)",
+        NUMBERS,
     )
     lines += _table(
         ["ball", "bats", "difference ± s.e.", "p (Holm)", "differ"],
         _pair_rows(league),
         f"every pair of bats of a ball: difference, its standard error (stat. and syst.), Holm-adjusted p at {alpha:g}",
+        NUMBERS,
     )
     refs = escape(str(league.attrs.get("league_reference_bats", "")))
     lines += [
