@@ -18,6 +18,9 @@ import pytest
 import xarray as xr
 
 from ballbat import workbook
+from ballbat.fitting import FitStatus
+from ballbat.kinematics import ImpactFlag
+from ballbat.pipeline.products import flag_attrs
 from ballbat.pipeline.provenance import sha256_file
 from ballbat.units import DEGREE, FOOT, INCH, MPH, RPM
 
@@ -44,7 +47,7 @@ def impacts() -> xr.Dataset:
             "omega": ("impact", np.array([1900.0, np.nan, 2500.4]) * RPM),
             "D": ("impact", np.array([0.5, 1.25, -0.75]) * INCH),
             "r_x": ("impact", np.full(n, 0.2)),
-            "flag": ("impact", np.array([0, 0, 4], dtype=np.int8)),
+            "flag": ("impact", np.array([0, 0, 4], dtype=np.int8), flag_attrs(ImpactFlag)),
             "flag_reason": ("impact", np.array(["ok", "ok", "excluded at ingest"])),
         },
         coords={"impact": ("impact", np.arange(n))},
@@ -65,12 +68,12 @@ def fit() -> xr.Dataset:
     }
     data = {k: (dims, np.array(v)) for k, v in per.items()}
     data["e_x_n"] = (dims, np.array([[20, 19], [13, 0]]))
-    data["e_x_status"] = (dims, np.array([[0, 0], [0, 3]]))
+    data["e_x_status"] = (dims, np.array([[0, 0], [0, 3]]), flag_attrs(FitStatus))
     pooled = {"e_x_pooled": [0.41, 0.2345], "e_x_pooled_err": [0.011, 0.0456], "e_x_pooled_err_scale": [0.004, 0.001]}
     pooled |= {"e_x_pooled_ci_low": [0.39, 0.14], "e_x_pooled_ci_high": [0.43, 0.33], "e_x_pooled_redchi": [1.0, 1.3]}
     data |= {k: ("ball", np.array(v)) for k, v in pooled.items()}
     data["e_x_pooled_n"] = ("ball", np.array([39, 13]))
-    data["e_x_pooled_status"] = ("ball", np.array([0, 0]))
+    data["e_x_pooled_status"] = ("ball", np.array([0, 0]), flag_attrs(FitStatus))
     sec4 = {
         "tan_ratio_slope": [0.51, 0.62],
         "tan_ratio_slope_err": [0.02, 0.03],
@@ -127,6 +130,19 @@ def book(tmp_path, epoch):
     path = tmp_path / "results.xlsx"
     workbook.dataset_workbook(path, impacts(), fit(), stronge(), COMPARISON, properties={"rule": "workbook"})
     return path
+
+
+def test_the_league_entry_status_legend_is_fit_statuss():
+    """The workbook states entry_status's codes (it does not import ballbat.fitting): they are FitStatus's."""
+    assert workbook.LEGENDS["entry_status"] == {int(m): m.name.lower().replace("_", " ") for m in FitStatus}
+
+
+def test_a_status_column_without_a_legend_is_refused(tmp_path):
+    """A status column whose file states no meanings of its codes is not written unexplained."""
+    ds = impacts()
+    ds["flag"].attrs = {}
+    with pytest.raises(ValueError, match="workbook sheet impacts: column flag has no legend of its codes"):
+        workbook.dataset_workbook(tmp_path / "x.xlsx", ds, fit(), stronge(), COMPARISON)
 
 
 def unit_of(words: str | None) -> str | None:

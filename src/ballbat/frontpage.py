@@ -380,11 +380,13 @@ def dataset_section(
 
 def _league_rows(league: xr.Dataset) -> list[list[str]]:
     """Rows of the league table: per ball, the bats from the highest e_x (those with a value)."""
-    from .league import ranked
-
+    balls = list(dict.fromkeys(str(b) for b in league["ball"].values))
+    e_x = league["e_x"].values
+    rank = [-v if math.isfinite(v) else math.inf for v in e_x.astype(float)]
+    order = sorted(range(league.sizes["row"]), key=lambda i: (balls.index(str(league["ball"].values[i])), rank[i]))
     rows = []
     words = {1: "yes", 0: "not shown", -1: "reference"}
-    for i in ranked(league):
+    for i in order:
         g = {k: league[k].values[i] for k in league.data_vars if league[k].dims == ("row",)}
         if not math.isfinite(float(g["e_x"])):
             continue

@@ -41,8 +41,6 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from .compare import NO_SYSTEMATIC_NOTE, systematic_var, total_uncertainty
-from .fitting import FitStatus
-from .kinematics import ImpactFlag
 from .pipeline.atomic import atomic_target
 from .units import from_si
 
@@ -556,16 +554,12 @@ def _systematics_sheet(wb: object, fit: xr.Dataset, stronge: xr.Dataset) -> None
                     _format_row(ws, row, ["", "", "", "", "1", unit, ""], [([5], [5])])
 
 
-def _enum_legend(flags: type) -> dict[int, str]:
-    return {int(m): m.name.lower().replace("_", " ") for m in flags}
-
-
 #: Legends of the status and flag columns whose variable states no CF ``flag_values``/``flag_meanings``
-#: (a file of an older format; the league's entry_status and pair_differs).
+#: (the league's entry_status and pair_differs; a file of an older format). entry_status is fit_ex.nc's
+#: e_x_status (``fitting.FitStatus``, not imported: the workbook rules would then follow the fitting code;
+#: tests/test_workbook.py checks the two agree).
 LEGENDS = {
-    "flag": _enum_legend(ImpactFlag),
-    "e_x_status": _enum_legend(FitStatus),
-    "entry_status": _enum_legend(FitStatus),
+    "entry_status": {0: "ok", 1: "no impacts", 2: "too few impacts", 3: "fit failed"},
     "exceeds_mu": {0: "within friction", 1: "needs more friction than mu"},
     "tost_equivalent": {-1: "not tested", 0: "not shown equivalent", 1: "equivalent"},
     "pair_differs": {
