@@ -11,8 +11,9 @@ from argparse import Namespace
 import numpy as np
 import pytest
 
+from ballbat.config_checks import validate_config
 from ballbat.pipeline import crate as crate_mod
-from ballbat.pipeline.config import ConfigError, validate_config
+from ballbat.pipeline.config import ConfigError
 from ballbat.pipeline.cratefiles import EARLIER_NAME, crate_file_problems, folder_files
 from ballbat.pipeline.provenance import sha256_file
 from ballbat.workflow_inputs import WorkflowInputs, results_root

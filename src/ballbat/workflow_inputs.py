@@ -17,6 +17,7 @@ from typing import TYPE_CHECKING
 from .config_checks import BYTES_PER_CASE, STUDY_BYTES_PER_REPLICATE, impact_bytes, scenario_tables, study_impacts
 from .datasets import renders
 from .pipeline.codedeps import module_files
+from .pipeline.guards import results_root
 from .pipeline.provenance import sha256_file
 from .tracks.data import camera_block, tool_file_extensions
 
@@ -42,11 +43,6 @@ def file_hashes(files: dict[str, str]) -> dict[str, str]:
     a copy with an older timestamp (cp -p, tar, rsync -a).
     """
     return {k: sha256_file(v) if Path(v).is_file() else "not a file" for k, v in files.items()}
-
-
-def results_root(config: dict) -> str:
-    """Return the run's results folder (config ``results``, default ``results``), without a trailing slash."""
-    return str(config.get("results") or "results").rstrip("/") or "results"
 
 
 class WorkflowInputs:

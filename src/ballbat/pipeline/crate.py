@@ -919,7 +919,7 @@ def write_crate_of_run(
     """
     from snakemake.io import IOFile
 
-    from ..workflow_inputs import results_root
+    from .guards import results_root
 
     workdir = Path.cwd()
     jobs = jobs_from_dag(workflow.dag, workflow.persistence, workdir, failed=failed)

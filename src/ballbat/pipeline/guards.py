@@ -270,3 +270,8 @@ def configfile_targets(configfiles: Iterable[str | os.PathLike[str]], results: s
                 "config file"
             )
     return lines
+
+
+def results_root(config: dict) -> str:
+    """Return the run's results folder (config ``results``, default ``results``), without a trailing slash."""
+    return str(config.get("results") or "results").rstrip("/") or "results"
