@@ -11,6 +11,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import forked
 import numpy as np
 import pytest
 import xarray as xr
@@ -151,7 +152,10 @@ def test_caption_quotes_the_paper_only_for_its_case(tables):
     assert "(paper: about 400 ft)." in text and "Not the paper's case" not in text
 
 
-def run_hit(*args: str) -> subprocess.CompletedProcess:
+def run_hit(*args: str, installed: bool = False) -> subprocess.CompletedProcess:
+    """`ballbat hit ARGS`: the installed command, or (the default) a process forked with its libraries loaded."""
+    if not installed:
+        return forked.ballbat("hit", *args, cwd=Path.cwd(), timeout=60)
     env = {**os.environ, "PYTHONPATH": str(Path(scenario_bands.__file__).parents[1])}
     return subprocess.run([str(BALLBAT), "hit", *args], capture_output=True, text=True, timeout=60, env=env)
 
@@ -162,7 +166,7 @@ def test_ballbat_hit_prints_the_batted_ball_with_bands(tmp_path, tables):
     out = run_hit("--pitch-speed", "90", "--bat-speed", "70", "--bat", "hickory", "--results", str(tmp_path / "h01"))
     assert out.returncode == 2 and "--D" in out.stderr  # D is required
     args = ["--pitch-speed", "90", "--bat-speed", "70", "--bat", "hickory", "--results", str(tmp_path / "h01")]
-    out = run_hit(*args, "--D", "0.5")
+    out = run_hit(*args, "--D", "0.5", installed=True)
     assert out.returncode == 0, out.stderr
     lines = out.stdout.splitlines()
     assert "e_x = 0.4550 ± 0.0100 (stat.) ± 0.0040 (syst.), bat e_x of dataset h01" in lines[0]

@@ -15,6 +15,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import forked
 import numpy as np
 import pytest
 import xarray as xr
@@ -204,7 +205,10 @@ def test_tost_in_the_table_uses_the_reference_bat(tmp_path):
 # ballbat compare, through the installed entry point, and bad input
 
 
-def run_compare(*args: str) -> subprocess.CompletedProcess:
+def run_compare(*args: str, installed: bool = False) -> subprocess.CompletedProcess:
+    """`ballbat compare ARGS`: the installed command, or (the default) a process forked with its libraries loaded."""
+    if not installed:
+        return forked.ballbat("compare", *args, cwd=Path.cwd(), timeout=60)
     env = {**os.environ, "PYTHONPATH": str(Path(league.__file__).parents[1])}
     return subprocess.run([str(BALLBAT), "compare", *args], capture_output=True, text=True, timeout=60, env=env)
 
@@ -212,7 +216,7 @@ def run_compare(*args: str) -> subprocess.CompletedProcess:
 def test_ballbat_compare_prints_the_table_the_pairs_and_tost(tmp_path):
     fit_file(tmp_path / "s1", "h01", {"hickory": (0.47, 0.006, 25, 0.004), "wood": (0.46, 0.006, 25, 0.004)})
     fit_file(tmp_path / "s2", "m01", {"maple": (0.38, 0.006, 25, 0.004), "wood": (0.465, 0.006, 25, 0.004)})
-    out = run_compare(str(tmp_path / "s1"), str(tmp_path / "s2"), "--reference-bat", "wood")
+    out = run_compare(str(tmp_path / "s1"), str(tmp_path / "s2"), "--reference-bat", "wood", installed=True)
     assert out.returncode == 0, out.stderr
     assert f"2 test session(s): {tmp_path / 's1' / 'h01'}, {tmp_path / 's2' / 'm01'}" in out.stdout
     lines = out.stdout.splitlines()

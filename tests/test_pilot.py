@@ -10,6 +10,7 @@ import subprocess
 import sys
 from pathlib import Path
 
+import forked
 import numpy as np
 import pytest
 import xarray as xr
@@ -105,5 +106,5 @@ def test_ballbat_design_from_a_pilot_folder(tmp_path):
     assert f"baseball, pooled over 1 bat(s): {n.n:.0f} (95 %: {n.n_low:.0f} to {n.n_high:.0f})" in out.stdout
     run[2] = str(tmp_path)
     (tmp_path / "empty").mkdir()
-    out = subprocess.run([*run[:2], str(tmp_path / "empty"), *run[3:]], capture_output=True, text=True, env=env)
+    out = forked.ballbat(*run[1:2], str(tmp_path / "empty"), *run[3:], cwd=tmp_path, timeout=60)
     assert out.returncode == 2 and str(tmp_path / "empty") in out.stderr and len(out.stderr.splitlines()) == 1
