@@ -5,13 +5,9 @@ from __future__ import annotations
 import argparse
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from ..usage import UsageError
 from .common import _schema_defaults
-
-if TYPE_CHECKING:
-    pass
 
 
 def cmd_check(args: argparse.Namespace) -> int:

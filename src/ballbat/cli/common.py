@@ -6,13 +6,9 @@ import argparse
 import math
 import re
 from pathlib import Path
-from typing import TYPE_CHECKING, NoReturn
+from typing import NoReturn
 
 from . import compare, design, hit, track_video
-
-if TYPE_CHECKING:
-    pass
-
 
 #: The config schema and the default property tables, shipped with the package (``data/`` links
 #: to ``workflow/schemas/`` and ``config/`` of the checkout, so there is one copy of each).

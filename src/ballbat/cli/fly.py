@@ -8,14 +8,9 @@ import json
 import math
 import sys
 from pathlib import Path
-from typing import TYPE_CHECKING
 
 from ..usage import UsageError
 from .common import _range_problem, _schema_defaults
-
-if TYPE_CHECKING:
-    pass
-
 
 FLY_NUMBERS = {
     "speed": ("mph", "exit speed (required)", "exit_speed_mph"),

@@ -4,14 +4,10 @@ from __future__ import annotations
 
 import argparse
 import sys
-from typing import TYPE_CHECKING
 
 from ..usage import UsageError
 from ..writer import OutputRefused
 from .common import EXAMPLES
-
-if TYPE_CHECKING:
-    pass
 
 
 def _pairs(text: str, what: str) -> dict[str, str]:
