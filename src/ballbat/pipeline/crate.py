@@ -230,6 +230,7 @@ class _Builder:
         self.crate = ROCrate(version="1.1")
         self.crate.metadata.extra_terms.update(WFRUN_TERMS)
         self.files: dict[str, Any] = {}
+        self._digests: dict[Path, str] = {}
         #: Input data files not copied into the snapshot (above its limits): path -> why.
         self.uncopied: dict[str, str] = {}
 
@@ -237,6 +238,12 @@ class _Builder:
         from rocrate.model.contextentity import ContextEntity
 
         return self.crate.add(ContextEntity(self.crate, ident, properties=props))
+
+    def sha256(self, path: Path) -> str:
+        """Return a file's sha256, read once per crate (a carried-over result is compared, then listed)."""
+        if path not in self._digests:
+            self._digests[path] = sha256_file(path)
+        return self._digests[path]
 
     def file(self, crate_path: str, types: list[str] | None = None, **props: Any) -> Any:
         """Return the File entity of ``results/crate_path`` with sha256, size and media type (added once)."""
@@ -246,7 +253,7 @@ class _Builder:
         base = {
             "@type": ["File", *(types or [])],
             "name": Path(crate_path).name,
-            "sha256": sha256_file(path),
+            "sha256": self.sha256(path),
             "contentSize": str(path.stat().st_size),
             "encodingFormat": media_type(path),
         }
@@ -839,7 +846,7 @@ def _unchanged(b: _Builder, entity: dict, crate_path: str) -> bool:
     path = b.results / crate_path
     if not path.is_file() or "sha256" not in entity:
         return False
-    return entity["sha256"] == sha256_file(path) and _made_by_workflow(path)
+    return entity["sha256"] == b.sha256(path) and _made_by_workflow(path)
 
 
 def _earlier_object(b: _Builder, graph: dict, ident: str) -> Any:
@@ -851,7 +858,7 @@ def _earlier_object(b: _Builder, graph: dict, ident: str) -> Any:
         props = {k: v for k, v in entity.items() if k != "@id"}
         return b.context(ident, props) if b.crate.dereference(ident) is None else {"@id": ident}
     path = b.results / ident
-    if path.is_file() and entity.get("sha256") == sha256_file(path):
+    if path.is_file() and entity.get("sha256") == b.sha256(path):
         b.file(ident)
         return {"@id": ident}
     digest = str(entity.get("sha256", ""))
