@@ -12,6 +12,7 @@ import fcntl
 import json
 import os
 import shutil
+import signal
 import subprocess
 import tempfile
 import time
@@ -44,7 +45,7 @@ class Browser:
         if exe is None:
             raise FileNotFoundError(f"no Chromium at {CHROMIUM} nor on PATH (make test-report installs it)")
         self.timeout = timeout
-        self._profile = tempfile.TemporaryDirectory(prefix="ballbat-chromium-")
+        self._profile = tempfile.mkdtemp(prefix="ballbat-chromium-")
         to_chrome_r, self._to_chrome = os.pipe()
         self._from_chrome, from_chrome_w = os.pipe()
         # fds 3 and 4 in the child: Chromium's protocol pipe
@@ -57,7 +58,7 @@ class Browser:
                 "--disable-dev-shm-usage",
                 "--hide-scrollbars",
                 "--no-first-run",
-                f"--user-data-dir={self._profile.name}",
+                f"--user-data-dir={self._profile}",
                 f"--window-size={width},{height}",
                 "--remote-debugging-pipe",
                 "about:blank",
@@ -66,6 +67,7 @@ class Browser:
             stdout=subprocess.DEVNULL,
             stderr=subprocess.DEVNULL,
             pass_fds=(3, 4),
+            start_new_session=True,  # its helpers (renderer, crashpad) in one group, stopped together
             preexec_fn=lambda: _pipe_to_3_and_4(to_chrome_r, from_chrome_w),
         )
         os.close(to_chrome_r)
@@ -89,19 +91,39 @@ class Browser:
         self.close()
 
     def close(self) -> None:
-        """Stop this Chromium (the process this object started) and remove its profile."""
+        """Stop this Chromium and its helper processes, then remove its profile.
+
+        Chromium's helpers (crashpad, renderer) can still be writing into the profile just
+        after the main process has gone, so the whole process group is stopped and waited for,
+        and the profile's removal is retried briefly; a profile left in /tmp is not a test failure.
+        """
         try:
-            os.close(self._to_chrome)
-            os.close(self._from_chrome)
-        except OSError:
+            self._call("Browser.close")  # graceful: flushes and ends the helpers
+        except (OSError, RuntimeError, TimeoutError):
             pass
-        self._proc.terminate()
+        for fd in (self._to_chrome, self._from_chrome):
+            try:
+                os.close(fd)
+            except OSError:
+                pass
         try:
             self._proc.wait(timeout=10)
         except subprocess.TimeoutExpired:
             self._proc.kill()
             self._proc.wait()
-        self._profile.cleanup()
+        try:
+            os.killpg(self._proc.pid, signal.SIGKILL)  # any helper still alive
+        except (ProcessLookupError, PermissionError):
+            pass
+        for _ in range(20):
+            try:
+                shutil.rmtree(self._profile)
+                break
+            except FileNotFoundError:
+                break
+            except OSError:
+                time.sleep(0.1)
+        shutil.rmtree(self._profile, ignore_errors=True)
 
     def _read_message(self, deadline: float) -> dict:
         while b"\0" not in self._buffer:
