@@ -15,7 +15,7 @@ from ballbat.pipeline.config import checked_block
 from ballbat.tracks.data import POINTS, to_dense, to_long
 from ballbat.tracks.reduce import reduce_tracks
 from ballbat.tracks.render import render_tracks, settings_from_config
-from ballbat.units import DEGREE, MPH, RPM
+from impacts import random_impacts  # bench/impacts.py
 
 N = int(sys.argv[1]) if len(sys.argv) > 1 else 10_000
 CFG = {
@@ -27,14 +27,7 @@ CFG = {
     "seed": 1,
 }
 
-rng = np.random.default_rng(0)
-truth = {
-    "v_bat": rng.uniform(63, 88, N) * MPH,
-    "v_ball": rng.uniform(55, 100, N) * MPH,
-    "theta": rng.uniform(0, 30, N) * DEGREE,
-    "omega": rng.uniform(0, 3500, N) * RPM,
-    "psi": rng.uniform(0, 35, N) * DEGREE,
-}
+truth = random_impacts(N, seed=0)
 r = np.full(N, 0.0366)
 ids = np.arange(N).astype(str)
 s = settings_from_config(checked_block(CFG, "render"))  # the schema's defaults filled

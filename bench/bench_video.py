@@ -28,7 +28,7 @@ import numpy as np
 
 from ballbat.pipeline.config import checked_block
 from ballbat.tracks.render import settings_from_config
-from ballbat.units import DEGREE, MPH, RPM
+from impacts import random_impacts  # bench/impacts.py
 from ballbat.video.io import open_clip, write_clip
 from ballbat.video.render import Look, render_frames
 from ballbat.video.scene import clip_truths
@@ -56,14 +56,7 @@ POINTS = {"swing": ("ball", "bat_tip"), "spin": ("ball", "dot_a", "dot_b")}
 
 def truths(n: int, seed: int = 0) -> list:
     """Return the true clips of ``n`` impacts drawn from ``seed``, and the render settings."""
-    rng = np.random.default_rng(seed)
-    truth = {
-        "v_bat": rng.uniform(63, 88, n) * MPH,
-        "v_ball": rng.uniform(55, 100, n) * MPH,
-        "theta": rng.uniform(0, 30, n) * DEGREE,
-        "omega": rng.uniform(500, 3500, n) * RPM,
-        "psi": rng.uniform(0, 35, n) * DEGREE,
-    }
+    truth = random_impacts(n, seed, omega_min_rpm=500)
     s = settings_from_config(checked_block(CFG, "render"))
     ids = np.array([f"I{i:02d}" for i in range(n)])
     return clip_truths(s, truth, np.full(n, 0.0366), ids, np.full(n, "baseball"), np.full(n, "wood")), s

@@ -10,6 +10,16 @@ Nothing of ballbat is loaded in the server: each child imports it afresh (from `
 when a run has its own copy of the package). The installed entry points themselves are tested
 as subprocesses (test_cli.test_entry_point_is_installed, test_release).
 
+A Snakemake run's jobs are Python scripts that Snakemake starts as ``{sys.executable} SCRIPT``:
+fresh interpreters again, each paying about a second of imports. In a forked run
+``sys.executable`` is a small launcher (:func:`_job_launcher`) that hands the script, its working
+folder, environment, memory limit and standard streams to a job server forked from the same
+preloaded server (:func:`_serve_jobs`); the server forks a child that runs the script as
+``__main__`` and reports its exit status back, which the launcher exits with. The job is still a
+process of its own, run by Snakemake's own code from Snakemake's own script file; only the
+interpreter's start is shared. ``BALLBAT_TEST_FRESH_JOBS=1`` turns this off for a run, and the
+suite's runs through ``make run`` and ``make test-slurm`` use fresh interpreters throughout.
+
 Set ``BALLBAT_TEST_COST_LOG`` to a file to get one JSON line per run: the test, the command,
 its wall time and its CPU time with its children's (the jobs of a Snakemake run).
 """
@@ -17,6 +27,8 @@ its wall time and its CPU time with its children's (the jobs of a Snakemake run)
 from __future__ import annotations
 
 import os
+import signal
+import socket
 import subprocess
 import sys
 import tempfile
@@ -72,6 +84,9 @@ def _child(kind: str, workdir: str, args: list[str], env: dict, out: str, err: s
     start = time.perf_counter()
     try:
         if kind == "snakemake":
+            launcher = env.get("BALLBAT_TEST_JOB_LAUNCHER")
+            if launcher and env.get("BALLBAT_TEST_FRESH_JOBS") != "1":
+                sys.executable = launcher  # Snakemake starts its Python jobs as {sys.executable} SCRIPT
             sys.argv = ["snakemake", *args]
             from snakemake.cli import main
 
@@ -83,6 +98,126 @@ def _child(kind: str, workdir: str, args: list[str], env: dict, out: str, err: s
             sys.exit(main(args))
     finally:
         _log_cost(kind, args, time.perf_counter() - start)
+
+#: Length prefix of a job request (bytes, little-endian) sent to the job server.
+_LEN = 8
+_JOBS: tuple[str, str] | None = None  # (socket path, launcher path) of this test process's job server
+
+
+def _job_server() -> tuple[str, str]:
+    """The job server of this test process (started on first use): its socket and its launcher."""
+    global _JOBS
+    if _JOBS is None:
+        folder = tempfile.mkdtemp(prefix="ballbat-jobs-")
+        sock, launcher = os.path.join(folder, "jobs.sock"), os.path.join(folder, "python")
+        with open(launcher, "w") as fh:
+            fh.write(_job_launcher(sys.executable))
+        os.chmod(launcher, 0o755)
+        server = _context().Process(target=_serve_jobs, args=(sock,), daemon=True)
+        server.start()
+        deadline = time.monotonic() + 30
+        while not os.path.exists(sock):
+            if not server.is_alive() or time.monotonic() > deadline:
+                raise RuntimeError("the job server of tests/forked.py did not start")
+            time.sleep(0.01)
+        _JOBS = (sock, launcher)
+    return _JOBS
+
+
+def _job_launcher(python: str) -> str:
+    """The launcher's source: ``python SCRIPT.py`` as a request to the job server, any other call exec'd."""
+    return f"""#!{python} -IS
+# Written by tests/forked.py: runs ``python SCRIPT.py`` in a child of the test suite's job server.
+import json, os, resource, socket, sys
+
+args = sys.argv[1:]
+addr = os.environ.get("BALLBAT_TEST_JOB_SERVER")
+if not addr or len(args) != 1 or not args[0].endswith(".py"):
+    os.execv({python!r}, [{python!r}, *args])
+for fd in (0, 1, 2):  # a closed standard stream is /dev/null, as it can't be passed on
+    try:
+        os.fstat(fd)
+    except OSError:
+        os.open(os.devnull, os.O_RDWR)
+body = json.dumps(
+    {{"argv": args, "cwd": os.getcwd(), "env": dict(os.environ), "as": resource.getrlimit(resource.RLIMIT_AS)}}
+).encode()
+conn = socket.socket(socket.AF_UNIX)
+conn.connect(addr)
+socket.send_fds(conn, [len(body).to_bytes({_LEN}, "little") + body], [0, 1, 2])
+reply = conn.recv(16)
+if not reply:
+    sys.stderr.write("tests/forked.py: the job's process ended without an exit status\\n")
+    sys.exit(1)
+sys.exit(int(reply))
+"""
+
+
+def _serve_jobs(path: str) -> None:
+    """Accept job requests on the socket ``path``; fork a child for each (:func:`_run_job`)."""
+    signal.signal(signal.SIGCHLD, signal.SIG_IGN)  # the children are reaped by the kernel
+    server = socket.socket(socket.AF_UNIX)
+    server.bind(path + ".tmp")
+    server.listen(64)
+    os.rename(path + ".tmp", path)  # the socket appears only once it listens
+    while True:
+        conn, _ = server.accept()
+        if os.fork() == 0:
+            server.close()
+            signal.signal(signal.SIGCHLD, signal.SIG_DFL)
+            _run_job(conn)
+        conn.close()
+
+
+def _run_job(conn: socket.socket) -> None:
+    """In a job's child: take the request, become the job, run its script as ``__main__``, report, exit."""
+    import json
+    import resource
+    import runpy
+    import traceback
+
+    data, fds, _, _ = socket.recv_fds(conn, 1 << 20, 3)
+    size, body = int.from_bytes(data[:_LEN], "little"), data[_LEN:]
+    while len(body) < size:
+        body += conn.recv(1 << 20)
+    job = json.loads(body)
+    for target, fd in enumerate(fds):
+        os.dup2(fd, target)
+        os.close(fd)
+    os.chdir(job["cwd"])
+    os.environ.clear()
+    os.environ.update(job["env"])
+    resource.setrlimit(resource.RLIMIT_AS, tuple(job["as"]))
+    script = job["argv"][0]
+    sys.argv = list(job["argv"])
+    extra = [p for p in job["env"].get("PYTHONPATH", "").split(os.pathsep) if p]
+    sys.path[:0] = [os.path.dirname(os.path.abspath(script)), *extra]  # as a fresh interpreter's path
+    sys.stdin = open(0, closefd=False)
+    sys.stdout = open(1, "w", closefd=False)
+    sys.stderr = open(2, "w", closefd=False)
+    start, code = time.perf_counter(), 1
+    try:
+        runpy.run_path(script, run_name="__main__")
+        code = 0
+    except SystemExit as stop:
+        if stop.code is None or isinstance(stop.code, int):
+            code = stop.code or 0
+        else:
+            print(stop.code, file=sys.stderr)
+    except BaseException:  # as an interpreter would: the traceback, then status 1
+        traceback.print_exc()
+    finally:
+        import atexit
+
+        try:
+            atexit._run_exitfuncs()
+        except BaseException:
+            traceback.print_exc()
+        _log_cost("job", job["argv"], time.perf_counter() - start)
+        sys.stdout.flush()
+        sys.stderr.flush()
+        conn.sendall(str(code).encode())
+        os._exit(code)
 
 
 def _log_cost(kind: str, args: list[str], wall: float) -> None:
@@ -118,6 +253,9 @@ def run(
     subprocess; a child still running after ``timeout`` seconds is killed (``TimeoutExpired``).
     """
     env = dict(os.environ) if env is None else env
+    if kind == "snakemake":
+        env = dict(env)
+        env["BALLBAT_TEST_JOB_SERVER"], env["BALLBAT_TEST_JOB_LAUNCHER"] = _job_server()
     mem = int(mem_gib * 2**30) if mem_gib else None
     argv = [str(a) for a in args]
     with tempfile.TemporaryDirectory() as tmp:

@@ -166,31 +166,32 @@ def test_non_numeric_empty_and_non_finite(tmp_path):
     assert len(probs) == 3  # all at once, nothing else
 
 
-def test_non_positive_speeds(tmp_path):
+BAD_CELLS = {  # (row of GOOD, column) -> the value a lab typed: each must be named with its row and column
+    "speeds": {
+        (0, 3): ("-75", "s.csv: row 2, column v_bat_mph", "-75 mph; a speed must be positive"),
+        (2, 4): ("0", "s.csv: row 4, column v_ball_mph", "0 mph; a speed must be positive"),
+    },
+    "angles": {
+        (1, 5): ("95", "s.csv: row 3, column theta_deg", "95 deg is outside the physical range (-90, 90)"),
+        (2, 5): ("-90", "s.csv: row 4, column theta_deg", "-90 deg is outside"),
+    },
+    "names": {
+        (0, 1): ("ash", "s.csv: row 2, column bat", "bat 'ash' is not in the bat table", "known: metal_rough"),
+        (3, 2): ("cricket", "s.csv: row 5, column ball", "ball 'cricket' is not in the ball table", "known: baseball, softball"),
+    },
+}
+
+
+@pytest.mark.parametrize("kind", sorted(BAD_CELLS))
+def test_a_bad_cell_is_named_by_row_and_column(tmp_path, kind):
+    """Non-positive speeds, angles outside (-90, 90) deg, bats and balls not in the tables."""
     rows = copy.deepcopy(GOOD)
-    rows[0][3] = "-75"
-    rows[2][4] = "0"
+    for (row, col), (value, *_) in BAD_CELLS[kind].items():
+        rows[row][col] = value
     probs = problems_of(write_csv(tmp_path / "s.csv", rows))
-    one(probs, "s.csv: row 2, column v_bat_mph", "-75 mph; a speed must be positive")
-    one(probs, "s.csv: row 4, column v_ball_mph", "0 mph; a speed must be positive")
-
-
-def test_angle_outside_physical_range(tmp_path):
-    rows = copy.deepcopy(GOOD)
-    rows[1][5] = "95"
-    rows[2][5] = "-90"
-    probs = problems_of(write_csv(tmp_path / "a.csv", rows))
-    one(probs, "a.csv: row 3, column theta_deg", "95 deg is outside the physical range (-90, 90)")
-    one(probs, "a.csv: row 4, column theta_deg", "-90 deg is outside")
-
-
-def test_bat_or_ball_not_in_tables(tmp_path):
-    rows = copy.deepcopy(GOOD)
-    rows[0][1] = "ash"
-    rows[3][2] = "cricket"
-    probs = problems_of(write_csv(tmp_path / "b.csv", rows))
-    one(probs, "b.csv: row 2, column bat", "bat 'ash' is not in the bat table", "known: metal_rough")
-    one(probs, "b.csv: row 5, column ball", "ball 'cricket' is not in the ball table", "known: baseball, softball")
+    for _, *parts in BAD_CELLS[kind].values():
+        one(probs, *parts)
+    assert len(probs) == len(BAD_CELLS[kind]), probs
 
 
 def test_duplicate_impact_ids(tmp_path):

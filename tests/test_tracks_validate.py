@@ -143,30 +143,26 @@ def test_camera_settings():
         assert any(e in p for p in ps), (e, ps)
 
 
-def test_calibration_uncertainties():
-    """fps_err (relative) and the rig's length uncertainties (inches): read, and each wrong one named."""
-    good = {
+def tracks_block(swing: dict | None = None, spin: dict | None = None, **rig) -> dict:
+    """A dataset's tracks block: the 3000 and 1000 fps cameras, with ``swing``/``spin``/``rig`` entries added."""
+    return {
         "file": "tracks.csv",
         "impacts": "impacts.csv",
         "cameras": {
-            "swing": {"fps": 3000, "m_per_px": 0.00074, "mirror": False, "fps_err": 0.001},
-            "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False},
+            "swing": {"fps": 3000, "m_per_px": 0.00074, "mirror": False, **(swing or {})},
+            "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False, **(spin or {})},
         },
-        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0, "pivot_to_impact_err_in": 0.1},
+        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0, **rig},
     }
+
+
+def test_calibration_uncertainties():
+    """fps_err (relative) and the rig's length uncertainties (inches): read, and each wrong one named."""
+    good = tracks_block(swing={"fps_err": 0.001}, pivot_to_impact_err_in=0.1)
     cams, rig = cameras_from_config(checked_block(good, "tracks"))  # the schema's defaults filled
     assert cams["swing"].fps_err == 0.001 and cams["spin"].fps_err == 0.0
     assert rig.pivot_to_impact_err == pytest.approx(0.1 * 0.0254) and rig.pivot_to_tip_err == 0.0
-    bad = {
-        **good,
-        "cameras": {**good["cameras"], "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False, "fps_err": 2}},
-        "rig": {
-            "pivot_to_tip_in": 34.0,
-            "pivot_to_impact_in": 28.0,
-            "pivot_to_tip_err_in": -1,
-            "pivot_to_impact_err_in": 5,
-        },
-    }
+    bad = tracks_block(spin={"fps_err": 2}, pivot_to_tip_err_in=-1, pivot_to_impact_err_in=5)
     with pytest.raises(InputError) as exc:
         cameras_from_config(bad, "datasets.lab.tracks")
     ps = exc.value.problems
@@ -181,15 +177,7 @@ def test_calibration_uncertainties():
 
 
 def test_camera_settings_good():
-    block = {
-        "file": "tracks.csv",
-        "impacts": "impacts.csv",
-        "cameras": {
-            "swing": {"fps": 3000, "m_per_px": 0.00074, "mirror": True, "m_per_px_err": 0.005},
-            "spin": {"fps": 1000, "m_per_px": 0.00125, "mirror": False},
-        },
-        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
-    }
+    block = tracks_block(swing={"mirror": True, "m_per_px_err": 0.005})
     cams, rig = cameras_from_config(checked_block(block, "tracks"))  # the schema's defaults filled
     assert cams["swing"].sign == -1 and cams["swing"].m_per_px_err == 0.005
     assert cams["spin"].m_per_px_err == 0.0  # the schema's default

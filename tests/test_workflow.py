@@ -58,31 +58,14 @@ def test_outputs_content(run_dir):
     fit = xr.open_dataset(res / "fit_ex.nc")
     assert int(fit.e_x_n.sel(ball="baseball", bat="wood")) == 12
     table = read_csv(res / "paper_comparison.csv")
-    assert list(table[0]) == [
-        "quantity",
-        "ball",
-        "bat",
-        "paper",
-        "paper_uncertainty",
-        "value",
-        "uncertainty",
-        "systematic",
-        "truth",
-        "unit",
-    ]
+    header = "quantity ball bat paper paper_uncertainty value uncertainty systematic truth unit"
+    assert list(table[0]) == header.split()
     rows = {(r["quantity"], r["ball"], r["bat"]): r for r in table}
     wood = rows[("e_x", "baseball", "wood")]
     assert float(wood["paper"]) == 0.464 and float(wood["truth"]) == 0.464
     assert abs(float(wood["value"]) - 0.464) < 3 * float(wood["uncertainty"])
     assert rows[("e_x", "softball", "wood")]["value"] == ""  # not in this dataset: empty, not invented
-    for q in (
-        "e_x_pooled",
-        "spin_theta_slope",
-        "speed_theta_slope",
-        "tan_ratio_slope",
-        "e_y_implied",
-        "mu_k_lower_bound",
-    ):
+    for q in "e_x_pooled spin_theta_slope speed_theta_slope tan_ratio_slope e_y_implied mu_k_lower_bound".split():
         assert rows[(q, "baseball", "")]["value"] != "", q
     assert (res / "paper_comparison.md").read_text().startswith("# Dataset small")
 
@@ -247,17 +230,8 @@ def test_workbook_in_the_fields_units(run_dir):
 
     res = run_dir / "results" / "small"
     book = openpyxl.load_workbook(res / "results.xlsx")
-    assert book.sheetnames == [
-        "impacts",
-        "e_x",
-        "sec4",
-        "eta2",
-        "systematics",
-        "paper_comparison",
-        "warnings",
-        "legend",
-        "provenance",
-    ]
+    sheets = "impacts e_x sec4 eta2 systematics paper_comparison warnings legend provenance"
+    assert book.sheetnames == sheets.split()
     names, words = ([c.value for c in row] for row in (book["impacts"][1], book["impacts"][2]))
     head = dict(zip(names, words, strict=True))
     assert head["v_bat"].endswith("(mph)") and head["v_ball"].endswith("(mph)")  # words with units: row 2
