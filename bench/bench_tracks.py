@@ -10,12 +10,12 @@ import sys
 import time
 
 import numpy as np
+from impacts import random_impacts  # bench/impacts.py
 
 from ballbat.pipeline.config import checked_block
 from ballbat.tracks.data import POINTS, to_dense, to_long
 from ballbat.tracks.reduce import reduce_tracks
 from ballbat.tracks.render import render_tracks, settings_from_config
-from impacts import random_impacts  # bench/impacts.py
 
 N = int(sys.argv[1]) if len(sys.argv) > 1 else 10_000
 CFG = {

@@ -25,10 +25,10 @@ from collections import Counter
 from pathlib import Path
 
 import numpy as np
+from impacts import random_impacts  # bench/impacts.py
 
 from ballbat.pipeline.config import checked_block
 from ballbat.tracks.render import settings_from_config
-from impacts import random_impacts  # bench/impacts.py
 from ballbat.video.io import open_clip, write_clip
 from ballbat.video.render import Look, render_frames
 from ballbat.video.scene import clip_truths

@@ -99,6 +99,7 @@ def _child(kind: str, workdir: str, args: list[str], env: dict, out: str, err: s
     finally:
         _log_cost(kind, args, time.perf_counter() - start)
 
+
 #: Length prefix of a job request (bytes, little-endian) sent to the job server.
 _LEN = 8
 _JOBS: tuple[str, str] | None = None  # (socket path, launcher path) of this test process's job server

@@ -30,6 +30,6 @@ import yaml  # noqa: F401
 from snakemake.cli import get_argument_parser
 
 matplotlib.use("Agg")
-import matplotlib.pyplot  # noqa: E402, F401
+import matplotlib.pyplot
 
 get_argument_parser()  # fills the plugin registries (singletons), which every start reads

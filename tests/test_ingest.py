@@ -177,7 +177,12 @@ BAD_CELLS = {  # (row of GOOD, column) -> the value a lab typed: each must be na
     },
     "names": {
         (0, 1): ("ash", "s.csv: row 2, column bat", "bat 'ash' is not in the bat table", "known: metal_rough"),
-        (3, 2): ("cricket", "s.csv: row 5, column ball", "ball 'cricket' is not in the ball table", "known: baseball, softball"),
+        (3, 2): (
+            "cricket",
+            "s.csv: row 5, column ball",
+            "ball 'cricket' is not in the ball table",
+            "known: baseball, softball",
+        ),
     },
 }
 

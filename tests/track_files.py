@@ -50,7 +50,13 @@ def _jd(v: float) -> str:
 
 def _object(name: str, cls: str, inner: list[str], ind: str) -> list[str]:
     """A property of type object holding an object of class ``cls`` with the lines ``inner``."""
-    return [f'{ind}<property name="{name}" type="object">', f'{ind}<object class="{cls}">', *inner, f"{ind}</object>", f"{ind}</property>"]
+    return [
+        f'{ind}<property name="{name}" type="object">',
+        f'{ind}<object class="{cls}">',
+        *inner,
+        f"{ind}</object>",
+        f"{ind}</property>",
+    ]
 
 
 def _prop(name: str, typ: str, value: str, ind: str) -> str:
@@ -86,13 +92,18 @@ def trk_text(
         _prop("center_y", "int", "400", i1),
     ]
     video_object = _object(
-        "video", "org.opensourcephysics.media.mov.MovieVideo", [
+        "video",
+        "org.opensourcephysics.media.mov.MovieVideo",
+        [
             _prop("path", "string", escape(video), i3),
             f'{i3}<property name="filters" type="collection" class="java.util.ArrayList" />',
-        ], i2
+        ],
+        i2,
     )
     out += _object(
-        "videoclip", f"{MEDIA}.VideoClip", [
+        "videoclip",
+        f"{MEDIA}.VideoClip",
+        [
             *video_object,
             _prop("video_framecount", "int", str(start + count + 20), i2),
             _prop("startframe", "int", str(start), i2),
@@ -101,26 +112,35 @@ def trk_text(
             _prop("starttime", "double", "0.0", i2),
             _prop("readout", "string", "frame", i2),
             _prop("playallsteps", "boolean", "true", i2),
-        ], i1
+        ],
+        i1,
     )
     out += _object(
-        "clipcontrol", f"{MEDIA}.StepperClipControl", [
+        "clipcontrol",
+        f"{MEDIA}.StepperClipControl",
+        [
             _prop("rate", "double", "1.0", i2),
             _prop("delta_t", "double", _jd(1000.0 / fps), i2),
             _prop("frame", "int", str(start), i2),
-        ], i1
+        ],
+        i1,
     )
     frame_data = _object(
-        "[0]", f"{MEDIA}.ImageCoordSystem$FrameData", [
+        "[0]",
+        f"{MEDIA}.ImageCoordSystem$FrameData",
+        [
             _prop("xorigin", "double", _jd(origin[0]), i4),
             _prop("yorigin", "double", _jd(origin[1]), i4),
             _prop("angle", "double", _jd(angle_deg), i4),
             _prop("xscale", "double", _jd(scale), i4),
             _prop("yscale", "double", _jd(scale), i4),
-        ], i3
+        ],
+        i3,
     )
     out += _object(
-        "coords", f"{MEDIA}.ImageCoordSystem", [
+        "coords",
+        f"{MEDIA}.ImageCoordSystem",
+        [
             _prop("fixedorigin", "boolean", "true", i2),
             _prop("fixedangle", "boolean", "true", i2),
             _prop("fixedscale", "boolean", "true", i2),
@@ -128,7 +148,8 @@ def trk_text(
             f'{i2}<property name="framedata" type="array" class="[L{MEDIA}.ImageCoordSystem$FrameData;">',
             *frame_data,
             f"{i2}</property>",
-        ], i1
+        ],
+        i1,
     )
     out += [
         _prop("length_unit", "string", unit, i1),
