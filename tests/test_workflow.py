@@ -221,6 +221,36 @@ def test_results_pass_the_cf_checker(run_dir):
     assert_cf([str(f) for f in files], run_dir / "cf.json")
 
 
+def test_the_remembering_cf_checker_reports_as_the_checker_does(tmp_path):
+    """tests/cf_check.py (the checker with its dataset queries remembered) gives the installed checker's report,
+    and names a unit that is not one and a standard name that is not CF's.
+    """
+    from workflow_helpers import run_cf_checker
+
+    x = xr.DataArray(np.arange(4.0), dims="impact", attrs={"units": "m", "long_name": "distance"})
+    good = xr.Dataset({"x": x, "t": x.copy().assign_attrs(units="s", long_name="time of flight")})
+    good.attrs["Conventions"] = "CF-1.10"
+    bad = good.assign(y=x.copy().assign_attrs(units="furlongs per fortnightly", standard_name="bat_speediness"))
+    files = [str(tmp_path / "good.nc"), str(tmp_path / "bad.nc")]
+    good.to_netcdf(files[0])
+    bad.to_netcdf(files[1])
+    fast, slow = (run_cf_checker(files, tmp_path / f"{k}.json", remembering=k) for k in (True, False))
+    for name in files:
+        fast[name]["cf:1.10"].pop("report_timestamp")
+        slow[name]["cf:1.10"].pop("report_timestamp")
+    assert fast == slow
+    msgs = {
+        Path(n).name: " ".join(
+            str(c["msgs"])
+            for level in ("high_priorities", "medium_priorities", "low_priorities")
+            for c in r["cf:1.10"][level]
+        )
+        for n, r in fast.items()
+    }
+    assert "bat_speediness" in msgs["bad.nc"] and "furlongs" in msgs["bad.nc"], msgs["bad.nc"]
+    assert "bat_speediness" not in msgs["good.nc"] and "furlongs" not in msgs["good.nc"]
+
+
 def test_workbook_in_the_fields_units(run_dir):
     """results.xlsx (issue 13): one sheet per table, names then units in the header, the values of
     the NetCDF files in mph/deg/rpm/in, and the provenance of every file; read by two real readers.

@@ -7,7 +7,7 @@ from) and the validator runs ``--offline``, so nothing is fetched behind one's b
 the cache makes the validator skip the checks that need it (and, for the context, fail the
 crate): the test asserts that no check was skipped.
 
-Usage: ``python tests/validate_crate.py results`` (``make validate-crate``); exit status 0 when
+Usage: ``python tests/validate_crate.py results [--files]`` (``make validate-crate``); exit status 0 when
 the crate meets every required check of provenance-run-crate-0.5 and tells the folder's truth
 (every File listed is there with its sha256 and size, every file of the folder is listed:
 :func:`ballbat.pipeline.cratefiles.crate_file_problems`); otherwise exit status 1 and one line
@@ -100,14 +100,17 @@ def issue_lines(result) -> list[str]:
 
 def main(argv: list[str]) -> int:
     """Check the crate of the folder named: its files (present, sha256, size, every file listed), then
-    roc-validator offline, its cache seeded. Print one line per failed check, naming the check and what
-    it failed on; return 0 when all pass, else 1.
+    roc-validator offline, its cache seeded (not with ``--files``: the files alone, in well under a
+    second). Print one line per failed check, naming the check and what it failed on; return 0 when
+    all pass, else 1.
     """
     from ballbat.pipeline.cratefiles import crate_file_problems
 
+    files_only = "--files" in argv
+    argv = [a for a in argv if a != "--files"]
     crate = Path(argv[0] if argv else "results")
     problems = [f"check failed: {p}" for p in crate_file_problems(crate)]
-    if not problems or not problems[0].startswith("check failed: crate "):
+    if not files_only and (not problems or not problems[0].startswith("check failed: crate ")):
         with tempfile.TemporaryDirectory() as tmp:
             result = validate(crate, seed_cache(Path(tmp) / "http_cache"))
         problems += issue_lines(result)
@@ -116,7 +119,9 @@ def main(argv: list[str]) -> int:
     if problems:
         print(f"{crate}: the crate fails {len(problems)} check(s)", file=sys.stderr)
         return 1
-    print(f"{crate}: the crate passes every check ({PROFILE}, required level; every file present and listed)")
+    checks = "every file present and listed"
+    checks = checks if files_only else f"{PROFILE}, required level; {checks}"
+    print(f"{crate}: the crate passes every check ({checks})")
     return 0
 
 
