@@ -19,7 +19,7 @@ from .records import (
     point_label,
     sweep_table,
 )
-from .truth import CONDITIONAL_TRUTH
+from .truth import CONDITIONAL_TRUTH, truth_scales_from_dataset, truths_from_dataset
 
 if TYPE_CHECKING:
     from collections.abc import Iterable, Sequence
@@ -415,3 +415,12 @@ def coverage_csv(cov: xr.Dataset) -> str:
     header = [*COVERAGE_COLUMNS, *grid]  # "setting,quantity,ball,bat,...": the header the guards know
     points, quantities = range(cov.sizes["point"]), range(cov.sizes["quantity"])
     return _csv_text(header, (list(row(p, j)) for p in points for j in quantities))
+
+
+def run(batches: Iterable[xr.Dataset], truth: xr.Dataset) -> xr.Dataset:
+    """Run the coverage stage: judge the study's batches of replicates against its truth file.
+
+    ``batches``: the study's batch files (:func:`ballbat.studies.batch.run`); ``truth``: its truth
+    (:func:`ballbat.studies.truth.run`, every sweep point). Returns :func:`coverage`'s dataset.
+    """
+    return coverage(combine(batches), truths_from_dataset(truth), truth_scales_from_dataset(truth))

@@ -3,18 +3,16 @@
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from dataclasses import dataclass
 
 import numpy as np
 import xarray as xr
+from scipy import stats
 
 from ..pipeline.products import Var, build_dataset
 from .coverage import _csv_text
 from .settings import StudySettings
 from .sweeps import point_dataset
-
-if TYPE_CHECKING:
-    pass
 
 
 def impacts_required(
@@ -136,3 +134,103 @@ def design_csv(des: xr.Dataset) -> str:
         return head + [str(des["bat"].values[j])] + [des[k].values[p, j] for k in DESIGN_COLUMNS[4:]]
 
     return _csv_text(DESIGN_COLUMNS, (row(p, j) for p in range(des.sizes["point"]) for j in range(des.sizes["pair"])))
+
+
+@dataclass(frozen=True)
+class Requirement:
+    """Impacts per bat needed, with its interval, from a per-impact error ``s1`` known on ``dof`` dof."""
+
+    label: str
+    ball: str
+    s1: float
+    s1_low: float
+    s1_high: float
+    dof: float
+    n: float
+    n_low: float
+    n_high: float
+
+
+def requirement(label: str, ball: str, s1: float, dof: float, delta: float, settings: dict) -> Requirement:
+    """Return the impacts per bat for per-impact error ``s1`` (estimated on ``dof``) and its interval.
+
+    ``settings``: ``confidence`` and ``power`` of the test, ``level`` of the interval.
+    """
+    a = 1.0 - settings["level"]
+    lo = s1 * math.sqrt(dof / stats.chi2.ppf(1 - a / 2, dof)) if dof > 0 else math.nan
+    hi = s1 * math.sqrt(dof / stats.chi2.ppf(a / 2, dof)) if dof > 0 else math.nan
+
+    def need(s: float) -> float:
+        return impacts_required(s, 1.0, delta, settings["confidence"], settings["power"])
+
+    return Requirement(label, ball, s1, lo, hi, dof, need(s1), need(lo), need(hi))
+
+
+def sweep_answer(des: xr.Dataset, level: float = 0.95) -> list[Requirement]:
+    """One requirement per pair of a design study swept over ``impacts_per_bat`` (its ``design.nc``).
+
+    ``s1`` is the weighted mean over the sweep points of ``sigma_e_x * sqrt(impacts_per_bat)``
+    (weights: the inverse squares of ``sigma_e_x_err * sqrt(impacts_per_bat)``); its interval the
+    chi-square interval on the points' replicates' degrees of freedom in total, as for a pilot.
+    """
+    settings = {
+        "confidence": float(des.attrs["confidence"]),
+        "power": float(des.attrs["power"]),
+        "level": level,
+    }
+    out = []
+    for j in range(des.sizes["pair"]):
+        n = des["impacts_per_bat"].values[:, j]
+        s = des["sigma_e_x"].values[:, j] * np.sqrt(n)
+        e = des["sigma_e_x_err"].values[:, j] * np.sqrt(n)
+        ok = np.isfinite(s) & np.isfinite(e) & (e > 0)
+        if not ok.any():
+            continue
+        w = 1.0 / e[ok] ** 2
+        s1 = float(np.sum(w * s[ok]) / np.sum(w))
+        # sigma_e_x_err = sigma / sqrt(2 (R - 1)): each point's dof R - 1 = (s / e)^2 / 2
+        dof = float(np.sum((s[ok] / e[ok]) ** 2 / 2.0))
+        label = f"{des['ball'].values[j]}:{des['bat'].values[j]}"
+        out.append(requirement(label, str(des["ball"].values[j]), s1, dof, float(des.attrs["delta_e_x"]), settings))
+    return out
+
+
+def with_sweep_answer(des: xr.Dataset, level: float = 0.95) -> xr.Dataset:
+    """Return a design study's dataset with its one answer per pair (:func:`sweep_answer`; sweeps of impacts only).
+
+    Adds ``impacts_required_answer``, ``_low``, ``_high`` and ``e_x_error_per_impact`` (dims pair);
+    a sweep of another setting is returned unchanged (its points are different experiments).
+    """
+    if des.attrs.get("sweep_parameter") != "impacts_per_bat":
+        return des
+    reqs = {r.label: r for r in sweep_answer(des, level)}
+    labels = [f"{b}:{t}" for b, t in zip(des["ball"].values, des["bat"].values, strict=True)]
+    pick = [reqs.get(lab) for lab in labels]
+
+    def col(name: str) -> np.ndarray:
+        return np.array([getattr(r, name) if r else np.nan for r in pick], dtype=float)
+
+    what = f"tell two such bats delta_e_x apart: one answer over the sweep ({100 * level:g} % interval"
+    out = des.copy()
+    out["impacts_required_answer"] = (("pair",), col("n"), {"units": "1", "long_name": f"impacts per bat to {what})"})
+    for side, name in (("low", "n_low"), ("high", "n_high")):
+        out[f"impacts_required_answer_{side}"] = (
+            ("pair",),
+            col(name),
+            {"units": "1", "long_name": f"{side} end of the interval of impacts_required_answer"},
+        )
+    out["e_x_error_per_impact"] = (
+        ("pair",),
+        col("s1"),
+        {"units": "1", "long_name": "sigma_e_x * sqrt(impacts_per_bat), weighted over the sweep's points"},
+    )
+    return out
+
+
+def run(cov: xr.Dataset, settings: StudySettings) -> xr.Dataset:
+    """Run the design stage: :func:`design` of a study's coverage, with one answer over a sweep of impacts per bat.
+
+    ``cov``: the study's coverage (:func:`ballbat.studies.coverage.run`). A sweep of
+    ``impacts_per_bat`` also gets :func:`with_sweep_answer`'s one requirement per pair.
+    """
+    return with_sweep_answer(design(cov, settings))

@@ -171,3 +171,10 @@ def truth_scales_from_dataset(ds: xr.Dataset) -> np.ndarray:
             "delete the study's truth files and run its truth jobs again"
         )
     return ds["truth_scale"].values.astype(float)
+
+
+def run(
+    settings: StudySettings, balls: dict[str, Ball], bats: dict[str, Bat], points: Sequence[int] | None = None
+) -> xr.Dataset:
+    """Run the truth stage: the design's truth at the sweep ``points`` (None: every point), :func:`truth_dataset`."""
+    return truth_dataset(settings, balls, bats, points)
