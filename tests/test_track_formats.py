@@ -46,6 +46,12 @@ POINTS = dict(TOOL_NAMES)
 TABLE_UNITS = {"time": "ms", "length": "cm", "y": "up"}
 
 
+def _written(path: Path, text: str) -> Path:
+    """``path`` with ``text`` written to it."""
+    path.write_text(text)
+    return path
+
+
 @pytest.fixture(scope="module")
 def rows():
     return read_long_csv(EXAMPLE / "tracked_tracks.csv")
@@ -63,8 +69,7 @@ def _same(got, want, tol=0.0):
 def test_trk_gives_the_marks_frames_and_settings(tmp_path, rows):
     """Tracker's framedata [n] is the mark at video frame n (image pixels); fps from delta_t; scale from coords."""
     tracks = rows[("W01", "swing")]
-    p = tmp_path / "W01_swing.trk"
-    p.write_text(trk_text(tracks, 3000.0, 0.00074, unit="cm"))
+    p = _written(tmp_path / "W01_swing.trk", trk_text(tracks, 3000.0, 0.00074, unit="cm"))
     ft = read_trk(p)
     for name, (f, x, y) in tracks.items():  # unrotated axes: the image pixels themselves, frames unchanged
         np.testing.assert_array_equal(ft.tracks[name][0], f)
@@ -81,32 +86,28 @@ def test_trk_clip_with_a_step_size(tmp_path, rows):
     f0 = min(t[0][0] for t in tracks.values())
     tracks = {n: t for n, t in tracks.items() if ((t[0] - f0) % 2 == 0).all()}
     assert tracks
-    p = tmp_path / "W01_swing.trk"
-    p.write_text(trk_text(tracks, 3000.0, 0.00074, step=2))
+    p = _written(tmp_path / "W01_swing.trk", trk_text(tracks, 3000.0, 0.00074, step=2))
     ft = read_trk(p)
     for name, (f, x, _) in tracks.items():
         np.testing.assert_array_equal(ft.tracks[name][0], f)
         np.testing.assert_array_equal(ft.tracks[name][1], x)
     p.write_text(trk_text(tracks, 3000.0, 0.00074, step=2, extra_mark=int(f0) + 1))
-    with pytest.raises(
-        FormatError, match=rf"frame {int(f0) + 1}: the mark is not on a step of the clip \(frames {int(f0)}, "
-    ):
+    off_step = rf"frame {int(f0) + 1}: the mark is not on a step of the clip \(frames {int(f0)}, "
+    with pytest.raises(FormatError, match=off_step):
         read_trk(p)
 
 
 def test_trk_turned_axes_are_undone(tmp_path, rows):
     """A coordinate system turned by 7 deg: ballbat's x-axis is the lab's, as set in Tracker."""
     tracks = rows[("W02", "spin")]
-    p = tmp_path / "a.trk"
-    p.write_text(trk_text(tracks, 1000.0, 0.00125, angle_deg=7.0, origin=(512.5, 300.25)))
+    p = _written(tmp_path / "a.trk", trk_text(tracks, 1000.0, 0.00125, angle_deg=7.0, origin=(512.5, 300.25)))
     ft = read_trk(p)
     _same(ft.tracks, tracks, tol=1e-9)
     assert "angle 7" in ft.source["axes"]
 
 
 def test_trk_mark_off_the_clip_is_named(tmp_path, rows):
-    p = tmp_path / "W01_swing.trk"
-    p.write_text(trk_text(rows[("W01", "swing")], 3000.0, 0.00074, extra_mark=2))
+    p = _written(tmp_path / "W01_swing.trk", trk_text(rows[("W01", "swing")], 3000.0, 0.00074, extra_mark=2))
     with pytest.raises(FormatError) as exc:
         read_trk(p)
     msg = "\n".join(exc.value.problems)
@@ -139,17 +140,17 @@ def test_trz_holds_exactly_one_project(tmp_path, rows):
     with zipfile.ZipFile(two, "w") as z:
         z.writestr("a.trk", "<x/>")
         z.writestr("b.trk", "<x/>")
-    with pytest.raises(
-        FormatError, match=r"two.trz: a .trz must hold exactly one .trk project \(found: a.trk, b.trk\)"
-    ):
+    not_one = r"two.trz: a .trz must hold exactly one .trk project \(found: a.trk, b.trk\)"
+    with pytest.raises(FormatError, match=not_one):
         read_trz(two)
 
 
 def test_kva_timestamps_calibration(tmp_path, rows):
     """Kinovea: frame = (t - FirstTimeStamp) / AverageTimeStampsPerFrame; fps = CaptureFramerate; scale: a line."""
     tracks = rows[("W04", "spin")]
-    p = tmp_path / "W04_spin.kva"
-    p.write_text(kva_text(tracks, 1000.0, 0.00125, per_frame=1001, first=123456, video_fps=29.97))
+    p = _written(
+        tmp_path / "W04_spin.kva", kva_text(tracks, 1000.0, 0.00125, per_frame=1001, first=123456, video_fps=29.97)
+    )
     ft = read_kva(p)
     _same(ft.tracks, tracks)
     assert ft.fps == 1000.0
@@ -162,20 +163,17 @@ def test_kva_timestamps_calibration(tmp_path, rows):
     x, y, t, r = point.text.split(";")
     point.text = f"{x};{y};{int(t) + 200};{r}"  # a point between two frames
     p.write_bytes(ET.tostring(root))
-    with pytest.raises(
-        FormatError, match=rf"track 'ball', point 2 \(t = {int(t) + 200}\): its timestamp is [0-9]+\.391 "
-    ):
+    between = rf"track 'ball', point 2 \(t = {int(t) + 200}\): its timestamp is [0-9]+\.391 "
+    with pytest.raises(FormatError, match=between):
         read_kva(p)
 
 
 def test_exported_tables_become_pixels(tmp_path, rows):
     """World units, y up, time in s or ms: back to the pixels (y down) at the stated scale and frame rate."""
     tracks = rows[("W05", "swing")]
-    k = tmp_path / "W05_swing.csv"
-    k.write_text(kinovea_csv_text(tracks, 3000.0, 0.00074))
+    k = _written(tmp_path / "W05_swing.csv", kinovea_csv_text(tracks, 3000.0, 0.00074))
     _same(read_kinovea_table(k, TABLE_UNITS, 3000.0, 0.00074).tracks, tracks, tol=1e-3)
-    t = tmp_path / "W05_swing.txt"
-    t.write_text(tracker_table_text(tracks, 3000.0, 0.00074))
+    t = _written(tmp_path / "W05_swing.txt", tracker_table_text(tracks, 3000.0, 0.00074))
     got = read_tracker_table(t, {"time": "s", "length": "m", "y": "up"}, 3000.0, 0.00074).tracks
     _same(got, tracks, tol=1e-3)
     # y stated the wrong way round: the motion comes out mirrored (not silently the same)
@@ -188,16 +186,14 @@ def test_tracker_table_with_a_decimal_comma(tmp_path, rows):
     """A European locale: semicolons and decimal commas, as Tracker writes them there."""
     tracks = rows[("W06", "spin")]
     text = tracker_table_text(tracks, 1000.0, 0.00125, delim=";").replace(".", ",")
-    t = tmp_path / "W06_spin.txt"
-    t.write_text(text)
+    t = _written(tmp_path / "W06_spin.txt", text)
     got = read_tracker_table(t, {"time": "s", "length": "m", "y": "up"}, 1000.0, 0.00125).tracks
     _same(got, tracks, tol=1e-3)
 
 
 def test_table_at_the_wrong_frame_rate_names_rows(tmp_path, rows):
     """The frame rate off by 2x (too low): times fall between frames and the rows are named."""
-    k = tmp_path / "W05_swing.csv"
-    k.write_text(kinovea_csv_text(rows[("W05", "swing")], 3000.0, 0.00074))
+    k = _written(tmp_path / "W05_swing.csv", kinovea_csv_text(rows[("W05", "swing")], 3000.0, 0.00074))
     with pytest.raises(FormatError) as exc:
         read_kinovea_table(k, TABLE_UNITS, 1500.0, 0.00074)
     msg = "\n".join(exc.value.problems)
@@ -484,8 +480,7 @@ def test_check_tracks_reads_a_folder_of_tool_files_as_the_workflow_does(tmp_path
         "csv": {"file": str(EXAMPLE / "tracked_tracks.csv"), "impacts": impacts, "cameras": full, "rig": rig},
         "dir": {"dir": str(lab), "points": POINTS, "impacts": impacts, "cameras": mirrors, "rig": rig},
     }.items():
-        cfg = tmp_path / f"{name}.yaml"
-        cfg.write_text(yaml.safe_dump({"datasets": {"lab": {"tracks": block}}}))
+        cfg = _written(tmp_path / f"{name}.yaml", yaml.safe_dump({"datasets": {"lab": {"tracks": block}}}))
         res = subprocess.run([BALLBAT, "check", "--kind", "tracks", "--config", cfg], capture_output=True, text=True)
         assert res.returncode == 0, res.stdout + res.stderr
         outs[name] = [line for line in res.stdout.splitlines() if line.startswith("impact ")]

@@ -128,19 +128,25 @@ def test_camera_settings():
         "cameras": {"swing": {"fps": -3000, "m_per_px": 0.00074, "mirror": "no", "zoom": 2}, "side": {}},
         "rig": {"pivot_to_tip_in": 28.0, "pivot_to_impact_in": 34.0},
     }
-    with pytest.raises(InputError) as exc:
-        cameras_from_config(cfg, "datasets.lab.tracks")
-    ps = exc.value.problems
-    expected = (
-        "datasets.lab.tracks.cameras.spin: camera missing",
-        "datasets.lab.tracks.cameras.side: unknown camera",
-        "datasets.lab.tracks.cameras.swing.fps: -3000 must be a positive number",
-        "datasets.lab.tracks.cameras.swing.mirror: 'no' must be true or false",
-        "datasets.lab.tracks.cameras.swing.zoom: unknown setting",
-        "datasets.lab.tracks.rig: pivot_to_impact_in 34.0 is beyond pivot_to_tip_in 28.0",
+    camera_problems_named(
+        cfg,
+        "cameras.spin: camera missing",
+        "cameras.side: unknown camera",
+        "cameras.swing.fps: -3000 must be a positive number",
+        "cameras.swing.mirror: 'no' must be true or false",
+        "cameras.swing.zoom: unknown setting",
+        "rig: pivot_to_impact_in 34.0 is beyond pivot_to_tip_in 28.0",
     )
+
+
+def camera_problems_named(block: dict, *expected: str) -> list[str]:
+    """The problems of a tracks ``block``'s cameras and rig: each expected one among them, with its key named."""
+    with pytest.raises(InputError) as exc:
+        cameras_from_config(block, "datasets.lab.tracks")
+    ps = exc.value.problems
     for e in expected:
-        assert any(e in p for p in ps), (e, ps)
+        assert any(f"datasets.lab.tracks.{e}" in p for p in ps), (e, ps)
+    return ps
 
 
 def tracks_block(swing: dict | None = None, spin: dict | None = None, **rig) -> dict:
@@ -163,16 +169,12 @@ def test_calibration_uncertainties():
     assert cams["swing"].fps_err == 0.001 and cams["spin"].fps_err == 0.0
     assert rig.pivot_to_impact_err == pytest.approx(0.1 * 0.0254) and rig.pivot_to_tip_err == 0.0
     bad = tracks_block(spin={"fps_err": 2}, pivot_to_tip_err_in=-1, pivot_to_impact_err_in=5)
-    with pytest.raises(InputError) as exc:
-        cameras_from_config(bad, "datasets.lab.tracks")
-    ps = exc.value.problems
-    expected = (
-        "datasets.lab.tracks.cameras.spin.fps_err: 2 must be a relative uncertainty >= 0 and below 0.1",
-        "datasets.lab.tracks.rig.pivot_to_tip_err_in: -1 must be a number >= 0",
-        "datasets.lab.tracks.rig.pivot_to_impact_err_in: 5 in is 17.9 % of pivot_to_impact_in 28.0",
+    ps = camera_problems_named(
+        bad,
+        "cameras.spin.fps_err: 2 must be a relative uncertainty >= 0 and below 0.1",
+        "rig.pivot_to_tip_err_in: -1 must be a number >= 0",
+        "rig.pivot_to_impact_err_in: 5 in is 17.9 % of pivot_to_impact_in 28.0",
     )
-    for e in expected:
-        assert any(e in p for p in ps), (e, ps)
     assert len(ps) == 3
 
 

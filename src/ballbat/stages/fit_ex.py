@@ -14,7 +14,7 @@ import numpy as np
 import xarray as xr
 
 from ..fitting import FitGrid, FitStatus, Sec4, analyze_impacts, check_physical, fit_status
-from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
+from ..pipeline.products import SectionSettings, Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 from ..systematics import FIT_QUANTITIES, SIDES, SOURCES, FitSystematics, has_shifts, shifted_impacts, source_names
 from .systematics import systematic_vars
 
@@ -23,7 +23,7 @@ if TYPE_CHECKING:
 
 
 @dataclass(frozen=True)
-class FitExSettings:
+class FitExSettings(SectionSettings):
     """Settings of the fit_ex stage.
 
     Attributes
@@ -39,14 +39,11 @@ class FitExSettings:
         replicate studies record every replicate's numbers as they come.
     """
 
+    SECTION = "analysis"
+
     mu_k_example: float
     systematic: bool
     check_physical: bool
-
-    @classmethod
-    def from_config(cls, config: dict) -> FitExSettings:
-        """Return the workflow's settings from the validated config."""
-        return cls.from_params(config["analysis"])
 
     @classmethod
     def from_params(cls, params: Mapping) -> FitExSettings:

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..analysis import normalize_values
-from ..pipeline.products import Var, add_variables
+from ..pipeline.products import SectionSettings, Var, add_variables
 from ..units import MPH
 
 if TYPE_CHECKING:
@@ -20,15 +20,12 @@ if TYPE_CHECKING:
 
 
 @dataclass(frozen=True)
-class NormalizeSettings:
+class NormalizeSettings(SectionSettings):
     """Settings of the normalize stage: the reference bat speed ``v_ref_mph`` (config ``normalize.v_ref_mph``)."""
 
-    v_ref_mph: float
+    SECTION = "normalize"
 
-    @classmethod
-    def from_config(cls, config: dict) -> NormalizeSettings:
-        """Return the workflow's settings from the validated config."""
-        return cls.from_params(config["normalize"])
+    v_ref_mph: float
 
     @classmethod
     def from_params(cls, params: Mapping) -> NormalizeSettings:

@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..linefit import MIN_FIT_IMPACTS
-from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
+from ..pipeline.products import SectionSettings, Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 from ..published import STRONGE_E_Y, STRONGE_MU
 from ..stronge.analysis import (
     HISTORY_VARIABLES,
@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 
 
 @dataclass(frozen=True)
-class StrongeSettings:
+class StrongeSettings(SectionSettings):
     """Settings of the fit_stronge stage: the config's ``stronge`` section.
 
     Attributes
@@ -53,6 +53,8 @@ class StrongeSettings:
         Points of the time histories.
     """
 
+    SECTION = "stronge"
+
     e_y: float
     mu: float
     vary_e_y: bool
@@ -60,11 +62,6 @@ class StrongeSettings:
     psi_grid_deg: dict
     psi_history_deg: float
     n_time: int
-
-    @classmethod
-    def from_config(cls, config: dict) -> StrongeSettings:
-        """Return the workflow's settings from the validated config (its ``stronge`` section)."""
-        return cls.from_params(config["stronge"])
 
     @classmethod
     def from_params(cls, s: Mapping) -> StrongeSettings:
