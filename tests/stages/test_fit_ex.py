@@ -1,0 +1,153 @@
+"""Sec. IV fits: e_x recovery from synthetic data, honest standard errors, line fits.
+
+Issue 36: e_x's intrinsic-scatter term (Paule-Mandel tau) and implied e_y's leverage-corrected sandwich.
+
+The stage layer (src/ballbat/stages/): each stage's run on small in-memory inputs.
+
+Each stage writes exactly its declared table, the source stages share the one impacts table,
+a stage gives the numbers of the compute functions it calls, its settings come from the
+validated config, the rule scripts are one call of a stage, and a replicate of the studies is
+those same calls.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+import numpy as np
+import pytest
+import yaml
+from helpers import SMALL
+
+from ballbat import fitting
+from ballbat.stages import fit_ex, normalize, reconstruct, reduce, render, simulate
+from ballbat.stages.fit_ex import fit_ex_table
+from ballbat.synthetic import SyntheticSettings
+from ballbat.tracks.data import camera_block
+from workflow_helpers import ROOT
+
+NORM = normalize.NormalizeSettings(v_ref_mph=77.0)
+REC = reconstruct.ReconstructSettings()
+FIT = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True)
+
+
+@pytest.fixture(scope="module")
+def default_settings(root):
+    cfg = yaml.safe_load((root / "config" / "config.yaml").read_text())
+    return cfg["datasets"]["synthetic"]["synthetic"]
+
+
+def run(settings, balls, bats, **over):
+    s = SyntheticSettings(**{**settings, **over})
+    return fit_ex.run(FIT, reconstruct.run(REC, normalize.run(NORM, simulate.run(s, balls, bats)), balls, bats))
+
+
+def test_recovery_default_config(default_settings, balls, bats):
+    """Issue 2: pooled e_x within 2 SE of the truth, each bat x ball within 3 SE."""
+    fit = run(default_settings, balls, bats)
+    for ball in fit.ball.values:
+        f = fit.sel(ball=ball)
+        assert abs(f.e_x_pooled - f.truth_e_x_pooled) < 2 * f.e_x_pooled_err, ball
+        for bat in fit.bat.values:
+            g = f.sel(bat=bat)
+            if int(g.e_x_n) == 0:
+                continue
+            assert abs(g.e_x - g.truth_e_x) < 3 * g.e_x_err, (ball, bat)
+            assert g.e_x_ci_low < g.e_x < g.e_x_ci_high
+    # Per-bat truth is exactly the configured Table II value (no intrinsic scatter).
+    assert float(fit.truth_e_x.sel(ball="baseball", bat="wood")) == pytest.approx(0.464, rel=1e-12)
+    assert int(fit.e_x_n.sel(ball="baseball", bat="softball_composite")) == 0  # no baseball on it
+
+
+@pytest.mark.slow  # about 2 s: 60 experiments
+def test_standard_errors_are_honest(default_settings, balls, bats):
+    """Coverage: over 60 seeds the pooled e_x lies within 2 SE of the truth ~95 % of the time."""
+    hits, pulls = 0, []
+    for seed in range(60):
+        fit = run(default_settings, balls, bats, seed=1000 + seed)
+        f = fit.sel(ball="baseball")
+        pull = float((f.e_x_pooled - f.truth_e_x_pooled) / f.e_x_pooled_err)
+        pulls.append(pull)
+        hits += abs(pull) < 2
+    assert hits / 60 >= 0.85  # binomial: 95 % expected, 0.85 is ~3.5 sigma below
+    assert abs(np.mean(pulls)) < 0.5  # no bias larger than half a standard error
+    assert 0.7 < np.std(pulls) < 1.4
+
+
+def test_truth_of_ratio_and_e_y(default_settings, balls, bats):
+    fit = run(default_settings, balls, bats)
+    for ball, e_y in (("baseball", 0.45), ("softball", 0.32)):
+        f = fit.sel(ball=ball)
+        assert float(f.truth_e_y_implied) == pytest.approx(e_y)
+        assert abs(f.e_y_implied - e_y) < 3 * f.e_y_implied_err
+        assert abs(f.tan_ratio_slope - f.truth_tan_ratio_slope) < 3 * f.tan_ratio_slope_err
+
+
+def test_fit_ex_declares_the_scatter_with_units_and_words():
+    table = fit_ex_table(False, 0.5)
+    for name in ("e_x_scatter", "e_x_scatter_ci_low", "e_x_scatter_ci_high"):
+        assert table[name].units == "1"
+        assert table[name].dims == ("ball", "bat")
+        assert "e_x_scatter" in table[name].long_name or "tau" in table[name].long_name
+
+
+@pytest.fixture(scope="module")
+def chain(config, balls, bats):
+    """A small synthetic dataset through simulate, render, reduce, normalize, reconstruct (the workflow's settings)."""
+    synth = simulate.from_config(config, "synthetic")
+    sim = simulate.run(dataclasses.replace(synth, impacts=SMALL), balls, bats)
+    rset = render.from_config(config, "synthetic")
+    tracks = render.render(rset, sim, balls)
+    rs = reduce.ReduceSettings.from_config(
+        camera_block(config["datasets"]["synthetic"]["render"]), "render", systematics=False
+    )
+    red = reduce.run(rs, tracks, balls, bats)
+    norm = normalize.run(normalize.NormalizeSettings.from_config(config), sim)
+    rec = reconstruct.run(reconstruct.ReconstructSettings.from_config(config), norm, balls, bats)
+    red_rec = reconstruct.run(
+        reconstruct.ReconstructSettings(), normalize.run(normalize.NormalizeSettings(77.0), red), balls, bats
+    )
+    return {"sim": sim, "tracks": tracks, "rset": rset, "red": red, "norm": norm, "rec": rec, "red_rec": red_rec}
+
+
+# ---------------------------------------------------------------------------------------
+# the stages give the compute functions' numbers
+
+
+def test_fit_ex_stage_gives_the_compute_functions_numbers(chain, config):
+    """fit_ex.run on a tiny reduced set: its values are those of fitting.analyze_impacts, nothing lost or added."""
+    rec = chain["red_rec"]
+    res = fitting.analyze_impacts(rec, 0.5)
+    fit = fit_ex.run(fit_ex.FitExSettings.from_config(config), rec)
+    np.testing.assert_array_equal(fit["e_x"].values, res.e_x.field("slope", -1.0))
+    np.testing.assert_array_equal(fit["e_x_err"].values, res.e_x.field("slope_err"))
+    np.testing.assert_array_equal(fit["e_x_pooled"].values, res.e_x_pooled.field("slope", -1.0))
+    np.testing.assert_array_equal(fit["tan_ratio_slope"].values, res.tan_ratio_slope.field("slope"))
+    np.testing.assert_array_equal(fit["e_y_implied"].values, res.per_ball["e_y_implied"])
+    np.testing.assert_array_equal(fit["e_x_err_scale"].values, res.systematic["e_x_err_scale"])
+    assert list(fit["ball"].values) == res.balls and list(fit["bat"].values) == res.bats
+    assert np.isfinite(fit["e_x_pooled"].values).all()
+    assert fit.attrs["n_impacts"] == rec.sizes["impact"]
+    assert fit.attrs["n_excluded"] == int((rec["flag"].values != 0).sum())
+    assert fit.attrs["v_ref"] == rec.attrs["v_ref"] and fit.attrs["mu_k_example"] == 0.5
+    # without the systematic (the studies): no *_err_scale, the same fits
+    quiet = fit_ex.run(fit_ex.FitExSettings(0.5, systematic=False, check_physical=True), rec)
+    assert "e_x_err_scale" not in quiet
+    np.testing.assert_array_equal(quiet["e_x"].values, fit["e_x"].values)
+
+
+def test_fit_ex_stage_refuses_an_impossible_e_x_unless_told(chain):
+    """Spin of the wrong sign gives e_x < -1: an error of the dataset; the studies record it as it comes."""
+    flipped = chain["norm"].copy()
+    flipped["omega"] = -flipped["omega"]
+    rec = reconstruct.run(reconstruct.ReconstructSettings(), flipped, *_tables())
+    with pytest.raises(fitting.ImplausibleFit, match="outside the physical range"):
+        fit_ex.run(fit_ex.FitExSettings(0.5, systematic=False, check_physical=True), rec)
+    fit = fit_ex.run(fit_ex.FitExSettings(0.5, systematic=False, check_physical=False), rec)
+    assert np.nanmin(fit["e_x_pooled"].values) < -1
+
+
+def _tables():
+    from ballbat.properties import load_balls, load_bats
+
+    return load_balls(ROOT / "config" / "balls.csv"), load_bats(ROOT / "config" / "bats.csv")
