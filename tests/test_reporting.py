@@ -1,4 +1,4 @@
-"""Figures and report text, from small fake datasets (the workflow's figures: test_workflow.py)."""
+"""Figures and report text, from small fake datasets (the workflow's figures: workflow/test_outputs.py)."""
 
 from __future__ import annotations
 

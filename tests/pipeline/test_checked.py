@@ -2,7 +2,7 @@
 
 Each refusal path of each guard, with the message it gives (the file named, what is wrong and
 what to do). The workflow's use of them (onstart, a dry run, a job's inputs) is in
-tests/test_redteam_guards.py.
+tests/workflow/test_guards.py.
 """
 
 from __future__ import annotations

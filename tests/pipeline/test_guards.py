@@ -2,7 +2,7 @@
 
 Each refusal path of each guard, with the message it gives (the file named, what is wrong and
 what to do). The workflow's use of them (onstart, a dry run, a job's inputs) is in
-tests/test_redteam_guards.py.
+tests/workflow/test_guards.py.
 
 Issue 37 §1: test sessions. A run's results folder is a setting; a folder's crate carries every run in
 it; a folder's workbooks keep every scenario's sheet; three sessions' folders make one league table.

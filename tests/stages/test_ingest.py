@@ -315,7 +315,7 @@ def test_unit_mistakes_warn_naming_the_column(tmp_path, column, factor, expected
         one(exc.problems, "units.csv", expected, hint)
         return
     # a mistake most rows survive (the spin's sign, psi then negative but possible) is warned about,
-    # and the fit refuses the e_x it gives (tests/test_plausibility.py)
+    # and the fit refuses the e_x it gives (the plausibility tests below)
     one(warnings, "units.csv", expected, hint)
     assert hint in ds.attrs["ingest_warnings"] and ds.attrs["n_warnings"] == len(warnings)
 

@@ -21,7 +21,7 @@ from ballbat.tracks.verdict import cross_check
 
 @pytest.fixture(scope="module")
 def rendered():
-    """24 impacts of three bats, 0.5 px tracking noise (as tests/test_tracks.py renders them)."""
+    """24 impacts of three bats, 0.5 px tracking noise (as tests/tracks/test_reduce.py renders them)."""
     return render(experiment(30, per_bat=8), render_cfg(seed=31))
 
 

@@ -1,6 +1,6 @@
 """End to end: a finished run is a no-op, and made again it is byte-identical (the suite's lab run,
-conftest.lab_run, in a copy). A module of its own (from test_workflow.py) so that ``make test``'s
-two pytest-xdist processes, a module each, run it beside test_workflow.py's tests.
+conftest.lab_run, in a copy). A module of its own (from workflow/test_outputs.py) so that ``make test``'s
+two pytest-xdist processes, a module each, run it beside workflow/test_outputs.py's tests.
 """
 
 from __future__ import annotations
