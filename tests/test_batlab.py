@@ -1,10 +1,4 @@
-"""Bat tables in the paper's convention or a lab's (ASTM F2398/F2219), converted and checked (issue 35).
-
-The hickory example (config/examples/hickory_*.csv, make_hickory.py) is a lab's bat sheet and
-30 impacts drawn with the forward model on that bat with true e_x = 0.455: in the lab convention
-it gives e_x within one standard error of the truth; the same numbers typed into the paper's
-columns are refused with a message that names the lab convention.
-"""
+"""A lab's bat measurements (ballbat.batlab): a pendulum period gives the same bat (issue 35)."""
 
 from __future__ import annotations
 

@@ -1,18 +1,5 @@
-"""One chain (issue 33): the chain in memory gives the workflow's files, for every kind of source.
-
-:func:`ballbat.chain.source` and :func:`ballbat.chain.run` on :meth:`DatasetSettings.from_config` are
-what the studies and ``ballbat check`` run; the workflow's rules run the same stages one by one
-through their files. Every variable of reduce.nc / ingest.nc and fit_ex.nc must agree, value for
-value (a rendered dataset's at round-off: its tracks make a round trip through tracks.nc): a
-rendered dataset (the default run's), a measured impacts file (maple), a tracks file (tracked,
-of the lab run) and a folder of Tracker projects (trk, of the lab run; ``ballbat check``'s reduction too).
-
-The stage layer (src/ballbat/stages/): each stage's run on small in-memory inputs.
-
-Each stage writes exactly its declared table, the source stages share the one impacts table,
-a stage gives the numbers of the compute functions it calls, its settings come from the
-validated config, the rule scripts are one call of a stage, and a replicate of the studies is
-those same calls.
+"""One chain (ballbat.chain): a replicate is a replace of the seeds; check uses the workflow's defaults; the
+stages' settings are frozen and come from the validated config (issue 33).
 """
 
 from __future__ import annotations

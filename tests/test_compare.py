@@ -1,9 +1,5 @@
-"""Issue 37 §5: the paper comparison of a bat not in the paper shows the rows that apply, and says why the
-others are left out (the maple example's table was mostly blank rows, its pooled e_x set against the
-paper's pooled e_x of three other bats).
-
-The numbers a lab reads: e_x with its calibration systematic (summary, workbook, captions),
-rounded as the field does, and the workbook's formats, units, dates and provenance (issue 21).
+"""The paper comparison and a lab's numbers (ballbat.compare): the rows that apply to a bat not in the paper,
+rounding as the field does, totals in quadrature (issue 37, section 5).
 """
 
 from __future__ import annotations

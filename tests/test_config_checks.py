@@ -1,32 +1,5 @@
-"""Hostile or careless configs are refused with the key and the reason (issue 10, items 7-9).
-
-Measured datasets: every bad input is named (file, row, column, problem), all at once.
-
-Issue #35, item 4: a measured impacts file's instruments state their calibration uncertainties.
-
-``datasets.<name>.calibration`` (``speed_scale_pct``, ``spin_scale_pct``, ``angle_offset_deg``): each
-stated one is a systematic source, every impact's values moved by +-1 sigma and refitted. The hand
-computation rescales the file's columns itself. "syst. —" appears only where nothing is stated, and
-then the text says so.
-
-Trajectories for a lab's own bat (issue 37, section 3; docs/flight.md "A lab's own bat"): a scenario
-takes its bat, tables and e_x from a dataset; e_x's stat. and syst. uncertainty gives 68 % and 95 %
-bands of exit speed, launch angle, backspin and carry; ``ballbat hit`` runs the same code; the Fig. 11
-caption quotes the paper only for Sec. V.B's case.
-
-NetCDF writing: metadata checks, provenance records, atomic and reproducible writes.
-
-Issue 37 §1: test sessions. A run's results folder is a setting; a folder's crate carries every run in
-it; a folder's workbooks keep every scenario's sheet; three sessions' folders make one league table.
-
-Studies that test systematics (issue 22): grid sweeps, contact-time sweep, drawn calibration, combined intervals.
-
-A study's truth job: one rule for its size, shared by the job, its plans and the size guard (issue 40).
-
-Reading the tracking tools' own files (docs/tracks.md, "Files of tracking tools").
-
-The files are written by tests/track_files.py, shaped as Tracker and Kinovea write them, from
-the tracks of config/examples/tracked_tracks.csv (rendered by ballbat's renderer).
+"""The config's domain rules (ballbat.config_checks): hostile or careless configs are refused with the key and
+the reason, all at once (issues 10, 22, 35, 37, 40).
 """
 
 from __future__ import annotations
@@ -36,6 +9,7 @@ import copy
 import pytest
 import yaml
 from conftest import ROOT
+from helpers import HICKORY_BATS, SWEEP, UNBALANCED
 from track_files import (
     TOOL_NAMES,
 )
@@ -164,9 +138,7 @@ def test_config_calibration_keys(config):
             validate_config({**config, "datasets": {**config["datasets"], "x": bad}}, schema)
 
 
-HICKORY_BATS = ROOT / "config" / "examples" / "hickory_bats.csv"
 HICKORY_IMPACTS = ROOT / "config" / "examples" / "hickory_impacts.csv"
-SWEEP = {"pitch_mph": 90, "pitch_descent_deg": 6, "pitch_backspin_rpm": 2000, "bat_mph": 70, "attack_deg": 6}
 
 
 def hickory_config(**scenario) -> dict:
@@ -292,14 +264,6 @@ def test_drawing_a_calibration_without_an_uncertainty_is_refused(raw, schema):
     raw["datasets"]["synthetic"]["render"]["cameras"]["swing"]["m_per_px_err"] = 0.0
     with pytest.raises(ConfigError, match=r"studies\.robustness\.draw_calibration: the dataset states no calibration"):
         validate_config(raw, schema, available=24 * 2**30)
-
-
-#: The unbalanced design of issue 40: 6 impacts on some bats and 60 on others, the softball bat
-#: swung with softballs only (102 of the 204 impacts on three pairs of 60).
-UNBALANCED = {
-    "baseball": {"wood": 6, "metal_rough": 60, "metal_smooth": 6},
-    "softball": {"wood": 60, "metal_rough": 6, "metal_smooth": 60, "softball_composite": 6},
-}
 
 
 def test_a_truth_the_machine_cannot_hold_is_refused_with_its_size(raw, schema):

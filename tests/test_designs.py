@@ -1,4 +1,4 @@
-"""Sec. IV fits: e_x recovery from synthetic data, honest standard errors, line fits."""
+"""The fits' designs (ballbat.designs): the Jacobian columns in order, against finite differences."""
 
 from __future__ import annotations
 

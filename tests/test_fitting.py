@@ -1,7 +1,4 @@
-"""Sec. IV fits: e_x recovery from synthetic data, honest standard errors, line fits.
-
-Issue 36: e_x's intrinsic-scatter term (Paule-Mandel tau) and implied e_y's leverage-corrected sandwich.
-"""
+"""Fit helpers (ballbat.fitting): e_y's variance, the bias of picking the largest value."""
 
 from __future__ import annotations
 

@@ -1,41 +1,19 @@
-"""Sec. V.B scenarios: the paper's D sweep shows what the paper reports; launch scenarios."""
+"""Sec. V.B (ballbat.implications): the paper's D sweep shows what the paper reports; air density, launch grids."""
 
 from __future__ import annotations
 
-import copy
-
+import helpers
 import numpy as np
 import pytest
-import yaml
 
-from ballbat.config_checks import validate_config
 from ballbat.implications import density_from_conditions, launch_conditions
-from ballbat.stages.implications import ImplicationsSettings
-from ballbat.stages.implications import run as run_scenario
 from ballbat.units import DEGREE, FOOT, INCH, MPH, RPM
 
+paper = helpers.paper  # a fixture of tests/helpers.py
 
-@pytest.fixture(scope="module")
-def cfg(config):
-    return config["implications"]
+complete = helpers.complete  # a fixture of tests/helpers.py
 
-
-@pytest.fixture(scope="module")
-def complete(config, root):
-    """A scenario as the workflow sees it: checked against the schema, its defaults filled."""
-    schema = yaml.safe_load((root / "workflow" / "schemas" / "config.schema.yaml").read_text())
-
-    def fill(sc):
-        cfg = copy.deepcopy(config)
-        cfg["implications"]["scenarios"] = {"s": sc}
-        return validate_config(cfg, schema)["implications"]["scenarios"]["s"]
-
-    return fill
-
-
-@pytest.fixture(scope="module")
-def paper(cfg, balls, bats):
-    return run_scenario(ImplicationsSettings(cfg["scenarios"]["paper"], cfg["air"]), balls, bats)
+cfg = helpers.cfg  # a fixture of tests/helpers.py
 
 
 def test_default_air_density(cfg):

@@ -15,65 +15,17 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from helpers import league_fit_file as fit_file
+from helpers import league_pair as pair
+from helpers import league_row as row
+from helpers import league_settings as settings
 from scipy import stats
 
 from ballbat import league
-from ballbat.pipeline.ncio import write_dataset
-
-SOURCES = list(league.SHARING)
-
-
-def fit_file(
-    folder: Path, dataset: str, bats: dict, ball: str = "baseball", older: bool = False, sources: list = SOURCES
-) -> Path:
-    """Write ``folder/dataset/fit_ex.nc`` with ``bats``: name -> (e_x, stat, n, systematic of ``sources[0]``)."""
-    names = list(bats)
-    shape = (1, len(names))
-    val = {k: np.array([[bats[b][i] for b in names]], dtype=float) for i, k in enumerate(("e_x", "err", "n", "s"))}
-    per = np.zeros((len(sources), *shape))
-    per[0] = val["s"]
-    one = {"units": "1", "long_name": "x"}
-    ds = xr.Dataset(
-        {
-            "e_x": (("ball", "bat"), val["e_x"], one),
-            "e_x_err": (("ball", "bat"), val["err"], one),
-            "e_x_n": (("ball", "bat"), val["n"].astype(np.int64), one),
-            "e_x_status": (("ball", "bat"), np.zeros(shape, dtype=np.int8), one),
-            "e_x_scatter": (("ball", "bat"), np.zeros(shape), one),
-            "e_x_syst_by_source": (("systematic", "ball", "bat"), per, one),
-        },
-        coords={
-            "ball": ("ball", np.array([ball]), {"long_name": "ball"}),
-            "bat": ("bat", np.array(names), {"long_name": "bat"}),
-            "systematic": ("systematic", np.array(sources), {"long_name": "source"}),
-        },
-    )
-    if older:  # fit_ex.nc before the intrinsic scatter (issue 36) and the systematics by source
-        ds = ds.drop_vars(["e_x_scatter", "e_x_syst_by_source", "systematic"])
-        ds["e_x_err_scale"] = (("ball", "bat"), val["s"], one)
-    path = folder / dataset / "fit_ex.nc"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return write_dataset(ds, path, title="test fit_ex", rule="fit_ex", inputs={}, config={})
-
-
-def settings(**kw) -> league.LeagueSettings:
-    return league.LeagueSettings.from_config({"league": kw})
 
 
 def table(*folders: Path, **kw) -> xr.Dataset:
     return league.league([s for f in folders for s in league.read_folder(f)], settings(**kw))
-
-
-def pair(ds: xr.Dataset, a: str, b: str) -> dict:
-    i = next(
-        i for i in range(ds.sizes["pair"]) if {str(ds.pair_bat_a[i].values), str(ds.pair_bat_b[i].values)} == {a, b}
-    )
-    return {k.removeprefix("pair_"): ds[k].values[i] for k in ds.data_vars if ds[k].dims == ("pair",)}
-
-
-def row(ds: xr.Dataset, bat: str) -> dict:
-    i = int(np.flatnonzero(ds["bat"].values == bat)[0])
-    return {k: ds[k].values[i] for k in ds.data_vars if ds[k].dims == ("row",)}
 
 
 # ---------------------------------------------------------------------------------------

@@ -1,6 +1,5 @@
-"""Sec. IV fits: e_x recovery from synthetic data, honest standard errors, line fits.
-
-Issue 36: e_x's intrinsic-scatter term (Paule-Mandel tau) and implied e_y's leverage-corrected sandwich.
+"""Line fits (ballbat.linefit): weighted and errors-in-variables lines, sandwich covariances and their degrees
+of freedom, the Paule-Mandel intrinsic scatter (Sec. IV; issue 36).
 """
 
 from __future__ import annotations

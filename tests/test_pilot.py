@@ -9,25 +9,11 @@ import math
 import numpy as np
 import pytest
 import xarray as xr
+from helpers import pilot_fit as fit
 from scipy import stats
 
 from ballbat import pilot
 from ballbat.studies.design import impacts_required
-
-
-def fit(se: dict, n: dict) -> xr.Dataset:
-    bats = list(se)
-    one, shape = {"units": "1", "long_name": "x"}, (1, len(bats))
-    return xr.Dataset(
-        {
-            "e_x": (("ball", "bat"), np.full(shape, 0.45), one),
-            "e_x_err": (("ball", "bat"), [[se[b] for b in bats]], one),
-            "e_x_n": (("ball", "bat"), [[n[b] for b in bats]], one),
-            "e_x_status": (("ball", "bat"), np.zeros(shape, dtype=np.int8), one),
-            "e_x_scatter": (("ball", "bat"), np.zeros(shape), one),
-        },
-        coords={"ball": ("ball", ["baseball"], {"long_name": "b"}), "bat": ("bat", bats, {"long_name": "b"})},
-    )
 
 
 def test_pilot_requirement_against_a_hand_computation():

@@ -1,19 +1,14 @@
-"""The raw-track chain (Sec. II): rendered tracks reduce back to their truth within the stated errors."""
+"""The raw tracks' QA figures (ballbat.plotting_tracks) draw the fits."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 from helpers import experiment, render, render_cfg
+from helpers import reduce_tracks_of as reduce
 
 from ballbat.stages.reduce import reduction_dataset
-from ballbat.tracks.reduce import FLAG_VAR, reduce_tracks
-
-
-def reduce(tr, s, **cams):
-    cameras = {"swing": s.swing.camera, "spin": s.spin.camera}
-    cameras.update(cams)
-    return reduce_tracks(tr, cameras, s.rig)
+from ballbat.tracks.reduce import FLAG_VAR
 
 
 @pytest.mark.slow  # about 3 s: render, reduce and draw the QA figures

@@ -1,18 +1,5 @@
-"""Tables I-II, unit conversions and the recoil factors (Sec. III, Eqs. rx and ry).
-
-Bat tables in the paper's convention or a lab's (ASTM F2398/F2219), converted and checked (issue 35).
-
-The hickory example (config/examples/hickory_*.csv, make_hickory.py) is a lab's bat sheet and
-30 impacts drawn with the forward model on that bat with true e_x = 0.455: in the lab convention
-it gives e_x within one standard error of the truth; the same numbers typed into the paper's
-columns are refused with a message that names the lab convention.
-
-Issue #35, item 4: bat and ball properties carry their uncertainties (``<column>_err``) to every result.
-
-Each stated uncertainty is one systematic source (``bat:<bat>:<column>``, ``ball:<ball>:<column>``),
-propagated as the tracks' calibrations are: the fits again with that one property at +1 and at -1
-standard uncertainty for every impact of that bat (ball), half the difference. The hand computation
-here writes the moved table itself and runs the chain on it.
+"""Tables I-II (ballbat.properties): bat and ball tables in the paper's convention or a lab's, their checks,
+the recoil factors, the properties' stated uncertainties (issue 35).
 """
 
 from __future__ import annotations
@@ -23,6 +10,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from helpers import HICKORY_HEAD
+from helpers import write_table as _write
 
 from ballbat import batlab
 from ballbat.properties import (
@@ -200,15 +189,7 @@ EX = ROOT / "config" / "examples"
 BALLS = ROOT / "config" / "balls.csv"
 MAPLE_HEAD = "bat,name,M_oz,I0_oz_in2,Iz_oz_in2,b_in,R_in"
 MAPLE_ROW = "maple,maple,{M},{I0},9.6,6.5,1.24"
-HICKORY_HEAD = (
-    "bat,name,convention,length_in,weight_oz,balance_in,pivot_in,moi_oz_in2,impact_from_tip_in,diameter_in,Iz_oz_in2"
-)
 HICKORY_ROW = "hickory,hickory,lab,34,{w},{bp},6,{moi},6,2.6,11.0"
-
-
-def _write(path: Path, head: str, row: str) -> Path:
-    path.write_text(f"{head}\n{row}\n")
-    return path
 
 
 # ---------------------------------------------------------------------------------------

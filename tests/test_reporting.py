@@ -1,4 +1,4 @@
-"""Figures and report text, from small fake datasets (the workflow's figures: workflow/test_outputs.py)."""
+"""Report text (ballbat.reporting): the stick period, the comparison table as HTML."""
 
 from __future__ import annotations
 

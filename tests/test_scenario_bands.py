@@ -1,35 +1,19 @@
-"""Trajectories for a lab's own bat (issue 37, section 3; docs/flight.md "A lab's own bat"): a scenario
-takes its bat, tables and e_x from a dataset; e_x's stat. and syst. uncertainty gives 68 % and 95 %
-bands of exit speed, launch angle, backspin and carry; ``ballbat hit`` runs the same code; the Fig. 11
-caption quotes the paper only for Sec. V.B's case.
+"""Bands of a lab's own bat (ballbat.scenario_bands): a dataset's e_x and its uncertainty give 68 % and 95 %
+bands; the Fig. 11 caption quotes the paper only for its case (issue 37, section 3).
 """
 
 from __future__ import annotations
 
+import helpers
 import numpy as np
 import pytest
 import xarray as xr
-from conftest import ROOT
+from helpers import scenario_settings as settings
 
 from ballbat import reporting, scenario_bands
-from ballbat.pipeline.config import checked_block
-from ballbat.properties import load_balls, load_bats
 from ballbat.stages import implications as stage
 
-HICKORY_BATS = ROOT / "config" / "examples" / "hickory_bats.csv"
-SWEEP = {"pitch_mph": 90, "pitch_descent_deg": 6, "pitch_backspin_rpm": 2000, "bat_mph": 70, "attack_deg": 6}
-
-
-@pytest.fixture(scope="module")
-def tables():
-    return load_balls(ROOT / "config" / "balls.csv"), load_bats(HICKORY_BATS)
-
-
-def settings(tables, **sweep) -> stage.ImplicationsSettings:
-    sweep = {"D_in": {"start": 0.0, "stop": 1.0, "num": 3}, **sweep}
-    block = {"ball": "baseball", "bat": "hickory", "sweep": {**SWEEP, **sweep}}
-    imp = checked_block({"scenarios": {"s": block}}, "implications")
-    return stage.ImplicationsSettings(scenario=imp["scenarios"]["s"], air=imp["air"])
+tables = helpers.tables  # a fixture of tests/helpers.py
 
 
 def test_dataset_e_x_is_the_bats_own_else_pooled():

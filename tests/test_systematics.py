@@ -1,23 +1,5 @@
-"""Calibration systematics (issue 22): every stated calibration uncertainty to every reported quantity.
-
-In memory: rendered tracks reduced with their shifts (ballbat.systematics.reduce_shifts), then
-normalize, reconstruct, fit_ex and the eta^2 fit, as the workflow runs them.
-
-Issue #35, item 4: a measured impacts file's instruments state their calibration uncertainties.
-
-``datasets.<name>.calibration`` (``speed_scale_pct``, ``spin_scale_pct``, ``angle_offset_deg``): each
-stated one is a systematic source, every impact's values moved by +-1 sigma and refitted. The hand
-computation rescales the file's columns itself. "syst. —" appears only where nothing is stated, and
-then the text says so.
-
-Issue #35, item 4: bat and ball properties carry their uncertainties (``<column>_err``) to every result.
-
-Each stated uncertainty is one systematic source (``bat:<bat>:<column>``, ``ball:<ball>:<column>``),
-propagated as the tracks' calibrations are: the fits again with that one property at +1 and at -1
-standard uncertainty for every impact of that bat (ball), half the difference. The hand computation
-here writes the moved table itself and runs the chain on it.
-
-The raw-track chain (Sec. II): rendered tracks reduce back to their truth within the stated errors.
+"""Systematics (ballbat.systematics): every stated calibration and property uncertainty to every reported
+quantity, each the fits again at +-1 sigma (issues 22, 35).
 """
 
 from __future__ import annotations
@@ -30,7 +12,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from helpers import BALLS, BATS, experiment, render, render_cfg
+from helpers import BALLS, BATS, HICKORY_HEAD, experiment, render, render_cfg
+from helpers import reduce_tracks_of as reduce
+from helpers import write_table as _write
 
 from ballbat import batlab, systematics
 from ballbat import chain as chain_instrument_calibration
@@ -43,7 +27,6 @@ from ballbat.stages import reduce as reduce_stage
 from ballbat.stages.fit_ex import FIT_FAMILIES
 from ballbat.stages.reduce import reduction_dataset
 from ballbat.tracks.data import camera_block
-from ballbat.tracks.reduce import reduce_tracks
 
 STRONGE = {
     "e_y": 0.5,
@@ -417,15 +400,7 @@ def test_workbook_lists_each_source_or_says_none(tmp_path, nominal):
 BALLS_property_systematics = ROOT / "config" / "balls.csv"
 MAPLE_HEAD = "bat,name,M_oz,I0_oz_in2,Iz_oz_in2,b_in,R_in"
 MAPLE_ROW = "maple,maple,{M},{I0},9.6,6.5,1.24"
-HICKORY_HEAD = (
-    "bat,name,convention,length_in,weight_oz,balance_in,pivot_in,moi_oz_in2,impact_from_tip_in,diameter_in,Iz_oz_in2"
-)
 HICKORY_ROW = "hickory,hickory,lab,34,{w},{bp},6,{moi},6,2.6,11.0"
-
-
-def _write(path: Path, head: str, row: str) -> Path:
-    path.write_text(f"{head}\n{row}\n")
-    return path
 
 
 def _chain(impacts: Path, bats: Path, balls: Path = BALLS_property_systematics):
@@ -608,12 +583,6 @@ def test_study_replicate_draws_and_its_systematic_is_the_finite_difference(tmp_p
         .sel(ball="baseball", bat="hickory")
     )
     assert r["value"] + r["calibration_effect"] == pytest.approx(with_true, abs=0.1 * r["systematic"])
-
-
-def reduce(tr, s, **cams):
-    cameras = {"swing": s.swing.camera, "spin": s.spin.camera}
-    cameras.update(cams)
-    return reduce_tracks(tr, cameras, s.rig)
 
 
 def test_pixel_scale_systematic_reaches_e_x():

@@ -1,4 +1,4 @@
-"""Tables I-II, unit conversions and the recoil factors (Sec. III, Eqs. rx and ry)."""
+"""Unit conversions (ballbat.units) are exact."""
 
 from __future__ import annotations
 

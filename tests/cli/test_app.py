@@ -1,9 +1,9 @@
-"""The `ballbat` command, run through its installed entry point (issue 13)."""
+"""`ballbat` itself (ballbat.cli.app): its start without the heavy libraries, the entry point, each command's
+help and its examples run, bad arguments in one line (issue 13).
+"""
 
 from __future__ import annotations
 
-import contextlib
-import io
 import os
 import shlex
 import subprocess
@@ -12,8 +12,9 @@ from pathlib import Path
 
 import pytest
 from conftest import ROOT
+from helpers import ballbat_in_process as ballbat
 
-from ballbat import __version__, cli
+from ballbat import __version__
 from ballbat.cli.common import EXAMPLES
 
 BALLBAT = Path(sys.executable).parent / "ballbat"
@@ -24,27 +25,6 @@ def ballbat_process(*args: str, cwd: Path | None = None) -> subprocess.Completed
     """Run the installed `ballbat` command in a process of its own."""
     env = {**os.environ, "COLUMNS": "200"}  # argparse wraps the help at the terminal's width
     return subprocess.run([str(BALLBAT), *args], capture_output=True, text=True, timeout=120, cwd=cwd, env=env)
-
-
-def ballbat(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    """Run `ballbat` as its entry point does (:func:`ballbat.cli.main`), in this process (no start-up cost).
-
-    Its exit status, standard output and error come back as from :func:`ballbat_process`; the
-    entry point itself is tested through the installed command (test_entry_point_is_installed).
-    """
-    out, err = io.StringIO(), io.StringIO()
-    here = Path.cwd()
-    try:
-        if cwd is not None:
-            os.chdir(cwd)
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            try:
-                status = cli.main(list(args))
-            except SystemExit as exc:  # argparse: --help, --version and bad arguments
-                status = exc.code if isinstance(exc.code, int) else 1
-    finally:
-        os.chdir(here)
-    return subprocess.CompletedProcess(["ballbat", *args], status, out.getvalue(), err.getvalue())
 
 
 COMMANDS = {

@@ -2,12 +2,11 @@
 
 from __future__ import annotations
 
-import subprocess
 import sys
 from pathlib import Path
 
-import forked
 import pytest
+from helpers import ballbat_forked as ballbat
 
 from ballbat.properties import load_balls, recoil_factors
 from ballbat.units import INCH, OUNCE, OZ_IN2
@@ -15,14 +14,6 @@ from ballbat.units import INCH, OUNCE, OZ_IN2
 ROOT = Path(__file__).resolve().parents[2]
 BALLBAT = Path(sys.executable).parent / "ballbat"
 HICKORY = "--length 34 --weight 32 --balance-point 23.0 --moi-6in 11200 --impact-from-tip 6 --diameter 2.6 --iz 11"
-
-
-def ballbat(*args: str, installed: bool = False) -> subprocess.CompletedProcess:
-    """Run `ballbat ARGS`: the installed command, or (the default) a process forked with its libraries loaded."""
-    if not installed:
-        return forked.ballbat(*args, cwd=ROOT, timeout=120)
-    assert BALLBAT.is_file(), f"{BALLBAT}: the entry point is not installed"
-    return subprocess.run([str(BALLBAT), *args], capture_output=True, text=True, cwd=ROOT, timeout=120)
 
 
 def test_bat_prints_the_paper_row_and_the_centre_of_percussion():

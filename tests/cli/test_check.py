@@ -1,45 +1,24 @@
-"""``ballbat bat`` through the installed entry point: a lab's measurements as a bat-table row (issue 35).
-
-The `ballbat` command, run through its installed entry point (issue 13).
-
-Reading the tracking tools' own files (docs/tracks.md, "Files of tracking tools").
-
-The files are written by tests/track_files.py, shaped as Tracker and Kinovea write them, from
-the tracks of config/examples/tracked_tracks.csv (rendered by ballbat's renderer).
-
-The mistakes labs make with raw tracks (issue 18) are caught before a fit: each stops the dataset
-naming the setting or the rows, or excludes the impacts concerned with their reason.
+"""``ballbat check`` (ballbat.cli.check): a measured impacts file, raw tracks and a folder of tool files checked
+as the workflow would read them, every problem listed, unit mistakes warned of (issues 13, 18, 35).
 """
 
 from __future__ import annotations
 
-import contextlib
-import io
-import os
 import subprocess
 import sys
 from pathlib import Path
 
-import forked
 import pytest
 import yaml
 from conftest import ROOT
+from helpers import ballbat_forked as ballbat
+from helpers import ballbat_in_process as ballbat_cli
 from track_files import (
     TOOL_NAMES,
     write_lab_folder,
 )
 
-from ballbat import cli
-
 BALLBAT = Path(sys.executable).parent / "ballbat"
-
-
-def ballbat(*args: str, installed: bool = False) -> subprocess.CompletedProcess:
-    """Run `ballbat ARGS`: the installed command, or (the default) a process forked with its libraries loaded."""
-    if not installed:
-        return forked.ballbat(*args, cwd=ROOT, timeout=120)
-    assert BALLBAT.is_file(), f"{BALLBAT}: the entry point is not installed"
-    return subprocess.run([str(BALLBAT), *args], capture_output=True, text=True, cwd=ROOT, timeout=120)
 
 
 def test_check_refuses_grams_as_ounces_and_b_outside_any_bat(tmp_path):
@@ -54,27 +33,6 @@ def test_check_refuses_grams_as_ounces_and_b_outside_any_bat(tmp_path):
 
 MAPLE = ROOT / "config" / "examples" / "maple_impacts.csv"
 MAPLE_BATS = ROOT / "config" / "examples" / "maple_bats.csv"
-
-
-def ballbat_cli(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    """Run `ballbat` as its entry point does (:func:`ballbat.cli.main`), in this process (no start-up cost).
-
-    Its exit status, standard output and error come back as from :func:`ballbat_process`; the
-    entry point itself is tested through the installed command (test_entry_point_is_installed).
-    """
-    out, err = io.StringIO(), io.StringIO()
-    here = Path.cwd()
-    try:
-        if cwd is not None:
-            os.chdir(cwd)
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            try:
-                status = cli.main(list(args))
-            except SystemExit as exc:  # argparse: --help, --version and bad arguments
-                status = exc.code if isinstance(exc.code, int) else 1
-    finally:
-        os.chdir(here)
-    return subprocess.CompletedProcess(["ballbat", *args], status, out.getvalue(), err.getvalue())
 
 
 def test_check_a_good_file_as_the_workflow_would():

@@ -1,10 +1,5 @@
-"""The bats league table (issue 37, section 2; docs/league.md): every bat's e_x over test sessions,
-pairwise differences whose shared systematics cancel within a session and add across sessions,
-Holm's adjustment, the consistency test of a bat in several sessions, the equivalence test (TOST),
-``ballbat compare FOLDER...`` and the workflow's league rule.
-
-The fit_ex.nc files here are built by hand (the variables the league reads, written by the
-workflow's writer), so every expected number is a hand computation.
+"""``ballbat compare`` (ballbat.cli.compare): the bats league table of results folders, printed; bad folders
+named in one line (issue 37, section 2; docs/league.md).
 """
 
 from __future__ import annotations
@@ -15,47 +10,11 @@ import sys
 from pathlib import Path
 
 import forked
-import numpy as np
-import xarray as xr
+from helpers import league_fit_file as fit_file
 
 from ballbat import league
-from ballbat.pipeline.ncio import write_dataset
 
 BALLBAT = Path(sys.executable).parent / "ballbat"
-SOURCES = list(league.SHARING)
-
-
-def fit_file(
-    folder: Path, dataset: str, bats: dict, ball: str = "baseball", older: bool = False, sources: list = SOURCES
-) -> Path:
-    """Write ``folder/dataset/fit_ex.nc`` with ``bats``: name -> (e_x, stat, n, systematic of ``sources[0]``)."""
-    names = list(bats)
-    shape = (1, len(names))
-    val = {k: np.array([[bats[b][i] for b in names]], dtype=float) for i, k in enumerate(("e_x", "err", "n", "s"))}
-    per = np.zeros((len(sources), *shape))
-    per[0] = val["s"]
-    one = {"units": "1", "long_name": "x"}
-    ds = xr.Dataset(
-        {
-            "e_x": (("ball", "bat"), val["e_x"], one),
-            "e_x_err": (("ball", "bat"), val["err"], one),
-            "e_x_n": (("ball", "bat"), val["n"].astype(np.int64), one),
-            "e_x_status": (("ball", "bat"), np.zeros(shape, dtype=np.int8), one),
-            "e_x_scatter": (("ball", "bat"), np.zeros(shape), one),
-            "e_x_syst_by_source": (("systematic", "ball", "bat"), per, one),
-        },
-        coords={
-            "ball": ("ball", np.array([ball]), {"long_name": "ball"}),
-            "bat": ("bat", np.array(names), {"long_name": "bat"}),
-            "systematic": ("systematic", np.array(sources), {"long_name": "source"}),
-        },
-    )
-    if older:  # fit_ex.nc before the intrinsic scatter (issue 36) and the systematics by source
-        ds = ds.drop_vars(["e_x_scatter", "e_x_syst_by_source", "systematic"])
-        ds["e_x_err_scale"] = (("ball", "bat"), val["s"], one)
-    path = folder / dataset / "fit_ex.nc"
-    path.parent.mkdir(parents=True, exist_ok=True)
-    return write_dataset(ds, path, title="test fit_ex", rule="fit_ex", inputs={}, config={})
 
 
 # ---------------------------------------------------------------------------------------

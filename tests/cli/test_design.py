@@ -1,6 +1,4 @@
-"""Design from a lab's own numbers (issue 37, section 4; src/ballbat/pilot.py): impacts per bat from a pilot's
-measured scatter with an interval, ``ballbat design``, and one answer over a design study's sweep.
-"""
+"""``ballbat design`` (ballbat.cli.design): impacts per bat from a pilot folder (issue 37, section 4)."""
 
 from __future__ import annotations
 
@@ -10,28 +8,12 @@ import sys
 from pathlib import Path
 
 import forked
-import numpy as np
-import xarray as xr
+from helpers import pilot_fit as fit
 
 from ballbat import pilot
 from ballbat.pipeline.ncio import write_dataset
 
 BALLBAT = Path(sys.executable).parent / "ballbat"
-
-
-def fit(se: dict, n: dict) -> xr.Dataset:
-    bats = list(se)
-    one, shape = {"units": "1", "long_name": "x"}, (1, len(bats))
-    return xr.Dataset(
-        {
-            "e_x": (("ball", "bat"), np.full(shape, 0.45), one),
-            "e_x_err": (("ball", "bat"), [[se[b] for b in bats]], one),
-            "e_x_n": (("ball", "bat"), [[n[b] for b in bats]], one),
-            "e_x_status": (("ball", "bat"), np.zeros(shape, dtype=np.int8), one),
-            "e_x_scatter": (("ball", "bat"), np.zeros(shape), one),
-        },
-        coords={"ball": ("ball", ["baseball"], {"long_name": "b"}), "bat": ("bat", bats, {"long_name": "b"})},
-    )
 
 
 def test_ballbat_design_from_a_pilot_folder(tmp_path):

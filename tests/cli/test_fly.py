@@ -1,39 +1,12 @@
-"""The `ballbat` command, run through its installed entry point (issue 13)."""
+"""``ballbat fly`` (ballbat.cli.fly): the calculator's case, launch conditions, many balls from a CSV (issue 13)."""
 
 from __future__ import annotations
 
-import contextlib
 import csv
-import io
 import json
-import os
-import subprocess
-from pathlib import Path
 
 import pytest
-
-from ballbat import cli
-
-
-def ballbat(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
-    """Run `ballbat` as its entry point does (:func:`ballbat.cli.main`), in this process (no start-up cost).
-
-    Its exit status, standard output and error come back as from :func:`ballbat_process`; the
-    entry point itself is tested through the installed command (test_entry_point_is_installed).
-    """
-    out, err = io.StringIO(), io.StringIO()
-    here = Path.cwd()
-    try:
-        if cwd is not None:
-            os.chdir(cwd)
-        with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
-            try:
-                status = cli.main(list(args))
-            except SystemExit as exc:  # argparse: --help, --version and bad arguments
-                status = exc.code if isinstance(exc.code, int) else 1
-    finally:
-        os.chdir(here)
-    return subprocess.CompletedProcess(["ballbat", *args], status, out.getvalue(), err.getvalue())
+from helpers import ballbat_in_process as ballbat
 
 
 def test_fly_reproduces_the_calculator():

@@ -1,8 +1,4 @@
-"""Trajectories for a lab's own bat (issue 37, section 3; docs/flight.md "A lab's own bat"): a scenario
-takes its bat, tables and e_x from a dataset; e_x's stat. and syst. uncertainty gives 68 % and 95 %
-bands of exit speed, launch angle, backspin and carry; ``ballbat hit`` runs the same code; the Fig. 11
-caption quotes the paper only for Sec. V.B's case.
-"""
+"""``ballbat hit`` (ballbat.cli.hit): the batted ball of a pitch and a swing, with bands from e_x (issue 37 §3)."""
 
 from __future__ import annotations
 
@@ -12,20 +8,19 @@ import sys
 from pathlib import Path
 
 import forked
+import helpers
 import numpy as np
 import pytest
 import xarray as xr
-from conftest import ROOT
+from helpers import scenario_settings as settings
 
 from ballbat import scenario_bands
-from ballbat.pipeline.config import checked_block
 from ballbat.pipeline.ncio import write_dataset
-from ballbat.properties import bat_record, load_balls, load_bats
-from ballbat.stages import implications as stage
+from ballbat.properties import bat_record
 
-HICKORY_BATS = ROOT / "config" / "examples" / "hickory_bats.csv"
+tables = helpers.tables  # a fixture of tests/helpers.py
+
 BALLBAT = Path(sys.executable).parent / "ballbat"
-SWEEP = {"pitch_mph": 90, "pitch_descent_deg": 6, "pitch_backspin_rpm": 2000, "bat_mph": 70, "attack_deg": 6}
 
 
 def fit_file(folder: Path, bats: dict, e_x: dict, err: dict, syst: float = 0.004) -> Path:
@@ -51,18 +46,6 @@ def fit_file(folder: Path, bats: dict, e_x: dict, err: dict, syst: float = 0.004
     path = folder / "fit_ex.nc"
     path.parent.mkdir(parents=True, exist_ok=True)
     return write_dataset(ds, path, title="test", rule="fit_ex", inputs={}, config={})
-
-
-@pytest.fixture(scope="module")
-def tables():
-    return load_balls(ROOT / "config" / "balls.csv"), load_bats(HICKORY_BATS)
-
-
-def settings(tables, **sweep) -> stage.ImplicationsSettings:
-    sweep = {"D_in": {"start": 0.0, "stop": 1.0, "num": 3}, **sweep}
-    block = {"ball": "baseball", "bat": "hickory", "sweep": {**SWEEP, **sweep}}
-    imp = checked_block({"scenarios": {"s": block}}, "implications")
-    return stage.ImplicationsSettings(scenario=imp["scenarios"]["s"], air=imp["air"])
 
 
 def run_hit(*args: str, installed: bool = False) -> subprocess.CompletedProcess:

@@ -1,8 +1,4 @@
-"""Reading the tracking tools' own files (docs/tracks.md, "Files of tracking tools").
-
-The files are written by tests/track_files.py, shaped as Tracker and Kinovea write them, from
-the tracks of config/examples/tracked_tracks.csv (rendered by ballbat's renderer).
-"""
+"""``ballbat import-tracks`` (ballbat.cli.import_tracks): tool files into the long tracks CSV."""
 
 from __future__ import annotations
 
@@ -10,31 +6,19 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
+import helpers
 import pytest
 import yaml
+from helpers import EXAMPLE
+from helpers import same_tracks as _same
 from track_files import (
     read_long_csv,
     write_lab_folder,
 )
 
-ROOT = Path(__file__).resolve().parents[2]
-EXAMPLE = ROOT / "config" / "examples"
+rows = helpers.rows  # a fixture of tests/helpers.py
+
 CAMS = {"swing": {"fps": 3000.0, "m_per_px": 0.00074}, "spin": {"fps": 1000.0, "m_per_px": 0.00125}}
-
-
-@pytest.fixture(scope="module")
-def rows():
-    return read_long_csv(EXAMPLE / "tracked_tracks.csv")
-
-
-def _same(got, want, tol=0.0):
-    assert set(got) == set(want)
-    for name, (f, x, y) in want.items():
-        gf, gx, gy = got[name]
-        np.testing.assert_array_equal(gf - gf.min(), f - f.min())
-        np.testing.assert_allclose(gx - gx[0], x - x[0], atol=tol, rtol=0)
-        np.testing.assert_allclose(gy - gy[0], y - y[0], atol=tol, rtol=0)
 
 
 BALLBAT = Path(sys.executable).parent / "ballbat"

@@ -1,13 +1,5 @@
-"""Typed settings take their defaults from the config schema alone (issue 20).
-
-Every settings dataclass is checked against the schema: a field default that differs from the
-schema's, or that the schema does not give, fails; every default the schema gives a render,
-reduce, camera, synthetic or study setting arrives in the settings built from a block that
-leaves it out; no code restates a schema default through ``.get(key, default)``. And a
-replicate of a study (``replicate_source``) and the workflow's rule functions give the same
-reduced impacts whichever render or reduce setting is changed, one at a time.
-
-Studies that test systematics (issue 22): grid sweeps, contact-time sweep, drawn calibration, combined intervals.
+"""The schema and its defaults (ballbat.pipeline.config): typed settings take their defaults from the config
+schema alone, and every setting is honoured (issue 20).
 """
 
 from __future__ import annotations

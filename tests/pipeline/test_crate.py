@@ -1,34 +1,16 @@
-"""Issue 37 §1: test sessions. A run's results folder is a setting; a folder's crate carries every run in
-it; a folder's workbooks keep every scenario's sheet; three sessions' folders make one league table.
+"""The crate of a results folder (ballbat.pipeline.crate): a later run adds its actions to the earlier ones, a
+result changed or gone or stale is said so, a run cut short keeps the earlier crate (issue 37, section 1).
 """
 
 from __future__ import annotations
 
-import json
+from helpers import crate_graph as _graph
+from helpers import crate_ids as _ids
+from helpers import crate_netcdf as _nc
 
 from ballbat.pipeline import crate as crate_mod
 from ballbat.pipeline.cratefiles import EARLIER_NAME, crate_file_problems
 from ballbat.pipeline.provenance import sha256_file
-
-
-def _nc(path, note):
-    """A small NetCDF file carrying the workflow's provenance mark."""
-    import xarray as xr
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    attrs = {"provenance_rule": "r", "provenance_config": json.dumps({"note": note}), "note": note}
-    xr.Dataset({"x": ("n", [1.0])}, attrs=attrs).to_netcdf(path, engine="netcdf4")
-
-
-def _graph(results):
-    doc = json.loads((results / "ro-crate-metadata.json").read_text())
-    return {e["@id"]: e for e in doc["@graph"]}
-
-
-def _ids(value):
-    refs = value if isinstance(value, list) else [value]
-    return sorted(r["@id"] for r in refs)
-
 
 # -- the crate of a folder describes every run in it -------------------------------------------------
 

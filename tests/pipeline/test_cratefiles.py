@@ -1,21 +1,10 @@
-"""Issue 37 §1: test sessions. A run's results folder is a setting; a folder's crate carries every run in
-it; a folder's workbooks keep every scenario's sheet; three sessions' folders make one league table.
-"""
+"""The files a crate lists (ballbat.pipeline.cratefiles): a session inside the default folder is its own."""
 
 from __future__ import annotations
 
-import json
+from helpers import crate_netcdf as _nc
 
 from ballbat.pipeline.cratefiles import folder_files
-
-
-def _nc(path, note):
-    """A small NetCDF file carrying the workflow's provenance mark."""
-    import xarray as xr
-
-    path.parent.mkdir(parents=True, exist_ok=True)
-    attrs = {"provenance_rule": "r", "provenance_config": json.dumps({"note": note}), "note": note}
-    xr.Dataset({"x": ("n", [1.0])}, attrs=attrs).to_netcdf(path, engine="netcdf4")
 
 
 def test_a_session_inside_the_default_folder_is_its_own(tmp_path):

@@ -1,11 +1,5 @@
 """Unit tests of the results folder's guards (ballbat.pipeline.guards), on small files in a temporary folder.
-
-Each refusal path of each guard, with the message it gives (the file named, what is wrong and
-what to do). The workflow's use of them (onstart, a dry run, a job's inputs) is in
-tests/workflow/test_guards.py.
-
-Issue 37 §1: test sessions. A run's results folder is a setting; a folder's crate carries every run in
-it; a folder's workbooks keep every scenario's sheet; three sessions' folders make one league table.
+The same guards on a real run: tests/workflow/test_guards.py.
 """
 
 from __future__ import annotations
@@ -15,32 +9,15 @@ import subprocess
 import sys
 from pathlib import Path
 
-import numpy as np
 import pytest
-import xarray as xr
+from helpers import product_file as product
+from helpers import users_netcdf4
 
 from ballbat.pipeline import checked, guards
 from ballbat.pipeline.atomic import hostname
 from ballbat.pipeline.checked import sealed_csv
-from ballbat.pipeline.ncio import write_dataset
 
 SIG = checked.HDF5_SIGNATURE
-
-
-def product(path: Path) -> Path:
-    """A NetCDF file as the workflow writes it (with its provenance record)."""
-    ds = xr.Dataset(
-        {"x": ("n", np.linspace(0.0, 1.0, 500), {"units": "m", "long_name": "a length"})},
-        coords={"n": ("n", np.arange(500), {"units": "1", "long_name": "index"})},
-    )
-    return write_dataset(ds, path, title="t", rule="r", inputs={}, config={})
-
-
-def users_netcdf4(path: Path) -> Path:
-    """A whole NetCDF-4 file of the user's (no provenance record)."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    xr.Dataset({"y": ("k", np.arange(10.0))}).to_netcdf(path, format="NETCDF4", engine="netcdf4")
-    return path
 
 
 def dead_pid() -> int:

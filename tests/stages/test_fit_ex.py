@@ -1,45 +1,17 @@
-"""Sec. IV fits: e_x recovery from synthetic data, honest standard errors, line fits.
-
-Issue 36: e_x's intrinsic-scatter term (Paule-Mandel tau) and implied e_y's leverage-corrected sandwich.
-
-The stage layer (src/ballbat/stages/): each stage's run on small in-memory inputs.
-
-Each stage writes exactly its declared table, the source stages share the one impacts table,
-a stage gives the numbers of the compute functions it calls, its settings come from the
-validated config, the rule scripts are one call of a stage, and a replicate of the studies is
-those same calls.
+"""The fit_ex stage (ballbat.stages.fit_ex): e_x recovered from synthetic data with honest standard errors,
+the intrinsic-scatter term declared, the stage giving the compute functions' numbers (Sec. IV; issue 36).
 """
 
 from __future__ import annotations
 
-import dataclasses
-
 import numpy as np
 import pytest
-import yaml
-from helpers import SMALL
+from helpers import fit_chain as run
 
 from ballbat import fitting
-from ballbat.stages import fit_ex, normalize, reconstruct, reduce, render, simulate
+from ballbat.stages import fit_ex, reconstruct
 from ballbat.stages.fit_ex import fit_ex_table
-from ballbat.synthetic import SyntheticSettings
-from ballbat.tracks.data import camera_block
 from workflow_helpers import ROOT
-
-NORM = normalize.NormalizeSettings(v_ref_mph=77.0)
-REC = reconstruct.ReconstructSettings()
-FIT = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True)
-
-
-@pytest.fixture(scope="module")
-def default_settings(root):
-    cfg = yaml.safe_load((root / "config" / "config.yaml").read_text())
-    return cfg["datasets"]["synthetic"]["synthetic"]
-
-
-def run(settings, balls, bats, **over):
-    s = SyntheticSettings(**{**settings, **over})
-    return fit_ex.run(FIT, reconstruct.run(REC, normalize.run(NORM, simulate.run(s, balls, bats)), balls, bats))
 
 
 def test_recovery_default_config(default_settings, balls, bats):
@@ -89,25 +61,6 @@ def test_fit_ex_declares_the_scatter_with_units_and_words():
         assert table[name].units == "1"
         assert table[name].dims == ("ball", "bat")
         assert "e_x_scatter" in table[name].long_name or "tau" in table[name].long_name
-
-
-@pytest.fixture(scope="module")
-def chain(config, balls, bats):
-    """A small synthetic dataset through simulate, render, reduce, normalize, reconstruct (the workflow's settings)."""
-    synth = simulate.from_config(config, "synthetic")
-    sim = simulate.run(dataclasses.replace(synth, impacts=SMALL), balls, bats)
-    rset = render.from_config(config, "synthetic")
-    tracks = render.render(rset, sim, balls)
-    rs = reduce.ReduceSettings.from_config(
-        camera_block(config["datasets"]["synthetic"]["render"]), "render", systematics=False
-    )
-    red = reduce.run(rs, tracks, balls, bats)
-    norm = normalize.run(normalize.NormalizeSettings.from_config(config), sim)
-    rec = reconstruct.run(reconstruct.ReconstructSettings.from_config(config), norm, balls, bats)
-    red_rec = reconstruct.run(
-        reconstruct.ReconstructSettings(), normalize.run(normalize.NormalizeSettings(77.0), red), balls, bats
-    )
-    return {"sim": sim, "tracks": tracks, "rset": rset, "red": red, "norm": norm, "rec": rec, "red_rec": red_rec}
 
 
 # ---------------------------------------------------------------------------------------

@@ -1,9 +1,5 @@
-"""The stage layer (src/ballbat/stages/): each stage's run on small in-memory inputs.
-
-Each stage writes exactly its declared table, the source stages share the one impacts table,
-a stage gives the numbers of the compute functions it calls, its settings come from the
-validated config, the rule scripts are one call of a stage, and a replicate of the studies is
-those same calls.
+"""The impacts table (ballbat.stages.impacts): what every source stage writes, owned by no other module, each
+stage writing exactly its own table.
 """
 
 from __future__ import annotations
@@ -12,34 +8,13 @@ import dataclasses
 from pathlib import Path
 
 import pytest
-from helpers import SMALL
 
 from ballbat.stages import fit_ex, implications, ingest, normalize, reconstruct, reduce, render, simulate, stronge
 from ballbat.stages.impacts import IMPACT_COORDS, IMPACTS, QUANTITIES, SIMULATED_TRUTH, truth_var
-from ballbat.tracks.data import camera_block
 from workflow_helpers import ROOT
 
 MAPLE = ROOT / "config" / "examples" / "maple_impacts.csv"
 MAPLE_BATS = ROOT / "config" / "examples" / "maple_bats.csv"
-
-
-@pytest.fixture(scope="module")
-def chain(config, balls, bats):
-    """A small synthetic dataset through simulate, render, reduce, normalize, reconstruct (the workflow's settings)."""
-    synth = simulate.from_config(config, "synthetic")
-    sim = simulate.run(dataclasses.replace(synth, impacts=SMALL), balls, bats)
-    rset = render.from_config(config, "synthetic")
-    tracks = render.render(rset, sim, balls)
-    rs = reduce.ReduceSettings.from_config(
-        camera_block(config["datasets"]["synthetic"]["render"]), "render", systematics=False
-    )
-    red = reduce.run(rs, tracks, balls, bats)
-    norm = normalize.run(normalize.NormalizeSettings.from_config(config), sim)
-    rec = reconstruct.run(reconstruct.ReconstructSettings.from_config(config), norm, balls, bats)
-    red_rec = reconstruct.run(
-        reconstruct.ReconstructSettings(), normalize.run(normalize.NormalizeSettings(77.0), red), balls, bats
-    )
-    return {"sim": sim, "tracks": tracks, "rset": rset, "red": red, "norm": norm, "rec": rec, "red_rec": red_rec}
 
 
 # ---------------------------------------------------------------------------------------

@@ -1,25 +1,5 @@
-"""Measured datasets: every bad input is named (file, row, column, problem), all at once.
-
-Per-row plausibility of measured impacts and the physical range of fitted e_x (issue 10, item 1).
-
-A unit mistake must not give a number that looks right. The maple example (31 impacts, true
-e_x = 0.42) is rewritten with the mistakes labs make; each is caught as an error of the dataset
-or, row by row, as excluded impacts kept with their reason. On clean synthetic experiments no
-impact is flagged.
-
-Unit mistakes in a few rows are named as such, even in one row (issue 35, item 5).
-
-Before, a row of spin in rad/s in an rpm file was excluded only as "implausible" (no hint of
-units), and such a row at small psi was kept and fitted with "0 warning(s)". Now an excluded
-row whose values fit another unit says which, and a kept row that fits another unit far better
-is a warning naming its line, its column and the unit.
-
-The stage layer (src/ballbat/stages/): each stage's run on small in-memory inputs.
-
-Each stage writes exactly its declared table, the source stages share the one impacts table,
-a stage gives the numbers of the compute functions it calls, its settings come from the
-validated config, the rule scripts are one call of a stage, and a replicate of the studies is
-those same calls.
+"""The ingest stage (ballbat.stages.ingest): a measured impacts file, every bad input named (file, row, column,
+problem) all at once; per-row plausibility, unit mistakes named as such (issue 10, item 1; issue 35, item 5).
 """
 
 from __future__ import annotations
@@ -34,6 +14,7 @@ import numpy as np
 import pytest
 import xarray as xr
 from conftest import ROOT
+from helpers import FIT, NORM, REC
 
 from ballbat import ingest
 from ballbat.fitting import FitStatus, ImplausibleFit
@@ -58,11 +39,6 @@ GOOD = [  # wood bat, baseball: plausible impacts (Sec. III forward model, e_x ~
     ["A3", "wood", "baseball", "70.0", "80.0", "5.0", "900"],
     ["A4", "wood", "baseball", "85.0", "92.0", "16.0", "3200"],
 ]
-
-
-NORM = normalize.NormalizeSettings(v_ref_mph=77.0)
-REC = reconstruct.ReconstructSettings()
-FIT = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True)
 
 
 def ingested(path, balls=BALLS, bats=BATS):

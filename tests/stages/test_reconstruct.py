@@ -1,27 +1,13 @@
-"""Sec. IV fits: e_x recovery from synthetic data, honest standard errors, line fits."""
+"""The reconstruct stage (ballbat.stages.reconstruct): implied e_y exact for bats of different e_x (Sec. IV)."""
 
 from __future__ import annotations
 
 import pytest
-import yaml
+from helpers import NORM, REC
+from helpers import fit_chain as run
 
-from ballbat.stages import fit_ex, normalize, reconstruct, simulate
+from ballbat.stages import normalize, reconstruct, simulate
 from ballbat.synthetic import SyntheticSettings
-
-NORM = normalize.NormalizeSettings(v_ref_mph=77.0)
-REC = reconstruct.ReconstructSettings()
-FIT = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True)
-
-
-@pytest.fixture(scope="module")
-def default_settings(root):
-    cfg = yaml.safe_load((root / "config" / "config.yaml").read_text())
-    return cfg["datasets"]["synthetic"]["synthetic"]
-
-
-def run(settings, balls, bats, **over):
-    s = SyntheticSettings(**{**settings, **over})
-    return fit_ex.run(FIT, reconstruct.run(REC, normalize.run(NORM, simulate.run(s, balls, bats)), balls, bats))
 
 
 def test_implied_e_y_is_exact_for_bats_of_different_e_x(default_settings, balls, bats):

@@ -1,19 +1,11 @@
-"""Sec. IV fits: e_x recovery from synthetic data, honest standard errors, line fits."""
+"""The simulate stage (ballbat.stages.simulate): synthetic impacts are seeded."""
 
 from __future__ import annotations
 
 import numpy as np
-import pytest
-import yaml
 
 from ballbat.stages import simulate
 from ballbat.synthetic import SyntheticSettings
-
-
-@pytest.fixture(scope="module")
-def default_settings(root):
-    cfg = yaml.safe_load((root / "config" / "config.yaml").read_text())
-    return cfg["datasets"]["synthetic"]["synthetic"]
 
 
 def test_synthetic_is_seeded(default_settings, balls, bats):

@@ -1,23 +1,12 @@
-"""Sec. IV fits: e_x recovery from synthetic data, honest standard errors, line fits."""
+"""The Stronge stage (ballbat.stages.stronge): a ball with too few usable impacts is reported, not fitted."""
 
 from __future__ import annotations
 
 import numpy as np
-import pytest
-import yaml
+from helpers import FIT, NORM, REC
 
 from ballbat.stages import fit_ex, normalize, reconstruct, simulate, stronge
 from ballbat.synthetic import SyntheticSettings
-
-NORM = normalize.NormalizeSettings(v_ref_mph=77.0)
-REC = reconstruct.ReconstructSettings()
-FIT = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True)
-
-
-@pytest.fixture(scope="module")
-def default_settings(root):
-    cfg = yaml.safe_load((root / "config" / "config.yaml").read_text())
-    return cfg["datasets"]["synthetic"]["synthetic"]
 
 
 def test_ball_with_too_few_usable_impacts_is_reported_not_fitted(default_settings, config, balls, bats):

@@ -1,9 +1,5 @@
-"""Tests of Stronge's lumped-parameter contact model (ballbat.stronge, ballbat.stronge.fit).
-
-Published numbers are from Sec. V.A and the Fig. 10 caption of Kensrud, Nathan & Smith,
-Am. J. Phys. 85, 503 (2017) ("the paper"). Where the paper's prose and the model as
-specified in docs/model.md disagree, the test asserts what the model does and says so in an
-``ERRATA``/``MODEL`` comment; docs/stronge.md documents each case with numbers.
+"""The eta^2 fit of Stronge's model (ballbat.stronge.fit): recovery, robust intervals and degrees of freedom,
+free mu, e_y absorbed, bad inputs named.
 """
 
 from __future__ import annotations
@@ -14,12 +10,6 @@ import pytest
 from ballbat.properties import recoil_factors
 from ballbat.stronge.fit import Eta2FitError, fit_eta2
 from ballbat.stronge.model import ContactParams, stronge_ex
-
-
-@pytest.fixture(scope="module")
-def wood(balls, bats):
-    """(r_x, r_y) of each ball on the wood bat (Tables I and II)."""
-    return {b: recoil_factors(balls[b], bats["wood"]) for b in ("baseball", "softball")}
 
 
 # ------------------------------------------------------------------------------------------

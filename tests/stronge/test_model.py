@@ -1,16 +1,5 @@
-"""Tests of Stronge's lumped-parameter contact model (ballbat.stronge, ballbat.stronge.fit).
-
-Published numbers are from Sec. V.A and the Fig. 10 caption of Kensrud, Nathan & Smith,
-Am. J. Phys. 85, 503 (2017) ("the paper"). Where the paper's prose and the model as
-specified in docs/model.md disagree, the test asserts what the model does and says so in an
-``ERRATA``/``MODEL`` comment; docs/stronge.md documents each case with numbers.
-
-The eta^2 fit's derivatives from one stacked call of the model equal those from one call per point (issue 39).
-
-:func:`ballbat.stronge.fit._jacobian`, :func:`ballbat.stronge.analysis.eiv_step` and
-:func:`ballbat.stronge.analysis.finite_sample_bias` evaluate every point they difference in a
-single call of :func:`ballbat.stronge.model.stronge_ex`. The references below are the
-per-point code they replaced; the results must agree to round-off.
+"""Stronge's lumped-parameter contact model (ballbat.stronge.model): the fast path against the general engine,
+broadcasting and limits, energy, the paper's curves and time histories.
 """
 
 from __future__ import annotations
@@ -22,7 +11,6 @@ import numpy as np
 import pytest
 
 from ballbat.properties import recoil_factors
-from ballbat.stronge.analysis import VtfData, VtfNoise
 from ballbat.stronge.fit import _jacobian
 from ballbat.stronge.model import ContactParams, omega_ratio, stronge_ex, stronge_solve
 from ballbat.stronge.regimes import regime_boundaries
@@ -30,12 +18,6 @@ from ballbat.stronge.regimes import regime_boundaries
 DEG = np.pi / 180
 #: Paper, Sec. V.A: fitted eta^2 with e_y = mu = 0.5.
 ETA2 = {"baseball": 4.75, "softball": 6.30}
-
-
-@pytest.fixture(scope="module")
-def wood(balls, bats):
-    """(r_x, r_y) of each ball on the wood bat (Tables I and II)."""
-    return {b: recoil_factors(balls[b], bats["wood"]) for b in ("baseball", "softball")}
 
 
 def test_fast_path_matches_general_engine():
@@ -300,21 +282,6 @@ def test_import_is_light():
 
 
 NAMES = ("eta2", "e_y", "mu")
-
-
-@pytest.fixture(scope="module")
-def data() -> VtfData:
-    """Thirty impacts on three bats, with noise on four measured values."""
-    rng = np.random.default_rng(39)
-    n = 30
-    psi = rng.uniform(0.02, 0.7, n)
-    r_x, r_y = rng.uniform(0.1, 0.4, n), rng.uniform(0.05, 0.3, n)
-    x = np.tan(psi) / (1.0 + r_x)
-    ex = stronge_ex(psi, ContactParams(5.0, 0.5, 0.5, r_x, r_y, 0.4))
-    y = (1.0 + ex) * x + rng.normal(0.0, 0.01, n)
-    noise = VtfNoise(rng.normal(0.0, 0.3, (n, 4)), rng.normal(0.0, 0.3, (n, 4)), rng.uniform(0.005, 0.02, (n, 4)))
-    bat = np.repeat(["a", "b", "c"], n // 3)
-    return VtfData(psi, x, y, rng.uniform(0.005, 0.02, n), r_x, r_y, np.full(n, 0.4), bat, noise)
 
 
 def test_jacobian_rows_equal_one_call_per_point(data):

@@ -1,10 +1,4 @@
-"""Tests of Stronge's lumped-parameter contact model (ballbat.stronge, ballbat.stronge.fit).
-
-Published numbers are from Sec. V.A and the Fig. 10 caption of Kensrud, Nathan & Smith,
-Am. J. Phys. 85, 503 (2017) ("the paper"). Where the paper's prose and the model as
-specified in docs/model.md disagree, the test asserts what the model does and says so in an
-``ERRATA``/``MODEL`` comment; docs/stronge.md documents each case with numbers.
-"""
+"""The contact regimes of Stronge's model (ballbat.stronge.regimes): codes and boundaries against the solver."""
 
 from __future__ import annotations
 

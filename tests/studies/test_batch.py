@@ -1,4 +1,4 @@
-"""Studies that test systematics (issue 22): grid sweeps, contact-time sweep, drawn calibration, combined intervals."""
+"""A study's batches (ballbat.studies.batch): a grid replicate records its systematic (issue 22)."""
 
 from __future__ import annotations
 

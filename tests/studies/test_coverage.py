@@ -1,13 +1,5 @@
-"""Typed settings take their defaults from the config schema alone (issue 20).
-
-Every settings dataclass is checked against the schema: a field default that differs from the
-schema's, or that the schema does not give, fails; every default the schema gives a render,
-reduce, camera, synthetic or study setting arrives in the settings built from a block that
-leaves it out; no code restates a schema default through ``.get(key, default)``. And a
-replicate of a study (``replicate_source``) and the workflow's rule functions give the same
-reduced impacts whichever render or reduce setting is changed, one at a time.
-
-Studies that test systematics (issue 22): grid sweeps, contact-time sweep, drawn calibration, combined intervals.
+"""Study coverage (ballbat.studies.coverage): combined intervals, the calibration effect, empty grid points,
+study files in SI with tables in the paper's units (issue 22).
 """
 
 from __future__ import annotations
@@ -22,59 +14,6 @@ import xarray as xr
 
 from ballbat.studies.coverage import COVERAGE_COLUMNS, EmptySweepPoint, coverage, coverage_csv
 from ballbat.units import DEGREE
-
-# ---------------------------------------------------------------------------------------
-# a replicate and the workflow's rules reduce alike, whichever setting is changed
-
-#: One change of every key of a dataset's render block (cameras and min_frames included), from the
-#: default config's values; ``with`` changes set first (in both runs) so that the key can bite.
-RENDER_CHANGES = {
-    ("rig", "pivot_to_tip_in"): 36.0,
-    ("rig", "pivot_to_impact_in"): 26.0,
-    ("rig", "pivot_to_tip_err_in"): 0.1,
-    ("rig", "pivot_to_impact_err_in"): 0.1,
-    ("min_frames", "tip"): 21,
-    ("min_frames", "flight"): 20,
-    ("min_frames", "spin"): 18,
-    ("swing_plane_deg",): [0.0, 20.0],
-    ("contact_ms",): [0.8, 1.0],
-    ("bat_slowdown",): [0.2, 0.3],
-    ("bat_axis_to_ball_mm",): 90.0,
-    ("axis_offset_mm",): 10.0,
-    ("tilted_fraction",): 0.5,
-    ("tilt_deg",): [20.0, 30.0],
-    ("draw_calibration",): True,
-}
-CAMERA_CHANGES = {
-    "swing": {
-        "fps": 4000.0,
-        "m_per_px": 0.0008,
-        "mirror": True,
-        "m_per_px_err": 0.02,
-        "fps_err": 0.001,
-        "width_px": 1000,
-        "height_px": 560,
-        "tee_px": [500.0, 420.0],
-        "pixel_noise_px": 3.5,
-        "pre_impact_frames": 8,
-        "max_frames": 60,
-    },
-    "spin": {
-        "fps": 1500.0,
-        "m_per_px": 0.0011,
-        "mirror": True,
-        "m_per_px_err": 0.02,
-        "fps_err": 0.001,
-        "width_px": 900,
-        "height_px": 490,
-        "tee_px": [560.0, 430.0],
-        "pixel_noise_px": 3.5,
-        "pre_impact_frames": 3,
-        "max_frames": 30,
-    },
-}
-RENDER_CHANGES |= {("cameras", cam, k): v for cam, kv in CAMERA_CHANGES.items() for k, v in kv.items()}
-
 
 # ---------------------------------------------------------------------------------------
 # studies store SI values with their units; the tables convert for display

@@ -1,11 +1,5 @@
-"""The stage layer (src/ballbat/stages/): each stage's run on small in-memory inputs.
-
-Each stage writes exactly its declared table, the source stages share the one impacts table,
-a stage gives the numbers of the compute functions it calls, its settings come from the
-validated config, the rule scripts are one call of a stage, and a replicate of the studies is
-those same calls.
-
-Studies that test systematics (issue 22): grid sweeps, contact-time sweep, drawn calibration, combined intervals.
+"""Study replicates (ballbat.studies.replicates): a replicate is the stages in memory; the calibration effect
+is what the true calibration would have given (issue 22).
 """
 
 from __future__ import annotations

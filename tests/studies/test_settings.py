@@ -1,26 +1,16 @@
-"""A study's truth job: one rule for its size, shared by the job, its plans and the size guard (issue 40)."""
+"""A study's settings (ballbat.studies.settings): its truth sized by one rule, shared by the job, its plans
+and the size guard (issue 40).
+"""
 
 from __future__ import annotations
 
 import copy
 import math
 
+from helpers import UNBALANCED, unbalanced
+
 from ballbat.config_checks import MEMORY_SHARE, validate_config
 from ballbat.studies.settings import StudySettings
-
-#: The unbalanced design of issue 40: 6 impacts on some bats and 60 on others, the softball bat
-#: swung with softballs only (102 of the 204 impacts on three pairs of 60).
-UNBALANCED = {
-    "baseball": {"wood": 6, "metal_rough": 60, "metal_smooth": 6},
-    "softball": {"wood": 60, "metal_rough": 6, "metal_smooth": 60, "softball_composite": 6},
-}
-
-
-def unbalanced(config, **over):
-    cfg = copy.deepcopy(config)
-    cfg["datasets"]["synthetic"]["synthetic"]["impacts"] = copy.deepcopy(UNBALANCED)
-    cfg["studies"]["calibration"].update(over)
-    return cfg
 
 
 def test_the_truth_keeps_the_designs_proportions_at_about_truth_impacts_a_pair(config):

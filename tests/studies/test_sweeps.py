@@ -1,8 +1,5 @@
-"""Issue 36: e_x's intrinsic-scatter term (Paule-Mandel tau) and implied e_y's leverage-corrected sandwich.
-
-Studies that test systematics (issue 22): grid sweeps, contact-time sweep, drawn calibration, combined intervals.
-
-A study's truth job: one rule for its size, shared by the job, its plans and the size guard (issue 40).
+"""Sweeps (ballbat.studies.sweeps): sweep points of one parameter and of a grid, the contact sweep, the
+scatter and spin-noise sweeps, bad values refused (issues 22, 36).
 """
 
 from __future__ import annotations

@@ -1,7 +1,4 @@
-"""Studies that test systematics (issue 22): grid sweeps, contact-time sweep, drawn calibration, combined intervals.
-
-A study's truth job: one rule for its size, shared by the job, its plans and the size guard (issue 40).
-"""
+"""A study's truth (ballbat.studies.truth): the job runs the size its plans use; single points' truths merge."""
 
 from __future__ import annotations
 
@@ -10,6 +7,7 @@ import math
 
 import numpy as np
 import pytest
+from helpers import unbalanced
 
 from ballbat.config_checks import impact_bytes, study_impacts
 from ballbat.studies import truth as study_truth
@@ -44,21 +42,6 @@ def test_truth_files_of_single_points_merge_into_the_study_truth(config, balls, 
         truth_scales_from_dataset(merged.drop_vars("truth_scale"))
     with pytest.raises(ValueError, match=r"missing \[0\], repeated \[1\]"):
         merge_truths([parts[0], parts[0]])
-
-
-#: The unbalanced design of issue 40: 6 impacts on some bats and 60 on others, the softball bat
-#: swung with softballs only (102 of the 204 impacts on three pairs of 60).
-UNBALANCED = {
-    "baseball": {"wood": 6, "metal_rough": 60, "metal_smooth": 6},
-    "softball": {"wood": 60, "metal_rough": 6, "metal_smooth": 60, "softball_composite": 6},
-}
-
-
-def unbalanced(config, **over):
-    cfg = copy.deepcopy(config)
-    cfg["datasets"]["synthetic"]["synthetic"]["impacts"] = copy.deepcopy(UNBALANCED)
-    cfg["studies"]["calibration"].update(over)
-    return cfg
 
 
 def test_the_truth_job_runs_the_size_its_plans_use(config, monkeypatch):

@@ -1,7 +1,4 @@
-"""The raw-track chain (Sec. II): rendered tracks reduce back to their truth within the stated errors.
-
-The contact prior's beta weights from logs computed once per grid equal the direct formula (issue 39).
-"""
+"""The contact fit (ballbat.tracks.fit_contact): its prior and its beta weights."""
 
 from __future__ import annotations
 

@@ -1,4 +1,6 @@
-"""The raw-track chain (Sec. II): rendered tracks reduce back to their truth within the stated errors."""
+"""The raw-track chain (Sec. II; ballbat.tracks.reduce): rendered tracks reduce back to their truth within the
+stated errors.
+"""
 
 from __future__ import annotations
 
@@ -7,6 +9,7 @@ from dataclasses import replace
 import numpy as np
 import pytest
 from helpers import BALLS, BATS, experiment, render, render_cfg
+from helpers import reduce_tracks_of as reduce
 
 from ballbat.pipeline.ncio import read_dataset, write_dataset
 from ballbat.stages.reduce import reduction_dataset
@@ -16,12 +19,6 @@ from ballbat.tracks.reduce import FLAG_VAR, ReduceFlag, reduce_tracks
 from ballbat.units import RPM, G
 
 QUANTITIES = ("v_bat", "v_ball", "theta", "omega")
-
-
-def reduce(tr, s, **cams):
-    cameras = {"swing": s.swing.camera, "spin": s.spin.camera}
-    cameras.update(cams)
-    return reduce_tracks(tr, cameras, s.rig)
 
 
 def zscores(red, tr):

@@ -1,4 +1,6 @@
-"""Studies that test systematics (issue 22): grid sweeps, contact-time sweep, drawn calibration, combined intervals."""
+"""The tracks renderer (ballbat.tracks.render): a drawn calibration changes the renderer's scale, not the
+reduction's (issue 22).
+"""
 
 from __future__ import annotations
 

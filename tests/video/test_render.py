@@ -1,4 +1,4 @@
-"""Synthetic clips (ballbat.video.scene, ballbat.video.render; docs/video.md)."""
+"""Synthetic clips (ballbat.video.render; docs/video.md)."""
 
 from __future__ import annotations
 

@@ -1,4 +1,4 @@
-"""Synthetic clips (ballbat.video.scene, ballbat.video.render; docs/video.md)."""
+"""A clip's scene (ballbat.video.scene): its truth is the tracks renderer's without its noise."""
 
 from __future__ import annotations
 

@@ -1,12 +1,4 @@
-"""One chain (issue 33): the chain in memory gives the workflow's files, for every kind of source.
-
-:func:`ballbat.chain.source` and :func:`ballbat.chain.run` on :meth:`DatasetSettings.from_config` are
-what the studies and ``ballbat check`` run; the workflow's rules run the same stages one by one
-through their files. Every variable of reduce.nc / ingest.nc and fit_ex.nc must agree, value for
-value (a rendered dataset's at round-off: its tracks make a round trip through tracks.nc): a
-rendered dataset (the default run's), a measured impacts file (maple), a tracks file (tracked,
-of the lab run) and a folder of Tracker projects (trk, of the lab run; ``ballbat check``'s reduction too).
-"""
+"""One chain (issue 33): the chain in memory gives the workflow's files, for every kind of source."""
 
 from __future__ import annotations
 

@@ -1,7 +1,4 @@
-"""Issue 37 §5: the paper comparison of a bat not in the paper shows the rows that apply, and says why the
-others are left out (the maple example's table was mostly blank rows, its pooled e_x set against the
-paper's pooled e_x of three other bats).
-"""
+"""The maple example's paper comparison, from the suite's lab run (issue 37, section 5)."""
 
 from __future__ import annotations
 

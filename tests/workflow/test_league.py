@@ -1,39 +1,15 @@
-"""The bats league table (issue 37, section 2; docs/league.md): every bat's e_x over test sessions,
-pairwise differences whose shared systematics cancel within a session and add across sessions,
-Holm's adjustment, the consistency test of a bat in several sessions, the equivalence test (TOST),
-``ballbat compare FOLDER...`` and the workflow's league rule.
-
-The fit_ex.nc files here are built by hand (the variables the league reads, written by the
-workflow's writer), so every expected number is a hand computation.
-
-The report's front page (ballbat.frontpage) from small in-memory results.
-"""
+"""The bats league table of the suite's runs and its place on the report's front page (issue 37, section 2)."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 import xarray as xr
+from helpers import league_row as row
+from helpers import league_settings as settings
 
 from ballbat import league
 from ballbat.pipeline.ncio import read_dataset
-
-
-def settings(**kw) -> league.LeagueSettings:
-    return league.LeagueSettings.from_config({"league": kw})
-
-
-def pair(ds: xr.Dataset, a: str, b: str) -> dict:
-    i = next(
-        i for i in range(ds.sizes["pair"]) if {str(ds.pair_bat_a[i].values), str(ds.pair_bat_b[i].values)} == {a, b}
-    )
-    return {k.removeprefix("pair_"): ds[k].values[i] for k in ds.data_vars if ds[k].dims == ("pair",)}
-
-
-def row(ds: xr.Dataset, bat: str) -> dict:
-    i = int(np.flatnonzero(ds["bat"].values == bat)[0])
-    return {k: ds[k].values[i] for k in ds.data_vars if ds[k].dims == ("row",)}
-
 
 # ---------------------------------------------------------------------------------------
 # the workflow's league rule (the shared runs)
@@ -73,8 +49,6 @@ def test_front_page_shows_the_league_table(default_run):
     """Issue 37 §5: a run with more than one bat of a ball has its league table on the front page: each bat's
     e_x from league.nc, highest first per ball, and every pair of bats with its Holm-adjusted p.
     """
-    import xarray as xr
-
     from ballbat.frontpage import round_pm
 
     front = (default_run / "results" / "report" / "front.rst").read_text()

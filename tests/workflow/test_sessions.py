@@ -1,27 +1,16 @@
-"""Issue 37 §1: test sessions. A run's results folder is a setting; a folder's crate carries every run in
-it; a folder's workbooks keep every scenario's sheet; three sessions' folders make one league table.
+"""Test sessions through Snakemake (issue 37, section 1): three sessions' folders make one league table, a
+rerun keeps a lab's scenario, a results file given after --configfile is named.
 """
 
 from __future__ import annotations
 
-import json
-
 import numpy as np
 import pytest
+from helpers import crate_graph as _graph
+from helpers import crate_ids as _ids
 
 from ballbat.pipeline.cratefiles import crate_file_problems
 from ballbat.pipeline.provenance import sha256_file
-
-
-def _graph(results):
-    doc = json.loads((results / "ro-crate-metadata.json").read_text())
-    return {e["@id"]: e for e in doc["@graph"]}
-
-
-def _ids(value):
-    refs = value if isinstance(value, list) else [value]
-    return sorted(r["@id"] for r in refs)
-
 
 # -- real runs: sessions in their own folders, a folder's workbook and crate over two configs ---------
 

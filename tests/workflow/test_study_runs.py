@@ -1,6 +1,5 @@
-"""Studies that test systematics (issue 22): grid sweeps, contact-time sweep, drawn calibration, combined intervals.
-
-A study's truth job: one rule for its size, shared by the job, its plans and the size guard (issue 40).
+"""Studies through Snakemake: the robustness study's DAG and a small run, each truth job at its plan's memory
+(issues 22, 40).
 """
 
 from __future__ import annotations
@@ -13,6 +12,7 @@ import re
 
 import pytest
 import xarray as xr
+from helpers import UNBALANCED
 
 from ballbat.studies.settings import StudySettings
 
@@ -52,14 +52,6 @@ def test_a_small_robustness_study_runs_through_snakemake(lab_run):
     )  # drawn calibration: e_x's pixel-scale systematic
     assert_not_blank(res / "grid.png")
     assert not (res / "design.csv").exists()  # a grid has no design table
-
-
-#: The unbalanced design of issue 40: 6 impacts on some bats and 60 on others, the softball bat
-#: swung with softballs only (102 of the 204 impacts on three pairs of 60).
-UNBALANCED = {
-    "baseball": {"wood": 6, "metal_rough": 60, "metal_smooth": 6},
-    "softball": {"wood": 60, "metal_rough": 6, "metal_smooth": 60, "softball_composite": 6},
-}
 
 
 def test_the_workflow_schedules_each_truth_job_at_its_plan(tmp_path):

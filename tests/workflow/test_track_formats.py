@@ -1,8 +1,4 @@
-"""Reading the tracking tools' own files (docs/tracks.md, "Files of tracking tools").
-
-The files are written by tests/track_files.py, shaped as Tracker and Kinovea write them, from
-the tracks of config/examples/tracked_tracks.csv (rendered by ballbat's renderer).
-"""
+"""Tool files through the workflow: Tracker and Kinovea files give the long CSV's e_x end to end."""
 
 from __future__ import annotations
 

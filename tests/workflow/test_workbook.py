@@ -1,58 +1,12 @@
-"""Unit tests of the results workbooks (ballbat.workbook) on small in-memory results.
-
-Each workbook is written to a real .xlsx file and read back with openpyxl: the sheets, the two
-header rows, every cell's value in the field's units, the number formats that round it, the
-provenance sheet, the custom document properties and the fixed document time.
-"""
+"""The default run's workbooks read in words (ballbat.workbook on a real run)."""
 
 from __future__ import annotations
 
-import json
-
-import numpy as np
 import openpyxl
 import pytest
-import xarray as xr
+from helpers import sheet_rows as rows
 
 from ballbat import workbook
-from ballbat.kinematics import ImpactFlag
-from ballbat.pipeline.products import flag_attrs
-from ballbat.units import DEGREE, INCH, MPH, RPM
-
-PROVENANCE = {
-    "provenance_rule": "reconstruct",
-    "provenance_inputs": json.dumps([{"name": "normalize", "path": "results/t/normalize.nc", "sha256": "ab12"}]),
-    "provenance_config": json.dumps({"v_ref_mph": 77.0}),
-    "provenance_software": json.dumps({"ballbat": "9.9"}),
-    "provenance_git": json.dumps({"commit": "unknown", "dirty": False}),
-}
-
-
-def impacts() -> xr.Dataset:
-    """Three impacts as reconstruct.nc holds them (SI), one with a missing spin and one flagged."""
-    n = 3
-    return xr.Dataset(
-        {
-            "impact_id": ("impact", np.array(["A1", "A2", "A3"])),
-            "ball": ("impact", np.array(["baseball", "baseball", "softball"])),
-            "bat": ("impact", np.array(["wood", "wood", "metal"])),
-            "v_bat": ("impact", np.array([70.0, 75.0, 80.0]) * MPH),
-            "v_bat_err": ("impact", np.array([0.5, 0.5, 0.25]) * MPH),
-            "theta": ("impact", np.array([10.0, -5.5, 20.25]) * DEGREE),
-            "omega": ("impact", np.array([1900.0, np.nan, 2500.4]) * RPM),
-            "D": ("impact", np.array([0.5, 1.25, -0.75]) * INCH),
-            "r_x": ("impact", np.full(n, 0.2)),
-            "flag": ("impact", np.array([0, 0, 4], dtype=np.int8), flag_attrs(ImpactFlag)),
-            "flag_reason": ("impact", np.array(["ok", "ok", "excluded at ingest"])),
-        },
-        coords={"impact": ("impact", np.arange(n))},
-        attrs={**PROVENANCE, "title": "reconstruct", "ingest_warnings": "first warning\nsecond warning\n"},
-    )
-
-
-def rows(ws) -> list[list]:
-    return [[c.value for c in row] for row in ws.iter_rows()]
-
 
 # ---------------------------------------------------------------------------------------
 # Issue 37 §5: a workbook a lab reads (headers in words with units, legends, widths, frozen headers)

@@ -1,40 +1,20 @@
-"""Reading the tracking tools' own files (docs/tracks.md, "Files of tracking tools").
-
-The files are written by tests/track_files.py, shaped as Tracker and Kinovea write them, from
-the tracks of config/examples/tracked_tracks.csv (rendered by ballbat's renderer).
-"""
+"""Kinovea files (ballbat.tracks.formats.kinovea): timestamps and calibration (docs/tracks.md)."""
 
 from __future__ import annotations
 
-from pathlib import Path
 from xml.etree import ElementTree as ET
 
-import numpy as np
+import helpers
 import pytest
+from helpers import same_tracks as _same
 from track_files import (
     kva_text,
-    read_long_csv,
 )
 
 from ballbat.tracks.formats import FormatError
 from ballbat.tracks.formats.kinovea import read_kva
 
-ROOT = Path(__file__).resolve().parents[3]
-EXAMPLE = ROOT / "config" / "examples"
-
-
-@pytest.fixture(scope="module")
-def rows():
-    return read_long_csv(EXAMPLE / "tracked_tracks.csv")
-
-
-def _same(got, want, tol=0.0):
-    assert set(got) == set(want)
-    for name, (f, x, y) in want.items():
-        gf, gx, gy = got[name]
-        np.testing.assert_array_equal(gf - gf.min(), f - f.min())
-        np.testing.assert_allclose(gx - gx[0], x - x[0], atol=tol, rtol=0)
-        np.testing.assert_allclose(gy - gy[0], y - y[0], atol=tol, rtol=0)
+rows = helpers.rows  # a fixture of tests/helpers.py
 
 
 def test_kva_timestamps_calibration(tmp_path, rows):

@@ -1,18 +1,15 @@
-"""Reading the tracking tools' own files (docs/tracks.md, "Files of tracking tools").
-
-The files are written by tests/track_files.py, shaped as Tracker and Kinovea write them, from
-the tracks of config/examples/tracked_tracks.csv (rendered by ballbat's renderer).
+"""A folder of tool files (ballbat.tracks.formats.layout): its settings, the config that contradicts a file,
+one scale per camera, every format giving the same tracks (docs/tracks.md).
 """
 
 from __future__ import annotations
 
-from pathlib import Path
-
+import helpers
 import numpy as np
 import pytest
+from helpers import EXAMPLE
 from track_files import (
     TOOL_NAMES,
-    read_long_csv,
     trk_text,
     write_lab_folder,
 )
@@ -23,16 +20,11 @@ from ballbat.tracks.data import with_found_settings
 from ballbat.tracks.formats import FormatError
 from ballbat.tracks.formats.layout import import_block, import_files
 
-ROOT = Path(__file__).resolve().parents[3]
-EXAMPLE = ROOT / "config" / "examples"
+rows = helpers.rows  # a fixture of tests/helpers.py
+
 CAMS = {"swing": {"fps": 3000.0, "m_per_px": 0.00074}, "spin": {"fps": 1000.0, "m_per_px": 0.00125}}
 POINTS = dict(TOOL_NAMES)
 TABLE_UNITS = {"time": "ms", "length": "cm", "y": "up"}
-
-
-@pytest.fixture(scope="module")
-def rows():
-    return read_long_csv(EXAMPLE / "tracked_tracks.csv")
 
 
 def test_tables_need_units_and_settings(tmp_path, rows):

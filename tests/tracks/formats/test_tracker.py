@@ -1,20 +1,16 @@
-"""Reading the tracking tools' own files (docs/tracks.md, "Files of tracking tools").
-
-The files are written by tests/track_files.py, shaped as Tracker and Kinovea write them, from
-the tracks of config/examples/tracked_tracks.csv (rendered by ballbat's renderer).
-"""
+"""Tracker projects (ballbat.tracks.formats.tracker): .trk marks, frames and settings, .trz (docs/tracks.md)."""
 
 from __future__ import annotations
 
 import copy
 import zipfile
-from pathlib import Path
 from xml.etree import ElementTree as ET
 
+import helpers
 import numpy as np
 import pytest
+from helpers import same_tracks as _same
 from track_files import (
-    read_long_csv,
     trk_text,
     write_trz,
 )
@@ -22,22 +18,7 @@ from track_files import (
 from ballbat.tracks.formats import FormatError
 from ballbat.tracks.formats.tracker import read_trk, read_trz
 
-ROOT = Path(__file__).resolve().parents[3]
-EXAMPLE = ROOT / "config" / "examples"
-
-
-@pytest.fixture(scope="module")
-def rows():
-    return read_long_csv(EXAMPLE / "tracked_tracks.csv")
-
-
-def _same(got, want, tol=0.0):
-    assert set(got) == set(want)
-    for name, (f, x, y) in want.items():
-        gf, gx, gy = got[name]
-        np.testing.assert_array_equal(gf - gf.min(), f - f.min())
-        np.testing.assert_allclose(gx - gx[0], x - x[0], atol=tol, rtol=0)
-        np.testing.assert_allclose(gy - gy[0], y - y[0], atol=tol, rtol=0)
+rows = helpers.rows  # a fixture of tests/helpers.py
 
 
 def test_trk_gives_the_marks_frames_and_settings(tmp_path, rows):
