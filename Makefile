@@ -79,12 +79,12 @@ report: run
 	$(BIN)/snakemake -c$(CORES) --report results/report.html
 
 # The report in a real browser: Debian's chromium (installed if missing; root needed), the
-# default run's report (make report), then tests/test_report_browser.py opens it headless,
+# default run's report (make report), then tests/workflow/test_report_browser.py opens it headless,
 # 1400 px wide: figures load, a caption and the front page show the fitted numbers.
 # Screenshot of the front page: results/report-front.png.
 test-report: report
 	command -v chromium >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null; }
-	BALLBAT_REPORT_ROOT=$(CURDIR) BALLBAT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest tests/test_report_browser.py
+	BALLBAT_REPORT_ROOT=$(CURDIR) BALLBAT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest tests/workflow/test_report_browser.py
 
 bench: install
 	$(BIN)/python bench/bench_workflow.py

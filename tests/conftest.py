@@ -215,37 +215,47 @@ LAB_STUDIES = {
 }
 
 
-#: The order of the test modules (``make test``: ``--dist loadscope --no-loadscope-reorder``, a
-#: module per pytest-xdist process, in this order, each process taking the next module when it is
-#: nearly done), so that both processes stay busy and end together. One process builds the lab run
-#: (test_workflow.py, its first module) while the other builds the default run and runs its tests,
-#: then the unit tests (no shared run); the lab run's other tests come last (:data:`LAST`), so that
-#: no process waits for the lab run while there is other work, and both share its reruns.
+#: The order of the test modules, as paths relative to tests/ (``make test``: ``--dist loadscope
+#: --no-loadscope-reorder``, a module per pytest-xdist process, in this order, each process taking the
+#: next module when it is nearly done), so that both processes stay busy and end together. One process
+#: builds the lab run (workflow/test_outputs.py, its first module) while the other builds the default
+#: run and runs its tests, then the unit tests (no shared run); the lab run's other tests come last
+#: (:data:`LAST`), so that no process waits for the lab run while there is other work, and both share
+#: its reruns.
 FIRST = (
-    "test_workflow.py",
-    "test_crate.py",
-    "test_lab_numbers.py",
-    "test_redteam3_diagnoses.py",
-    "test_report_browser.py",
+    "workflow/test_outputs.py",
+    "workflow/test_crate.py",
+    "workflow/test_lab_numbers.py",
+    "workflow/test_diagnoses.py",
+    "workflow/test_report_browser.py",
 )
 
 #: The modules that copy or read the lab run, after every other module: the heaviest first (their
 #: Snakemake reruns), the quick ones last so that the two processes end together.
 LAST = (
-    "test_faults_runs.py",
-    "test_faults.py",
-    "test_workflow_rerun.py",
-    "test_redteam_guards.py",
-    "test_byod.py",
-    "test_redteam.py",
-    "test_studies.py",
-    "test_study_grid.py",
-    "test_track_formats.py",
+    "workflow/test_faults_runs.py",
+    "workflow/test_faults.py",
+    "workflow/test_reruns.py",
+    "workflow/test_guards.py",
+    "workflow/test_byod.py",
+    "workflow/test_redteam.py",
+    "workflow/test_studies.py",
+    "workflow/test_study_runs.py",
+    "workflow/test_track_formats.py",
 )
+
+#: The folder of the test modules: :data:`FIRST` and :data:`LAST` name them by their path relative to it
+#: (basenames repeat: tests/test_ingest.py, tests/stages/test_ingest.py).
+TESTS = Path(__file__).resolve().parent
+
+
+def module_key(path: Path) -> str:
+    """A test module's path relative to tests/, with forward slashes (as :data:`FIRST` and :data:`LAST` name it)."""
+    return Path(path).resolve().relative_to(TESTS).as_posix()
 
 
 def pytest_collection_modifyitems(config, items):
     """Order the modules: :data:`FIRST`, the rest as collected, then :data:`LAST` (the same order in every process)."""
     rank = {name: i for i, name in enumerate(FIRST)}
     rank.update({name: len(FIRST) + 1 + i for i, name in enumerate(LAST)})
-    items.sort(key=lambda item: rank.get(item.path.name, len(FIRST)))
+    items.sort(key=lambda item: rank.get(module_key(item.path), len(FIRST)))

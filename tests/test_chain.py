@@ -1,11 +1,5 @@
-"""One chain (issue 33): the chain in memory gives the workflow's files, for every kind of source.
-
-:func:`ballbat.chain.source` and :func:`ballbat.chain.run` on :meth:`DatasetSettings.from_config` are
-what the studies and ``ballbat check`` run; the workflow's rules run the same stages one by one
-through their files. Every variable of reduce.nc / ingest.nc and fit_ex.nc must agree, value for
-value (a rendered dataset's at round-off: its tracks make a round trip through tracks.nc): a
-rendered dataset (the default run's), a measured impacts file (maple), a tracks file (tracked,
-of the lab run) and a folder of Tracker projects (trk, of the lab run; ``ballbat check``'s reduction too).
+"""One chain (ballbat.chain): a replicate is a replace of the seeds; check uses the workflow's defaults; the
+stages' settings are frozen and come from the validated config (issue 33).
 """
 
 from __future__ import annotations
@@ -13,79 +7,13 @@ from __future__ import annotations
 import copy
 import dataclasses
 
-import numpy as np
 import pytest
-import xarray as xr
-import yaml
 
 from ballbat import chain
-from ballbat.config_checks import validate_config
-from ballbat.pipeline.config import packaged_schema
-from ballbat.properties import load_balls, load_bats
-from ballbat.tracks.io import load_tracks
-
-
-def _config(work, extra: str | None = None) -> dict:
-    cfg = yaml.safe_load((work / "config" / "config.yaml").read_text())
-    if extra:
-        cfg["datasets"].update(yaml.safe_load((work / extra).read_text())["datasets"])
-    return validate_config(cfg, packaged_schema(), available=64 * 2**30)
-
-
-def _same(memory: xr.Dataset, path, rtol: float = 0.0) -> None:
-    """Every data variable of the file, value for value (floats within ``rtol``), in the Dataset made in memory."""
-    with xr.open_dataset(path) as ds:
-        names = [k for k in ds.data_vars if not k.endswith("_shift")]
-        assert names, path
-        for k in names:
-            assert k in memory, f"{path.name}: {k} not made by the chain"
-            a, b = memory[k].values, ds[k].values
-            if a.dtype.kind in "fc":
-                np.testing.assert_allclose(a, b, rtol=rtol, atol=0, err_msg=f"{path.name}: {k}")
-            else:
-                assert a.astype(str).tolist() == b.astype(str).tolist(), f"{path.name}: {k}"
-
-
-@pytest.mark.slow
-def test_a_rendered_dataset(default_run, monkeypatch):
-    """The default dataset: simulate, render and reduce in memory, then the fits: reduce.nc and fit_ex.nc."""
-    monkeypatch.chdir(default_run)
-    settings = chain.DatasetSettings.from_config(_config(default_run), "synthetic")
-    assert settings.render is not None and settings.reduce is not None and settings.reduce.systematics
-    balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
-    src = chain.source(settings, balls, bats)
-    res = default_run / "results" / "synthetic"
-    # the workflow's tracks go through tracks.nc and are laid out again from its long table (each
-    # track from its first tracked frame): times differ at round-off (3e-12 s, 1e-8 of a frame)
-    _same(src, res / "reduce.nc", rtol=1e-7)
-    out = chain.run(settings, src, balls, bats)
-    _same(out.reconstruct, res / "reconstruct.nc", rtol=1e-7)
-    _same(out.fit_ex, res / "fit_ex.nc", rtol=1e-7)
-
-
-@pytest.mark.slow
-def test_a_measured_file_and_a_tracks_file(lab_run, monkeypatch):
-    """Maple's impacts file (ingest) and the tracked example's tracks file (reduce), as the lab run made them."""
-    monkeypatch.chdir(lab_run)
-    cfg = _config(lab_run)
-    maple = chain.DatasetSettings.from_config(cfg, "maple")
-    assert maple.synthetic is None and maple.reduce is None
-    block = cfg["datasets"]["maple"]
-    tables = {k: block.get(k, cfg["tables"][k]) for k in ("balls", "bats")}
-    src = chain.ingest(block["impacts"], tables["balls"], tables["bats"])
-    res = lab_run / "results"
-    _same(src, res / "maple" / "ingest.nc")
-    fit = chain.run(maple, src, load_balls(tables["balls"]), load_bats(tables["bats"])).fit_ex
-    _same(fit, res / "maple" / "fit_ex.nc")
-
-    cfg = _config(lab_run, "tools.yaml")
-    tracked = chain.DatasetSettings.from_config(cfg, "tracked")
-    balls, bats = load_balls(cfg["tables"]["balls"]), load_bats(cfg["tables"]["bats"])
-    block = cfg["datasets"]["tracked"]["tracks"]
-    tracks = load_tracks(block["file"], block["impacts"], balls, bats)
-    src = chain.source(tracked, balls, bats, tracks=tracks, source_file=block["file"])
-    _same(src, res / "tracked" / "reduce.nc")
-    _same(chain.run(tracked, src, balls, bats).fit_ex, res / "tracked" / "fit_ex.nc")
+from ballbat.stages import fit_ex, implications, ingest, normalize, reconstruct, reduce, render, simulate, stronge
+from ballbat.synthetic import SyntheticSettings
+from ballbat.tracks.data import camera_block
+from ballbat.tracks.render import settings_from_config
 
 
 def test_a_replicate_is_a_replace_of_the_seeds(config):
@@ -109,34 +37,42 @@ def test_check_uses_the_workflows_defaults(config):
     assert copy.deepcopy(check.block) == {"impacts": "x.csv"}
 
 
-@pytest.mark.slow
-def test_a_folder_of_tracker_files(lab_run, monkeypatch):
-    """The lab run's ``trk`` dataset (a folder of Tracker projects): the chain in memory, and ``ballbat check``'s
-    reduction of the same block, give the workflow's reduce.nc (import_tracks, then reduce) and fit_ex.nc.
-    """
-    from ballbat.stages import reduce
-    from ballbat.tracks.data import camera_block, with_found_settings
-    from ballbat.tracks.formats.layout import import_block
+# ---------------------------------------------------------------------------------------
+# settings
 
-    monkeypatch.chdir(lab_run)
-    cfg = _config(lab_run, "tools.yaml")
-    balls, bats = load_balls(cfg["tables"]["balls"]), load_bats(cfg["tables"]["bats"])
-    block = cfg["datasets"]["trk"]["tracks"]
-    res = lab_run / "results" / "trk"
-    tracks, imported = import_block(block, "datasets.trk.tracks", balls, bats)
-    found = with_found_settings(camera_block(block), imported.settings_yaml())
-    settings = chain.DatasetSettings.from_config(cfg, "trk")
-    settings = dataclasses.replace(
-        settings, reduce=reduce.ReduceSettings.from_config(found, "datasets.trk.tracks", systematics=True)
+
+NEW_SETTINGS = (
+    fit_ex.FitExSettings,
+    normalize.NormalizeSettings,
+    reconstruct.ReconstructSettings,
+    stronge.StrongeSettings,
+    reduce.ReduceSettings,
+    ingest.IngestSettings,
+    implications.ImplicationsSettings,
+)
+
+
+@pytest.mark.parametrize("cls", NEW_SETTINGS, ids=lambda c: c.__name__)
+def test_stage_settings_are_frozen_and_have_no_code_defaults(cls):
+    """Values come from the validated config alone (defaults live in the schema)."""
+    assert cls.__dataclass_params__.frozen
+    for f in dataclasses.fields(cls):
+        assert f.default is dataclasses.MISSING and f.default_factory is dataclasses.MISSING, f.name
+
+
+def test_settings_from_the_validated_config(config):
+    assert fit_ex.FitExSettings.from_config(config) == fit_ex.FitExSettings(
+        config["analysis"]["mu_k_example"], systematic=True, check_physical=True
     )
-    # exactly: the import's tracks file keeps every digit of the pixels
-    src = chain.source(settings, balls, bats, tracks=tracks)
-    _same(src, res / "reduce.nc")
-    _same(chain.run(settings, src, balls, bats).fit_ex, res / "fit_ex.nc")
-    red, verdict = chain.reduce_tracks_block(block, "datasets.trk.tracks", balls, bats)  # ballbat check's
-    checked = reduce.reduction_dataset(red)
-    with xr.open_dataset(res / "reduce.nc") as ds:  # a check runs no calibration reruns: no systematic's variables
-        syst = {k for k in ds.data_vars if "systematic" in ds[k].dims or k.startswith("systematic")}
-    assert syst and not syst & set(checked.data_vars)
-    _same(checked.assign({k: src[k] for k in syst}), res / "reduce.nc")
-    assert verdict.lines and "\n".join(verdict.lines) == src.attrs["reduce_checks"]
+    assert normalize.NormalizeSettings.from_config(config).v_ref_mph == config["normalize"]["v_ref_mph"]
+    assert dataclasses.asdict(stronge.StrongeSettings.from_config(config)) == config["stronge"]
+    block = config["datasets"]["synthetic"]["render"]
+    rs = reduce.ReduceSettings.from_config(camera_block(block), "render", systematics=False)
+    assert rs.cameras["swing"].fps == block["cameras"]["swing"]["fps"]
+    assert rs.rig.pivot_to_impact == pytest.approx(block["rig"]["pivot_to_impact_in"] * 0.0254)
+    assert simulate.from_config(config, "synthetic") == SyntheticSettings(
+        **config["datasets"]["synthetic"]["synthetic"]
+    )
+    assert render.from_config(config, "synthetic") == settings_from_config(block)
+    with pytest.raises(dataclasses.FrozenInstanceError):
+        normalize.NormalizeSettings(77.0).v_ref_mph = 80.0  # type: ignore[misc]

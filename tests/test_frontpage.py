@@ -255,27 +255,3 @@ def test_names_render_literally():
     sc = xr.Dataset(coords={"case": np.arange(2)}, attrs={"kind": "launch", "ball": "ball_", "bat": "*odd*"})
     html = render(fp.scenario_line("my_run_", sc))
     assert "<strong>my_run_</strong> (launch conditions): ball_ on the *odd* bat; 2 cases." in html
-
-
-@pytest.mark.slow
-def test_front_page_shows_the_league_table(default_run):
-    """Issue 37 §5: a run with more than one bat of a ball has its league table on the front page: each bat's
-    e_x from league.nc, highest first per ball, and every pair of bats with its Holm-adjusted p.
-    """
-    import xarray as xr
-
-    from ballbat.frontpage import round_pm
-
-    front = (default_run / "results" / "report" / "front.rst").read_text()
-    assert "Bats league table" in front
-    league = xr.open_dataset(default_run / "results" / "league.nc")
-    section = front[front.index("Bats league table") :]
-    for i in range(league.sizes["row"]):
-        v, s, _ = round_pm(float(league["e_x"][i]), float(league["e_x_stat"][i]), float(league["e_x_syst"][i]))
-        assert f"**{v}**" in section and f"± {s}" in section
-    table = section[: section.index("every pair of bats")].split("   * - ")[2:]  # the header row first
-    shown = [(r.split("\n")[0], float(r.split("**")[1])) for r in table]
-    for ball in ("baseball", "softball"):
-        e_x = [v for b, v in shown if b == ball]
-        assert e_x == sorted(e_x, reverse=True) and len(e_x) == int((league["ball"] == ball).sum())
-    assert section.count("p (Holm)") == 1 and section.count(" − ") == league.sizes["pair"]

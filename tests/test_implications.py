@@ -1,39 +1,19 @@
-"""Sec. V.B scenarios: the paper's D sweep shows what the paper reports; launch scenarios."""
+"""Sec. V.B (ballbat.implications): the paper's D sweep shows what the paper reports; air density, launch grids."""
 
-import copy
+from __future__ import annotations
 
+import helpers
 import numpy as np
 import pytest
-import yaml
 
-from ballbat.config_checks import validate_config
-from ballbat.implications import comparison_rows, density_from_conditions, launch_conditions
-from ballbat.stages.implications import ImplicationsSettings
-from ballbat.stages.implications import run as run_scenario
+from ballbat.implications import density_from_conditions, launch_conditions
 from ballbat.units import DEGREE, FOOT, INCH, MPH, RPM
 
+paper = helpers.paper  # a fixture of tests/helpers.py
 
-@pytest.fixture(scope="module")
-def cfg(config):
-    return config["implications"]
+complete = helpers.complete  # a fixture of tests/helpers.py
 
-
-@pytest.fixture(scope="module")
-def complete(config, root):
-    """A scenario as the workflow sees it: checked against the schema, its defaults filled."""
-    schema = yaml.safe_load((root / "workflow" / "schemas" / "config.schema.yaml").read_text())
-
-    def fill(sc):
-        cfg = copy.deepcopy(config)
-        cfg["implications"]["scenarios"] = {"s": sc}
-        return validate_config(cfg, schema)["implications"]["scenarios"]["s"]
-
-    return fill
-
-
-@pytest.fixture(scope="module")
-def paper(cfg, balls, bats):
-    return run_scenario(ImplicationsSettings(cfg["scenarios"]["paper"], cfg["air"]), balls, bats)
+cfg = helpers.cfg  # a fixture of tests/helpers.py
 
 
 def test_default_air_density(cfg):
@@ -69,13 +49,6 @@ def test_paper_sweep_matches_sec_VB(paper):
     assert np.all(np.diff(paper.friction_ratio.values) > 0)
 
 
-def test_comparison_rows(paper):
-    rows = {r["quantity"]: r for r in comparison_rows(paper)}
-    assert rows["carry_max"]["unit"] == "ft" and 375 < rows["carry_max"]["value"] < 425
-    assert rows["D_at_exit_speed_max"]["value"] == pytest.approx(0.0, abs=0.1)
-    assert rows["backspin_at_D0"]["value"] < 0
-
-
 def test_launch_conditions_grid_and_list(complete):
     def launch(**kw):
         return complete({"ball": "baseball", "launch": kw})["launch"]
@@ -87,22 +60,3 @@ def test_launch_conditions_grid_and_list(complete):
     np.testing.assert_allclose(lst["backspin"], 2000 * RPM)
     with pytest.raises(ValueError, match=r"the lists must have one length.*exit_speed_mph has 2, launch_deg has 3"):
         launch_conditions(launch(exit_speed_mph=[90, 100], launch_deg=[20, 25, 30], combine="list"))
-
-
-def test_launch_scenario_flies_calculator_case(cfg, complete, balls, bats):
-    # The calculator's published case with our baseball (5.04 oz, r = 1.42 in), not its 5.125 oz:
-    # a lighter, smaller ball; only check it flies to the right neighbourhood and is sane.
-    sc = complete({"ball": "baseball", "launch": {"exit_speed_mph": 103, "launch_deg": 27.5, "backspin_rpm": 2500}})
-    ds = run_scenario(ImplicationsSettings(sc, cfg["air"]), balls, bats)
-    assert ds.sizes["case"] == 1
-    assert 400 < float(ds.carry[0]) / FOOT < 440
-    assert float(ds.trajectory_z[0, -1]) == pytest.approx(0.0, abs=1e-6)
-
-
-def test_unknown_ball_or_bat(cfg, complete, balls, bats):
-    cricket = complete({"ball": "cricket", "launch": {"exit_speed_mph": 90, "launch_deg": 20}})
-    with pytest.raises(ValueError, match="scenario ball 'cricket' is not in the ball table"):
-        run_scenario(ImplicationsSettings(cricket, cfg["air"]), balls, bats)
-    sc = {**cfg["scenarios"]["paper"], "bat": "oak"}
-    with pytest.raises(ValueError, match="scenario bat 'oak' is not in the bat table"):
-        run_scenario(ImplicationsSettings(sc, cfg["air"]), balls, bats)

@@ -1,4 +1,9 @@
-"""Sec. III kinematics: forward model, psi reconstruction, normalisation (Kensrud et al. 2017)."""
+"""Sec. III kinematics: forward model, psi reconstruction, normalisation (Kensrud et al. 2017).
+
+Tables I-II, unit conversions and the recoil factors (Sec. III, Eqs. rx and ry).
+"""
+
+from __future__ import annotations
 
 import numpy as np
 import pytest
@@ -8,6 +13,7 @@ from ballbat.kinematics import (
     e_y_from_tan_ratio_slope,
     gross_slip_onset,
     normalize_to_bat_speed,
+    offset_from_psi,
     reconstruct_psi,
     spin_bracket,
     tan_ratio_slope_model,
@@ -15,7 +21,7 @@ from ballbat.kinematics import (
     vtf_ordinate,
 )
 from ballbat.properties import recoil_factors
-from ballbat.units import DEGREE, MPH, RPM
+from ballbat.units import DEGREE, INCH, MPH, RPM
 
 
 @pytest.fixture
@@ -93,3 +99,19 @@ def test_sec4_gross_slip_example(balls, bats):
 def test_e_y_inversion_round_trip():
     s = tan_ratio_slope_model(0.4, 0.45, 0.25, 0.23)
     assert e_y_from_tan_ratio_slope(s, 0.4, 0.25, 0.23) == pytest.approx(0.45, rel=1e-13)
+
+
+@pytest.mark.parametrize(
+    ("ball", "bat", "D_max_in"),
+    [
+        # Table I: psi_max 30 deg -> D_max 1.35 in (baseball); 41 deg -> 2.00 in (softball).
+        # The paper does not say which bat's R; the metal bats (R = 1.28-1.29 in) reproduce the
+        # baseball value and the softball composite bat (R = 1.13 in) the softball value.
+        ("baseball", "metal_rough", 1.35),
+        ("softball", "softball_composite", 2.00),
+    ],
+)
+def test_table1_D_max_from_psi_max(balls, bats, ball, bat, D_max_in):
+    D = offset_from_psi(balls[ball].psi_max, balls[ball].r, bats[bat].R)
+    assert D / INCH == pytest.approx(D_max_in, abs=0.015)  # Table I rounds to 0.01 in
+    assert balls[ball].psi_max == pytest.approx({"baseball": 30, "softball": 41}[ball] * DEGREE)

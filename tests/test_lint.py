@@ -111,13 +111,81 @@ def test_functions_stay_short():
     assert lengths.function_lengths(root / "tracks" / "reduce.py")  # the count sees the functions
 
 
+def _test_module_imports(source: str) -> list[str]:
+    """The modules a source imports that are test modules (a dotted part named test_*: ``stages.test_ingest``)."""
+    names = []
+    for node in ast.walk(ast.parse(source)):
+        if isinstance(node, ast.Import):
+            names += [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            names.append(node.module)
+    return [n for n in names if any(part.startswith("test_") for part in n.split("."))]
+
+
+def test_the_scan_sees_test_modules_in_subfolders():
+    """Whatever the folder, an import of a test module is found, and one of a helper is not."""
+    for source in ("import test_lint", "from stages.test_ingest import ROOT", "import workflow.test_outputs as w"):
+        assert _test_module_imports(source), source
+    assert _test_module_imports("import helpers\nfrom workflow_helpers import snakemake\nimport forked") == []
+
+
 def test_no_test_module_imports_another(root):
     """Shared test helpers live in conftest.py or helpers.py / workflow_helpers.py, not in a test module."""
     found = []
-    for path in sorted((root / "tests").glob("*.py")):
-        for node in ast.walk(ast.parse(path.read_text())):
-            names = [a.name for a in node.names] if isinstance(node, ast.Import) else []
-            if isinstance(node, ast.ImportFrom) and node.module:
-                names = [node.module]
-            found += [f"{path.name}: {n}" for n in names if n.split(".")[0].startswith("test_")]
+    for path in sorted((root / "tests").rglob("*.py")):
+        rel = path.relative_to(root / "tests").as_posix()
+        found += [f"{rel}: {name}" for name in _test_module_imports(path.read_text())]
     assert found == []
+
+
+#: Test modules under tests/ that check the project as a whole, not one module of the package.
+PROJECT_CHECKS = {"test_docs.py", "test_import_graph.py", "test_lint.py", "test_release.py", "test_example_scripts.py"}
+
+
+def layout_problems(tests: Path, package: Path) -> list[str]:
+    """The test modules under ``tests`` (outside workflow/) not named after a package module at the mirrored path.
+
+    ``tests/SUB/test_X.py`` tests ``src/ballbat/SUB/X.py``; the Snakemake runs live under ``tests/workflow/``.
+    """
+    problems = []
+    for path in sorted(tests.rglob("test_*.py")):
+        rel = path.relative_to(tests)
+        if rel.parts[0] in ("workflow", "data") or rel.as_posix() in PROJECT_CHECKS:
+            continue
+        module = package.joinpath(*rel.parts[:-1], rel.name.removeprefix("test_"))
+        if not module.is_file():
+            problems.append(f"tests/{rel.as_posix()}: no src/ballbat/{module.relative_to(package).as_posix()}")
+        elif rel.parts[:-1] and not (path.parent / "__init__.py").is_file():
+            problems.append(f"tests/{rel.as_posix()}: its folder has no __init__.py (module names would clash)")
+    return problems
+
+
+def test_tests_mirror_the_package(root):
+    """Every test module outside tests/workflow/ is named after a package module at the mirrored path (issue 33)."""
+    assert layout_problems(root / "tests", root / "src" / "ballbat") == []
+    assert (root / "tests" / "workflow" / "__init__.py").is_file()
+
+
+def test_the_layout_check_finds_a_stray_module(tmp_path):
+    """A test module named after no module, or in a folder the package has not, is named."""
+    package = tmp_path / "src" / "ballbat"
+    (package / "stages").mkdir(parents=True)
+    (package / "collision.py").write_text("")
+    (package / "stages" / "ingest.py").write_text("")
+    tests = tmp_path / "tests"
+    (tests / "stages").mkdir(parents=True)
+    (tests / "stages" / "__init__.py").write_text("")
+    for name in ("test_collision.py", "test_redteam.py", "stages/test_ingest.py", "stages/test_collision.py"):
+        (tests / name).write_text("")
+    assert layout_problems(tests, package) == [
+        "tests/stages/test_collision.py: no src/ballbat/stages/collision.py",
+        "tests/test_redteam.py: no src/ballbat/redteam.py",
+    ]
+
+
+def test_the_module_order_names_existing_modules(root):
+    """The module order (conftest's FIRST and LAST) names test modules that exist (by their path relative to tests/)."""
+    import conftest
+
+    missing = [name for name in conftest.FIRST + conftest.LAST if not (root / "tests" / name).is_file()]
+    assert missing == []

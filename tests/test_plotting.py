@@ -1,4 +1,4 @@
-"""Figures and report text, from small fake datasets (the workflow's figures: test_workflow.py)."""
+"""Figures and report text, from small fake datasets (the workflow's figures: workflow/test_outputs.py)."""
 
 from __future__ import annotations
 
@@ -7,8 +7,7 @@ import pytest
 import xarray as xr
 from PIL import Image
 
-from ballbat import plotting, reporting
-from ballbat.pipeline.checked import sealed_csv
+from ballbat import plotting
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.pipeline.products import build_dataset
 from ballbat.stages.stronge import STRONGE_COORDS, stronge_variables
@@ -17,10 +16,6 @@ from ballbat.stronge.regimes import Regime
 from workflow_helpers import assert_not_blank
 
 BALLS = ["baseball", "softball"]
-
-
-def _attrs(units, long_name):
-    return {"units": units, "long_name": long_name}
 
 
 def fake_stronge() -> xr.Dataset:
@@ -102,15 +97,6 @@ def fake_stronge() -> xr.Dataset:
         coords={name: (var, coords[name]) for name, var in STRONGE_COORDS.items()},
         attrs={"psi_history_deg": 30.0, "frame": "bat (recoil factors r_x, r_y)"},
     )
-
-
-def test_stick_period():
-    t = np.linspace(0, 1.6, 17)
-    stick = np.where(t < 1.4, 1.0, np.where(t <= 1.5, 0.0, np.nan))
-    assert reporting.stick_period(t, stick) == (0.0, pytest.approx(1.4))
-    assert reporting.stick_period(t, np.zeros_like(t)) == (None, None)
-    late = np.where((t > 0.2) & (t < 0.5), 1.0, 0.0)  # initial slip, then stick
-    assert reporting.stick_period(t, late) == (pytest.approx(0.3), pytest.approx(0.5))
 
 
 def _lines(ax) -> dict:
@@ -247,16 +233,3 @@ def test_save_figure_is_deterministic(tmp_path):
 def test_unknown_figure_names_the_known_ones(tmp_path):
     with pytest.raises(ValueError, match="fig3, fig4"):
         plotting.draw("fig7", {}, {})
-
-
-def test_comparison_html(tmp_path):
-    csv = tmp_path / "t.csv"
-    csv.write_text(
-        sealed_csv(  # as the workflow writes its tables: with their check line
-            "quantity,ball,bat,paper,paper_uncertainty,value,uncertainty,truth,unit\n"
-            "e_x,baseball,wood,0.464,0.014,0.47,0.02,,1\n"
-        )
-    )
-    text = reporting.comparison_html(csv, tmp_path / "t.html", title="A & B")
-    assert "<td>0.464</td>" in text and "A &amp; B" in text
-    assert (tmp_path / "t.html").read_text() == text

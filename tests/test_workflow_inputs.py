@@ -1,4 +1,8 @@
-"""The rules' view of the config (ballbat.workflow_inputs): inputs, params, resources and targets, as Python."""
+"""The rules' view of the config (ballbat.workflow_inputs): inputs, params, resources and targets, as Python.
+
+Issue 37 §1: test sessions. A run's results folder is a setting; a folder's crate carries every run in
+it; a folder's workbooks keep every scenario's sheet; three sessions' folders make one league table.
+"""
 
 from __future__ import annotations
 
@@ -8,7 +12,7 @@ from argparse import Namespace
 import pytest
 
 from ballbat.config_checks import impact_bytes
-from ballbat.workflow_inputs import DATASET_FIGURES, WorkflowInputs, existing, file_hashes
+from ballbat.workflow_inputs import DATASET_FIGURES, WorkflowInputs, existing, file_hashes, results_root
 from workflow_helpers import ROOT
 
 
@@ -99,3 +103,21 @@ def test_league_targets(config):
     assert WorkflowInputs(cfg, ROOT).league_targets() == []
     cfg["datasets"]["lab"] = {"impacts": "lab.csv"}
     assert len(WorkflowInputs(cfg, ROOT).league_targets()) == 4
+
+
+# -- the results folder is a setting ------------------------------------------------------------------
+
+
+def test_every_target_starts_with_the_results_folder(config):
+    """A session's folder (config ``results``) prefixes every product; the default stays ``results/``."""
+    assert results_root(config) == "results" and results_root({}) == "results"
+    cfg = copy.deepcopy(config)
+    cfg["results"] = "results/2026-11-h01/"
+    cfg["studies"]["calibration"]["on_request"] = False
+    inputs = WorkflowInputs(cfg, ROOT)
+    assert inputs.results == "results/2026-11-h01"
+    targets = inputs.final_targets() + inputs.league_targets() + inputs.study_targets()
+    assert targets and all(t.startswith("results/2026-11-h01/") for t in targets), targets[:3]
+    ds = Namespace(dataset="synthetic")
+    assert inputs.get_source(ds) == "results/2026-11-h01/synthetic/reduce.nc"
+    assert inputs.get_tracks_inputs(ds) == {"tracks": "results/2026-11-h01/synthetic/tracks.nc"}

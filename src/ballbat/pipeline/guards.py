@@ -36,7 +36,7 @@ if TYPE_CHECKING:
 PROVENANCE_MARK = b"provenance_rule"
 MARK_WINDOW = 1 << 16
 #: How the workflow's CSV tables begin (paper_comparison.csv, a study's coverage.csv and design.csv;
-#: tests/test_redteam_guards.py holds them to the writers' columns): a table written before tables
+#: tests/workflow/test_guards.py holds them to the writers' columns): a table written before tables
 #: carried their check line is still recognised as the workflow's.
 TABLE_HEADERS = ("quantity,ball,bat,paper,", "setting,quantity,ball,bat,", "parameter,setting,ball,bat,")
 

@@ -1,0 +1,1 @@
+"""Tests of ballbat.tracks.formats, a module each (tests/tracks/formats/test_X.py)."""

@@ -1,0 +1,61 @@
+"""The column reader of a plain tracks CSV agrees with the row-by-row reader (issue 34: a 10^6-row file)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from ballbat.properties import InputError
+from ballbat.tracks import io as tio
+
+EXAMPLE = Path(__file__).resolve().parents[2] / "config" / "examples"
+
+
+def _same(a, b) -> None:
+    assert a.impact_id.tolist() == b.impact_id.tolist()
+    for cam in a.cameras:
+        ca, cb = a.cameras[cam], b.cameras[cam]
+        np.testing.assert_array_equal(ca.frame0, cb.frame0)
+        for p in ca.x:
+            np.testing.assert_array_equal(ca.x[p], cb.x[p])
+            np.testing.assert_array_equal(ca.y[p], cb.y[p])
+
+
+def test_columns_and_rows_give_the_same_tracks(tmp_path, monkeypatch):
+    """The shipped tracked example read by columns, and by rows (the column reader switched off)."""
+    tracks, impacts = EXAMPLE / "tracked_tracks.csv", EXAMPLE / "tracked_impacts.csv"
+    assert tio._fast_csv(tracks, {"W01": "row 2"}) is None  # impacts the file does not match: rows decide
+    by_columns = tio.load_tracks(tracks, impacts)
+    monkeypatch.setattr(tio, "_fast_csv", lambda *a: None)
+    _same(by_columns, tio.load_tracks(tracks, impacts))
+
+
+@pytest.mark.parametrize(
+    "edit",
+    [
+        lambda t: t.replace("W03,swing,ball,", "W03, swing,ball,", 1),  # a space: rows read it
+        lambda t: t.replace(",", ";").replace(".", ","),  # European Excel
+    ],
+)
+def test_files_the_column_reader_declines_are_read_by_rows(tmp_path, edit):
+    """A space after a comma or a semicolon file falls back to the row reader, with the same result."""
+    tracks, impacts = EXAMPLE / "tracked_tracks.csv", EXAMPLE / "tracked_impacts.csv"
+    path = tmp_path / "tracks.csv"
+    path.write_text(edit(tracks.read_text()))
+    ids = {row: row for row in ("W01",)}
+    assert tio._fast_csv(path, ids) is None
+    _same(tio.load_tracks(tracks, impacts), tio.load_tracks(path, impacts))
+
+
+def test_a_frame_twice_is_named_by_the_row_checks(tmp_path):
+    """The column reader does not resolve a duplicated frame: the row checks name both rows."""
+    tracks, impacts = EXAMPLE / "tracked_tracks.csv", EXAMPLE / "tracked_impacts.csv"
+    lines = tracks.read_text().splitlines()
+    dup = next(k for k, ln in enumerate(lines) if ln.startswith("W03,swing,ball,"))
+    path = tmp_path / "tracks.csv"
+    path.write_text("\n".join([*lines, lines[dup]]) + "\n")
+    with pytest.raises(InputError) as err:
+        tio.load_tracks(path, impacts)
+    assert f"row {len(lines) + 1}, column frame" in err.value.problems[0] and "appears twice" in err.value.problems[0]
