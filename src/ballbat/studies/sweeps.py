@@ -169,16 +169,21 @@ def study_dataset(dataset: dict, study: dict) -> dict:
 def point_dataset(dataset: dict, parameter: str | Sequence[str] | None, value: float | Sequence[float]) -> dict:
     """Return the dataset's config block with the swept setting at ``value`` (a copy).
 
-    A grid point gives the names and values as sequences (each set in turn).
+    A grid point gives the names and values as sequences (each set in turn, on one copy).
     """
-    if parameter is not None and not isinstance(parameter, str):
-        ds = copy.deepcopy(dataset)
-        for name, v in zip(parameter, value, strict=True):
-            ds = point_dataset(ds, name, v)
-        return ds
     ds = copy.deepcopy(dataset)
     if parameter is None:
         return ds
+    if isinstance(parameter, str):
+        _set_swept(ds, parameter, value)
+        return ds
+    for name, v in zip(parameter, value, strict=True):
+        _set_swept(ds, name, v)
+    return ds
+
+
+def _set_swept(ds: dict, parameter: str, value: float) -> None:
+    """Set the swept setting ``parameter`` of the dataset block ``ds`` (in place) to ``value``."""
     syn = ds["synthetic"]
     if parameter == "impacts_per_bat":
         syn["impacts"] = {b: {t: int(value) for t in bats} for b, bats in syn["impacts"].items()}
@@ -201,7 +206,6 @@ def point_dataset(dataset: dict, parameter: str | Sequence[str] | None, value: f
         ds["render"]["contact_ms"] = [float(value) - CONTACT_HALF_WIDTH_MS, float(value) + CONTACT_HALF_WIDTH_MS]
     else:
         raise ValueError(f"unknown sweep parameter {parameter!r} (known: {', '.join(SWEEP_PARAMETERS)})")
-    return ds
 
 
 def truth_counts(dataset: dict, truth_impacts: int) -> tuple[int, dict[str, dict[str, int]]]:
