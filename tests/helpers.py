@@ -31,6 +31,7 @@ from ballbat.stages import fit_ex, normalize, reconstruct, simulate
 from ballbat.stages import implications as stage
 from ballbat.stages.implications import ImplicationsSettings
 from ballbat.stages.implications import run as run_scenario
+from ballbat.studies.settings import StudySettings
 from ballbat.synthetic import SyntheticSettings
 from ballbat.tracks.reduce import reduce_tracks
 from ballbat.tracks.render import render_tracks, settings_from_config
@@ -286,6 +287,13 @@ def crate_ids(value):
 def crate_graph(results):
     doc = json.loads((results / "ro-crate-metadata.json").read_text())
     return {e["@id"]: e for e in doc["@graph"]}
+
+
+def study_settings(config, name="calibration", **over):
+    """The settings of study ``name`` of ``config`` with the values ``over`` changed."""
+    cfg = copy.deepcopy(config)
+    cfg["studies"][name].update(over)
+    return StudySettings.from_config(cfg, name)
 
 
 def unbalanced(config, **over):
