@@ -24,6 +24,7 @@ from ballbat import cli, league
 from ballbat.config_checks import validate_config
 from ballbat.kinematics import ImpactFlag
 from ballbat.pipeline.config import checked_block
+from ballbat.pipeline.crate import JobRecord
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.pipeline.products import flag_attrs
 from ballbat.properties import load_balls, load_bats
@@ -31,6 +32,7 @@ from ballbat.stages import fit_ex, normalize, reconstruct, simulate
 from ballbat.stages import implications as stage
 from ballbat.stages.implications import ImplicationsSettings
 from ballbat.stages.implications import run as run_scenario
+from ballbat.studies.settings import StudySettings
 from ballbat.synthetic import SyntheticSettings
 from ballbat.tracks.reduce import reduce_tracks
 from ballbat.tracks.render import render_tracks, settings_from_config
@@ -286,6 +288,28 @@ def crate_ids(value):
 def crate_graph(results):
     doc = json.loads((results / "ro-crate-metadata.json").read_text())
     return {e["@id"]: e for e in doc["@graph"]}
+
+
+def crate_folder(tmp_path):
+    """A results folder with one job's NetCDF output (with a provenance mark), its log, and an input."""
+    (tmp_path / "Snakefile").write_text("# the workflow\n")
+    (tmp_path / "config").mkdir()
+    (tmp_path / "config" / "in.csv").write_text("a,b\n1,2\n")
+    results = tmp_path / "results"
+    (results / "logs").mkdir(parents=True)
+    crate_netcdf(results / "a.nc", "a")
+    (results / "logs" / "a.log").write_text("log\n")
+    job = JobRecord(
+        rule="r", wildcards={}, inputs=["config/in.csv"], outputs=["results/a.nc"], logs=["results/logs/a.log"]
+    )
+    return results, job
+
+
+def study_settings(config, name="calibration", **over):
+    """The settings of study ``name`` of ``config`` with the values ``over`` changed."""
+    cfg = copy.deepcopy(config)
+    cfg["studies"][name].update(over)
+    return StudySettings.from_config(cfg, name)
 
 
 def unbalanced(config, **over):

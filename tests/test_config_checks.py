@@ -302,3 +302,74 @@ def test_schema_takes_a_folder_and_still_wants_settings_of_a_long_file():
         validate_config({"datasets": {"lab": {"tracks": no_points}}}, schema, available=10**12)
     with pytest.raises(ConfigError, match="units"):
         validate_config({"datasets": {"lab": {"tracks": {**lab, "units": {"time": "ms"}}}}}, schema, available=10**12)
+
+
+@pytest.mark.parametrize(
+    ("edit", "message"),
+    [
+        (
+            lambda c: c["studies"]["calibration"].update(dataset="nope"),
+            "studies.calibration.dataset: no dataset 'nope'",
+        ),
+        (
+            lambda c: c["studies"]["design"]["sweep"].update(values=[5, 2.5]),
+            "studies.design.sweep.values[1]: impacts per bat must be a whole number >= 3",
+        ),
+        (
+            lambda c: c["studies"]["design"]["sweep"].update(parameter="noise_scale"),
+            "studies.design.sweep.parameter: noise_scale scales the direct noise, but the dataset renders tracks",
+        ),
+        (lambda c: c["studies"]["calibration"].update(replicates=1), "studies.calibration.replicates"),
+        (
+            lambda c: c["studies"]["calibration"].update(truth_impacts=10**7),
+            "studies.calibration.truth_impacts: 70,000,092 impacts need about",  # 108 x ceil(7e7 / 108)
+        ),
+        (lambda c: c["studies"]["calibration"].update(colour=1), "studies.calibration"),
+    ],
+)
+def test_hostile_study_configs_are_named(raw, schema, edit, message):
+    edit(raw)
+    with pytest.raises(ConfigError) as err:
+        validate_config(raw, schema, available=24 * 2**30)
+    assert message in str(err.value)
+
+
+def test_dropping_a_dataset_drops_its_studies(raw, schema):
+    from ballbat.pipeline.config import drop_nulls
+
+    raw["datasets"] = {"synthetic": None, "lab": {"impacts": "x.csv"}}
+    cfg = validate_config(drop_nulls(raw), schema, available=24 * 2**30)
+    assert cfg["studies"] == {}
+    raw2 = yaml.safe_load(yaml.safe_dump(raw))
+    raw2["datasets"] = {"synthetic": {"synthetic": {}}, "lab": {"impacts": "x.csv"}}
+    raw2["studies"] = {"calibration": None, "design": {"dataset": "synthetic", "replicates": 3, "seed": 1}}
+    assert list(drop_nulls(raw2)["studies"]) == ["design"]
+
+
+def test_drawing_properties_from_tables_without_uncertainties_is_refused_before_the_dag(raw, schema):
+    """draw_properties with tables that state no *_err: one line at the config check, not a failed job."""
+    raw["studies"]["calibration"]["draw_properties"] = True
+    with pytest.raises(ConfigError, match=r"studies.calibration.draw_properties: the tables .* state no uncertainty"):
+        validate_config(raw, schema, available=24 * 2**30)
+    raw["datasets"]["synthetic"]["bats"] = "config/examples/property_study_bats.csv"
+    raw["datasets"]["synthetic"]["synthetic"]["impacts"] = {"baseball": {"hickory": 10}}
+    raw["datasets"]["synthetic"]["synthetic"]["e_x"] = {"baseball": {"hickory": 0.455}}
+    raw["datasets"]["synthetic"]["synthetic"]["e_y"] = {"baseball": 0.45}
+    raw["datasets"]["synthetic"]["synthetic"]["psi_deg"] = {"baseball": [0.0, 30.0]}
+    raw["studies"] = {"calibration": raw["studies"]["calibration"]}
+    raw["implications"]["scenarios"] = {}
+    assert validate_config(raw, schema, available=24 * 2**30)["studies"]["calibration"]["draw_properties"]
+
+
+def test_a_study_of_a_measured_dataset_is_refused(raw, schema):
+    raw["datasets"]["lab"] = {"impacts": "x.csv"}
+    raw["studies"]["calibration"]["dataset"] = "lab"
+    with pytest.raises(ConfigError, match="'lab' is not synthetic"):
+        validate_config(raw, schema, available=24 * 2**30)
+
+
+def test_a_frame_rate_sweep_needs_rendered_tracks(raw, schema):
+    raw["datasets"]["synthetic"]["render"]["enabled"] = False
+    raw["studies"]["design"]["sweep"] = {"parameter": "spin_fps", "values": [1000]}
+    with pytest.raises(ConfigError, match="spin_fps needs a dataset that renders camera tracks"):
+        validate_config(raw, schema, available=24 * 2**30)

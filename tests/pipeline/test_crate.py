@@ -4,6 +4,10 @@ result changed or gone or stale is said so, a run cut short keeps the earlier cr
 
 from __future__ import annotations
 
+import json
+
+import pytest
+from helpers import crate_folder as _folder
 from helpers import crate_graph as _graph
 from helpers import crate_ids as _ids
 from helpers import crate_netcdf as _nc
@@ -120,3 +124,115 @@ def test_a_run_cut_short_keeps_the_earlier_crate_aside(tmp_path):
     assert (results / EARLIER_NAME).is_file()
     _run(results, tmp_path, [_job("rb", "b", "config/b.csv")])
     assert "#job-ra-dataset=a" in _graph(results)
+
+
+def test_failed_crate_leaves_none(tmp_path, monkeypatch):
+    """A crate that fails half-way leaves no metadata file (the old one goes first) and no temporary file."""
+    results = tmp_path / "results"
+    results.mkdir()
+    (results / "ro-crate-metadata.json").write_text("{}")
+    (results / "a.nc").write_bytes(b"x")
+    (results / ".workflow.snapshot.old123").mkdir()  # what an earlier crate cut short left
+
+    def boom(*args, **kwargs):
+        raise RuntimeError("disk full")
+
+    monkeypatch.setattr(crate_mod, "build_crate", boom)
+    job = crate_mod.JobRecord(rule="r", wildcards={}, inputs=[], outputs=["results/a.nc"])
+    with pytest.raises(RuntimeError, match="disk full"):
+        crate_mod.write_run_crate(results, [job], config={}, configfiles=[], workdir=tmp_path)
+    assert sorted(p.name for p in results.iterdir()) == ["a.nc", "workflow.snapshot"]
+
+
+# ---------------------------------------------------------------------------------------
+# Issue 34: the crate is the folder's truth (target-only and failed runs, limits)
+
+
+def test_other_files_are_listed_with_their_staleness(tmp_path):
+    """A target-only run's crate lists every file of the folder: the other products (an earlier run's) each
+    say so, with their staleness against the inputs Snakemake recorded for them (sha256 first, else time).
+    """
+    from ballbat.pipeline.cratefiles import crate_file_problems
+
+    results, job = _folder(tmp_path)
+    _nc(results / "old.nc", "old")
+    _nc(results / "same.nc", "same")
+    _nc(results / "derived.nc", "made from old.nc")
+    (results / "logs" / "old.log").write_text("log of old.nc's job\n")
+    (results / "unknown.tsv").write_text("s\n1\n")
+    digest = sha256_file(tmp_path / "config" / "in.csv")
+    old = {"config/in.csv": "sha256:00"}
+    records = {
+        "results/old.nc": {
+            "rule": "q",
+            "input": ["config/in.csv"],
+            "input_checksums": old,
+            "log": ["results/logs/old.log"],
+        },
+        "results/same.nc": {"rule": "q", "input": ["config/in.csv"], "input_checksums": {"config/in.csv": digest}},
+        "results/derived.nc": {"rule": "d", "input": ["results/old.nc"], "input_checksums": {}},
+    }
+    crate_mod.write_run_crate(
+        results, [job], config={}, configfiles=[], workdir=tmp_path, record=lambda p: records.get(p)
+    )
+    graph = _graph(results)
+    assert crate_file_problems(results) == []
+    assert "stale: its input config/in.csv has changed since (sha256)" in graph["old.nc"]["description"]
+    assert "made by rule q; up to date with the 1 inputs it recorded" in graph["same.nc"]["description"]
+    assert "its staleness is not known" in graph["unknown.tsv"]["description"]
+    assert "stale: its input results/old.nc is stale" in graph["derived.nc"]["description"]
+    assert (
+        "stale: the log of the job that made results/old.nc (stale: its input" in graph["logs/old.log"]["description"]
+    )
+    assert "5 file(s) of the folder are not results of this run" in graph["./"]["description"]
+    assert "old.nc" not in _ids(graph["#run"]["result"]) and "a.nc" in _ids(graph["#run"]["result"])
+
+
+def test_failed_run_lists_no_unfinished_job(tmp_path):
+    """After a failed run the crate marks the run failed; the job that did not finish has no action, and
+    its old output is listed as not made by this run (never as its result).
+    """
+    results, job = _folder(tmp_path)
+    _nc(results / "b.nc", "an earlier run's")
+    unfinished = crate_mod.JobRecord(rule="s", wildcards={}, inputs=[], outputs=["results/b.nc"], completed=False)
+    crate_mod.write_run_crate(results, [job, unfinished], config={}, configfiles=[], workdir=tmp_path)
+    graph = _graph(results)
+    assert graph["#run"]["actionStatus"]["@id"] == "http://schema.org/FailedActionStatus"
+    assert "1 job(s) did not finish (s)" in graph["#run"]["error"]
+    assert "#job-s" not in graph and "#job-r" in graph
+    assert "not made by this run" in graph["b.nc"]["description"]
+
+
+def test_a_users_file_at_an_output_path_is_not_the_jobs_result(tmp_path):
+    """A user's own workbook and Markdown file at a job's output paths are listed as not the workflow's."""
+    import openpyxl
+
+    results, job = _folder(tmp_path)
+    openpyxl.Workbook().save(results / "results.xlsx")
+    (results / "table.md").write_text("| my | table |\n")
+    job.outputs += ["results/results.xlsx", "results/table.md"]
+    crate_mod.write_run_crate(results, [job], config={}, configfiles=[], workdir=tmp_path)
+    graph = _graph(results)
+    assert _ids(graph["#job-r"]["result"]) == ["a.nc", "logs/a.log"]
+    for name in ("results.xlsx", "table.md"):
+        assert graph[name]["description"].startswith("not written by this workflow"), name
+
+
+def test_snapshot_copies_are_limited(tmp_path, monkeypatch):
+    """An input data file above the snapshot's limit is not copied: the crate records its path, size and sha256."""
+    results, job = _folder(tmp_path)
+    (tmp_path / "config" / "big.csv").write_text("x\n" * 100)
+    job.inputs.append("config/big.csv")
+    monkeypatch.setattr(crate_mod, "SNAPSHOT_FILE_LIMIT", 50)
+    crate_mod.write_run_crate(results, [job], config={}, configfiles=[], workdir=tmp_path)
+    graph = _graph(results)
+    assert (results / "workflow.snapshot" / "config" / "in.csv").is_file()
+    assert not (results / "workflow.snapshot" / "config" / "big.csv").exists()
+    big = [graph[i] for i in _ids(graph["#job-r"]["object"]) if i.startswith("#uncopied-")]
+    assert len(big) == 1 and big[0]["name"] == "config/big.csv" and big[0]["contentSize"] == "200"
+    assert big[0]["sha256"] == sha256_file(tmp_path / "config" / "big.csv")
+    assert "200 bytes, above the limit of 50 per file" in big[0]["description"]
+    monkeypatch.setattr(crate_mod, "SNAPSHOT_FILE_LIMIT", 10**6)
+    monkeypatch.setattr(crate_mod, "SNAPSHOT_DATA_LIMIT", 50)
+    crate_mod.write_run_crate(results, [job], config={}, configfiles=[], workdir=tmp_path)
+    assert "past the limit of 50 for all data copies" in json.dumps(_graph(results))

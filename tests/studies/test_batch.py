@@ -5,6 +5,9 @@ from __future__ import annotations
 import copy
 
 import numpy as np
+import pytest
+import xarray as xr
+from helpers import study_settings as settings
 
 from ballbat.studies import batch as study_batch
 from ballbat.studies.settings import StudySettings
@@ -24,3 +27,12 @@ def test_a_grid_replicate_records_a_systematic(config, balls, bats):
     syst = batch.systematic.values[0]
     for q in ("e_x", "e_x_pooled", "tan_ratio_slope", "spin_theta_slope", "e_y_implied", "eta2"):
         assert np.all(np.isfinite(syst[names == q])) and np.all(syst[names == q] > 0), q
+
+
+@pytest.mark.slow  # about 3 s: 8 replicates in two batchings
+def test_replicates_do_not_depend_on_the_batch_size(config, balls, bats):
+    """Replicate k is the same experiment whether it runs in batch 0 of 4 or batch 1 of 3."""
+    three = settings(config, replicates=4, batch_size=3, truth_impacts=60)
+    b = xr.concat([study_batch.run(three, i, balls, bats) for i in (0, 1)], "replicate")
+    one = study_batch.run(settings(config, replicates=4, batch_size=4, truth_impacts=60), 0, balls, bats)
+    np.testing.assert_array_equal(one.value.values, b.value.values)

@@ -7,7 +7,9 @@ from __future__ import annotations
 import copy
 import math
 
+import pytest
 from helpers import UNBALANCED, unbalanced
+from helpers import study_settings as settings
 
 from ballbat.config_checks import MEMORY_SHARE, validate_config
 from ballbat.studies.settings import StudySettings
@@ -38,3 +40,11 @@ def test_the_unbalanced_design_runs_within_its_plan_on_this_machines_size(raw, s
     s = StudySettings.from_config(cfg, "calibration")
     assert s.truth_mem_mb(0) * 1e6 <= MEMORY_SHARE * 23 * 2**30
     assert s.truth_mem_mb(0) == 500 + math.ceil(70_176 * 50_000 / 1e6)
+
+
+def test_batches_cover_every_replicate_once(config):
+    s = settings(config, "design", replicates=7, batch_size=3)
+    seen = [g for b in range(s.n_batches) for g in s.batch_range(b)]
+    assert seen == list(range(7 * len(s.values)))
+    with pytest.raises(ValueError, match="out of range"):
+        s.batch_range(s.n_batches)

@@ -99,3 +99,20 @@ def test_a_pair_of_no_impacts_stays_empty(config):
     ds["synthetic"]["impacts"] = {"baseball": {"wood": 0}}
     with pytest.raises(ValueError, match="no impacts"):
         truth_counts(ds, 1000)
+
+
+@pytest.mark.parametrize(
+    ("parameter", "value", "check"),
+    [
+        ("impacts_per_bat", 9, lambda d: {n for v in d["synthetic"]["impacts"].values() for n in v.values()} == {9}),
+        ("e_x", 0.3, lambda d: {e for v in d["synthetic"]["e_x"].values() for e in v.values()} == {0.3}),
+        ("pixel_noise_px", 3.5, lambda d: {c["pixel_noise_px"] for c in d["render"]["cameras"].values()} == {3.5}),
+        ("spin_fps", 2000, lambda d: d["render"]["cameras"]["spin"]["fps"] == 2000),
+        ("noise_scale", 2.0, lambda d: d["synthetic"]["noise"]["omega_rpm"] == 150.0),
+    ],
+)
+def test_sweep_sets_the_dataset(config, parameter, value, check):
+    base = config["datasets"]["synthetic"]
+    before = copy.deepcopy(base)
+    assert check(point_dataset(base, parameter, value))
+    assert base == before  # a copy: the config is untouched

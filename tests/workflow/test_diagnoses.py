@@ -2,7 +2,8 @@
 
 Each row of a table below is a case of issue 34 ("Reliability 3") that, on the code before it,
 gave a wrong or vague message, a late error or a silently wrong number; the row holds the
-expected outcome. Crate-only checks are in tests/workflow/test_crate.py.
+expected outcome. Crate-only checks are in tests/pipeline/test_crate.py (a crate of a folder) and
+tests/workflow/test_crate.py (a run's crate).
 """
 
 from __future__ import annotations
@@ -157,7 +158,7 @@ def test_dirty_when_a_copied_workflow_differs_from_the_commit(tmp_path, monkeypa
 
 def test_a_users_workbook_or_notes_at_an_output_path_are_not_the_workflows(tmp_path):
     """A user's own .xlsx or .md at a product's path is named as not the workflow's: never replaced by a run
-    (foreign_outputs), and named while parsing (users_files); the workflow's own pass (workflow/test_crate.py: the
+    (foreign_outputs), and named while parsing (users_files); the workflow's own pass (pipeline/test_crate.py: the
     crate does not list such a file as the job's result).
     """
     import json
