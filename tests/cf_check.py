@@ -7,7 +7,7 @@ open dataset. The checker asks them again for every variable it checks, and each
 every attribute of every variable, so a file's check grew as the square of its variables:
 17 s for a file of 108 variables, 2-3 s with the answers kept. The answers are the same (each
 query only reads the file, which the checker opens read-only) and each caller gets its own copy
-of a list; tests/test_workflow.py compares the report with the unpatched checker's once
+of a list; tests/workflow/test_outputs.py compares the report with the unpatched checker's once
 (:func:`workflow_helpers.assert_cf` runs this script).
 """
 

@@ -114,7 +114,7 @@ def default_report(default_run, tmp_path_factory):
 #: The lab run's tool-file datasets (``tools.yaml``; docs/tracks.md): the example tracks as a
 #: long CSV (``tracked``) and as a folder of Tracker projects (``trk``), reduced and fitted
 #: (--until fit_ex tracks_qa). The other formats give the same tracks as the .trk files
-#: (test_track_formats.test_every_format_imports_the_same_tracks).
+#: (tracks/formats/test_layout.py::test_every_format_imports_the_same_tracks).
 TOOL_CAMERAS = {"swing": {"fps": 3000.0, "m_per_px": 0.00074}, "spin": {"fps": 1000.0, "m_per_px": 0.00125}}
 
 

@@ -8,7 +8,7 @@ own working folder, environment, streams and exit status, as a subprocess would 
 
 Nothing of ballbat is loaded in the server: each child imports it afresh (from ``workdir/src``
 when a run has its own copy of the package). The installed entry points themselves are tested
-as subprocesses (test_cli.test_entry_point_is_installed, test_release).
+as subprocesses (cli/test_app.py::test_entry_point_is_installed, test_release.py).
 
 A Snakemake run's jobs are Python scripts that Snakemake starts as ``{sys.executable} SCRIPT``:
 fresh interpreters again, each paying about a second of imports. In a forked run
