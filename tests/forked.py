@@ -26,7 +26,9 @@ its wall time and its CPU time with its children's (the jobs of a Snakemake run)
 
 from __future__ import annotations
 
+import atexit
 import os
+import shutil
 import signal
 import socket
 import subprocess
@@ -110,10 +112,8 @@ def _job_server() -> tuple[str, str]:
     global _JOBS
     if _JOBS is None:
         folder = tempfile.mkdtemp(prefix="ballbat-jobs-")
-        sock, launcher = os.path.join(folder, "jobs.sock"), os.path.join(folder, "python")
-        with open(launcher, "w") as fh:
-            fh.write(_job_launcher(sys.executable))
-        os.chmod(launcher, 0o755)
+        atexit.register(shutil.rmtree, folder, True)
+        sock, launcher = os.path.join(folder, "jobs.sock"), _write_launcher(folder)
         server = _context().Process(target=_serve_jobs, args=(sock,), daemon=True)
         server.start()
         deadline = time.monotonic() + 30
@@ -123,6 +123,28 @@ def _job_server() -> tuple[str, str]:
             time.sleep(0.01)
         _JOBS = (sock, launcher)
     return _JOBS
+
+
+def _write_launcher(folder: str) -> str:
+    """Write the launcher into ``folder``, or where it can run if ``folder`` is on a noexec mount.
+
+    The fallback is tests/.forked/PID (git ignores it), on the checkout's own file system, where
+    the virtual environment's programs run.
+    """
+    for where in (folder, str(Path(__file__).resolve().parent / ".forked" / str(os.getpid()))):
+        os.makedirs(where, exist_ok=True)
+        launcher = os.path.join(where, "python")
+        with open(launcher, "w") as fh:
+            fh.write(_job_launcher(sys.executable))
+        os.chmod(launcher, 0o755)
+        try:
+            if subprocess.run([launcher, "-c", "pass"], timeout=60).returncode == 0:
+                if where != folder:
+                    atexit.register(shutil.rmtree, where, True)
+                return launcher
+        except OSError:  # PermissionError: mounted noexec
+            pass
+    raise RuntimeError(f"tests/forked.py: the job launcher runs neither in {folder} nor in tests/.forked")
 
 
 def _job_launcher(python: str) -> str:
