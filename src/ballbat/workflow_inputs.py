@@ -10,6 +10,7 @@ rules: each method that takes ``wildcards`` is an input, params or resources fun
 from __future__ import annotations
 
 import math
+import os
 from argparse import Namespace
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -70,9 +71,9 @@ class WorkflowInputs:
 
     def code(self, script: str) -> list[str]:
         """Return the package modules a script imports (so editing them reruns the rule)."""
-        here = Path.cwd()
+        here = os.path.join(os.getcwd(), "")  # relative to the working folder where inside it (string ops: parse time)
         files = module_files(str(self.scripts / script))
-        return [str(Path(f).relative_to(here)) if Path(f).is_relative_to(here) else f for f in files]
+        return [f[len(here) :] if f.startswith(here) else f for f in files]
 
     def dataset_config(self, wildcards: Namespace) -> dict:
         """Return the dataset's validated config block."""

@@ -61,15 +61,21 @@ def _imports(path: Path, module: str | None) -> set[str]:
 
 
 def _module_file(name: str) -> Path | None:
-    parts = name.split(".")[1:]
-    if not parts:
-        return PACKAGE_DIR / "__init__.py"
-    p = PACKAGE_DIR.joinpath(*parts)
-    if p.with_suffix(".py").is_file():
-        return p.with_suffix(".py")
-    if (p / "__init__.py").is_file():
-        return p / "__init__.py"
-    return None
+    """Return the source file of the ballbat module ``name`` (a module ``x.py`` before a package ``x/``), or None."""
+    return _package_files().get(name)
+
+
+@cache
+def _package_files() -> dict[str, Path]:
+    """Every module of the package by dotted name: one walk of its folder (not two stats per name asked)."""
+    files: dict[str, Path] = {}
+    for init in sorted(PACKAGE_DIR.rglob("__init__.py")):
+        rel = init.parent.relative_to(PACKAGE_DIR).parts
+        files[".".join((PACKAGE, *rel))] = init
+    for src in sorted(PACKAGE_DIR.rglob("*.py")):
+        if src.name != "__init__.py":
+            files[".".join((PACKAGE, *src.relative_to(PACKAGE_DIR).with_suffix("").parts))] = src
+    return files
 
 
 @cache
