@@ -8,6 +8,7 @@ import pytest
 from ballbat import fitting
 
 
+@pytest.mark.slow  # more than 2 s
 def test_largest_value_removes_most_of_the_bias_of_picking_the_largest():
     """Eq. muk's bound is the largest true tan(psi - theta); the largest *measured* value is biased high.
 

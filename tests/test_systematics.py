@@ -101,6 +101,7 @@ def test_doubling_a_sigma_doubles_its_systematic(key):
     np.testing.assert_allclose(by(s2, "eta2", source), 2 * by(s1, "eta2", source), rtol=0.05)
 
 
+@pytest.mark.slow  # more than 2 s
 def test_combined_is_the_quadrature_of_the_sources_and_total_adds_the_statistical():
     """Several sources at once: <q>_syst is their quadrature sum, <q>_err_total adds the standard error."""
     rec, fit, st = chain(
@@ -529,6 +530,7 @@ def _study(tmp_path):
     return StudySettings.from_config(validate_config(base, schema), "properties")
 
 
+@pytest.mark.slow  # more than 2 s
 def test_study_replicate_draws_and_its_systematic_is_the_finite_difference(tmp_path):
     """One replicate: its truth is its drawn bat's, its systematic the +-1 sigma refit's, its effect first order."""
     from dataclasses import replace

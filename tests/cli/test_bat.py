@@ -26,6 +26,7 @@ def test_bat_prints_the_paper_row_and_the_centre_of_percussion():
     assert "convention" in lines[4] and lines[5].startswith("hickory,hickory,lab,34,32,23,6")
 
 
+@pytest.mark.slow  # more than 2 s
 def test_bat_period_and_pivot_give_the_same_row():
     period = 2 * 3.141592653589793 * (11200.0 / (32.0 * 9.80665 / INCH * 17.0)) ** 0.5
     args = "--length 34 --weight 32 --balance-point 23 --pivot 6 --impact-from-knob 28 --diameter 2.6 --iz 11"

@@ -10,6 +10,7 @@ import sys
 from pathlib import Path
 
 import forked
+import pytest
 from helpers import league_fit_file as fit_file
 
 from ballbat import league
@@ -29,6 +30,7 @@ def run_compare(*args: str, installed: bool = False) -> subprocess.CompletedProc
     return subprocess.run([str(BALLBAT), "compare", *args], capture_output=True, text=True, timeout=60, env=env)
 
 
+@pytest.mark.slow  # more than 2 s
 def test_ballbat_compare_prints_the_table_the_pairs_and_tost(tmp_path):
     fit_file(tmp_path / "s1", "h01", {"hickory": (0.47, 0.006, 25, 0.004), "wood": (0.46, 0.006, 25, 0.004)})
     fit_file(tmp_path / "s2", "m01", {"maple": (0.38, 0.006, 25, 0.004), "wood": (0.465, 0.006, 25, 0.004)})

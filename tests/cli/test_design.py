@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import forked
+import pytest
 from helpers import pilot_fit as fit
 
 from ballbat import pilot
@@ -16,6 +17,7 @@ from ballbat.pipeline.ncio import write_dataset
 BALLBAT = Path(sys.executable).parent / "ballbat"
 
 
+@pytest.mark.slow  # more than 2 s
 def test_ballbat_design_from_a_pilot_folder(tmp_path):
     ds = fit({"A": 0.006}, {"A": 25})
     write_dataset(ds, tmp_path / "h01" / "fit_ex.nc", title="t", rule="fit_ex", inputs={}, config={})

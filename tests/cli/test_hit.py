@@ -56,6 +56,7 @@ def run_hit(*args: str, installed: bool = False) -> subprocess.CompletedProcess:
     return subprocess.run([str(BALLBAT), "hit", *args], capture_output=True, text=True, timeout=60, env=env)
 
 
+@pytest.mark.slow  # more than 2 s
 def test_ballbat_hit_prints_the_batted_ball_with_bands(tmp_path, tables):
     """Why: no command gave pitch + bat -> batted ball. Through the installed entry point, the scenario's numbers."""
     fit_file(tmp_path / "h01", {"hickory": tables[1]["hickory"]}, {"hickory": 0.455}, {"hickory": 0.010})

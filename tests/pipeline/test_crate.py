@@ -50,6 +50,7 @@ def _run(results, tmp_path, jobs, record=None):
     )
 
 
+@pytest.mark.slow  # more than 2 s
 def test_a_later_run_adds_its_actions_to_the_earlier_ones(tmp_path):
     """Run 1 makes dataset a (rule ra); run 2, another config, makes b (rule rb). Run 2's crate has both
     jobs: a's action carried with its times, config values, rule and input (its snapshot copy too), its

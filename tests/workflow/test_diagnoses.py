@@ -446,6 +446,7 @@ def test_diagnoses_point_the_right_way(case, edit, expected, before, tmp_path):
     assert expected in text and before not in text, text
 
 
+@pytest.mark.slow  # more than 2 s
 def test_a_setting_read_from_tool_files_is_named_as_such(tmp_path):
     """A folder of Tracker files whose spin clips say 500 fps (the truth: 1000): the diagnosis names
     cameras.spin.fps, a key the user never set, and now says the value was read from the files.
@@ -509,6 +510,7 @@ def test_a_wrong_time_unit_of_a_table_is_named(case, fmt, said, first, then, tmp
     assert first in text and then in text and "is units.time wrong" in text, text
 
 
+@pytest.mark.slow  # more than 2 s
 def test_a_wrong_length_unit_of_tables_is_suggested(tmp_path):
     """Tracker tables in metres read with units.length cm: the diagnosis names units.length (it never did)."""
     import subprocess
