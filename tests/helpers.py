@@ -124,6 +124,14 @@ def fake_replicates(n, se, spread, truth=1.0, dof=np.inf, seed=0):
 BALLBAT = Path(sys.executable).parent / "ballbat"
 
 
+def run_ballbat(*args: str, installed: bool = False, timeout: float = 60) -> subprocess.CompletedProcess:
+    """`ballbat ARGS`: the installed command (on this checkout's package), or (the default) a forked process."""
+    if not installed:
+        return forked.ballbat(*args, cwd=Path.cwd(), timeout=timeout)
+    env = {**os.environ, "PYTHONPATH": str(Path(cli.__file__).parents[2])}
+    return subprocess.run([str(BALLBAT), *args], capture_output=True, text=True, timeout=timeout, env=env)
+
+
 def ballbat_in_process(*args: str, cwd: Path | None = None) -> subprocess.CompletedProcess:
     """Run `ballbat` as its entry point does (:func:`ballbat.cli.main`), in this process (no start-up cost).
 

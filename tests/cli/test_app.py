@@ -12,12 +12,12 @@ from pathlib import Path
 
 import pytest
 from conftest import ROOT
+from helpers import BALLBAT
 from helpers import ballbat_in_process as ballbat
 
 from ballbat import __version__
 from ballbat.cli.common import EXAMPLES
 
-BALLBAT = Path(sys.executable).parent / "ballbat"
 MAPLE = ROOT / "config" / "examples" / "maple_impacts.csv"
 
 

@@ -2,7 +2,6 @@
 
 from __future__ import annotations
 
-import sys
 from pathlib import Path
 
 import pytest
@@ -12,7 +11,6 @@ from ballbat.properties import load_balls, recoil_factors
 from ballbat.units import INCH, OUNCE, OZ_IN2
 
 ROOT = Path(__file__).resolve().parents[2]
-BALLBAT = Path(sys.executable).parent / "ballbat"
 HICKORY = "--length 34 --weight 32 --balance-point 23.0 --moi-6in 11200 --impact-from-tip 6 --diameter 2.6 --iz 11"
 
 

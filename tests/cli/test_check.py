@@ -5,20 +5,18 @@ as the workflow would read them, every problem listed, unit mistakes warned of (
 from __future__ import annotations
 
 import subprocess
-import sys
 from pathlib import Path
 
 import pytest
 import yaml
 from conftest import ROOT
+from helpers import BALLBAT
 from helpers import ballbat_forked as ballbat
 from helpers import ballbat_in_process as ballbat_cli
 from track_files import (
     TOOL_NAMES,
     write_lab_folder,
 )
-
-BALLBAT = Path(sys.executable).parent / "ballbat"
 
 
 def test_check_refuses_grams_as_ounces_and_b_outside_any_bat(tmp_path):

@@ -2,16 +2,13 @@
 
 from __future__ import annotations
 
-import os
-import subprocess
-import sys
 from pathlib import Path
 
-import forked
 import helpers
 import numpy as np
 import pytest
 import xarray as xr
+from helpers import run_ballbat
 from helpers import scenario_settings as settings
 
 from ballbat import scenario_bands
@@ -19,8 +16,6 @@ from ballbat.pipeline.ncio import write_dataset
 from ballbat.properties import bat_record
 
 tables = helpers.tables  # a fixture of tests/helpers.py
-
-BALLBAT = Path(sys.executable).parent / "ballbat"
 
 
 def fit_file(folder: Path, bats: dict, e_x: dict, err: dict, syst: float = 0.004) -> Path:
@@ -48,22 +43,16 @@ def fit_file(folder: Path, bats: dict, e_x: dict, err: dict, syst: float = 0.004
     return write_dataset(ds, path, title="test", rule="fit_ex", inputs={}, config={})
 
 
-def run_hit(*args: str, installed: bool = False) -> subprocess.CompletedProcess:
-    """`ballbat hit ARGS`: the installed command, or (the default) a process forked with its libraries loaded."""
-    if not installed:
-        return forked.ballbat("hit", *args, cwd=Path.cwd(), timeout=60)
-    env = {**os.environ, "PYTHONPATH": str(Path(scenario_bands.__file__).parents[1])}
-    return subprocess.run([str(BALLBAT), "hit", *args], capture_output=True, text=True, timeout=60, env=env)
-
-
 @pytest.mark.slow  # more than 2 s
 def test_ballbat_hit_prints_the_batted_ball_with_bands(tmp_path, tables):
     """Why: no command gave pitch + bat -> batted ball. Through the installed entry point, the scenario's numbers."""
     fit_file(tmp_path / "h01", {"hickory": tables[1]["hickory"]}, {"hickory": 0.455}, {"hickory": 0.010})
-    out = run_hit("--pitch-speed", "90", "--bat-speed", "70", "--bat", "hickory", "--results", str(tmp_path / "h01"))
+    out = run_ballbat(
+        "hit", "--pitch-speed", "90", "--bat-speed", "70", "--bat", "hickory", "--results", str(tmp_path / "h01")
+    )
     assert out.returncode == 2 and "--D" in out.stderr  # D is required
     args = ["--pitch-speed", "90", "--bat-speed", "70", "--bat", "hickory", "--results", str(tmp_path / "h01")]
-    out = run_hit(*args, "--D", "0.5", installed=True)
+    out = run_ballbat("hit", *args, "--D", "0.5", installed=True)
     assert out.returncode == 0, out.stderr
     lines = out.stdout.splitlines()
     assert "e_x = 0.4550 ± 0.0100 (stat.) ± 0.0040 (syst.), bat e_x of dataset h01" in lines[0]
@@ -75,7 +64,7 @@ def test_ballbat_hit_prints_the_batted_ball_with_bands(tmp_path, tables):
     assert float(carry[5]) == pytest.approx(float(ds["carry_low68"][0]) / ft, abs=0.05)
     assert float(carry[10]) == pytest.approx(float(ds["carry_low95"][0]) / ft, abs=0.05)
     assert float(carry[12]) == pytest.approx(float(ds["carry_high95"][0]) / ft, abs=0.05)
-    out = run_hit(*args[:-2], "--results", str(tmp_path / "none"), "--D", "0.5")
+    out = run_ballbat("hit", *args[:-2], "--results", str(tmp_path / "none"), "--D", "0.5")
     assert out.returncode == 2 and out.stderr == f"ballbat hit: error: {tmp_path / 'none'}: no such folder\n"
-    out = run_hit(*args[:4], "--bat", "wood", "--results", str(tmp_path / "h01"), "--D", "0.5")
+    out = run_ballbat("hit", *args[:4], "--bat", "wood", "--results", str(tmp_path / "h01"), "--D", "0.5")
     assert out.stderr == f"ballbat hit: error: --bat wood: not a bat of {tmp_path / 'h01'} (its bats: hickory)\n"

@@ -3,13 +3,11 @@
 from __future__ import annotations
 
 import subprocess
-import sys
-from pathlib import Path
 
 import helpers
 import pytest
 import yaml
-from helpers import EXAMPLE
+from helpers import BALLBAT, EXAMPLE
 from helpers import same_tracks as _same
 from track_files import (
     read_long_csv,
@@ -19,9 +17,6 @@ from track_files import (
 rows = helpers.rows  # a fixture of tests/helpers.py
 
 CAMS = {"swing": {"fps": 3000.0, "m_per_px": 0.00074}, "spin": {"fps": 1000.0, "m_per_px": 0.00125}}
-
-
-BALLBAT = Path(sys.executable).parent / "ballbat"
 
 
 @pytest.mark.slow  # about 3 s: the installed command on a folder of Tracker files
