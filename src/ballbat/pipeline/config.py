@@ -13,10 +13,22 @@ from __future__ import annotations
 import copy
 import math
 import re
-from typing import TYPE_CHECKING
+from typing import ClassVar, Self
 
-if TYPE_CHECKING:
-    pass
+
+class SectionSettings:
+    """A stage's settings read from one section of the validated config (``SECTION``), as its rule's params.
+
+    Subclasses (frozen dataclasses) define ``from_params(params)``: the section itself, which
+    is what the rule passes as params; ``from_config`` is then the same values from the config.
+    """
+
+    SECTION: ClassVar[str] = ""
+
+    @classmethod
+    def from_config(cls, config: dict) -> Self:
+        """Return the workflow's settings from the validated config (its section ``SECTION``)."""
+        return cls.from_params(config[cls.SECTION])
 
 
 class ConfigError(ValueError):

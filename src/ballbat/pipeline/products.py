@@ -20,25 +20,10 @@ import enum
 import re
 from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, ClassVar, Self
+from typing import Any
 
 import numpy as np
 import xarray as xr
-
-
-class SectionSettings:
-    """A stage's settings read from one section of the validated config (``SECTION``), as its rule's params.
-
-    Subclasses (frozen dataclasses) define ``from_params(params)``: the section itself, which
-    is what the rule passes as params; ``from_config`` is then the same values from the config.
-    """
-
-    SECTION: ClassVar[str] = ""
-
-    @classmethod
-    def from_config(cls, config: dict) -> Self:
-        """Return the workflow's settings from the validated config (its section ``SECTION``)."""
-        return cls.from_params(config[cls.SECTION])
 
 
 @dataclass(frozen=True)

@@ -14,7 +14,8 @@ import numpy as np
 import xarray as xr
 
 from ..fitting import FitGrid, FitStatus, Sec4, analyze_impacts, check_physical, fit_status
-from ..pipeline.products import SectionSettings, Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
+from ..pipeline.config import SectionSettings
+from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 from ..systematics import FIT_QUANTITIES, SIDES, SOURCES, FitSystematics, has_shifts, shifted_impacts, source_names
 from .systematics import systematic_vars
 

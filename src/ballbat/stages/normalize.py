@@ -10,7 +10,8 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..analysis import normalize_values
-from ..pipeline.products import SectionSettings, Var, add_variables
+from ..pipeline.config import SectionSettings
+from ..pipeline.products import Var, add_variables
 from ..units import MPH
 
 if TYPE_CHECKING:

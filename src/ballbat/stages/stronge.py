@@ -13,7 +13,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..linefit import MIN_FIT_IMPACTS
-from ..pipeline.products import SectionSettings, Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
+from ..pipeline.config import SectionSettings
+from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 from ..published import STRONGE_E_Y, STRONGE_MU
 from ..stronge.analysis import (
     HISTORY_VARIABLES,
