@@ -20,7 +20,8 @@ _NAME = re.compile(r"^(?P<impact_id>.+)_(?P<camera>swing|spin)$")
 
 EXAMPLE = """examples:
   ballbat track-video W01_swing.mkv W01_spin.mkv --ball-radius-px 49.5,29.3 -o tracks.csv
-  ballbat track-video clips/*.cihx --ball-radius-px 49.5,29.3 --dot-radius-px 3.2 -o tracks.csv"""
+  ballbat track-video clips/*.cihx --ball-radius-px 49.5,29.3 --dot-radius-px 3.2 -o tracks.csv
+  ballbat track-video clips/*.cine --ball-radius-px 49.5,29.3 -o tracks.csv"""
 
 
 def add_parser(sub: argparse._SubParsersAction, formatter_class: type[argparse.HelpFormatter]) -> None:

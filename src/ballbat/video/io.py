@@ -25,6 +25,7 @@ from pathlib import Path
 import numpy as np
 
 from ..pipeline.atomic import atomic_target
+from .cine import CINE_EXT, cine_frames, cine_info
 from .clip import ClipInfo, VideoError
 from .mraw import MRAW_EXT, mraw_frames, mraw_info
 
@@ -113,6 +114,8 @@ class Clip:
             yield from _tiff_frames(self.info)
         elif self.info.format == "mraw":
             yield from mraw_frames(self.info)
+        elif self.info.format == "cine":
+            yield from cine_frames(self.info)
         else:
             yield from _av_frames(self.info)
 
@@ -127,10 +130,12 @@ def open_clip(path: str | os.PathLike[str]) -> Clip:
         return Clip(_tiff_info(path))
     if ext in MRAW_EXT:
         return Clip(mraw_info(path))
+    if ext in CINE_EXT:
+        return Clip(cine_info(path))
     if ext in VIDEO_EXT or ext in (".avi", ".mov"):
         return Clip(_av_info(path))
     raise VideoError(
-        f"{path}: unknown clip extension {ext!r} (known: .tif, .tiff, .cihx, .cih, .mkv, .mp4, .avi, .mov)"
+        f"{path}: unknown clip extension {ext!r} (known: .tif, .tiff, .cihx, .cih, .cine, .mkv, .mp4, .avi, .mov)"
     )
 
 
