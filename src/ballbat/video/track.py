@@ -243,7 +243,8 @@ def _roi(img: np.ndarray, cx: float, cy: float, half: float) -> tuple[np.ndarray
 def find_dots(img: np.ndarray, ball: tuple, dot_r: float, sigma: float) -> tuple[list, str | None]:
     """Dark spots inside the ball: [(x, y, contrast)], or the reason they are left out."""
     cx, cy, r = ball[:3]
-    sub, x0, y0 = _roi(img.astype(np.float32), cx, cy, r + 2)
+    sub, x0, y0 = _roi(img, cx, cy, r + 2)
+    sub = sub.astype(np.float32)  # the region only, not the whole frame
     size = int(2 * np.ceil(2 * dot_r) + 1)
     dark = ndimage.grey_closing(sub, size=(size, size)) - sub
     yy, xx = np.mgrid[0 : sub.shape[0], 0 : sub.shape[1]]
@@ -269,7 +270,8 @@ def find_dots(img: np.ndarray, ball: tuple, dot_r: float, sigma: float) -> tuple
 
 def find_marker(img: np.ndarray, cx: float, cy: float, half: float, mr: float, sigma: float) -> tuple | None:
     """Return the tip marker (a bright disc of radius ``mr`` in a dark surround) nearest (cx, cy): (x, y, contrast)."""
-    sub, x0, y0 = _roi(img.astype(np.float32), cx, cy, half)
+    sub, x0, y0 = _roi(img, cx, cy, half)
+    sub = sub.astype(np.float32)  # the region only, not the whole frame
     if min(sub.shape) < 2 * mr:
         return None
     local = ndimage.uniform_filter(sub, size=int(4 * mr + 1))
