@@ -9,6 +9,7 @@ from pathlib import Path
 import av
 import numpy as np
 import pytest
+import yaml
 from video_clips import M_PER_PX, PLAIN, RADIUS_PX, spin_truth
 
 from ballbat.cli import main
@@ -163,3 +164,20 @@ def test_track_video_replaces_its_own_tables(tmp_path, capsys):
     assert first.splitlines()[-1].startswith(b"# ballbat table:")  # sealed: the writer knows it for its own
     assert main(args) == 0, capsys.readouterr().err
     assert out.read_bytes() == first and (tmp_path / "tracks.quality.csv").exists()
+
+
+def test_the_balls_measured_radius_checks_the_scale_typed(tmp_path, capsys):
+    """The ball's radius in the clip against the one given (from Table I and m_per_px): 5 % off warns."""
+    clip = _good(tmp_path)
+    code, err, _ = _run(tmp_path, capsys, clip)
+    assert code == 0 and "warning" not in err
+    out = tmp_path / "off" / "tracks.csv"
+    wrong = 1.05 * RADIUS_PX  # an m_per_px typed 5 % small
+    code = main(["track-video", str(clip), "--ball-radius-px", f"{wrong},{wrong}", "-o", str(out), "--parents"])
+    captured = capsys.readouterr()
+    assert code == 0, captured.err
+    assert "W01_spin.tif: the ball measures" in captured.err and "m_per_px" in captured.err
+    check = yaml.safe_load(captured.out)["clips"][0]["ball_radius_px"]
+    assert check["given"] == pytest.approx(wrong) and check["frames"] == 3
+    assert check["measured"] == pytest.approx(RADIUS_PX, rel=0.02)  # the clip's own radius, whatever was given
+    assert -6.0 < float(check["off"].rstrip(" %")) < -2.0

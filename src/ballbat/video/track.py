@@ -61,6 +61,7 @@ class Found:
         default_factory=lambda: {k: [] for k in ("point", "frame", "x_px", "y_px", "residual_px", "contrast")}
     )
     left_out: list[tuple[str, int, str]] = field(default_factory=list)
+    ball_radii: list[float] = field(default_factory=list)  # the fitted radius (px) of each ball found
 
     def add(self, point: str, frame: int, x: float, y: float, residual: float, contrast: float) -> None:
         """Add a found point."""
@@ -354,6 +355,7 @@ def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found, 
         return None
     trail.push(k, fit[0], fit[1])
     found.add("ball", k, fit[0], fit[1], fit[3], fit[4])
+    found.ball_radii.append(fit[2])
     return fit
 
 
