@@ -304,6 +304,23 @@ def test_schema_takes_a_folder_and_still_wants_settings_of_a_long_file():
         validate_config({"datasets": {"lab": {"tracks": {**lab, "units": {"time": "ms"}}}}}, schema, available=10**12)
 
 
+def test_schema_takes_a_folder_of_clips_with_its_markers_and_no_points():
+    schema = yaml.safe_load((ROOT / "workflow" / "schemas" / "config.schema.yaml").read_text())
+    clips = {
+        "dir": "data/clips",
+        "format": "video",
+        "impacts": "i.csv",
+        "cameras": {"swing": {"mirror": False, "m_per_px": 0.00074}, "spin": {"mirror": False, "m_per_px": 0.00125}},
+        "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
+        "video": {"dot_radius_mm": 4.0, "marker_radius_mm": 6.0},
+    }
+    cfg = validate_config({"datasets": {"lab": {"tracks": clips}}}, schema, available=10**12)
+    assert cfg["datasets"]["lab"]["tracks"]["video"] == {"dot_radius_mm": 4.0, "marker_radius_mm": 6.0}
+    no_markers = {k: v for k, v in clips.items() if k != "video"}
+    with pytest.raises(ConfigError, match=r"datasets\.lab\.tracks: 'video' is a required property"):
+        validate_config({"datasets": {"lab": {"tracks": no_markers}}}, schema, available=10**12)
+
+
 @pytest.mark.parametrize(
     ("edit", "message"),
     [

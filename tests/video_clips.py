@@ -40,3 +40,46 @@ def swing_truth(n: int = 8, width: int = 240, height: int = 160, tip_start: floa
     y = {"ball": np.full(n, 70.6), "bat_tip": np.full(n, 104.2) - 0.5 * k}
     base = (x["bat_tip"][-1] + 30.0, y["bat_tip"][-1])
     return ClipTruth("T1", "swing", 3000.0, width, height, k, x, y, RADIUS_PX, base, 28 / 34)
+
+
+#: A lab's two cameras as the clips of a ``format: video`` folder are rendered (1024 x 512 px) and the rig.
+LAB_CAMERAS = {
+    "swing": {"fps": 3000, "m_per_px": 0.00074, "tee_px": [600, 300], "width_px": 1024, "height_px": 512},
+    "spin": {"fps": 1000, "m_per_px": 0.00125, "tee_px": [350, 330], "width_px": 1024, "height_px": 512},
+}
+LAB_RIG = {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0}
+#: The true impacts of the clip folder: baseballs on the wood bat.
+LAB_TRUTH = {
+    "v_bat": np.array([70.0, 75.0, 72.0]),  # mph
+    "v_ball": np.array([80.0, 90.0, 70.0]),  # mph
+    "theta": np.array([8.0, 20.0, 30.0]),  # deg
+    "omega": np.array([1500.0, 3000.0, 2500.0]),  # rpm
+    "psi": np.array([10.0, 25.0, 35.0]),  # deg
+}
+
+
+def render_clip_folder(folder, seed: int = 3) -> list[ClipTruth]:
+    """Render :data:`LAB_TRUTH`'s impacts W1.. in both cameras as TIFF stacks in ``folder``, with impacts.csv.
+
+    The markers are 4 mm (dots) and 6 mm (tip) in radius; returns each clip's truth.
+    """
+    from ballbat.pipeline.config import checked_block
+    from ballbat.tracks.render import settings_from_config
+    from ballbat.units import DEGREE, MPH, RPM
+    from ballbat.video.io import write_clip
+    from ballbat.video.render import render_frames
+    from ballbat.video.scene import clip_truths
+
+    s = settings_from_config(checked_block({"cameras": LAB_CAMERAS, "rig": LAB_RIG, "seed": seed}, "render"))
+    unit = {"v_bat": MPH, "v_ball": MPH, "theta": DEGREE, "omega": RPM, "psi": DEGREE}
+    truth = {k: v * unit[k] for k, v in LAB_TRUTH.items()}
+    n = LAB_TRUTH["psi"].size
+    ids = np.array([f"W{i + 1}" for i in range(n)])
+    true = clip_truths(s, truth, np.full(n, 0.0366), ids, np.full(n, "baseball"), np.full(n, "wood"))
+    look = Look(dot_radius_m=0.004, marker_radius_m=0.006)
+    for c in true:
+        frames = render_frames(c, look, LAB_CAMERAS[c.camera]["m_per_px"])
+        write_clip(folder / f"{c.impact_id}_{c.camera}.tif", frames, c.fps, frame_numbers=c.frames)
+    rows = "".join(f"{i},wood,baseball\n" for i in ids)
+    (folder / "impacts.csv").write_text("impact_id,bat,ball\n" + rows)
+    return true

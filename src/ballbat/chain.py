@@ -280,8 +280,9 @@ def reduce_tracks_block(
         tracks = load_tracks(tracks_path or block["file"], impacts_path or block.get("impacts"), balls, bats)
         return reduce.reduce_and_check(settings, tracks, balls, bats)
     from .tracks.formats.layout import import_block
+    from .video.importer import clip_reader
 
-    tracks, imported = import_block(block, where, balls, bats)
+    tracks, imported = import_block(block, where, balls, bats, clip_reader=clip_reader)
     found = imported.settings_yaml()
     try:
         settings = reduce.ReduceSettings.from_config(

@@ -159,6 +159,9 @@ class WorkflowInputs:
         t = self.dataset_config(wildcards)["tracks"]
         exts = tool_file_extensions(t.get("format"))
         found = sorted(str(p) for p in Path(t["dir"]).glob("*") if p.is_file() and p.suffix.lower() in exts)
+        # a Photron header's frames are in the .mraw beside it: an input too, so new frames rerun the import
+        mraw = [p.with_suffix(".mraw") for p in map(Path, found) if p.suffix.lower() in (".cih", ".cihx")]
+        found += sorted(str(p) for p in mraw if p.is_file())  # a missing one: the import names it
         return {"files": found, "impacts": existing(t["impacts"])}
 
     def tool_file_hashes(self, wildcards: Namespace) -> dict[str, str]:

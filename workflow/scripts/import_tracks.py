@@ -1,4 +1,4 @@
-"""Rule import_tracks: adapter around ballbat.tracks.formats.layout.import_block (the file: ballbat.stages.render)."""
+"""Rule import_tracks: adapter around ballbat.tracks.formats.layout.import_block (clips: ballbat.video.importer)."""
 
 import yaml
 
@@ -8,11 +8,16 @@ from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
 from ballbat.stages.render import tracks_dataset
 from ballbat.tracks.formats.layout import import_block
+from ballbat.video.importer import clip_reader
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     inp = snakemake.input
     tracks, imported = import_block(
-        snakemake.params.settings, snakemake.params.where, load_balls(inp.balls), load_bats(inp.bats)
+        snakemake.params.settings,
+        snakemake.params.where,
+        load_balls(inp.balls),
+        load_bats(inp.bats),
+        clip_reader=clip_reader,
     )
     found = imported.settings_yaml()
     log.info("%d files, %d impacts, %d tracked points", found["files"], tracks.n, found["rows"])

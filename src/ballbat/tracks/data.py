@@ -267,6 +267,8 @@ FORMATS = {
     "kinovea": (".kva",),
     "tracker_table": (".txt", ".csv", ".tsv"),
     "kinovea_table": (".csv", ".txt"),
+    # high-speed clips, tracked on import (ballbat.video.importer)
+    "video": (".cine", ".cihx", ".cih", ".tif", ".tiff", ".mkv", ".mp4", ".avi", ".mov"),
 }
 #: Formats known from the extension alone.
 BY_EXTENSION = {".trk": "tracker", ".trz": "tracker", ".kva": "kinovea"}

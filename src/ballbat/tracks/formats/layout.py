@@ -28,7 +28,7 @@ from .tracker import read_trk, read_trz
 
 if TYPE_CHECKING:
     import os
-    from collections.abc import Iterable
+    from collections.abc import Callable, Iterable
 
 #: Formats whose files hold no settings (the config states units, fps, m_per_px).
 TABLES = ("tracker_table", "kinovea_table")
@@ -170,6 +170,7 @@ def import_files(
     units: dict | None = None,
     cameras: dict | None = None,
     where: str = "tracks",
+    reader: Callable[[Path, str, str, dict], FileTracks] | None = None,
 ) -> Imported:
     """Read a lab's tool files into long rows; camera settings from the files, checked against ``cameras``.
 
@@ -187,6 +188,9 @@ def import_files(
         Config camera settings (``fps``, ``m_per_px``, ...) per camera, to check and complete.
     where : str
         Config key of the block, for messages.
+    reader : callable, optional
+        Reader of the ``video`` format's clips, ``(path, impact id, camera, camera config) ->
+        FileTracks`` (:func:`ballbat.video.importer.clip_reader`; the clips are tracked there).
 
     Raises
     ------
@@ -198,13 +202,7 @@ def import_files(
     if problems:
         raise FormatError(problems)
     files, problems = find_files(paths, pattern, fmt)
-    read: list[tuple[str, str, FileTracks]] = []
-    for iid, cam, path in files:
-        f = fmt or BY_EXTENSION[path.suffix.lower()]
-        try:
-            read.append((iid, cam, _read(path, f, units, cameras.get(cam) or {})))
-        except FormatError as exc:
-            problems += exc.problems
+    read = _read_files(files, fmt, units, cameras, reader, problems)
     settings: dict[str, dict] = {}
     for cam in CAMERAS:
         these = [ft for _, c, ft in read if c == cam]
@@ -252,6 +250,23 @@ def import_files(
     return Imported(out, settings, [(i, c, ft.path) for i, c, ft in read], ignored)
 
 
+def _read_files(files, fmt, units, cameras: dict, reader, problems: list[str]) -> list[tuple[str, str, FileTracks]]:
+    """Read every (impact id, camera, path) of ``files``; each file's problems go to ``problems``."""
+    read: list[tuple[str, str, FileTracks]] = []
+    for iid, cam, path in files:
+        f = fmt or BY_EXTENSION[path.suffix.lower()]
+        try:
+            if f == "video":
+                if reader is None:
+                    raise FormatError([f"{path}: a clip, and no clip reader was given (ballbat.video.importer)"])
+                read.append((iid, cam, reader(path, iid, cam, cameras.get(cam) or {})))
+            else:
+                read.append((iid, cam, _read(path, f, units, cameras.get(cam) or {})))
+        except FormatError as exc:
+            problems += exc.problems
+    return read
+
+
 def _block_problems(points: dict, fmt: str | None, units: dict | None, cameras: dict, where: str) -> list[str]:
     """Problems of the block's settings for its files: points, format, units, what a table needs from the config."""
     problems = check_points(points, f"{where}.points")
@@ -263,6 +278,13 @@ def _block_problems(points: dict, fmt: str | None, units: dict | None, cameras: 
             f"{where}.units: given, but only a table (format tracker_table or kinovea_table) needs it: "
             "the tools' own files say their units"
         )
+    if fmt == "video":
+        for c in CAMERAS:
+            if "m_per_px" not in (cameras.get(c) or {}):
+                problems.append(
+                    f"{where}.cameras.{c}.m_per_px: missing (a clip holds no scale, and the tracker sizes the ball "
+                    "by it; no default)"
+                )
     if fmt in TABLES:
         problems += check_units(units, f"{where}.units")
         for c in CAMERAS:
@@ -340,12 +362,16 @@ def _table_spelling(imp: Imported, impacts: dict[str, str]) -> None:
     imp.columns["impact_id"] = ids.astype(str)
 
 
-def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | None = None) -> tuple[Tracks, Imported]:
+def import_block(
+    cfg: dict, where: str, balls: dict | None = None, bats: dict | None = None, clip_reader: Callable | None = None
+) -> tuple[Tracks, Imported]:
     """Read a dataset's validated ``tracks`` block that names a folder (``dir``): return (Tracks, Imported).
 
     The impacts file (``impacts``) gives each impact's bat and ball; every impact must have a
     file of each camera and every file an impact. Every problem is raised at once as an
-    :class:`~ballbat.properties.InputError`.
+    :class:`~ballbat.properties.InputError`. ``clip_reader(block, {impact id: ball radius m})``
+    returns the reader of a ``format: video`` block's clips
+    (:func:`ballbat.video.importer.clip_reader`).
     """
     from ...properties import InputError
     from ..io import _assemble, read_impacts
@@ -353,15 +379,24 @@ def import_block(cfg: dict, where: str, balls: dict | None = None, bats: dict | 
     ipath = Path(cfg["impacts"])
     impacts, irows, problems = read_impacts(ipath, balls, bats)
     impacts = impacts or {}
+    if "video" in cfg and cfg.get("format") != "video":
+        problems.append(f"{where}.video: given, but only a folder of clips (format: video) is tracked")
+    reader = None
+    if cfg.get("format") == "video" and clip_reader is not None:
+        radius = {
+            row.get("impact_id", ""): balls[row["ball"]].r for _, row in irows if balls and row.get("ball") in balls
+        }
+        reader = clip_reader(cfg, radius)
     try:
         imp = import_files(
             [cfg["dir"]],
-            cfg.get("points"),
+            cfg.get("points") or ({p: p for p in BALLBAT_POINTS} if cfg.get("format") == "video" else None),
             pattern=cfg["pattern"],
             fmt=cfg.get("format"),
             units=cfg.get("units"),
             cameras=cfg.get("cameras"),
             where=where,
+            reader=reader,
         )
     except FormatError as exc:
         raise InputError(problems + exc.problems) from None

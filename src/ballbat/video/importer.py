@@ -1,0 +1,82 @@
+"""High-speed clips as a dataset's tracking files: each clip tracked into the tracks one tool file holds.
+
+A dataset's ``tracks`` block with ``format: video`` names a folder of clips, one per impact and
+camera (``{impact_id}_{camera}.{ext}``: ``.cine``, ``.cihx``/``.cih``, ``.tif``/``.tiff``,
+``.mkv``, ``.mp4``, ``.avi``, ``.mov``), as it names a folder of Tracker or Kinovea files. Each
+clip is read and tracked (:func:`ballbat.video.track.track_clip`) into a
+:class:`~ballbat.tracks.formats.FileTracks`: its points under ballbat's own names, the frame
+rate the file holds (checked against the config's by the import, as a Tracker file's is).
+The tracker's sizes come from the lab's scale: the ball's radius is the balls table's radius
+over the camera's ``m_per_px``, the dots' and the tip marker's from ``video.dot_radius_mm`` and
+``video.marker_radius_mm``. The clip then checks the scale: the ball's fitted radius (median of
+its frames) more than :data:`RADIUS_LIMIT` from the expected one is an error naming the clip,
+both radii and the ``m_per_px`` the clip implies.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from pathlib import Path
+
+import numpy as np
+
+from ..tracks.data import POINTS
+from ..tracks.formats import FileTracks, FormatError
+from .clip import VideoError
+from .io import open_clip
+from .track import TrackOptions, require_ball, track_clip
+
+#: Largest relative difference of the ball's measured radius from the one the config implies
+#: (Table I's radius / m_per_px). The fitted radius is within 1 % of the truth on rendered clips
+#: (lossless and H.264 at CRF 18; docs/video.md); a real ball's diameter is within about 1 % of
+#: its type's. More than 5 % is an m_per_px typed wrong, or another ball.
+RADIUS_LIMIT = 0.05
+
+
+def clip_tracks(path: Path, camera: str, m_per_px: float, ball_radius_m: float, video: dict) -> FileTracks:
+    """Track one clip into the tracks of its camera's points; a :class:`FormatError` naming what is wrong."""
+    opt = TrackOptions(
+        ball_radius_m / m_per_px,
+        POINTS[camera],
+        video["dot_radius_mm"] * 1e-3 / m_per_px,
+        video["marker_radius_mm"] * 1e-3 / m_per_px,
+    )
+    try:
+        clip = open_clip(path)
+        found = track_clip(clip, opt)
+        require_ball(found, str(path))
+    except VideoError as exc:
+        raise FormatError([str(exc)]) from None
+    measured = float(np.median(found.ball_radii))
+    if abs(measured / opt.ball_radius_px - 1.0) > RADIUS_LIMIT:
+        raise FormatError(
+            [
+                f"{path}: the ball measures {measured:.2f} px in radius (median of {len(found.ball_radii)} frames), "
+                f"the config's m_per_px {m_per_px:g} makes it {opt.ball_radius_px:.2f} px: the clip says m_per_px "
+                f"{ball_radius_m / measured:.4g} (or the ball is not the impacts table's)"
+            ]
+        )
+    rows = found.rows
+    point = np.array(rows["point"], dtype=object)
+    tracks = {}
+    for p in POINTS[camera]:
+        sel = point == p
+        tracks[p] = tuple(
+            np.array(rows[k], dtype=t)[sel] for k, t in (("frame", np.int64), ("x_px", float), ("y_px", float))
+        )
+    info = clip.info
+    return FileTracks(str(path), tracks, fps=info.fps, source={"fps": info.source.get("fps", "the clip")})
+
+
+def clip_reader(block: dict, ball_radius_m: dict[str, float]) -> Callable[[Path, str, str, dict], FileTracks]:
+    """Return the reader of a ``format: video`` block's clips: (path, impact id, camera, camera config) -> FileTracks.
+
+    ``ball_radius_m`` maps each impact id to its ball's radius (the balls table's).
+    """
+
+    def read(path: Path, impact_id: str, camera: str, cam: dict) -> FileTracks:
+        if impact_id not in ball_radius_m:
+            raise FormatError([f"{path}: impact {impact_id!r} has no ball in the impacts table"])
+        return clip_tracks(path, camera, float(cam["m_per_px"]), ball_radius_m[impact_id], block["video"])
+
+    return read

@@ -1,0 +1,100 @@
+"""A folder of clips as a dataset's tracking files (ballbat.video.importer; docs/video.md, "In the workflow").
+
+Slow: each import tracks the six clips (1024 x 512 px) again.
+"""
+
+from __future__ import annotations
+
+import copy
+from pathlib import Path
+
+import numpy as np
+import pytest
+from video_clips import LAB_CAMERAS, render_clip_folder
+
+from ballbat.properties import InputError, load_balls, load_bats
+from ballbat.tracks.formats.layout import import_block
+from ballbat.video.importer import clip_reader
+
+ROOT = Path(__file__).parents[2]
+
+
+@pytest.fixture(scope="module")
+def clips(tmp_path_factory):
+    """Three impacts rendered in both cameras as TIFF stacks, their impacts table and their truth."""
+    folder = tmp_path_factory.mktemp("clips")
+    return folder, render_clip_folder(folder)
+
+
+def _block(folder: Path, **cameras) -> dict:
+    cams = copy.deepcopy({c: {"m_per_px": v["m_per_px"]} for c, v in LAB_CAMERAS.items()})
+    for cam, values in cameras.items():
+        cams[cam].update(values)
+    return {
+        "dir": str(folder),
+        "format": "video",
+        "pattern": "{impact_id}_{camera}.{ext}",
+        "impacts": str(folder / "impacts.csv"),
+        "cameras": cams,
+        "video": {"dot_radius_mm": 4.0, "marker_radius_mm": 6.0},
+    }
+
+
+def _tables():
+    return load_balls(ROOT / "config" / "balls.csv"), load_bats(ROOT / "config" / "bats.csv")
+
+
+@pytest.mark.slow
+def test_clips_are_tracked_into_the_tracks_the_reduction_reads(clips):
+    folder, true = clips
+    tracks, imported = import_block(_block(folder), "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
+    assert list(tracks.impact_id) == ["W1", "W2", "W3"] and imported.settings_yaml()["files"] == 6
+    # the frame rates from the clips (the config gives none)
+    assert imported.cameras["swing"]["fps"] == 3000.0 and "file(s)" in imported.cameras["swing"]["fps_from"]
+    for c in true:
+        i = list(tracks.impact_id).index(c.impact_id)
+        for p in c.x:
+            # the dots' names are the tracker's (which is a and which b is fixed once per clip)
+            names = ("dot_a", "dot_b") if p.startswith("dot") else (p,)
+            n, err = min((_rms(tracks.cameras[c.camera], i, p, c, q) for q in names), key=lambda r: r[1])
+            assert n > 3 and err < 0.5, (c.impact_id, c.camera, p, n, err)
+
+
+def _rms(ct, i: int, p: str, c, q: str) -> tuple[int, float]:
+    """Points of ``p`` tracked in impact ``i`` and their RMS distance from the truth's ``q`` (px)."""
+    at = {int(f): k for k, f in enumerate(c.frames)}
+    have = [(j, at[int(f)]) for j, f in enumerate(ct.frames()[i]) if np.isfinite(ct.x[p][i][j]) and int(f) in at]
+    d = [np.hypot(ct.x[p][i][j] - c.x[q][k], ct.y[p][i][j] - c.y[q][k]) for j, k in have]
+    return len(d), float(np.sqrt(np.nanmean(np.square(d))))
+
+
+@pytest.mark.slow
+def test_a_scale_the_clips_contradict_is_named(clips):
+    folder, _ = clips
+    wrong = _block(folder, spin={"m_per_px": 0.00125 * 1.12})  # typed 12 % large: the ball 11 % small
+    with pytest.raises(InputError, match=r"W1_spin\.tif: the ball measures .* the clip says m_per_px 0\.001"):
+        import_block(wrong, "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
+
+
+@pytest.mark.slow
+def test_a_frame_rate_the_clips_contradict_is_named(clips):
+    folder, _ = clips
+    wrong = _block(folder, swing={"fps": 2000})
+    with pytest.raises(InputError, match=r"cameras\.swing\.fps: the config says 2000 but .*W1_swing\.tif says 3000"):
+        import_block(wrong, "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
+
+
+@pytest.mark.slow
+def test_a_video_folder_needs_the_scale(clips):
+    folder, _ = clips
+    block = _block(folder)
+    del block["cameras"]["spin"]["m_per_px"]
+    with pytest.raises(InputError, match=r"cameras\.spin\.m_per_px: missing \(a clip holds no scale"):
+        import_block(block, "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
+
+
+def test_markers_given_for_a_folder_of_tool_files_are_named(tmp_path):
+    (tmp_path / "impacts.csv").write_text("impact_id,bat,ball\nW1,wood,baseball\n")
+    block = {**_block(tmp_path), "format": "tracker", "points": {p: p for p in ("ball", "bat_tip", "dot_a", "dot_b")}}
+    with pytest.raises(InputError, match=r"datasets\.vid\.tracks\.video: given, but only a folder of clips"):
+        import_block(block, "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
