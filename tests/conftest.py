@@ -84,6 +84,18 @@ def _shared_run(tmp_path_factory, name: str, build) -> Path:
 
 
 @pytest.fixture(scope="session")
+def lab_clips(tmp_path_factory):
+    """A lab's folder of clips: three impacts in both cameras (video_clips.render_clip_folder), and their truth.
+
+    Read only: a test that changes the folder copies it first.
+    """
+    from video_clips import render_clip_folder
+
+    folder = tmp_path_factory.mktemp("lab_clips")
+    return folder, render_clip_folder(folder)
+
+
+@pytest.fixture(scope="session")
 def default_run(tmp_path_factory):
     """The workflow run once with the default config (`snakemake -c2`), shared by the tests that read it.
 

@@ -58,10 +58,11 @@ LAB_TRUTH = {
 }
 
 
-def render_clip_folder(folder, seed: int = 3) -> list[ClipTruth]:
-    """Render :data:`LAB_TRUTH`'s impacts W1.. in both cameras as TIFF stacks in ``folder``, with impacts.csv.
+def render_clip_folder(folder, seed: int = 3, n: int | None = None) -> list[ClipTruth]:
+    """Render :data:`LAB_TRUTH`'s first ``n`` impacts (default all) W1.. in both cameras as TIFF stacks in ``folder``.
 
-    The markers are 4 mm (dots) and 6 mm (tip) in radius; returns each clip's truth.
+    With impacts.csv beside them. The markers are 4 mm (dots) and 6 mm (tip) in radius; returns
+    each clip's truth.
     """
     from ballbat.pipeline.config import checked_block
     from ballbat.tracks.render import settings_from_config
@@ -72,8 +73,8 @@ def render_clip_folder(folder, seed: int = 3) -> list[ClipTruth]:
 
     s = settings_from_config(checked_block({"cameras": LAB_CAMERAS, "rig": LAB_RIG, "seed": seed}, "render"))
     unit = {"v_bat": MPH, "v_ball": MPH, "theta": DEGREE, "omega": RPM, "psi": DEGREE}
-    truth = {k: v * unit[k] for k, v in LAB_TRUTH.items()}
-    n = LAB_TRUTH["psi"].size
+    n = LAB_TRUTH["psi"].size if n is None else n
+    truth = {k: v[:n] * unit[k] for k, v in LAB_TRUTH.items()}
     ids = np.array([f"W{i + 1}" for i in range(n)])
     true = clip_truths(s, truth, np.full(n, 0.0366), ids, np.full(n, "baseball"), np.full(n, "wood"))
     look = Look(dot_radius_m=0.004, marker_radius_m=0.006)

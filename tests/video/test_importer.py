@@ -1,6 +1,6 @@
 """A folder of clips as a dataset's tracking files (ballbat.video.importer; docs/video.md, "In the workflow").
 
-Slow: each import tracks the six clips (1024 x 512 px) again.
+Slow: each import tracks its clips (1024 x 512 px) again.
 """
 
 from __future__ import annotations
@@ -20,10 +20,10 @@ ROOT = Path(__file__).parents[2]
 
 
 @pytest.fixture(scope="module")
-def clips(tmp_path_factory):
-    """Three impacts rendered in both cameras as TIFF stacks, their impacts table and their truth."""
-    folder = tmp_path_factory.mktemp("clips")
-    return folder, render_clip_folder(folder)
+def one_impact(tmp_path_factory):
+    """The first impact's two clips alone (the tests of settings the clips contradict)."""
+    folder = tmp_path_factory.mktemp("one")
+    return folder, render_clip_folder(folder, n=1)
 
 
 def _block(folder: Path, **cameras) -> dict:
@@ -45,8 +45,8 @@ def _tables():
 
 
 @pytest.mark.slow
-def test_clips_are_tracked_into_the_tracks_the_reduction_reads(clips):
-    folder, true = clips
+def test_clips_are_tracked_into_the_tracks_the_reduction_reads(lab_clips):
+    folder, true = lab_clips
     tracks, imported = import_block(_block(folder), "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
     assert list(tracks.impact_id) == ["W1", "W2", "W3"] and imported.settings_yaml()["files"] == 6
     # the frame rates from the clips (the config gives none)
@@ -69,24 +69,24 @@ def _rms(ct, i: int, p: str, c, q: str) -> tuple[int, float]:
 
 
 @pytest.mark.slow
-def test_a_scale_the_clips_contradict_is_named(clips):
-    folder, _ = clips
+def test_a_scale_the_clips_contradict_is_named(one_impact):
+    folder, _ = one_impact
     wrong = _block(folder, spin={"m_per_px": 0.00125 * 1.12})  # typed 12 % large: the ball 11 % small
     with pytest.raises(InputError, match=r"W1_spin\.tif: the ball measures .* the clip says m_per_px 0\.001"):
         import_block(wrong, "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
 
 
 @pytest.mark.slow
-def test_a_frame_rate_the_clips_contradict_is_named(clips):
-    folder, _ = clips
+def test_a_frame_rate_the_clips_contradict_is_named(one_impact):
+    folder, _ = one_impact
     wrong = _block(folder, swing={"fps": 2000})
     with pytest.raises(InputError, match=r"cameras\.swing\.fps: the config says 2000 but .*W1_swing\.tif says 3000"):
         import_block(wrong, "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
 
 
 @pytest.mark.slow
-def test_a_video_folder_needs_the_scale(clips):
-    folder, _ = clips
+def test_a_video_folder_needs_the_scale(one_impact):
+    folder, _ = one_impact
     block = _block(folder)
     del block["cameras"]["spin"]["m_per_px"]
     with pytest.raises(InputError, match=r"cameras\.spin\.m_per_px: missing \(a clip holds no scale"):

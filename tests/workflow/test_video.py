@@ -5,20 +5,20 @@ from __future__ import annotations
 import numpy as np
 import pytest
 import yaml
-from video_clips import LAB_CAMERAS, LAB_RIG, LAB_TRUTH, render_clip_folder
+from video_clips import LAB_CAMERAS, LAB_RIG, LAB_TRUTH
 
 from ballbat.units import DEGREE, MPH, RPM
 from workflow_helpers import make_workdir, snakemake, write_config
 
 
 @pytest.mark.slow
-def test_a_folder_of_clips_is_tracked_and_reduced_to_its_impacts(tmp_path):
+def test_a_folder_of_clips_is_tracked_and_reduced_to_its_impacts(tmp_path, lab_clips):
+    import shutil
+
     import xarray as xr
 
     wd = make_workdir(tmp_path)
-    clips = wd / "lab" / "clips"
-    clips.mkdir(parents=True)
-    render_clip_folder(clips)
+    shutil.copytree(lab_clips[0], wd / "lab" / "clips")
     block = {
         "dir": "lab/clips",
         "format": "video",
