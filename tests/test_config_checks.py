@@ -390,3 +390,10 @@ def test_a_frame_rate_sweep_needs_rendered_tracks(raw, schema):
     raw["studies"]["design"]["sweep"] = {"parameter": "spin_fps", "values": [1000]}
     with pytest.raises(ConfigError, match="spin_fps needs a dataset that renders camera tracks"):
         validate_config(raw, schema, available=24 * 2**30)
+
+
+def test_a_study_of_a_filmed_dataset_is_refused(raw, schema):
+    """Replicates reduce rendered tracks; a dataset that films its impacts (render.video) is named."""
+    raw["datasets"]["synthetic"]["render"]["video"] = {"format": "mkv"}
+    with pytest.raises(ConfigError, match=r"studies\.calibration\.dataset: 'synthetic' films its impacts"):
+        validate_config(raw, schema, available=10**12)

@@ -14,7 +14,7 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING
 
-from .datasets import renders
+from .datasets import films, renders
 from .pipeline.config import (
     ConfigError,
     _message,
@@ -113,6 +113,11 @@ def _studies(config: dict, schema: dict | None = None) -> list[str]:
         elif "synthetic" not in ds:
             problems.append(
                 f"{where}.dataset: {study['dataset']!r} is not synthetic (a study replicates a synthetic experiment)"
+            )
+        elif films(ds):
+            problems.append(
+                f"{where}.dataset: {study['dataset']!r} films its impacts (render.video): a study replicates "
+                "rendered tracks, not clips (minutes a replicate); name a dataset without render.video"
             )
         else:
             found = check_study_sweep(ds, study, where)

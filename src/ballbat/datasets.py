@@ -7,9 +7,14 @@ stay cheap to import at every workflow start.
 
 from __future__ import annotations
 
-__all__ = ["renders"]
+__all__ = ["films", "renders"]
 
 
 def renders(dataset: dict) -> bool:
     """Whether a validated dataset renders camera tracks (its render block's ``enabled``, default filled)."""
     return "render" in dataset and bool(dataset["render"]["enabled"])
+
+
+def films(dataset: dict) -> bool:
+    """Whether a validated dataset renders high-speed clips (``render.video``), tracked and reduced from the pixels."""
+    return renders(dataset) and "video" in dataset["render"]

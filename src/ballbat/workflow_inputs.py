@@ -16,7 +16,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING
 
 from .config_checks import BYTES_PER_CASE, STUDY_BYTES_PER_REPLICATE, impact_bytes, scenario_tables, study_impacts
-from .datasets import renders
+from .datasets import films, renders
 from .pipeline.codedeps import module_files
 from .pipeline.guards import results_root
 from .pipeline.provenance import sha256_file
@@ -147,7 +147,7 @@ class WorkflowInputs:
         camera settings found in them), or the rendered tracks.nc (both .nc hold their impact table).
         """
         d = self.dataset_config(wildcards)
-        if "tracks" in d and "dir" in d["tracks"]:
+        if ("tracks" in d and "dir" in d["tracks"]) or films(d):
             out = f"{self.results}/{wildcards.dataset}/imported"
             return {"tracks": f"{out}_tracks.nc", "cameras": f"{out}_cameras.yaml"}
         if "tracks" in d:  # a missing file fails this dataset's reduce job only (existing), not the DAG
@@ -155,8 +155,14 @@ class WorkflowInputs:
         return {"tracks": f"{self.results}/{wildcards.dataset}/tracks.nc"}
 
     def get_tool_files(self, wildcards: Namespace) -> dict:
-        """Return the tool files of a dataset whose tracks block names a folder (dir), and its impacts file."""
-        t = self.dataset_config(wildcards)["tracks"]
+        """Return the tool files of a dataset whose tracks block names a folder (dir), and its impacts file.
+
+        A dataset that films its impacts (``render.video``): the folder of clips the render_clips rule writes.
+        """
+        d = self.dataset_config(wildcards)
+        if films(d):
+            return {"files": self.clips_dir(wildcards)}
+        t = d["tracks"]
         exts = tool_file_extensions(t.get("format"))
         found = sorted(str(p) for p in Path(t["dir"]).glob("*") if p.is_file() and p.suffix.lower() in exts)
         # a Photron header's frames are in the .mraw beside it: an input too, so new frames rerun the import
@@ -169,12 +175,23 @@ class WorkflowInputs:
 
         A tool file replaced by other content reruns the import, whatever its timestamp (:func:`file_hashes`).
         """
+        if films(self.dataset_config(wildcards)):  # the clips are the render_clips rule's, rebuilt by their inputs
+            return self.data_hashes(wildcards)
         files = {Path(f).name: f for f in self.get_tool_files(wildcards)["files"]}
         return {**self.data_hashes(wildcards), **file_hashes(files)}
 
     def get_import_settings(self, wildcards: Namespace) -> dict:
-        """Return the dataset's ``tracks`` block (the import rule's params)."""
-        return self.dataset_config(wildcards)["tracks"]
+        """Return the dataset's ``tracks`` block (the import rule's params); filmed impacts: the block of the clips."""
+        d = self.dataset_config(wildcards)
+        if films(d):
+            from .stages.clips import clip_block
+
+            return clip_block(d["render"], self.clips_dir(wildcards))
+        return d["tracks"]
+
+    def clips_dir(self, wildcards: Namespace) -> str:
+        """Return the folder of a filmed dataset's clips (the render_clips rule's output)."""
+        return f"{self.results}/{wildcards.dataset}/clips"
 
     def get_reduce_settings(self, wildcards: Namespace) -> dict:
         """Return the camera block the reduction reads (of ``tracks``, or of ``render``)."""

@@ -247,6 +247,8 @@ def test_every_render_default_arrives():
         if path == ("enabled",):  # chooses the chain: the dataset renders tracks
             assert renders({"render": checked_block(MINIMAL_RENDER, "render")}) is default is True
             continue
+        if path[0] == "video":  # the clips' look (a filmed dataset): tests/stages/test_clips.py
+            continue
         got = _render_value(s, path)
         assert got == pytest.approx(default, rel=1e-12), (path, got, default)
 
@@ -408,6 +410,8 @@ CALIBRATION_ERRORS = {
 WITH = {("tilt_deg",): {("tilted_fraction",): 0.5}}
 #: Keys with a test of their own below: enabled (the chain) and seed (a study's replicates draw their own).
 OWN_TEST = {("enabled",), ("seed",)}
+#: The clips of a filmed dataset (render.video), not the replicates': tests/stages/test_clips.py changes each.
+OWN_TEST |= {("video", k) for k in ("format", "crf", "exposure_us", "bit_depth", "dot_radius_mm", "marker_radius_mm")}
 
 
 def _leaves(kind: str) -> set[tuple]:

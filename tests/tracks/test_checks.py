@@ -248,3 +248,16 @@ def test_every_impact_excluded_stops_with_a_count(rendered):
     msg = stopped(few, s)
     assert f"0 of {tr.n} impacts usable" in msg and f"too_few_frames: {tr.n}" in msg, msg
     assert "impact 0: reduce: " in msg
+
+
+def test_a_singular_system_leaves_its_impact_out_not_the_others():
+    """The tip-arc fit solves every impact at once: one degenerate impact gets NaN, the others their answer."""
+    from ballbat.tracks.checks import _solve_each
+
+    A = np.stack([2 * np.eye(4), np.zeros((4, 4)), np.diag([1.0, 2.0, 4.0, 8.0])])
+    x = _solve_each(A, np.ones((3, 4)))
+    np.testing.assert_array_equal(x[0], 0.5)
+    assert np.isnan(x[1]).all()
+    np.testing.assert_array_equal(x[2], [1.0, 0.5, 0.25, 0.125])
+    inv = _solve_each(A, np.broadcast_to(np.eye(4), A.shape).copy())
+    np.testing.assert_array_equal(inv[2], np.linalg.inv(A[2]))

@@ -38,3 +38,30 @@ def test_a_folder_of_clips_is_tracked_and_reduced_to_its_impacts(tmp_path, lab_c
     for name, u in unit.items():
         got, err = red[name].values, red[f"{name}_err"].values
         assert np.all(np.abs(got - LAB_TRUTH[name] * u) < 4 * err), (name, got / u, err / u)
+
+
+@pytest.mark.slow
+def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_path):
+    """render.video: the clips drawn (render_clips), tracked (import_tracks) and reduced: within 4 standard
+    errors of the experiment's truth; the folder of clips is written whole, and a rerun does nothing.
+    """
+    import xarray as xr
+
+    wd = make_workdir(tmp_path)
+    example = yaml.safe_load((wd / "config" / "examples" / "video.yaml").read_text())["datasets"]["video"]
+    example["synthetic"]["impacts"] = {"baseball": {"wood": 4}}
+    example["synthetic"]["e_x"] = {"baseball": {"wood": 0.464}}
+    write_config(wd, lambda cfg: cfg["datasets"].update(filmed=example))
+    snakemake(wd, "-c2", "--", "results/filmed/reduce.nc")
+    res = wd / "results" / "filmed"
+    names = sorted(p.name for p in (res / "clips").iterdir())
+    assert len([n for n in names if n.endswith(".mkv")]) == 8 and "impacts.csv" in names
+    assert not [p for p in res.iterdir() if p.name.startswith(".clips.")]  # no temporary folder left
+    truth = xr.open_dataset(res / "simulate.nc")
+    red = xr.open_dataset(res / "reduce.nc")
+    assert list(red["impact_id"].values) == [str(i) for i in truth["impact"].values]
+    for name in ("v_bat", "v_ball", "theta", "omega"):
+        got, err, true = red[name].values, red[f"{name}_err"].values, truth[f"truth_{name}"].values
+        assert np.all(np.abs(got - true) < 4 * err), (name, got, true, err)
+    again = snakemake(wd, "-c2", "-n", "--", "results/filmed/reduce.nc")
+    assert "Nothing to be done" in again.stdout + again.stderr

@@ -30,6 +30,33 @@ rule render_tracks:
         "../scripts/render_tracks.py"
 
 
+rule render_clips:
+    """Film a synthetic experiment: both cameras' high-speed clips of every impact (render.video; docs/video.md)."""
+    input:
+        truth=f"{R}/{{dataset}}/simulate.nc",
+        balls=get_balls_table,
+        code=code("render_clips.py"),
+    output:
+        clips=directory(f"{R}/{{dataset}}/clips"),
+    log:
+        f"{R}/{{dataset}}/logs/render_clips.log",
+    benchmark:
+        f"{R}/{{dataset}}/benchmarks/render_clips.tsv"
+    group:
+        "dataset"
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=dataset_mem_mb,
+        runtime=60,
+    params:
+        settings=get_render_settings,
+        sha256=data_hashes,
+    script:
+        "../scripts/render_clips.py"
+
+
 rule import_tracks:
     """Read a lab's tracking-tool files (Tracker, Kinovea; one per impact and camera) into long tracks."""
     input:

@@ -225,7 +225,7 @@ def provenance_attrs(
     ----------
     rule : name of the workflow rule (or function) that wrote the file.
     inputs : input files (a list, or a mapping name -> path or list of paths); each is
-        recorded with its sha256.
+        recorded with its sha256 (a folder: each file in it).
     config : the config values the rule used.
     workdir : where to look for the git checkout (default: the package's own).
     """
@@ -236,6 +236,8 @@ def provenance_attrs(
             items += [(name, v) for v in vals]
     else:
         items = [(None, v) for v in inputs]
+    # a folder input (a directory() output, such as a dataset's clips): each of its files
+    items = [(n, f) for n, v in items for f in (sorted(_files_in(v)) if Path(v).is_dir() else [v])]
     files = [{"name": name, "path": str(path), "sha256": sha256_file(path)} for name, path in items]
     git = git_state(str(workdir) if workdir else None)
     return {
@@ -245,6 +247,11 @@ def provenance_attrs(
         "provenance_software": dumps(software_versions()),
         "provenance_git": dumps(git),
     }
+
+
+def _files_in(folder: str | os.PathLike[str]) -> list[str]:
+    """Every file under ``folder`` (its subfolders too), as paths."""
+    return [str(p) for p in Path(folder).rglob("*") if p.is_file()]
 
 
 def data_inputs(named_input: Mapping[str, object]) -> dict:

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     from ..properties import Ball
     from ..tracks.data import Tracks
 
-__all__ = ["RenderSettings", "from_config", "from_params", "render", "run", "tracks_dataset"]
+__all__ = ["RenderSettings", "from_config", "from_params", "render", "render_inputs", "run", "tracks_dataset"]
 
 
 #: The variables of a tracks file (long rows along ``row``, the impact table along ``impact``);
@@ -67,16 +67,15 @@ def render(settings: RenderSettings, simulated: xr.Dataset, balls: dict[str, Bal
     -------
     Tracks
     """
+    truth, r, ids, ball, bat = render_inputs(simulated, balls)
+    return render_tracks(truth, r, settings, ids, ball, bat)
+
+
+def render_inputs(simulated: xr.Dataset, balls: dict[str, Ball]) -> tuple[dict, np.ndarray, np.ndarray, ...]:
+    """Return what the renderers take of a synthetic experiment: (truth, ball radii, impact ids, balls, bats)."""
     truth = {k: simulated[f"truth_{k}"].values for k in SIMULATED_TRUTH if f"truth_{k}" in simulated}
     r = np.array([balls[b].r for b in simulated["ball"].values.astype(str)])
-    return render_tracks(
-        truth,
-        r,
-        settings,
-        simulated["impact"].values.astype(str),
-        simulated["ball"].values,
-        simulated["bat"].values,
-    )
+    return truth, r, simulated["impact"].values.astype(str), simulated["ball"].values, simulated["bat"].values
 
 
 def tracks_dataset(tracks: Tracks) -> xr.Dataset:

@@ -442,19 +442,40 @@ def tip_arc(
             b[:, 2] += prior * (tau0 - tau)
             A[~ok] = np.eye(4)
             b[~ok] = 0.0
-            step = np.linalg.solve(A, b[..., None])[..., 0]
-            a, V, tau, w = a + step[:, 0], V + step[:, 1], tau + step[:, 2], w + step[:, 3]
+            step = _solve_each(A, b)
+            ok &= np.isfinite(step).all(axis=1)  # a singular system: that impact's check is not made
+            a, V, tau, w = (q + np.where(ok, step[:, j], 0.0) for j, q in enumerate((a, V, tau, w)))
         f, J = model(a, V, tau, w)
         r = np.where(mask, along - f, 0.0)
         s2 = np.sum(r**2, axis=1) / np.maximum(n - 4, 1)
         A = gram(J)
         A[:, 2, 2] += s2 / sigma_tau**2
         A[~ok] = np.eye(4)
-        cov = np.linalg.inv(A) * s2[:, None, None]
+        cov = _solve_each(A, np.broadcast_to(np.eye(4), A.shape).copy()) * s2[:, None, None]
         kappa = w * L_cfg**2
         kappa_err = np.sqrt(cov[:, 3, 3]) * L_cfg**2
     good = ok & np.isfinite(kappa) & np.isfinite(kappa_err) & (kappa_err > 0)
     return np.where(good, kappa, np.nan), np.where(good, kappa_err, np.nan)
+
+
+def _solve_each(A: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """Solve each system ``A[i] x = b[i]`` (b a vector or a matrix per system); NaN where ``A[i]`` is singular.
+
+    One batched solve; only if it fails, system by system, so one impact's degenerate fit does not
+    stop the others' checks.
+    """
+    vec = b.ndim == A.ndim - 1
+    rhs = b[..., None] if vec else b
+    try:
+        x = np.linalg.solve(A, rhs)
+    except np.linalg.LinAlgError:
+        x = np.full(rhs.shape, np.nan)
+        for i in range(A.shape[0]):
+            try:
+                x[i] = np.linalg.solve(A[i], rhs[i])
+            except np.linalg.LinAlgError:
+                pass
+    return x[..., 0] if vec else x
 
 
 # ---------------------------------------------------------------------------------------

@@ -1,0 +1,111 @@
+"""Stage render_clips: ``results/{dataset}/clips/``, both cameras' high-speed clips of a synthetic experiment.
+
+A synthetic dataset whose ``render`` block holds ``video`` is filmed rather than tracked: each
+impact's two clips are drawn (:func:`ballbat.video.scene.clip_truths`, the tracks renderer's
+own positions without its tracking noise, drawn by :func:`ballbat.video.render.render_frames`)
+and written as a lab's files (:func:`ballbat.video.io.write_clip`), with the impacts table
+beside them. The import then tracks them as it tracks a lab's folder of clips
+(:mod:`ballbat.video.importer`), and the reduction goes on: the whole chain from pixels.
+"""
+
+from __future__ import annotations
+
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from .render import render_inputs
+
+if TYPE_CHECKING:
+    import xarray as xr
+
+    from ..properties import Ball
+    from ..tracks.render import RenderSettings
+    from ..video.render import Look
+
+__all__ = ["clip_block", "clip_look", "render_clips"]
+
+#: The file each ``video.format`` writes (docs/video.md, "Files").
+EXTENSIONS = {"tif": ".tif", "mkv": ".mkv", "mp4": ".mp4"}
+
+
+def clip_block(render: dict, clips_dir: str) -> dict:
+    """Return the ``tracks`` block (``format: video``) that reads a rendered dataset's clips back.
+
+    The cameras' scales, mirrors and uncertainties, the rig and the frame limits are the
+    ``render`` block's: the lab's settings, as it would state them for its own clips.
+    """
+    from ..tracks.data import camera_block
+
+    block = camera_block(render)
+    block.update(
+        {
+            "dir": clips_dir,
+            "format": "video",
+            "pattern": "{impact_id}_{camera}.{ext}",
+            "impacts": f"{clips_dir}/impacts.csv",
+            "video": {k: render["video"][k] for k in ("dot_radius_mm", "marker_radius_mm")},
+        }
+    )
+    return block
+
+
+def clip_look(video: dict, seed: int) -> Look:
+    """Return how the cameras image the scene: the ``render.video`` block's exposure, bits and markers."""
+    from ..video.render import Look
+
+    return Look(
+        exposure_s=video["exposure_us"] * 1e-6,
+        bit_depth=video["bit_depth"],
+        dot_radius_m=video["dot_radius_mm"] * 1e-3,
+        marker_radius_m=video["marker_radius_mm"] * 1e-3,
+        seed=seed,
+    )
+
+
+def render_clips(
+    settings: RenderSettings, video: dict, simulated: xr.Dataset, balls: dict[str, Ball], out: str | os.PathLike[str]
+) -> list[Path]:
+    """Write every impact's two clips and ``impacts.csv`` into the folder ``out``, whole or not at all.
+
+    ``video`` is the ``render.video`` block: the file format (and H.264's ``crf``), the exposure,
+    the bit depth and the markers' sizes. The clips are written into a temporary folder beside
+    ``out`` and renamed to it at the end.
+    """
+    from ..video.io import write_clip
+    from ..video.render import render_frames
+    from ..video.scene import clip_truths
+
+    truth, r, ids, ball, bat = render_inputs(simulated, balls)
+    clips = clip_truths(settings, truth, r, ids, ball, bat)
+    out = Path(out)
+    tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
+    try:
+        written = []
+        for i, c in enumerate(clips):
+            look = clip_look(video, settings.seed * 100_003 + i)  # each clip its own background and noise
+            m = getattr(settings, c.camera).camera.m_per_px
+            name = f"{c.impact_id}_{c.camera}{EXTENSIONS[video['format']]}"
+            frames = render_frames(c, look, m)
+            write_clip(tmp / name, frames, c.fps, exposure_s=look.exposure_s, frame_numbers=c.frames, crf=video["crf"])
+            written.append(out / name)
+        rows = "".join(f"{a},{t},{b}\n" for a, t, b in zip(ids, bat.astype(str), ball.astype(str), strict=True))
+        (tmp / "impacts.csv").write_text("impact_id,bat,ball\n" + rows)
+        if out.exists():
+            shutil.rmtree(out)
+        os.replace(tmp, out)
+    except BaseException:
+        shutil.rmtree(tmp, ignore_errors=True)
+        raise
+    return written
+
+
+def n_frames(paths: list[Path]) -> int:
+    """Frames in the clips written (the job's log)."""
+    from ..video.io import open_clip
+
+    return int(np.sum([open_clip(p).info.n_frames or 0 for p in paths]))
