@@ -37,6 +37,31 @@ def test_largest_value_removes_most_of_the_bias_of_picking_the_largest():
     assert largest_value(np.array([0.2, np.nan]), np.array([0.01, 0.01])) == pytest.approx(0.2, abs=1e-6)
 
 
+def test_largest_value_is_the_full_grid_number_to_the_bit():
+    """The grid points where log Phi is -0.0 are left out of the evaluation, not out of the sum: same bits.
+
+    The full (grid x impacts) evaluation, as :func:`ballbat.fitting.largest_value` made it
+    before it skipped them, on values whose spreads differ by 10x, and log Phi(z) is -0.0
+    everywhere past :data:`ballbat.fitting.LOG_NDTR_ZERO` (the skipped points).
+    """
+    from scipy.special import log_ndtr
+
+    def full_grid(y, sigma):
+        top = float(np.max(y))
+        m = np.linspace(top - 10 * sigma.max(), float(np.max(y + 10 * sigma)), fitting.LARGEST_GRID)
+        cdf = np.exp(np.sum(log_ndtr((m[:, None] - y[None, :]) / sigma[None, :]), axis=1))
+        return 2 * top - float(m[0] + np.trapezoid(1.0 - cdf, m))
+
+    rng = np.random.default_rng(7)
+    for n in (1, 5, 48, 130):
+        y = rng.normal(0.2, 0.05, n)
+        sigma = 0.01 * rng.uniform(0.2, 2.0, n)
+        assert fitting.largest_value(y, sigma) == full_grid(y, sigma)
+    z = np.concatenate([np.linspace(fitting.LOG_NDTR_ZERO - 2.3, 60.0, 200001), [1e3, 1e300, np.inf]])
+    assert np.all(log_ndtr(z) == 0.0)
+    assert log_ndtr(37.0) < 0.0  # the threshold is not far beyond where it has to be
+
+
 def test_e_y_variance_forms():
     rng = np.random.default_rng(5)
     a, b = rng.normal(size=20), rng.normal(size=20)

@@ -386,6 +386,9 @@ def e_y_variance(
 #: Points of the grid on which :func:`largest_value` integrates the distribution of the largest value.
 LARGEST_GRID = 4001
 
+#: z beyond which ``scipy.special.log_ndtr(z)`` is -0.0 (it is from 37.7 on; tests/test_fitting.py checks).
+LOG_NDTR_ZERO = 40.0
+
 
 def largest_value(y: ArrayLike, sigma: ArrayLike) -> float:
     """Estimate the largest of several true values from their measurements ``y +- sigma`` (independent, normal).
@@ -407,7 +410,14 @@ def largest_value(y: ArrayLike, sigma: ArrayLike) -> float:
     y, sigma = y[ok], sigma[ok]
     top = float(np.max(y))
     m = np.linspace(top - 10 * sigma.max(), float(np.max(y + 10 * sigma)), LARGEST_GRID)
-    cdf = np.exp(np.sum(log_ndtr((m[:, None] - y[None, :]) / sigma[None, :]), axis=1))
+    # log Phi((m - y_i) / sigma_i) is -0.0 from 37.7 sigma_i on, most of the grid x impacts: each
+    # impact's grid points below that (a run from the start) are evaluated, the rest left -0.0
+    logs = np.full((y.size, m.size), -0.0)
+    ends = np.searchsorted(m, y + LOG_NDTR_ZERO * sigma)
+    for i, end in enumerate(ends):
+        logs[i, :end] = log_ndtr((m[:end] - y[i]) / sigma[i])
+    # summed over the impacts as the (grid, impact) array always was (C order): the same bits
+    cdf = np.exp(np.sum(np.ascontiguousarray(logs.T), axis=1))
     # E[max] = m_0 + integral of (1 - F) from m_0 (F(m_0) = 0 to double precision)
     mean = float(m[0] + np.trapezoid(1.0 - cdf, m))
     return 2 * top - mean
