@@ -241,17 +241,17 @@ def eiv_line(
     g = scatter_gain(x, var_x)
     tau2 = 0.0
     for it in range(iterations + (SCATTER_PASSES if scatter else 0)):
-        var0 = np.sum((jy - beta[0] * jx) ** 2 * sig2, axis=1)
-        if np.any(var0 <= 0):
+        var0 = ((jy - beta[0] * jx) ** 2 * sig2).sum(axis=1)
+        if (var0 <= 0).any():
             return LineFit.not_fitted(n)
         if scatter and it >= iterations - 1:
             tau2 = paule_mandel(y - X @ beta, var0, g, n - p)
         W = 1.0 / (var0 + tau2 * g)
         xwx = X.T @ (W[:, None] * X)
         A = xwx.copy()
-        A[0, 0] -= np.sum(W * var_x)
+        A[0, 0] -= (W * var_x).sum()
         rhs = X.T @ (W * y)
-        rhs[0] -= np.sum(W * cov_xy)
+        rhs[0] -= (W * cov_xy).sum()
         if np.linalg.det(A) <= 0 or A[0, 0] <= 0:
             return LineFit.not_fitted(n)
         beta = np.linalg.solve(A, rhs)
@@ -301,7 +301,7 @@ def _q_root(r2: np.ndarray, v0: np.ndarray, g: np.ndarray, target: float) -> flo
     from scipy.optimize import brentq
 
     def q(t):
-        return float(np.sum(r2 / (v0 + t * g))) - target
+        return float((r2 / (v0 + t * g)).sum()) - target  # ndarray.sum: np.sum's reduction, without its wrapper
 
     if q(0.0) <= 0 or not np.any(g > 0):
         return 0.0
