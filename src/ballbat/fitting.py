@@ -66,15 +66,19 @@ class Columns(Mapping):
         self.attrs = ds.attrs
 
     def __getitem__(self, key: str) -> xr.Variable:
+        """Return the variable ``key`` (its ``values`` are the Dataset's array)."""
         return self._vars[key]
 
     def __contains__(self, key: object) -> bool:
+        """Whether the Dataset has a variable or coordinate ``key``."""
         return key in self._vars
 
     def __iter__(self):
+        """Iterate over the variables' names."""
         return iter(self._vars)
 
     def __len__(self) -> int:
+        """Return the number of variables."""
         return len(self._vars)
 
 
