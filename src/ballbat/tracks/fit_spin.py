@@ -349,15 +349,17 @@ def _spin_dot_rows(p, j, ct_x, ct_y, m, wd, ud, J, r) -> None:
     c, sn = np.cos(ang), np.sin(ang)
     dcx, dcy = p[:, [0]] + p[:, [1]] * ud, p[:, [2]] + p[:, [3]] * ud - 0.5 * G * ud**2
     bx, by = 2 + 2 * j, 3 + 2 * j
-    r[:, bx] = np.where(m, (ct_x - dcx - rho * c) * wd, 0.0)
-    r[:, by] = np.where(m, (ct_y - dcy - rho * sn) * wd, 0.0)
+    rc, rs = rho * c, rho * sn  # (-rho) c is -(rho c) to the bit: IEEE rounding is symmetric
+    r[:, bx] = np.where(m, (ct_x - dcx - rc) * wd, 0.0)
+    r[:, by] = np.where(m, (ct_y - dcy - rs) * wd, 0.0)
     k = 5 + 2 * j  # the dot's radius and phase
-    J[:, bx, :, 4] = rho * sn * ud * wd
-    J[:, bx, :, k] = -c * wd
-    J[:, bx, :, k + 1] = rho * sn * wd
-    J[:, by, :, 4] = -rho * c * ud * wd
-    J[:, by, :, k] = -sn * wd
-    J[:, by, :, k + 1] = -rho * c * wd
+    np.multiply(rs * ud, wd, out=J[:, bx, :, 4])
+    np.multiply(-c, wd, out=J[:, bx, :, k])
+    np.multiply(rs, wd, out=J[:, bx, :, k + 1])
+    np.negative(rc, out=rc)
+    np.multiply(rc * ud, wd, out=J[:, by, :, 4])
+    np.multiply(-sn, wd, out=J[:, by, :, k])
+    np.multiply(rc, wd, out=J[:, by, :, k + 1])
 
 
 def _offset_score(J, r, cov, ok, wd, chi2) -> tuple[np.ndarray, np.ndarray]:
