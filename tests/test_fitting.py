@@ -37,13 +37,17 @@ def test_largest_value_removes_most_of_the_bias_of_picking_the_largest():
     assert largest_value(np.array([0.2, np.nan]), np.array([0.01, 0.01])) == pytest.approx(0.2, abs=1e-6)
 
 
-def test_largest_value_is_the_full_grid_number_to_the_bit():
+@pytest.mark.parametrize("by_impact", [True, False])
+def test_largest_value_is_the_full_grid_number_to_the_bit(monkeypatch, by_impact):
     """The grid points where log Phi is -0.0 are left out of the evaluation, not out of the sum: same bits.
 
     The full (grid x impacts) evaluation, as :func:`ballbat.fitting.largest_value` made it
-    before it skipped them, on values whose spreads differ by 10x, and log Phi(z) is -0.0
-    everywhere past :data:`ballbat.fitting.LOG_NDTR_ZERO` (the skipped points).
+    before it skipped them, on values whose spreads differ by 10x, by each value's run of grid
+    points and by blocks of grid points (:data:`ballbat.fitting.LARGEST_BY_IMPACT`), and
+    log Phi(z) is -0.0 everywhere past :data:`ballbat.fitting.LOG_NDTR_ZERO` (the skipped points).
     """
+    if not by_impact:
+        monkeypatch.setattr(fitting, "LARGEST_BY_IMPACT", 0)
     from scipy.special import log_ndtr
 
     def full_grid(y, sigma):

@@ -394,6 +394,37 @@ LARGEST_GRID = 4001
 LOG_NDTR_ZERO = 40.0
 
 
+#: Above this many values :func:`_log_cdf` works through the grid in blocks (bounded memory).
+LARGEST_BY_IMPACT = 2000
+
+
+def _log_cdf(m: np.ndarray, y: np.ndarray, sigma: np.ndarray) -> np.ndarray:
+    """sum_i log Phi((m - y_i) / sigma_i) at every grid point ``m``: the log of :func:`largest_value`'s F.
+
+    log Phi is -0.0 from z = 37.7 on (:data:`LOG_NDTR_ZERO`), which is most of the grid x
+    values; only the rest is evaluated, and each grid point's sum runs over a C-ordered row of
+    all the values as the full (grid, value) array's did: the same bits. Up to
+    :data:`LARGEST_BY_IMPACT` values, each value's run of grid points (from the start) is
+    evaluated; beyond, blocks of grid points with the points that matter picked out.
+    """
+    from scipy.special import log_ndtr
+
+    if y.size <= LARGEST_BY_IMPACT:
+        logs = np.full((y.size, m.size), -0.0)
+        for i, end in enumerate(np.searchsorted(m, y + LOG_NDTR_ZERO * sigma)):
+            logs[i, :end] = log_ndtr((m[:end] - y[i]) / sigma[i])
+        return np.sum(np.ascontiguousarray(logs.T), axis=1)
+    out = np.empty(m.size)
+    rows = max(1, 2**20 // y.size)
+    for lo in range(0, m.size, rows):
+        z = (m[lo : lo + rows, None] - y[None, :]) / sigma[None, :]
+        logs = np.full(z.shape, -0.0)
+        near = z < LOG_NDTR_ZERO
+        logs[near] = log_ndtr(z[near])
+        out[lo : lo + rows] = np.sum(logs, axis=1)
+    return out
+
+
 def largest_value(y: ArrayLike, sigma: ArrayLike) -> float:
     """Estimate the largest of several true values from their measurements ``y +- sigma`` (independent, normal).
 
@@ -405,8 +436,6 @@ def largest_value(y: ArrayLike, sigma: ArrayLike) -> float:
     about what max(y) exceeds the largest true value. Returns max(y) minus that excess (NaN
     measurements left out; max(y) where no uncertainty is finite).
     """
-    from scipy.special import log_ndtr
-
     y, sigma = np.asarray(y, dtype=float), np.asarray(sigma, dtype=float)
     ok = np.isfinite(y) & np.isfinite(sigma) & (sigma > 0)
     if not ok.any():
@@ -414,14 +443,7 @@ def largest_value(y: ArrayLike, sigma: ArrayLike) -> float:
     y, sigma = y[ok], sigma[ok]
     top = float(np.max(y))
     m = np.linspace(top - 10 * sigma.max(), float(np.max(y + 10 * sigma)), LARGEST_GRID)
-    # log Phi((m - y_i) / sigma_i) is -0.0 from 37.7 sigma_i on, most of the grid x impacts: each
-    # impact's grid points below that (a run from the start) are evaluated, the rest left -0.0
-    logs = np.full((y.size, m.size), -0.0)
-    ends = np.searchsorted(m, y + LOG_NDTR_ZERO * sigma)
-    for i, end in enumerate(ends):
-        logs[i, :end] = log_ndtr((m[:end] - y[i]) / sigma[i])
-    # summed over the impacts as the (grid, impact) array always was (C order): the same bits
-    cdf = np.exp(np.sum(np.ascontiguousarray(logs.T), axis=1))
+    cdf = np.exp(_log_cdf(m, y, sigma))
     # E[max] = m_0 + integral of (1 - F) from m_0 (F(m_0) = 0 to double precision)
     mean = float(m[0] + np.trapezoid(1.0 - cdf, m))
     return 2 * top - mean
