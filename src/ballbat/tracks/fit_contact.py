@@ -97,7 +97,8 @@ def _contact_population(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -
 
         def nll(p, L=L):
             # elementwise and summed along rows, not a BLAS product: the same bits wherever L lies in memory
-            return -float(np.sum(np.log(np.sum(L * _beta_weights(grid, p)[None, :], axis=1) + 1e-300)))
+            # (ndarray.sum: np.sum's reduction without its wrapper; this runs a hundred times a replicate)
+            return -float(np.log((L * _beta_weights(grid, p)[None, :]).sum(axis=1) + 1e-300).sum())
 
         uniform = np.array([0.0, np.log(2.0)])  # beta(1, 1)
         simplex = uniform + np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
