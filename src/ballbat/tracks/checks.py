@@ -373,6 +373,14 @@ def free_fall(
 # the tip's arc radius
 
 
+def _masked_columns(mask: np.ndarray, cols: tuple) -> np.ndarray:
+    """Return the columns stacked on a last axis, 0 off ``mask`` (filled in place: no stack, no 3-d where)."""
+    J = np.empty((*mask.shape, len(cols)))
+    for c, v in enumerate(cols):
+        J[..., c] = np.where(mask, v, 0.0)
+    return J
+
+
 def tip_arc(
     swing: CameraTracks,
     X: np.ndarray,
@@ -425,10 +433,7 @@ def tip_arc(
             if k:
                 dw += np.multiply(k * (-1) ** k * w[:, None] ** (k - 1) / fact[k] * x2k, x, out=tmp)
             x2k *= x2
-        J = np.empty((*s.shape, 4))
-        for c, v in enumerate((np.ones_like(s), s * dx, -V[:, None] * dx, dw)):
-            J[..., c] = np.where(mask, v, 0.0)
-        return a[:, None] + f, J
+        return a[:, None] + f, _masked_columns(mask, (np.ones_like(s), s * dx, -V[:, None] * dx, dw))
 
     ok = (n >= 6) & np.isfinite(V) & np.isfinite(tau) & np.isfinite(a)
     with np.errstate(all="ignore"):
