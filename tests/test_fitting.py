@@ -37,6 +37,35 @@ def test_largest_value_removes_most_of_the_bias_of_picking_the_largest():
     assert largest_value(np.array([0.2, np.nan]), np.array([0.01, 0.01])) == pytest.approx(0.2, abs=1e-6)
 
 
+@pytest.mark.parametrize("by_impact", [True, False])
+def test_largest_value_is_the_full_grid_number_to_the_bit(monkeypatch, by_impact):
+    """The grid points where log Phi is -0.0 are left out of the evaluation, not out of the sum: same bits.
+
+    The full (grid x impacts) evaluation, as :func:`ballbat.fitting.largest_value` made it
+    before it skipped them, on values whose spreads differ by 10x, by each value's run of grid
+    points and by blocks of grid points (:data:`ballbat.fitting.LARGEST_BY_IMPACT`), and
+    log Phi(z) is -0.0 everywhere past :data:`ballbat.fitting.LOG_NDTR_ZERO` (the skipped points).
+    """
+    if not by_impact:
+        monkeypatch.setattr(fitting, "LARGEST_BY_IMPACT", 0)
+    from scipy.special import log_ndtr
+
+    def full_grid(y, sigma):
+        top = float(np.max(y))
+        m = np.linspace(top - 10 * sigma.max(), float(np.max(y + 10 * sigma)), fitting.LARGEST_GRID)
+        cdf = np.exp(np.sum(log_ndtr((m[:, None] - y[None, :]) / sigma[None, :]), axis=1))
+        return 2 * top - float(m[0] + np.trapezoid(1.0 - cdf, m))
+
+    rng = np.random.default_rng(7)
+    for n in (1, 5, 48, 130):
+        y = rng.normal(0.2, 0.05, n)
+        sigma = 0.01 * rng.uniform(0.2, 2.0, n)
+        assert fitting.largest_value(y, sigma) == full_grid(y, sigma)
+    z = np.concatenate([np.linspace(fitting.LOG_NDTR_ZERO - 2.3, 60.0, 200001), [1e3, 1e300, np.inf]])
+    assert np.all(log_ndtr(z) == 0.0)
+    assert log_ndtr(37.0) < 0.0  # the threshold is not far beyond where it has to be
+
+
 def test_e_y_variance_forms():
     rng = np.random.default_rng(5)
     a, b = rng.normal(size=20), rng.normal(size=20)
@@ -48,3 +77,22 @@ def test_e_y_variance_forms():
     assert one_part == pytest.approx(np.sum((a / (1 - h1)) ** 2))
     with pytest.raises(ValueError, match="hc3"):
         fitting.e_y_variance(a, b, h1, h2, 4, "hc9")
+
+
+def test_columns_read_the_datasets_arrays():
+    """fitting.Columns: a Dataset's variables and coordinates by name, their very arrays; replacements kept apart."""
+    import xarray as xr
+
+    ds = xr.Dataset(
+        {"v_bat": ("impact", np.array([30.0, 31.0])), "flag": ("impact", np.array([0, 1]))},
+        coords={"impact": np.arange(2), "ball": ("impact", np.array(["a", "b"]))},
+        attrs={"v_ref": 31.3},
+    )
+    cols = fitting.Columns(ds)
+    for k in ("v_bat", "flag", "impact", "ball"):
+        assert k in cols and np.shares_memory(cols[k].values, ds[k].values)
+    assert "v_ball" not in cols and cols.attrs["v_ref"] == 31.3 and len(cols) == 4
+    moved = fitting.Columns(cols, {"v_bat": ds["v_bat"].variable * 2.0})
+    assert np.array_equal(moved["v_bat"].values, [60.0, 62.0]) and np.array_equal(cols["v_bat"].values, [30.0, 31.0])
+    with pytest.raises(KeyError):
+        cols["v_ball"]

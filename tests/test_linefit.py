@@ -318,3 +318,15 @@ def test_the_switch_turns_the_term_off(monkeypatch):
     x, y, jx, jy, sigma = _scattered_line(np.random.default_rng(6), 200, 1.3, 0.1)
     monkeypatch.setattr(linefit, "SCATTER_TERM", False)
     assert np.isnan(eiv_line(x, y, jx, jy, sigma, scatter=True).scatter)
+
+
+def test_t_and_chi2_quantiles_are_scipy_stats_numbers():
+    """The fits' quantiles from scipy.special are t.ppf's and chi2.ppf's to the bit, NaN where those are."""
+    from scipy import stats
+
+    for dof in (1, 2, 3, 7.5, 52, 1000):
+        for q in (0.025, 0.5, 0.975):
+            assert linefit.t_quantile(q, dof) == float(stats.t.ppf(q, dof))
+            assert linefit.chi2_quantile(q, dof) == float(stats.chi2.ppf(q, dof))
+    for dof, q in ((0, 0.975), (-1, 0.975), (5, 0.0), (5, 1.0)):
+        assert np.isnan(linefit.t_quantile(q, dof)) and np.isnan(linefit.chi2_quantile(q, dof))

@@ -79,3 +79,27 @@ def test_beta_logs_are_shared_and_read_only():
     with pytest.raises(ValueError):
         a[0] = 0.0
     assert np.all(a < 0) and np.all(b < 0)
+
+
+@pytest.mark.parametrize("block", [1000, 7])
+def test_contact_likelihood_on_the_whole_grid_is_the_pointwise_number(monkeypatch, block):
+    """All grid points at once (in blocks of impacts) give the bits of one grid point at a time."""
+    from ballbat.tracks import fit_contact as fc
+    from ballbat.tracks.masked import msum
+    from ballbat.tracks.render import contact_distance
+
+    monkeypatch.setattr(fc, "CONTACT_BLOCK", block)
+    rng = np.random.default_rng(3)
+    n, width = 30, 6
+    dtw = rng.uniform(-1e-3, 1e-3, (n, width))
+    v = rng.uniform(30, 50, n)
+    sw = v[:, None] * np.maximum(dtw, 0) + rng.normal(0, 1e-3, (n, width))
+    ww = rng.uniform(size=(n, width)) > 0.2
+    sigma = rng.uniform(5e-4, 2e-3, n)
+    grid = np.linspace(4e-4, 1.2e-3, fc.CONTACT_GRID)
+    expected = np.empty((n, grid.size))
+    for j, tc in enumerate(grid):  # the loop the stage ran before
+        x = np.clip(dtw + 0.5 * tc, 0.0, tc)
+        model = v[:, None] * (contact_distance(x, tc) + np.maximum(dtw - 0.5 * tc, 0.0))
+        expected[:, j] = -0.5 * msum((sw - model) ** 2, ww.astype(float)) / sigma**2
+    assert np.array_equal(fc._contact_loglik(dtw, sw, ww, v, sigma, grid), expected)

@@ -10,6 +10,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..analysis import normalize_values
+from ..fitting import Columns
 from ..pipeline.config import SectionSettings
 from ..pipeline.products import Var, add_variables
 from ..units import MPH
@@ -51,7 +52,7 @@ def run(settings: NormalizeSettings, impacts: xr.Dataset) -> xr.Dataset:
     ``v_ref_mph`` (the config's value, in mph) recorded in SI as the attribute ``v_ref``.
     """
     v_ref = settings.v_ref_mph * MPH
-    out = add_variables(impacts, NORMALIZE_TABLE, normalize_values(impacts, v_ref))
+    out = add_variables(impacts, NORMALIZE_TABLE, normalize_values(Columns(impacts), v_ref))
     out.attrs["v_ref"] = float(v_ref)
     out.attrs["v_ref_units"] = "m s-1"
     return out

@@ -12,6 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..analysis import property_values, reconstruct_values
+from ..fitting import Columns
 from ..kinematics import ImpactFlag
 from ..pipeline.products import Var, add_variables, flag_attrs
 from ..properties import ball_variants, bat_record, bat_variants
@@ -69,7 +70,7 @@ def run(settings: ReconstructSettings, impacts: xr.Dataset, balls: dict[str, Bal
     each one's table convention, its cells as given and the paper-convention values used
     (:func:`ballbat.properties.bat_record`).
     """
-    out = add_variables(impacts, RECONSTRUCT_TABLE, reconstruct_values(impacts, balls, bats))
+    out = add_variables(impacts, RECONSTRUCT_TABLE, reconstruct_values(Columns(impacts), balls, bats))
     used = sorted(set(impacts["bat"].values.astype(str)))
     out.attrs["bat_properties"] = bat_record({k: bats[k] for k in used})
     return append_sources(out, *property_shifts(out, balls, bats))
@@ -85,6 +86,7 @@ def property_shifts(
     shifts of every impact's properties at +1 and -1 sigma (source, side, impact: nonzero only for
     that bat's, or ball's, impacts) and each source's description. Empty when none is stated.
     """
+    rec = Columns(rec)  # plain arrays, not a DataArray per read
     ball_ids, bat_ids = rec["ball"].values.astype(str), rec["bat"].values.astype(str)
     nominal = {k: rec[k].values for k in PROPERTY_SHIFTED}
     names, rel, what = [], [], {}

@@ -373,6 +373,14 @@ def free_fall(
 # the tip's arc radius
 
 
+def _masked_columns(mask: np.ndarray, cols: tuple) -> np.ndarray:
+    """Return the columns stacked on a last axis, 0 off ``mask`` (filled in place: no stack, no 3-d where)."""
+    J = np.empty((*mask.shape, len(cols)))
+    for c, v in enumerate(cols):
+        J[..., c] = np.where(mask, v, 0.0)
+    return J
+
+
 def tip_arc(
     swing: CameraTracks,
     X: np.ndarray,
@@ -412,20 +420,20 @@ def tip_arc(
     def model(a, V, tau, w):
         # the series in x = V s: f = sum_k c_k x^(2k+1), c_k = (-w)^k / (2k+1)!; its derivatives
         # by V and s share sum_k c_k (2k+1) x^(2k), by w sum_k k (-1)^k w^(k-1) x^(2k+1) / (2k+1)!
+        # (in place where it can be: the same operations on the same numbers as out of place)
         s = np.where(mask, t - tau[:, None], 0.0)
         x = V[:, None] * s
         x2 = x * x
         x2k = np.ones_like(s)  # x^(2k)
-        f, dx, dw = np.zeros_like(s), np.zeros_like(s), np.zeros_like(s)
+        f, dx, dw, tmp = np.zeros_like(s), np.zeros_like(s), np.zeros_like(s), np.empty_like(s)
         for k in range(5):
             term = (-w[:, None]) ** k / fact[k] * x2k
-            f = f + term * x
-            dx = dx + (2 * k + 1) * term
+            f += np.multiply(term, x, out=tmp)
+            dx += np.multiply(2 * k + 1, term, out=tmp)
             if k:
-                dw = dw + k * (-1) ** k * w[:, None] ** (k - 1) / fact[k] * x2k * x
-            x2k = x2k * x2
-        J = np.stack([np.ones_like(s), s * dx, -V[:, None] * dx, dw], axis=-1)
-        return a[:, None] + f, np.where(mask[..., None], J, 0.0)
+                dw += np.multiply(k * (-1) ** k * w[:, None] ** (k - 1) / fact[k] * x2k, x, out=tmp)
+            x2k *= x2
+        return a[:, None] + f, _masked_columns(mask, (np.ones_like(s), s * dx, -V[:, None] * dx, dw))
 
     ok = (n >= 6) & np.isfinite(V) & np.isfinite(tau) & np.isfinite(a)
     with np.errstate(all="ignore"):

@@ -97,7 +97,8 @@ def _contact_population(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -
 
         def nll(p, L=L):
             # elementwise and summed along rows, not a BLAS product: the same bits wherever L lies in memory
-            return -float(np.sum(np.log(np.sum(L * _beta_weights(grid, p)[None, :], axis=1) + 1e-300)))
+            # (ndarray.sum: np.sum's reduction without its wrapper; this runs a hundred times a replicate)
+            return -float(np.log((L * _beta_weights(grid, p)[None, :]).sum(axis=1) + 1e-300).sum())
 
         uniform = np.array([0.0, np.log(2.0)])  # beta(1, 1)
         simplex = uniform + np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
@@ -107,6 +108,30 @@ def _contact_population(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -
         p = best.x if best.fun < nll(uniform) - 1e-9 * len(L) else uniform  # flat: no gain, uniform kept
         prior[groups == g] = _beta_weights(grid, p)
     return prior
+
+
+#: Impacts per block of the contact-time likelihood (its arrays are impacts x grid x window frames).
+CONTACT_BLOCK = 1000
+
+
+def _contact_loglik(dtw, sw, ww, v, sigma, grid) -> np.ndarray:
+    """Log-likelihood (impact, grid) of each contact time of ``grid`` from the window's frames.
+
+    ``dtw`` the frames' times from the contact's middle, ``sw`` the ball's distance along its
+    flight from rest, ``ww`` the frames in the window (impact, frame). All grid points at
+    once, in blocks of :data:`CONTACT_BLOCK` impacts; each impact's sum over its frames runs
+    along the last (contiguous) axis, as one grid point at a time summed it: the same bits.
+    """
+    logl = np.empty((dtw.shape[0], grid.size))
+    tc = grid[None, :, None]
+    for lo in range(0, dtw.shape[0], CONTACT_BLOCK):
+        b = slice(lo, lo + CONTACT_BLOCK)
+        d = dtw[b][:, None, :]
+        x = np.clip(d + 0.5 * tc, 0.0, tc)  # time since the start, within the contact
+        model = v[b][:, None, None] * (contact_distance(x, tc) + np.maximum(d - 0.5 * tc, 0.0))
+        ss = np.sum(np.where(ww[b][:, None, :], (sw[b][:, None, :] - model) ** 2, 0.0), axis=2)
+        logl[b] = -0.5 * ss / sigma[b][:, None] ** 2
+    return logl
 
 
 def fit_contact(
@@ -180,11 +205,7 @@ def fit_contact(
         dtw, sw = np.take_along_axis(dt, idx, axis=1), np.take_along_axis(s, idx, axis=1)
         ww = np.take_along_axis(win, idx, axis=1) & (first[:, None] + np.arange(width)[None, :] < X.shape[1])
         grid = np.linspace(lo, hi, CONTACT_GRID)
-        logl = np.empty((X.shape[0], grid.size))
-        for j, tc in enumerate(grid):
-            x = np.clip(dtw + 0.5 * tc, 0.0, tc)  # time since the start, within the contact
-            model = v[:, None] * (contact_distance(x, tc) + np.maximum(dtw - 0.5 * tc, 0.0))
-            logl[:, j] = -0.5 * msum((sw - model) ** 2, ww.astype(float)) / flight.sigma**2
+        logl = _contact_loglik(dtw, sw, ww, v, flight.sigma, grid)
         logl -= np.max(logl, axis=1, keepdims=True)
         lik = np.exp(logl)
         grp = np.zeros(X.shape[0], dtype=int) if groups is None else np.unique(groups, return_inverse=True)[1]

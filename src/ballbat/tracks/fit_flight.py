@@ -91,8 +91,11 @@ def find_onset(x: np.ndarray, y: np.ndarray) -> Onset:
     rank = np.cumsum(valid, axis=1)
     early = valid & (rank <= N_REST)
     cols = np.arange(x.shape[1])[None, :]
-    x0 = nanmedian_rows(np.where(early, x, np.nan))  # numpy.nanmedian's numbers, without masked arrays
-    y0 = nanmedian_rows(np.where(early, y, np.nan))
+    # numpy.nanmedian's numbers, without masked arrays, over the columns up to the last early frame
+    # (the same values: the columns after it hold none)
+    end = int(last_true(early.any(axis=0)[None, :])[0]) + 1
+    x0 = nanmedian_rows(np.where(early, x, np.nan)[:, :end])
+    y0 = nanmedian_rows(np.where(early, y, np.nan)[:, :end])
     # Two passes: the tracking scatter from the first frames, then from every frame at rest
     # before the impact that pass found (more frames, a steadier threshold).
     rest_frames = early

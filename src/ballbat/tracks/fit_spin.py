@@ -309,24 +309,77 @@ def _spin_joint_fit(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, inter
     return tuple(joined)
 
 
-def _spin_dot_rows(p, j, ct_x, ct_y, m, wd, ud, zero_one):
-    """Residual rows (x, y) and their Jacobian blocks (impact, frame, 9) of dot ``j`` at the parameters ``p``.
+def _spin_design(wd, ud, ub, wb) -> tuple[np.ndarray, np.ndarray]:
+    """Return :func:`_spin_block`'s Jacobian (impact, 6, frame, 9) with what no iteration changes, and its residuals.
 
-    For :func:`_spin_block`: the dot at the ball's centre plus its radius turned by the
-    spin; ``m`` its tracked frames, ``wd`` their weights, ``ud`` their times (0 untracked),
-    ``zero_one`` arrays of 0 and 1 of their shape.
+    Row blocks: the ball's x and y, then x and y of each dot (:func:`_spin_dot_rows` fills
+    the columns that move with the parameters). Each entry is the same product (value x
+    weight) the blocks were once stacked from, so the normal equations do not change by a bit.
     """
-    zero, one = zero_one
+    n, nf = ub.shape
+    J = np.empty((n, 6, nf, 9))
+    r = np.empty((n, 6, nf))
+    zero, one = np.zeros_like(ub), np.ones_like(ub)
+    ball = ([-one, -ub, zero, zero] + [zero] * 5, [zero, zero, -one, -ub] + [zero] * 5)
+    for k, cols in enumerate(ball):
+        for c, v in enumerate(cols):
+            J[:, k, :, c] = v * wb
+    for j, d in enumerate(("dot_a", "dot_b")):
+        w, u = wd[d], ud[d]
+        own, other = (5, 6), (7, 8)
+        if j == 1:
+            own, other = other, own
+        xcols = {0: -one, 1: -u, 2: zero, 3: zero, other[0]: zero, other[1]: zero}
+        ycols = {0: zero, 1: zero, 2: -one, 3: -u, other[0]: zero, other[1]: zero}
+        for c in xcols:
+            J[:, 2 + 2 * j, :, c] = xcols[c] * w
+            J[:, 3 + 2 * j, :, c] = ycols[c] * w
+    return J, r
+
+
+def _spin_dot_rows(p, j, ct_x, ct_y, m, wd, ud, J, r) -> None:
+    """Write dot ``j``'s residual rows (x, y) and the moving columns of its Jacobian at the parameters ``p``.
+
+    For :func:`_spin_block` (:func:`_spin_design`'s ``J`` and ``r``): the dot at the ball's
+    centre plus its radius turned by the spin; ``m`` its tracked frames, ``wd`` their weights,
+    ``ud`` their times (0 untracked).
+    """
     rho, phase = p[:, [5 + 2 * j]], p[:, [6 + 2 * j]]
     ang = phase + p[:, [4]] * ud
     c, sn = np.cos(ang), np.sin(ang)
     dcx, dcy = p[:, [0]] + p[:, [1]] * ud, p[:, [2]] + p[:, [3]] * ud - 0.5 * G * ud**2
-    rows = [np.where(m, (ct_x - dcx - rho * c) * wd, 0.0), np.where(m, (ct_y - dcy - rho * sn) * wd, 0.0)]
-    jx = [-one, -ud, zero, zero, rho * sn * ud] + ([-c, rho * sn, zero, zero] if j == 0 else [zero, zero, -c, rho * sn])
-    jy = [zero, zero, -one, -ud, -rho * c * ud] + (
-        [-sn, -rho * c, zero, zero] if j == 0 else [zero, zero, -sn, -rho * c]
-    )
-    return rows, [np.stack(jx, axis=-1) * wd[..., None], np.stack(jy, axis=-1) * wd[..., None]]
+    bx, by = 2 + 2 * j, 3 + 2 * j
+    rc, rs = rho * c, rho * sn  # (-rho) c is -(rho c) to the bit: IEEE rounding is symmetric
+    r[:, bx] = np.where(m, (ct_x - dcx - rc) * wd, 0.0)
+    r[:, by] = np.where(m, (ct_y - dcy - rs) * wd, 0.0)
+    k = 5 + 2 * j  # the dot's radius and phase
+    np.multiply(rs * ud, wd, out=J[:, bx, :, 4])
+    np.multiply(-c, wd, out=J[:, bx, :, k])
+    np.multiply(rs, wd, out=J[:, bx, :, k + 1])
+    np.negative(rc, out=rc)
+    np.multiply(rc * ud, wd, out=J[:, by, :, 4])
+    np.multiply(-sn, wd, out=J[:, by, :, k])
+    np.multiply(rc, wd, out=J[:, by, :, k + 1])
+
+
+def _offset_score(J, r, cov, ok, wd, chi2) -> tuple[np.ndarray, np.ndarray]:
+    """Score test of a common offset of the dots' circles (:func:`_spin_block`'s last residuals and design).
+
+    Returns the statistic (chi^2, 2 degrees of freedom) and the offset (one Gauss-Newton step).
+    """
+    nf = wd["dot_a"].shape[1]
+    Jo = np.zeros((*r.shape, 2))
+    nb = 2 * nf  # the ball's x and y rows come first, then x and y of each dot
+    for j, d in enumerate(("dot_a", "dot_b")):
+        k = nb + 2 * j * nf
+        Jo[:, k : k + nf, 0] = -wd[d]
+        Jo[:, k + nf : k + 2 * nf, 1] = -wd[d]
+    B = gram(J, Jo)
+    V = gram(Jo) - gram(B, cov @ B)
+    g = tdot(Jo, r)
+    V[~ok] = np.eye(2)
+    step = -np.linalg.solve(V, g[..., None])[..., 0]
+    return np.sum(g * -step, axis=1) / chi2, step
 
 
 def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept, radius, masks, s_dot):
@@ -366,24 +419,17 @@ def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept
     wb = np.where(flight.mask, 1.0 / flight.sigma[:, None], 0.0)
     dots = ("dot_a", "dot_b")
     with np.errstate(all="ignore"):
-        # what does not change between iterations: the dots' weights and times, the ball's Jacobian
+        # what does not change between iterations: the dots' weights and times, most of the Jacobian
         wd = {d: np.where(masks[d], 1.0 / s_dot[:, None], 0.0) for d in dots}
         ud = {d: np.where(masks[d], u, 0.0) for d in dots}
-        zero, one = np.zeros_like(u), np.ones_like(u)
-        ball_jac = [
-            np.stack([-one, -ub, zero, zero] + [zero] * 5, axis=-1) * wb[..., None],
-            np.stack([zero, zero, -one, -ub] + [zero] * 5, axis=-1) * wb[..., None],
-        ]
+        J6, r6 = _spin_design(wd, ud, ub, wb)
+        J, r = J6.reshape(u.shape[0], -1, 9), r6.reshape(u.shape[0], -1)  # views: rows (ball x, y, dots' x, y)
         for _ in range(SPIN_GN_ITERATIONS):
             cx, cy = p[:, [0]] + p[:, [1]] * ub, p[:, [2]] + p[:, [3]] * ub - 0.5 * G * ub**2
-            rows = [np.where(wb > 0, (X - cx) * wb, 0.0), np.where(wb > 0, (Y - cy) * wb, 0.0)]
-            jac = list(ball_jac)
+            r6[:, 0] = np.where(wb > 0, (X - cx) * wb, 0.0)
+            r6[:, 1] = np.where(wb > 0, (Y - cy) * wb, 0.0)
             for j, d in enumerate(dots):
-                r_d, j_d = _spin_dot_rows(p, j, ct_x[d], ct_y[d], masks[d], wd[d], ud[d], (zero, one))
-                rows += r_d
-                jac += j_d
-            r = np.concatenate(rows, axis=1)
-            J = np.concatenate(jac, axis=1)
+                _spin_dot_rows(p, j, ct_x[d], ct_y[d], masks[d], wd[d], ud[d], J6, r6)
             A = gram(J)
             b = tdot(J, r)
             ok = np.all(np.isfinite(A), axis=(1, 2)) & np.all(np.isfinite(b), axis=1)
@@ -396,19 +442,7 @@ def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept
         n_rows = 2 * (flight.mask.sum(axis=1) + masks["dot_a"].sum(axis=1) + masks["dot_b"].sum(axis=1))
         chi2 = np.sum(r**2, axis=1) / np.maximum(n_rows - 9, 1)
         err = np.sqrt(cov[:, 4, 4] * chi2)
-        # score test of a common offset of the dots' circles (the last iteration's residuals and design)
-        Jo = np.zeros((*r.shape, 2))
-        nb = 2 * u.shape[1]  # the ball's x and y rows come first, then x and y of each dot
-        for j, d in enumerate(dots):
-            k = nb + 2 * j * u.shape[1]
-            Jo[:, k : k + u.shape[1], 0] = -wd[d]
-            Jo[:, k + u.shape[1] : k + 2 * u.shape[1], 1] = -wd[d]
-        B = gram(J, Jo)
-        V = gram(Jo) - gram(B, cov @ B)
-        g = tdot(Jo, r)
-        V[~ok] = np.eye(2)
-        step = -np.linalg.solve(V, g[..., None])[..., 0]
-        offset_chi2 = np.sum(g * -step, axis=1) / chi2
+        offset_chi2, step = _offset_score(J, r, cov, ok, wd, chi2)
     good = ok & np.isfinite(p[:, 4]) & np.isfinite(err)
     new_omega = np.where(good, p[:, 4], omega)
     new_err = np.where(good, err, omega_err)

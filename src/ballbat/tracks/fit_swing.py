@@ -69,6 +69,13 @@ def _swing_axis(X: np.ndarray, Y: np.ndarray, t: np.ndarray, w: np.ndarray, n: n
     return cx, cy, ux, uy, tm, along, perp
 
 
+def _swing_jacobian(J: np.ndarray, mask: np.ndarray, d_omega: np.ndarray, d_tau: np.ndarray) -> np.ndarray:
+    """Write the columns of :func:`fit_swing`'s Jacobian that change (by omega and tau) into ``J``, 0 off ``mask``."""
+    J[..., 1] = np.where(mask, d_omega, 0.0)
+    J[..., 2] = np.where(mask, d_tau, 0.0)
+    return J
+
+
 def fit_swing(
     X: ArrayLike,
     Y: ArrayLike,
@@ -125,12 +132,13 @@ def fit_swing(
         tau = tau0.copy()
         prior = np.full_like(om, 1e12)  # first iterations: tau held at its prior
         sigma_tau = np.hypot(TAU_PRIOR_FRAMES / fps, np.nan_to_num(np.asarray(t_contact_err, dtype=float)))
+        J = np.empty((*mask.shape, 3))
+        J[..., 0] = np.where(mask, 1.0, 0.0)
         for it in range(GN_ITERATIONS):
             arg = om[:, None] * (t - tau[:, None])
             c = np.cos(arg)
             r = along - (a[:, None] + L * np.sin(arg))
-            J = np.stack([np.ones_like(t), L * (t - tau[:, None]) * c, -L * om[:, None] * c], axis=-1)
-            J = np.where(mask[..., None], J, 0.0)
+            J = _swing_jacobian(J, mask, L * (t - tau[:, None]) * c, -L * om[:, None] * c)
             r = np.where(mask, r, 0.0)
             A = gram(J)
             b = tdot(J, r)
@@ -149,8 +157,7 @@ def fit_swing(
         s2 = np.sum(rr**2, axis=1) / (n - 3)
         arg = om[:, None] * (t - tau[:, None])
         c = np.cos(arg)
-        J = np.stack([np.ones_like(t), L * (t - tau[:, None]) * c, -L * om[:, None] * c], axis=-1)
-        J = np.where(mask[..., None], J, 0.0)
+        J = _swing_jacobian(J, mask, L * (t - tau[:, None]) * c, -L * om[:, None] * c)
         A = gram(J)
         A[:, 2, 2] += s2 / sigma_tau**2
         A[~(n >= 4)] = np.eye(3)
