@@ -77,22 +77,3 @@ def test_e_y_variance_forms():
     assert one_part == pytest.approx(np.sum((a / (1 - h1)) ** 2))
     with pytest.raises(ValueError, match="hc3"):
         fitting.e_y_variance(a, b, h1, h2, 4, "hc9")
-
-
-def test_columns_read_the_datasets_arrays():
-    """fitting.Columns: a Dataset's variables and coordinates by name, their very arrays; replacements kept apart."""
-    import xarray as xr
-
-    ds = xr.Dataset(
-        {"v_bat": ("impact", np.array([30.0, 31.0])), "flag": ("impact", np.array([0, 1]))},
-        coords={"impact": np.arange(2), "ball": ("impact", np.array(["a", "b"]))},
-        attrs={"v_ref": 31.3},
-    )
-    cols = fitting.Columns(ds)
-    for k in ("v_bat", "flag", "impact", "ball"):
-        assert k in cols and np.shares_memory(cols[k].values, ds[k].values)
-    assert "v_ball" not in cols and cols.attrs["v_ref"] == 31.3 and len(cols) == 4
-    moved = fitting.Columns(cols, {"v_bat": ds["v_bat"].variable * 2.0})
-    assert np.array_equal(moved["v_bat"].values, [60.0, 62.0]) and np.array_equal(cols["v_bat"].values, [30.0, 31.0])
-    with pytest.raises(KeyError):
-        cols["v_ball"]

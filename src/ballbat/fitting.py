@@ -35,12 +35,12 @@ References
 from __future__ import annotations
 
 import enum
-from collections.abc import Mapping
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
 import numpy as np
 
+from .columns import Columns
 from .designs import MEASURED, Measured, measured_sigma, normalized_theta_design, spin_design, tan_ratio_design
 from .kinematics import gross_slip_onset, normalize_to_bat_speed, tan_ratio_slope_model
 from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, scatter_gain, wls_slope
@@ -49,37 +49,6 @@ from .systematics import has_shifts
 if TYPE_CHECKING:
     import xarray as xr
     from numpy.typing import ArrayLike
-
-
-class Columns(Mapping):
-    """A Dataset's variables by name, read-only: ``cols[k].values`` without building a DataArray.
-
-    ``Dataset[k]`` builds a DataArray and looks for its coordinates among all the Dataset's
-    variables (some 0.15 ms a call on a reconstructed dataset of 200 variables); the fits read
-    a few dozen arrays a ball. The variables (:class:`xarray.Variable`) hold the same arrays,
-    so the numbers do not change. ``attrs`` are the Dataset's.
-    """
-
-    def __init__(self, ds: xr.Dataset | Columns, replaced: dict | None = None) -> None:
-        base = ds._vars if isinstance(ds, Columns) else ds.variables
-        self._vars = {**base, **(replaced or {})}
-        self.attrs = ds.attrs
-
-    def __getitem__(self, key: str) -> xr.Variable:
-        """Return the variable ``key`` (its ``values`` are the Dataset's array)."""
-        return self._vars[key]
-
-    def __contains__(self, key: object) -> bool:
-        """Whether the Dataset has a variable or coordinate ``key``."""
-        return key in self._vars
-
-    def __iter__(self):
-        """Iterate over the variables' names."""
-        return iter(self._vars)
-
-    def __len__(self) -> int:
-        """Return the number of variables."""
-        return len(self._vars)
 
 
 class FitStatus(enum.IntEnum):

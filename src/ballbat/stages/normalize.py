@@ -10,7 +10,7 @@ from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
 from ..analysis import normalize_values
-from ..fitting import Columns
+from ..columns import Columns
 from ..pipeline.config import SectionSettings
 from ..pipeline.products import Var, add_variables
 from ..units import MPH

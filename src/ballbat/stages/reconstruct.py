@@ -12,7 +12,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..analysis import property_values, reconstruct_values
-from ..fitting import Columns
+from ..columns import Columns
 from ..kinematics import ImpactFlag
 from ..pipeline.products import Var, add_variables, flag_attrs
 from ..properties import ball_variants, bat_record, bat_variants
