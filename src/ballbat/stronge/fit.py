@@ -35,7 +35,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .model import ContactParams, stronge_ex
+from .model import ImpactGeometry
 
 __all__ = ["Eta2Fit", "Eta2FitError", "fit_eta2"]
 
@@ -187,12 +187,10 @@ def fit_eta2(
     what = _describe(psi, e_y, mu, vary_e_y, vary_mu)
     x, y, r_x, r_y, alpha, sig = _checked_inputs(psi, x, y, r_x, r_y, alpha, sigma, vary_e_y, vary_mu, what)
 
-    def residual(eta2_, e_, mu_):
-        ex = stronge_ex(psi, ContactParams(eta2_, e_, mu_, r_x, r_y, alpha))
-        return (y - (1.0 + ex) * x) / sig
-
+    geometry = ImpactGeometry(psi, r_x, r_y, alpha)
+    residual = _Residual(geometry, x, y, sig)
     bounds = (float(eta2_bounds[0]), float(eta2_bounds[1]))
-    start = _scan_start(psi, x, y, r_x, r_y, alpha, sig, e_y, mu, bounds)
+    start = _scan_start(geometry, x, y, sig, e_y, mu, bounds)
     res = _least_squares(residual, (start, e_y, mu), bounds, (vary_e_y, vary_mu), scale_covar, what)
     best = res.params["eta2"].value
     if not res.success or not np.isfinite(best):
@@ -278,11 +276,40 @@ def _checked_inputs(psi, x, y, r_x, r_y, alpha, sigma, vary_e_y, vary_mu, what):
     return x, y, r_x, r_y, alpha, sig
 
 
-def _scan_start(psi, x, y, r_x, r_y, alpha, sig, e_y, mu, bounds: tuple[float, float]) -> float:
+class _Residual:
+    """The weighted residual ``(y - (1 + e_x) x) / sigma`` of the impacts at (eta2, e_y, mu), and its calls.
+
+    The model is evaluated on the impacts' :class:`ImpactGeometry` (prepared once per fit).
+    lmfit asks for the residual at the same point more than once (its checks before the fit,
+    MINPACK's first call and the result's residual): a call at a point already evaluated
+    (scalar parameters equal to the bit) returns the stored residual, the same numbers,
+    without running the model again. ``calls`` counts the model's evaluations.
+    """
+
+    def __init__(self, geometry: ImpactGeometry, x, y, sig) -> None:
+        self.geometry, self.x, self.y, self.sig = geometry, x, y, sig
+        self.seen: dict[tuple[float, float, float], np.ndarray] = {}
+        self.calls = 0
+
+    def __call__(self, eta2, e_y, mu) -> np.ndarray:
+        key = None
+        if np.ndim(eta2) == np.ndim(e_y) == np.ndim(mu) == 0:
+            key = (float(eta2), float(e_y), float(mu))
+            if key in self.seen:
+                return self.seen[key].copy()
+        self.calls += 1
+        ex = self.geometry.e_x(eta2, e_y, mu)
+        r = (self.y - (1.0 + ex) * self.x) / self.sig
+        if key is not None:
+            self.seen[key] = r.copy()
+        return r
+
+
+def _scan_start(geometry: ImpactGeometry, x, y, sig, e_y, mu, bounds: tuple[float, float]) -> float:
     """Return the starting eta^2: the lowest chi^2 of a logarithmic scan of ``bounds`` (48 values)."""
     scan = np.geomspace(bounds[0], bounds[1], 48)
     # one call of the closed-form model for the whole scan (elementwise: the same numbers as one call per value)
-    ex_scan = stronge_ex(psi, ContactParams(scan[:, None], e_y, mu, r_x, r_y, alpha))
+    ex_scan = geometry.e_x(scan[:, None], e_y, mu)
     res_scan = (y - (1.0 + ex_scan) * x) / sig
     return scan[int(np.argmin([float(r @ r) for r in res_scan]))]
 

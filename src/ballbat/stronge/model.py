@@ -44,6 +44,7 @@ from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "ContactParams",
+    "ImpactGeometry",
     "StrongeSolution",
     "omega_ratio",
     "stronge_ex",
@@ -171,28 +172,61 @@ class _Params:
     eta2: NDArray
 
 
+class ImpactGeometry:
+    """Impacts whose e_x is wanted at many parameters: psi, r_x, r_y and alpha checked and prepared once.
+
+    A fit evaluates the model at the same impacts for one eta^2 after another; what does not
+    depend on (eta2, e_y, mu) (the checks of psi, r_x, r_y and alpha, ``|tan psi|`` and the
+    effective masses' factors of Omega_t/Omega_n) is computed here once. :func:`stronge_ex`
+    is ``ImpactGeometry(psi, r_x, r_y, alpha).e_x(eta2, e_y, mu)``, the same numbers.
+
+    Parameters
+    ----------
+    psi : incidence angles, rad, |psi| < pi/2.
+    r_x, r_y, alpha : as in :class:`ContactParams`; they broadcast against psi.
+    """
+
+    def __init__(self, psi: ArrayLike, r_x: ArrayLike = 0.0, r_y: ArrayLike = 0.0, alpha: ArrayLike = 0.4) -> None:
+        psi, r_x, r_y, alpha = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (psi, r_x, r_y, alpha)))
+        with np.errstate(invalid="ignore"):
+            _check("psi", psi, np.abs(psi) < HALF_PI, "|psi| < pi/2 (radians)")
+            _check("r_x", r_x, (r_x > -1) & np.isfinite(r_x), "-1 < r_x < inf")
+            _check("r_y", r_y, (r_y > -1) & np.isfinite(r_y), "-1 < r_y < inf")
+            _check("alpha", alpha, (alpha > 0) & np.isfinite(alpha), "0 < alpha < inf")
+        self.shape = psi.shape
+        self.tan_psi = np.abs(np.tan(psi))
+        # Omega_t/Omega_n = sqrt(mass_num / (mass_den eta2)), the operations of omega_ratio in its order
+        self.mass_num = (1.0 + alpha) * (1.0 + r_x)
+        self.mass_den = alpha * (1.0 + r_y)
+
+    def e_x(self, eta2: ArrayLike, e_y: ArrayLike, mu: ArrayLike) -> NDArray[np.float64] | float:
+        """e_x of these impacts at (eta2, e_y, mu), which broadcast against them (:func:`stronge_ex`)."""
+        return _solve_ex(self.params(eta2, e_y, mu))
+
+    def params(self, eta2: ArrayLike, e_y: ArrayLike, mu: ArrayLike) -> _Params:
+        """Return the broadcast, flattened, dimensionless parameters of these impacts at (eta2, e_y, mu)."""
+        eta2, e_y, mu = (np.asarray(a, dtype=float) for a in (eta2, e_y, mu))
+        shape = np.broadcast_shapes(self.shape, eta2.shape, e_y.shape, mu.shape)
+        with np.errstate(invalid="ignore"):
+            _check("eta2", eta2, (eta2 > 0) & np.isfinite(eta2), "0 < eta2 < inf")
+            _check("e_y", e_y, (e_y > 0) & (e_y <= 1), "0 < e_y <= 1")
+            _check("mu", mu, (mu >= 0) & np.isfinite(mu), "0 <= mu < inf")
+        flat = [np.broadcast_to(a, shape).ravel() for a in (self.tan_psi, self.mass_num, self.mass_den, eta2, e_y, mu)]
+        T, num, den, eta2, e_y, mu = flat
+        rho = np.sqrt(num / (den * eta2))
+        rho = np.where(np.abs(rho - 1.0) < 1e-14, 1.0, rho)  # e.g. the superball, eta2 = 3.5
+        lam = mu * eta2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            Lam = np.where(T > 0, lam / T, np.inf)
+        Lam = np.where((T == 0) | (Lam > 1e300), np.inf, Lam)
+        thf = HALF_PI * (1.0 + e_y)
+        return _Params(shape, T, rho, lam, Lam, e_y.copy(), thf, eta2.copy())
+
+
 def _prepare(psi: ArrayLike, contact: ContactParams) -> _Params:
-    psi, eta2, e_y, mu, r_x, r_y, alpha = contact.broadcast(psi)
-    with np.errstate(invalid="ignore"):
-        _check("psi", psi, np.abs(psi) < HALF_PI, "|psi| < pi/2 (radians)")
-        _check("eta2", eta2, (eta2 > 0) & np.isfinite(eta2), "0 < eta2 < inf")
-        _check("e_y", e_y, (e_y > 0) & (e_y <= 1), "0 < e_y <= 1")
-        _check("mu", mu, (mu >= 0) & np.isfinite(mu), "0 <= mu < inf")
-        _check("r_x", r_x, (r_x > -1) & np.isfinite(r_x), "-1 < r_x < inf")
-        _check("r_y", r_y, (r_y > -1) & np.isfinite(r_y), "-1 < r_y < inf")
-        _check("alpha", alpha, (alpha > 0) & np.isfinite(alpha), "0 < alpha < inf")
-    shape = psi.shape
-    f = [a.ravel() for a in (psi, eta2, e_y, mu, r_x, r_y, alpha)]
-    psi, eta2, e_y, mu, r_x, r_y, alpha = f
-    T = np.abs(np.tan(psi))
-    rho = omega_ratio(eta2, r_x, r_y, alpha)
-    rho = np.where(np.abs(rho - 1.0) < 1e-14, 1.0, rho)  # e.g. the superball, eta2 = 3.5
-    lam = mu * eta2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        Lam = np.where(T > 0, lam / T, np.inf)
-    Lam = np.where((T == 0) | (Lam > 1e300), np.inf, Lam)
-    thf = HALF_PI * (1.0 + e_y)
-    return _Params(shape, T, rho, lam, Lam, e_y.copy(), thf, eta2.copy())
+    """Return the dimensionless parameters of the impacts psi at ``contact`` (:class:`ImpactGeometry`)."""
+    c = contact
+    return ImpactGeometry(psi, c.r_x, c.r_y, c.alpha).params(c.eta2, c.e_y, c.mu)
 
 
 def _sincos(x):
@@ -356,9 +390,9 @@ def _stick_event(piece: _StickPiece, end):
     K = max(STICK_GRID, int(np.ceil(np.max(rho * (end - th0), initial=0.0) / STICK_DPHASE)))
     k = np.arange(0, K + 1) / K
     grid = th0[:, None] + (end - th0)[:, None] * k
-    r_, L_, e_, f_ = rho[:, None], Lam[:, None], e[:, None], thf[:, None]
+    r_, L_ = rho[:, None], Lam[:, None]
     U, S = _stick_state(th0[:, None], u0[:, None], s0[:, None], r_, grid)
-    N, dN, _ = _normal(grid, e_, f_)
+    N, dN = _normal_on_grid(grid, e, thf, end)
     with np.errstate(invalid="ignore"):
         g = np.abs(S) - L_ * N
         gp = np.sign(S) * U - L_ * dN
@@ -393,6 +427,28 @@ def _stick_event(piece: _StickPiece, end):
     out[i] = _newton_bracketed(F, hi[i].copy(), lo[i], hi[i])
     sig[i] = sign_s
     return out, sig
+
+
+def _normal_on_grid(grid, e, thf, end):
+    """N/N_max and its derivative on a stick piece's grid (n, K + 1), computed once per distinct row.
+
+    Row i of the grid is ``th0_i + (end_i - th0_i) k``, so impacts with the same (th0, end,
+    e_y, theta_f) share their N on it: in a fit (one e_y) the first piece of every impact
+    runs from 0 to t_c, and impacts that stuck through loading all start unloading at t_c.
+    When end, e_y and theta_f are common and at most half the starts distinct, N is computed
+    on the distinct rows. The numbers are :func:`_normal`'s on the whole grid (elementwise,
+    the same operations on the same values).
+    """
+    shared = end.size > 1 and bool(np.all((end == end[0]) & (e == e[0]) & (thf == thf[0])))
+    if shared:
+        uniq, first, inv = np.unique(grid[:, 0], return_index=True, return_inverse=True)
+        shared = 2 * uniq.size <= end.size
+    if not shared:  # mostly distinct rows: the whole grid
+        N, dN, _ = _normal(grid, e[:, None], thf[:, None])
+        return N, dN
+    N, dN, _ = _normal(grid[first], e[first, None], thf[first, None])
+    inv = inv.reshape(-1)
+    return N[inv], dN[inv]
 
 
 class _StickPiece(NamedTuple):
@@ -630,7 +686,11 @@ def stronge_ex(psi: ArrayLike, contact: ContactParams) -> NDArray[np.float64]:
     I(theta_1))`` with theta_1 the end of the initial stick, found by Newton iteration;
     other cases run the general phase machine of :func:`stronge_solve`.
     """
-    p = _prepare(psi, contact)
+    return _solve_ex(_prepare(psi, contact))
+
+
+def _solve_ex(p: _Params) -> NDArray[np.float64] | float:
+    """e_x of the prepared impacts ``p`` (:func:`stronge_ex`): the fast path where rho <= 1, else the engine."""
     uf = np.empty(p.rho.size)
     soft = p.rho <= 1.0
     for a in range(0, uf.size, CHUNK):
