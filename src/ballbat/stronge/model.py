@@ -559,9 +559,9 @@ class _Pieces:
     uf: NDArray  # (n,) final U
 
 
-def _engine(p: _Params, idx) -> _Pieces:
-    """Run the phase machine for the impacts ``idx`` (flat indices into ``p``), in blocks."""
-    blocks = [_engine_block(p, idx[a : a + CHUNK]) for a in range(0, max(idx.size, 1), CHUNK)]
+def _engine(p: _Params, idx, record: bool = True) -> _Pieces:
+    """Run the phase machine for the impacts ``idx`` (flat indices into ``p``), in blocks (:func:`_engine_block`)."""
+    blocks = [_engine_block(p, idx[a : a + CHUNK], record) for a in range(0, max(idx.size, 1), CHUNK)]
     if len(blocks) == 1:
         return blocks[0]
     P = max(b.start.shape[1] for b in blocks)
@@ -606,15 +606,20 @@ def _end_of_slip(piece: _StickPiece, slip_mode):
     return tnew, U1, S1, np.where(ev, 0, slip_mode).astype(np.int8)
 
 
-def _engine_block(p: _Params, idx) -> _Pieces:
-    """Run the phase machine for one block of impacts."""
+def _engine_block(p: _Params, idx, record: bool = True) -> _Pieces:
+    """Run the phase machine for one block of impacts.
+
+    ``record=False``: only the final U (:func:`stronge_ex`); the pieces' records are left empty
+    (width 0), the same ``uf``.
+    """
     rho, Lam, e, thf = p.rho[idx], p.Lam[idx], p.e[idx], p.thf[idx]
     n = idx.size
     P = MAX_PIECES
-    start = np.full((n, P), np.inf)
-    mode_rec = np.zeros((n, P), dtype=np.int8)
-    u_rec = np.zeros((n, P))
-    s_rec = np.zeros((n, P))
+    width = P if record else 0
+    start = np.full((n, width), np.inf)
+    mode_rec = np.zeros((n, width), dtype=np.int8)
+    u_rec = np.zeros((n, width))
+    s_rec = np.zeros((n, width))
     npieces = np.zeros(n, dtype=int)
     th = np.zeros(n)
     u = np.ones(n)
@@ -625,10 +630,11 @@ def _engine_block(p: _Params, idx) -> _Pieces:
     for k in range(P):
         if act.size == 0:
             break
-        start[act, k] = th[act]
-        mode_rec[act, k] = mode[act]
-        u_rec[act, k] = u[act]
-        s_rec[act, k] = s[act]
+        if record:
+            start[act, k] = th[act]
+            mode_rec[act, k] = mode[act]
+            u_rec[act, k] = u[act]
+            s_rec[act, k] = s[act]
         npieces[act] = k + 1
         piece = _StickPiece(th[act], u[act], s[act], rho[act], Lam[act], e[act], thf[act])
         piece_mode = mode[act]
@@ -653,7 +659,7 @@ def _engine_block(p: _Params, idx) -> _Pieces:
             f" e.g. tan(psi)={p.tan_psi[k]:g}, eta2={p.eta2[k]:g}, e_y={p.e[k]:g},"
             f" mu*eta2={p.lam[k]:g}, Omega_t/Omega_n={p.rho[k]:g}"
         )
-    P = max(int(npieces.max(initial=1)), 1)
+    P = min(max(int(npieces.max(initial=1)), 1), width)
     return _Pieces(start[:, :P], mode_rec[:, :P], u_rec[:, :P], s_rec[:, :P], npieces, uf)
 
 
@@ -704,7 +710,7 @@ def _solve_ex(p: _Params) -> NDArray[np.float64] | float:
             if i.size:
                 uf[i] = _uf_soft(p.rho[i], p.Lam[i], p.e[i], p.thf[i])
             j = np.flatnonzero(~m) + a
-            uf[j] = _engine(p, j).uf
+            uf[j] = _engine(p, j, record=False).uf
     ex = -uf
     return ex.reshape(p.shape) if p.shape else float(ex[0])
 
