@@ -69,6 +69,19 @@ class Eta2Fit:
     message: str
 
 
+class _Described:
+    """The inputs of a fit in words (:func:`_describe`), written only when a message needs them."""
+
+    def __init__(self, *args) -> None:
+        self.args = args
+
+    def __str__(self) -> str:
+        return _describe(*self.args)
+
+    def __format__(self, spec: str) -> str:
+        return format(str(self), spec)
+
+
 def _describe(psi, e_y, mu, vary_e_y, vary_mu) -> str:
     psi = np.asarray(psi, dtype=float)
     with np.errstate(invalid="ignore"):
@@ -288,7 +301,7 @@ def fit_eta2(
     least-squares fit (lmfit, Levenberg-Marquardt) starts there.
     """
     psi = np.asarray(psi, dtype=float).ravel()
-    what = _describe(psi, e_y, mu, vary_e_y, vary_mu)
+    what = _Described(psi, e_y, mu, vary_e_y, vary_mu)
     x, y, r_x, r_y, alpha, sig = _checked_inputs(psi, x, y, r_x, r_y, alpha, sigma, vary_e_y, vary_mu, what)
 
     geometry = ImpactGeometry(psi, r_x, r_y, alpha)
@@ -441,7 +454,7 @@ def _robust_errors(res: _LeastSquares, residual, strata, level: float) -> tuple[
     The errors of the free parameters are the HC3 sandwich's centred within ``strata``; the
     rise is t_nu^2 times the ratio of the robust to the unscaled variance of eta^2.
     """
-    from scipy.stats import t as t_dist
+    from scipy.special import stdtrit  # Student's t quantile: scipy.stats.t.ppf's own, without its checks
 
     from ..linefit import sandwich_cov, sandwich_dof
 
@@ -452,7 +465,7 @@ def _robust_errors(res: _LeastSquares, residual, strata, level: float) -> tuple[
     errs.update({k: float(np.sqrt(cov[i, i])) for i, k in enumerate(names)})
     dof = sandwich_dof(J, strata, 0)
     var_unscaled = float(np.linalg.inv(J.T @ J)[0, 0])
-    delta = float(t_dist.ppf(0.5 + level / 2.0, dof)) ** 2 * errs["eta2"] ** 2 / var_unscaled
+    delta = float(stdtrit(dof, 0.5 + level / 2.0)) ** 2 * errs["eta2"] ** 2 / var_unscaled
     return errs, dof, delta
 
 

@@ -36,6 +36,7 @@ References
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -211,7 +212,8 @@ class ImpactGeometry:
             _check("eta2", eta2, (eta2 > 0) & np.isfinite(eta2), "0 < eta2 < inf")
             _check("e_y", e_y, (e_y > 0) & (e_y <= 1), "0 < e_y <= 1")
             _check("mu", mu, (mu >= 0) & np.isfinite(mu), "0 <= mu < inf")
-        flat = [np.broadcast_to(a, shape).ravel() for a in (self.tan_psi, self.mass_num, self.mass_den, eta2, e_y, mu)]
+        size = math.prod(shape)
+        flat = [_flat(a, shape, size) for a in (self.tan_psi, self.mass_num, self.mass_den, eta2, e_y, mu)]
         T, num, den, eta2, e_y, mu = flat
         rho = np.sqrt(num / (den * eta2))
         rho = np.where(np.abs(rho - 1.0) < 1e-14, 1.0, rho)  # e.g. the superball, eta2 = 3.5
@@ -221,6 +223,15 @@ class ImpactGeometry:
         Lam = np.where((T == 0) | (Lam > 1e300), np.inf, Lam)
         thf = HALF_PI * (1.0 + e_y)
         return _Params(shape, T, rho, lam, Lam, e_y.copy(), thf, eta2.copy())
+
+
+def _flat(a: NDArray, shape: tuple, size: int) -> NDArray:
+    """Return ``a`` broadcast to ``shape`` and flattened (a scalar filled in, an array of that shape as it is)."""
+    if a.shape == shape:
+        return a.ravel()
+    if a.ndim == 0:
+        return np.full(size, a)
+    return np.broadcast_to(a, shape).ravel()
 
 
 def _prepare(psi: ArrayLike, contact: ContactParams) -> _Params:
