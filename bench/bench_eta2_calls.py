@@ -1,11 +1,15 @@
-"""Calls of Stronge's model and CPU time of the eta^2 fits in calibration replicates (issue 39).
+"""Evaluations of Stronge's model and CPU time of the eta^2 fits in calibration replicates (issue 39).
 
 Runs ``N`` replicates (default 5) of the calibration study as its batch job does
 (``ballbat.studies.batch.run``, batch 1) after one warm-up replicate and prints, per
-replicate, how many times :func:`ballbat.stronge.model.stronge_ex` is called and from where
-(the function that called it), and the CPU time (``time.process_time``) of the eta^2 fits
-(``_eta2``: the measured fit and the noise-free truth of each ball). Repeat the run
-and read the smallest time when the machine is shared.
+replicate and per fit (``fit_ball``: the measured value and the noise-free truth of each
+ball), how many times Stronge's model is evaluated (``_solve_ex``, which both
+:func:`ballbat.stronge.model.stronge_ex` and ``ImpactGeometry.e_x`` run) and from where (the
+first function outside the model and the fit's residual: ``_scan_start``, MINPACK's calls
+``fcn``, the sandwich's ``_jacobian``, ``_ex_at`` of the errors-in-variables step,
+``finite_sample_bias``), with the impacts evaluated, and the CPU time
+(``time.process_time``) of the eta^2 fits (``_eta2``). Repeat the run and read the smallest
+time when the machine is shared.
 
 Run: ``.venv/bin/python bench/bench_eta2_calls.py [N]``.
 """
@@ -19,19 +23,33 @@ import traceback
 
 from ballbat.config_checks import load_config
 from ballbat.properties import load_balls, load_bats
-from ballbat.stronge import analysis, fit, model
+from ballbat.stronge import analysis, model
 from ballbat.studies import batch as study_batch
 from ballbat.studies import replicates
 from ballbat.studies.settings import StudySettings
 
 CALLS: collections.Counter[str] = collections.Counter()
+SIZES: collections.Counter[str] = collections.Counter()
+FITS = [0]
 SPENT = [0.0]
+#: Frames between a caller and the model's evaluation (the model's own and the fit's residual).
+PASSING = {"_solve_ex", "stronge_ex", "e_x", "__call__", "wrapper"}
 
 
 def _counted(fn):
-    def wrapper(psi, contact):
-        CALLS[traceback.extract_stack(limit=2)[0].name] += 1
-        return fn(psi, contact)
+    def wrapper(p):
+        caller = next(f.name for f in reversed(traceback.extract_stack(limit=8)) if f.name not in PASSING)
+        CALLS[caller] += 1
+        SIZES[caller] += p.rho.size
+        return fn(p)
+
+    return wrapper
+
+
+def _fits(fn):
+    def wrapper(*args, **kwargs):
+        FITS[0] += 1
+        return fn(*args, **kwargs)
 
     return wrapper
 
@@ -48,20 +66,23 @@ def _timed(fn):
 
 
 def main(n: int = 5) -> None:
-    """Run ``n`` calibration replicates; print the model's calls by caller and the eta^2 fits' CPU time."""
+    """Run ``n`` calibration replicates; print the model's evaluations by caller and the eta^2 fits' CPU time."""
     cfg = load_config()
     balls, bats = load_balls("config/balls.csv"), load_bats("config/bats.csv")
     cfg["studies"]["calibration"]["batch_size"] = 1
     study_batch.run(StudySettings.from_config(cfg, "calibration"), 0, balls, bats)  # warm-up
     cfg["studies"]["calibration"]["batch_size"] = n
-    counted = _counted(model.stronge_ex)
-    fit.stronge_ex = analysis.stronge_ex = counted
+    model._solve_ex = _counted(model._solve_ex)
+    analysis.fit_ball = _fits(analysis.fit_ball)
     replicates._eta2 = _timed(replicates._eta2)
     study_batch.run(StudySettings.from_config(cfg, "calibration"), 1, balls, bats)
-    print(f"{n} calibration replicates: stronge_ex calls per replicate, by caller")
+    fits = FITS[0] / n
+    print(f"{n} calibration replicates, {fits:.0f} fit_ball a replicate: evaluations of the model, by caller")
+    print(f"  {'caller':<22} {'per replicate':>14} {'per fit_ball':>13} {'impacts each':>13}")
     for name, k in CALLS.most_common():
-        print(f"  {name:<24} {k / n:6.1f}")
-    print(f"  {'total':<24} {sum(CALLS.values()) / n:6.1f}")
+        print(f"  {name:<22} {k / n:14.1f} {k / n / fits:13.2f} {SIZES[name] / k:13.0f}")
+    total = sum(CALLS.values())
+    print(f"  {'total':<22} {total / n:14.1f} {total / n / fits:13.2f}")
     print(f"eta^2 fits (value and truth): {SPENT[0] / n * 1e3:.1f} ms CPU per replicate")
 
 

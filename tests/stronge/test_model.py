@@ -332,18 +332,21 @@ def test_impact_geometry_is_stronge_ex():
 
 
 def test_phase_machine_is_the_same_in_blocks_and_without_records(monkeypatch):
-    """The stick grids sampled in blocks of GRID_BLOCK impacts, N computed once per shared grid row and
-    the engine run without its piece records (stronge_ex's way) give the numbers of one block with every
-    record, bit for bit: each impact's grid is its own.
+    """The stick grids sampled in blocks of GRID_BLOCK impacts, N computed once per shared grid row, the
+    first stick of a batch with Omega_t >= Omega_n not sampled (it cannot end while loading) and the engine
+    run without its piece records (stronge_ex's way) give the numbers of one block, every grid sampled,
+    with every record, bit for bit.
     """
     from ballbat.stronge import model
 
     psi, c = _hard_batch(700)
+    psi[:5] = 0.0  # stick to separation
     scan = ContactParams(np.geomspace(1, 3.4, 12)[:, None], 0.5, 0.5, c.r_x[:60], c.r_y[:60])
     prepared = [model._prepare(psi, c), model._prepare(psi[:60], scan)]
     blocked = [model._engine(p, np.arange(p.rho.size), record=False).uf for p in prepared]
     assert model.GRID_BLOCK < psi.size
     monkeypatch.setattr(model, "GRID_BLOCK", 10**6)
+    monkeypatch.setattr(model, "_stuck_through_loading", lambda piece, end: False)
     monkeypatch.setattr(
         model, "_normal_on_grid", lambda grid, e, thf, end: model._normal(grid, e[:, None], thf[:, None])[:2]
     )

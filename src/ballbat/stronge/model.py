@@ -403,6 +403,8 @@ def _stick_event(piece: _StickPiece, end):
     and the roots of all of them are found together.
     """
     th0, rho = piece.th0, piece.rho
+    if _stuck_through_loading(piece, end):
+        return np.full(th0.shape, np.nan), np.zeros(th0.shape)
     K = max(STICK_GRID, int(np.ceil(np.max(rho * (end - th0), initial=0.0) / STICK_DPHASE)))
     k = np.arange(0, K + 1) / K
     starts = range(0, max(th0.size, 1), GRID_BLOCK)
@@ -426,6 +428,20 @@ def _stick_event(piece: _StickPiece, end):
     out[i] = _newton_bracketed(F, hi[i].copy(), lo[i], hi[i])
     sig[i] = sign_s
     return out, sig
+
+
+def _stuck_through_loading(piece: _StickPiece, end) -> bool:
+    """Whether every impact of the batch starts sticking from rest and provably sticks through loading.
+
+    From theta = 0 with U = 1, S = 0 the stick is S = sin(rho theta)/rho, and for rho >= 1
+    ``|sin(rho theta)| <= rho sin(theta)`` on [0, pi/2] (sin x / x falls on (0, pi]; beyond pi,
+    rho sin(theta) > 2 rho theta / pi > 2), so |S| <= N < Lam N when Lam > 1: g stays below zero
+    and the grid would find no crossing up to t_c. Such a batch (every impact's first piece
+    when Omega_t >= Omega_n, all of the general engine's in :func:`stronge_ex`) is not sampled;
+    a batch with any other piece is, whole, as before.
+    """
+    first = (piece.th0 == 0.0) & (piece.u0 == 1.0) & (piece.s0 == 0.0) & (end <= HALF_PI)
+    return bool(np.all(first & (piece.rho >= 1.0) & (piece.Lam > 1.0)))
 
 
 #: Impacts per block whose stick grids :func:`_stick_event` samples at once: the work arrays
