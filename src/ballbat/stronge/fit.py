@@ -25,7 +25,9 @@ Uncertainties (documented in docs/stronge.md, "The eta^2 fit"):
   variance. Either way the interval is +-(quantile) standard errors for a model linear in
   eta2, and follows the curvature of chi^2 otherwise.
 
-lmfit and scipy.stats are imported inside :func:`fit_eta2` only.
+The fit is Levenberg-Marquardt (MINPACK): with e_y and mu fixed it is lmfit's ``leastsq``
+computed without lmfit's Parameters (:func:`_lm_eta2_alone`, the same numbers), otherwise
+lmfit's. lmfit and scipy are imported inside :func:`fit_eta2` only.
 """
 
 from __future__ import annotations
@@ -125,7 +127,7 @@ E_Y_BOUNDS, MU_BOUNDS = (0.05, 1.0), (1e-3, 10.0)
 LMFIT_MESSAGES = {
     0: "Invalid Input Parameters. I.e. more variables than data points given, tolerance < 0.0, or no data provided.",
     4: "One or more variable did not affect the fit.",
-    5: f"Too many function calls (max set to {2 * 4000:d})! Use: minimize(func, params, ..., max_nfev=NNN)"
+    5: f"Too many function calls (max set to {2 * LMFIT_MAX_NFEV:d})! Use: minimize(func, params, ..., max_nfev=NNN)"
     " to increase this maximum.",
 }
 
