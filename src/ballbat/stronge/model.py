@@ -493,10 +493,14 @@ def _normal_on_grid(grid, e, thf, end):
     e_y, theta_f) share their N on it: in a fit (one e_y) the first piece of every impact
     runs from 0 to t_c, and impacts that stuck through loading all start unloading at t_c.
     When end, e_y and theta_f are common and at most half the starts distinct, N is computed
-    on the distinct rows. The numbers are :func:`_normal`'s on the whole grid (elementwise,
-    the same operations on the same values).
+    on the distinct rows (one row, returned as (1, K + 1), broadcasts against the grid). The
+    numbers are :func:`_normal`'s on the whole grid (elementwise, the same operations on the
+    same values).
     """
     shared = end.size > 1 and bool(np.all((end == end[0]) & (e == e[0]) & (thf == thf[0])))
+    if shared and bool(np.all(grid[:, 0] == grid[0, 0])):
+        N, dN, _ = _normal(grid[:1], e[:1, None], thf[:1, None])
+        return N, dN
     if shared:
         uniq, first, inv = np.unique(grid[:, 0], return_index=True, return_inverse=True)
         shared = 2 * uniq.size <= end.size
