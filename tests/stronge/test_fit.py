@@ -240,3 +240,20 @@ def test_the_residual_runs_the_model_once_per_point(balls, bats):
     res(np.array([[4.75]]), 0.5, 0.5)
     res(4.750000000000001, 0.5, 0.5)
     assert res.calls == 3
+
+
+def test_value_alone_without_errors(balls, bats):
+    """errors=False (a study's noise-free truth): the same value and chi^2, the errors and dof NaN;
+    the profile interval needs the errors, and asking for both is a ValueError.
+    """
+    from ballbat.stronge.analysis import VtfData, fit_ball
+
+    psi, x, y, r_x, r_y = _synthetic(balls, bats, np.random.default_rng(6), n=30)
+    bats_of = np.repeat(["a", "b", "c"], 10)
+    data = VtfData(psi, x, y, np.full(30, 0.01), r_x, r_y, np.full(30, 0.4), bats_of)
+    full = fit_ball(data, e_y=0.5, mu=0.5, vary_e_y=False, vary_mu=False, interval=False)
+    alone = fit_ball(data, e_y=0.5, mu=0.5, vary_e_y=False, vary_mu=False, interval=False, errors=False)
+    assert (alone.eta2, alone.chisqr) == (full.eta2, full.chisqr)
+    assert np.isfinite(full.eta2_err) and np.isnan(alone.eta2_err) and np.isnan(alone.dof)
+    with pytest.raises(ValueError, match="the profile interval needs the standard errors"):
+        fit_eta2(psi, x, y, r_x, r_y, errors=False)

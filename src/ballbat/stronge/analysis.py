@@ -285,6 +285,7 @@ def fit_ball(
     vary_mu: bool,
     sigma: NDArray[np.float64] | None = None,
     interval: bool = True,
+    errors: bool = True,
     errors_in_variables: bool = True,
     finite_sample: bool = True,
 ) -> Eta2Fit:
@@ -310,6 +311,8 @@ def fit_ball(
         Weights' uncertainties in place of ``data.sigma`` (the truth of a replicate study
         is fitted with the measured data's weights).
     interval : compute the profile-likelihood interval (the truth of a study needs the value only).
+    errors : compute the standard error and its degrees of freedom (False: NaN, with
+        ``interval=False``; the truth of a study needs the value only).
     errors_in_variables : correct for the measurement noise (needs ``data.noise``; off for
         noise-free values, such as a study's truth).
     finite_sample : remove the estimator's bias of order 1/n (:func:`finite_sample_bias`;
@@ -337,6 +340,7 @@ def fit_ball(
         robust=True,
         strata=d.bat,
         interval=interval,
+        errors=errors,
     )
     names = ["eta2"] + (["e_y"] if vary_e_y else []) + (["mu"] if vary_mu else [])
     at = {"eta2": fit.eta2, "e_y": fit.e_y, "mu": fit.mu}

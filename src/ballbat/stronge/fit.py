@@ -260,6 +260,7 @@ def fit_eta2(
     robust: bool = False,
     strata: ArrayLike | None = None,
     interval: bool = True,
+    errors: bool = True,
 ) -> Eta2Fit:
     """Fit eta^2 (and optionally e_y, mu) of Stronge's model to Eq. (vtf) data.
 
@@ -282,6 +283,8 @@ def fit_eta2(
     strata : a label per impact (its bat) for ``robust``; None: one uncentred stratum.
     interval : compute the profile-likelihood interval (False: NaN, for fits whose value
         alone is wanted, such as a replicate study's noise-free truth).
+    errors : compute the standard errors and their degrees of freedom (False: NaN; the value
+        alone, e.g. a replicate study's noise-free truth; needs ``interval=False``).
 
     Returns
     -------
@@ -318,13 +321,8 @@ def fit_eta2(
     chi_min, nfree = res.chisqr, res.nfree
     redchi = chi_min / nfree
     e_best, mu_best = res.values["e_y"], res.values["mu"]
-    if robust:
-        if strata is not None and np.shape(strata) != psi.shape:
-            raise ValueError(f"fit_eta2: strata must have one label per impact ({what})")
-        errs, dof, delta = _robust_errors(res, residual, strata, level)
-    else:
-        errs, dof = dict(res.stderr), float(nfree)
-        delta = _chi2_rise(level, redchi if scale_covar else 1.0)
+    options = {"robust": robust, "errors": errors, "interval": interval, "scale_covar": scale_covar, "n": psi.size}
+    errs, dof, delta = _fit_errors(res, residual, strata, level, options, what)
 
     if vary_e_y or vary_mu:
 
@@ -448,6 +446,24 @@ def _chi2_rise(level: float, scale: float) -> float:
     from scipy.stats import chi2
 
     return float(chi2.ppf(level, 1)) * scale
+
+
+def _fit_errors(res: _LeastSquares, residual, strata, level: float, options: dict, what) -> tuple[dict, float, float]:
+    """Return the standard errors, their degrees of freedom and the interval's chi^2 rise (``options``: fit_eta2's).
+
+    ``errors=False``: NaN (and no interval); ``robust``: the sandwich (:func:`_robust_errors`);
+    otherwise lmfit's, with n - p degrees of freedom.
+    """
+    if not options["errors"]:
+        if options["interval"]:
+            raise ValueError(f"fit_eta2: the profile interval needs the standard errors (errors=False) ({what})")
+        return dict.fromkeys(("eta2", "e_y", "mu"), np.nan), np.nan, np.nan
+    if options["robust"]:
+        if strata is not None and np.shape(strata) != (options["n"],):
+            raise ValueError(f"fit_eta2: strata must have one label per impact ({what})")
+        return _robust_errors(res, residual, strata, level)
+    redchi = res.chisqr / res.nfree
+    return dict(res.stderr), float(res.nfree), _chi2_rise(level, redchi if options["scale_covar"] else 1.0)
 
 
 def _robust_errors(res: _LeastSquares, residual, strata, level: float) -> tuple[dict[str, float], float, float]:

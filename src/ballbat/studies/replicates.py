@@ -128,6 +128,7 @@ def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> t
             vtf_data(rec_truth, sel),
             sigma=d.sigma,
             interval=False,
+            errors=False,  # the truth is a value; its error and dof are never read
             errors_in_variables=False,
             finite_sample=False,
             **kw,
