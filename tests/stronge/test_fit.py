@@ -134,7 +134,7 @@ def test_fit_input_errors(balls, bats):
 
 @pytest.mark.parametrize(("success", "eta2"), [(False, 4.75), (True, np.nan)])
 def test_failed_fit_names_its_inputs(balls, bats, monkeypatch, success, eta2):
-    """A failure that lmfit reports, or a non-finite eta^2, is an Eta2FitError naming the fit's inputs."""
+    """A failure that lmfit reports (mu free), or a non-finite eta^2, is an Eta2FitError naming the fit's inputs."""
     import lmfit
 
     real = lmfit.minimize
@@ -149,9 +149,111 @@ def test_failed_fit_names_its_inputs(balls, bats, monkeypatch, success, eta2):
     psi, x, y, r_x, r_y = _synthetic(balls, bats, np.random.default_rng(4), n=10)
     lo, hi = np.degrees(psi.min()), np.degrees(psi.max())
     with pytest.raises(Eta2FitError) as info:
-        fit_eta2(psi, x, y, r_x, r_y, e_y=0.4)
+        fit_eta2(psi, x, y, r_x, r_y, e_y=0.4, vary_mu=True)
     assert str(info.value) == (
         f"fit_eta2: fit failed (the fit wandered off) (n=10 impacts, psi {lo:.3g}..{hi:.3g} deg,"
-        " e_y=0.4 (fixed), mu=0.5 (fixed))"
+        " e_y=0.4 (fixed), mu=0.5 (free))"
     )
     assert isinstance(info.value, RuntimeError)  # callers that catch a failed fit as a RuntimeError still do
+
+
+@pytest.mark.parametrize(
+    ("ier", "best", "why"),
+    [(5, 0.3, "fit failed (Too many function calls"), (1, np.nan, "the least-squares fit raised ValueError")],
+)
+def test_failed_fit_of_eta2_alone_names_its_inputs(balls, bats, monkeypatch, ier, best, why):
+    """eta^2 alone (MINPACK without lmfit's Parameters): a failure MINPACK reports, or a non-finite
+    internal value, is an Eta2FitError naming the fit's inputs.
+    """
+    import scipy.optimize
+
+    real = scipy.optimize.leastsq
+
+    def failing(fcn, x0, **kwargs):
+        _, cov, info, _, _ = real(fcn, x0, **kwargs)
+        return np.array([best]), cov, info, "wandered off", ier
+
+    monkeypatch.setattr(scipy.optimize, "leastsq", failing)
+    psi, x, y, r_x, r_y = _synthetic(balls, bats, np.random.default_rng(4), n=10)
+    lo, hi = np.degrees(psi.min()), np.degrees(psi.max())
+    with pytest.raises(Eta2FitError) as info:
+        fit_eta2(psi, x, y, r_x, r_y, e_y=0.4)
+    assert str(info.value).startswith(f"fit_eta2: {why}")
+    assert str(info.value).endswith(f"(n=10 impacts, psi {lo:.3g}..{hi:.3g} deg, e_y=0.4 (fixed), mu=0.5 (fixed))")
+
+
+def _via_lmfit(residual, start, bounds, scale_covar):
+    """lmfit.minimize on eta^2 alone, as fit_eta2 called it before it fitted eta^2 alone itself."""
+    import lmfit
+
+    from ballbat.stronge.fit import _LeastSquares, _lmfit_errors
+
+    params = lmfit.Parameters()
+    params.add("eta2", value=start[0], min=bounds[0], max=bounds[1])
+    params.add("e_y", value=start[1], min=0.05, max=1.0, vary=False)
+    params.add("mu", value=start[2], min=1e-3, max=10.0, vary=False)
+    res = lmfit.minimize(
+        lambda p: residual(p["eta2"].value, p["e_y"].value, p["mu"].value),
+        params,
+        method="leastsq",
+        scale_covar=scale_covar,
+    )
+    values = {k: res.params[k].value for k in ("eta2", "e_y", "mu")}
+    errs = _lmfit_errors(res.params)
+    return _LeastSquares(values, errs, ("eta2",), float(res.chisqr), int(res.nfree), res.success, str(res.message))
+
+
+@pytest.mark.parametrize(("seed", "e_y", "mu"), [(0, 0.5, 0.5), (1, 0.4, 0.2), (2, 1.0, 1.5), (3, 0.5, 0.0)])
+def test_eta2_alone_is_lmfits_fit_to_the_bit(balls, bats, monkeypatch, seed, e_y, mu):
+    """With e_y and mu fixed, fit_eta2 computes lmfit's leastsq itself: every number of the result
+    (value, standard errors, interval, chi^2, message; robust or not, scaled or not) equals the one
+    lmfit gives, bit for bit (mu = 0 is clipped to lmfit's lower bound 1e-3 in both).
+    """
+    from ballbat.stronge import fit as fit_module
+
+    psi, x, y, r_x, r_y = _synthetic(balls, bats, np.random.default_rng(seed), n=40)
+    strata = np.repeat(["a", "b", "c", "d"], 10)
+    for kw in ({}, {"scale_covar": False, "sigma": 0.01}, {"robust": True, "strata": strata}):
+        ours = fit_eta2(psi, x, y, r_x, r_y, e_y=e_y, mu=mu, **kw)
+        with monkeypatch.context() as m:
+            m.setattr(fit_module, "_lm_eta2_alone", _via_lmfit)
+            theirs = fit_eta2(psi, x, y, r_x, r_y, e_y=e_y, mu=mu, **kw)
+        assert ours.message == theirs.message == "Fit succeeded."
+        for name in ("eta2", "eta2_err", "eta2_ci_low", "eta2_ci_high", "chisqr", "redchi", "dof", "e_y", "mu"):
+            np.testing.assert_equal(getattr(ours, name), getattr(theirs, name), err_msg=name)  # NaN == NaN
+
+
+def test_the_residual_runs_the_model_once_per_point(balls, bats):
+    """The fit's residual returns a point it has evaluated (scalar parameters equal to the bit) without
+    running the model again, the same numbers; array parameters (the Jacobian's steps) always run it.
+    """
+    from ballbat.stronge.fit import _Residual
+    from ballbat.stronge.model import ImpactGeometry
+
+    psi, x, y, r_x, r_y = _synthetic(balls, bats, np.random.default_rng(5), n=20)
+    res = _Residual(ImpactGeometry(psi, r_x, r_y, 0.4), x, y, np.ones_like(x))
+    a = res(4.75, 0.5, 0.5)
+    a[0] = np.nan  # the caller's copy: what the residual keeps stays as computed
+    b = res(4.75, 0.5, 0.5)
+    assert res.calls == 1
+    np.testing.assert_array_equal(b, (y - (1 + stronge_ex(psi, ContactParams(4.75, 0.5, 0.5, r_x, r_y))) * x))
+    res(np.array([[4.75]]), 0.5, 0.5)
+    res(4.750000000000001, 0.5, 0.5)
+    assert res.calls == 3
+
+
+def test_value_alone_without_errors(balls, bats):
+    """errors=False (a study's noise-free truth): the same value and chi^2, the errors and dof NaN;
+    the profile interval needs the errors, and asking for both is a ValueError.
+    """
+    from ballbat.stronge.analysis import VtfData, fit_ball
+
+    psi, x, y, r_x, r_y = _synthetic(balls, bats, np.random.default_rng(6), n=30)
+    bats_of = np.repeat(["a", "b", "c"], 10)
+    data = VtfData(psi, x, y, np.full(30, 0.01), r_x, r_y, np.full(30, 0.4), bats_of)
+    full = fit_ball(data, e_y=0.5, mu=0.5, vary_e_y=False, vary_mu=False, interval=False)
+    alone = fit_ball(data, e_y=0.5, mu=0.5, vary_e_y=False, vary_mu=False, interval=False, errors=False)
+    assert (alone.eta2, alone.chisqr) == (full.eta2, full.chisqr)
+    assert np.isfinite(full.eta2_err) and np.isnan(alone.eta2_err) and np.isnan(alone.dof)
+    with pytest.raises(ValueError, match="the profile interval needs the standard errors"):
+        fit_eta2(psi, x, y, r_x, r_y, errors=False)

@@ -299,3 +299,58 @@ def test_jacobian_rows_equal_one_call_per_point(data):
         col = (residual(*up.values()) - residual(*down.values())) / (2 * h)
         np.testing.assert_allclose(J[:, i], col, rtol=1e-8, atol=1e-6 * np.max(np.abs(col)))
         assert np.max(np.abs(J[:, i])) > 0.0
+
+
+def _hard_batch(n, seed=7):
+    """Impacts with Omega_t > Omega_n (eta2 < 3.5): the phase machine, not the fast path."""
+    rng = np.random.default_rng(seed)
+    psi = rng.uniform(0.05, 1.2, n)
+    eta2 = rng.uniform(0.5, 3.4, n)
+    r_x, r_y = rng.uniform(0, 0.5, n), rng.uniform(0, 0.5, n)
+    return psi, ContactParams(eta2, 0.5, rng.uniform(0.1, 1.0, n), r_x, r_y)
+
+
+def test_impact_geometry_is_stronge_ex():
+    """ImpactGeometry(psi, r_x, r_y, alpha).e_x(eta2, e_y, mu) is stronge_ex's numbers, bit for bit, in any
+    broadcast (a scan of eta2 against the impacts, one value, one per impact), and it names bad inputs.
+    """
+    from ballbat.stronge.model import ImpactGeometry
+
+    psi, c = _hard_batch(40)
+    geometry = ImpactGeometry(psi, c.r_x, c.r_y, c.alpha)
+    for eta2, mu in ((np.geomspace(1, 30, 48)[:, None], 0.5), (4.75, 0.5), (c.eta2, c.mu)):
+        want = stronge_ex(psi, ContactParams(eta2, 0.5, mu, c.r_x, c.r_y, c.alpha))
+        np.testing.assert_array_equal(geometry.e_x(eta2, 0.5, mu), want)
+    with pytest.raises(ValueError, match="psi must satisfy"):
+        ImpactGeometry(np.array([0.1, 2.0]))
+    with pytest.raises(ValueError, match="r_y must satisfy"):
+        ImpactGeometry(psi, 0.1, -1.5)
+    with pytest.raises(ValueError, match="eta2 must satisfy"):
+        geometry.e_x(np.array([[4.0], [-1.0]]), 0.5, 0.5)
+    with pytest.raises(ValueError, match="e_y must satisfy"):
+        geometry.e_x(4.0, 1.5, 0.5)
+
+
+def test_phase_machine_is_the_same_in_blocks_and_without_records(monkeypatch):
+    """The stick grids sampled in blocks of GRID_BLOCK impacts, N computed once per shared grid row, the
+    first stick of a batch with Omega_t >= Omega_n not sampled (it cannot end while loading) and the engine
+    run without its piece records (stronge_ex's way) give the numbers of one block, every grid sampled,
+    with every record, bit for bit.
+    """
+    from ballbat.stronge import model
+
+    psi, c = _hard_batch(700)
+    psi[:5] = 0.0  # stick to separation
+    scan = ContactParams(np.geomspace(1, 3.4, 12)[:, None], 0.5, 0.5, c.r_x[:60], c.r_y[:60])
+    prepared = [model._prepare(psi, c), model._prepare(psi[:60], scan)]
+    blocked = [model._engine(p, np.arange(p.rho.size), record=False).uf for p in prepared]
+    assert model.GRID_BLOCK < psi.size
+    monkeypatch.setattr(model, "GRID_BLOCK", 10**6)
+    monkeypatch.setattr(model, "_stuck_through_loading", lambda piece, end: False)
+    monkeypatch.setattr(
+        model, "_normal_on_grid", lambda grid, e, thf, end: model._normal(grid, e[:, None], thf[:, None])[:2]
+    )
+    whole = [model._engine(p, np.arange(p.rho.size)) for p in prepared]
+    for a, b in zip(blocked, whole, strict=True):
+        np.testing.assert_array_equal(a, b.uf)
+    assert whole[0].start.shape[1] > 1  # the records are there, and several pieces deep

@@ -25,7 +25,9 @@ Uncertainties (documented in docs/stronge.md, "The eta^2 fit"):
   variance. Either way the interval is +-(quantile) standard errors for a model linear in
   eta2, and follows the curvature of chi^2 otherwise.
 
-lmfit and scipy.stats are imported inside :func:`fit_eta2` only.
+The fit is Levenberg-Marquardt (MINPACK): with e_y and mu fixed it is lmfit's ``leastsq``
+computed without lmfit's Parameters (:func:`_lm_eta2_alone`, the same numbers), otherwise
+lmfit's. lmfit and scipy are imported inside :func:`fit_eta2` only.
 """
 
 from __future__ import annotations
@@ -35,7 +37,7 @@ from dataclasses import dataclass
 import numpy as np
 from numpy.typing import ArrayLike
 
-from .model import ContactParams, stronge_ex
+from .model import ImpactGeometry
 
 __all__ = ["Eta2Fit", "Eta2FitError", "fit_eta2"]
 
@@ -67,6 +69,19 @@ class Eta2Fit:
     scale_covar: bool
     success: bool
     message: str
+
+
+class _Described:
+    """The inputs of a fit in words (:func:`_describe`), written only when a message needs them."""
+
+    def __init__(self, *args) -> None:
+        self.args = args
+
+    def __str__(self) -> str:
+        return _describe(*self.args)
+
+    def __format__(self, spec: str) -> str:
+        return format(str(self), spec)
 
 
 def _describe(psi, e_y, mu, vary_e_y, vary_mu) -> str:
@@ -102,25 +117,129 @@ def _jacobian(residual, at: dict[str, float], names: list[str]) -> tuple[np.ndar
     return np.stack(cols, axis=1), rows[0]
 
 
-def _least_squares(residual, start: tuple, bounds: tuple, vary: tuple, scale_covar: bool, what: str):
-    """Return lmfit's Levenberg-Marquardt fit of ``residual(eta2, e_y, mu)`` from ``start`` (eta2, e_y, mu).
+#: lmfit's settings of ``scipy.optimize.leastsq`` (MINPACK's lmdif) in ``Minimizer.leastsq`` (lmfit 1.3).
+LMFIT_LEASTSQ = dict(ftol=1.5e-8, xtol=1.5e-8, gtol=0.0, epsfcn=1.0e-10, factor=100)
+#: lmfit's ceiling of function evaluations for one varied parameter, 2000 (nvarys + 1).
+LMFIT_MAX_NFEV = 4000
+#: The bounds lmfit's Parameters hold e_y and mu in (a fixed value is clipped into them as well).
+E_Y_BOUNDS, MU_BOUNDS = (0.05, 1.0), (1e-3, 10.0)
+#: lmfit's messages for MINPACK's other outcomes (``ier``; 1-3: "Fit succeeded.").
+LMFIT_MESSAGES = {
+    0: "Invalid Input Parameters. I.e. more variables than data points given, tolerance < 0.0, or no data provided.",
+    4: "One or more variable did not affect the fit.",
+    5: f"Too many function calls (max set to {2 * LMFIT_MAX_NFEV:d})! Use: minimize(func, params, ..., max_nfev=NNN)"
+    " to increase this maximum.",
+}
 
-    eta^2 is held in ``bounds``; e_y (0.05-1) and mu (0.001-10) vary where ``vary`` says.
+
+@dataclass
+class _LeastSquares:
+    """What :func:`fit_eta2` keeps of a least-squares fit: values, lmfit's standard errors (NaN: fixed), chi^2."""
+
+    values: dict[str, float]
+    stderr: dict[str, float]
+    vary: tuple[str, ...]
+    chisqr: float
+    nfree: int
+    success: bool
+    message: str
+    params: object = None  # lmfit's Parameters at the fit (the profile with free nuisance parameters)
+
+
+def _least_squares(residual, start: tuple, bounds: tuple, vary: tuple, scale_covar: bool, what: str) -> _LeastSquares:
+    """Return the Levenberg-Marquardt fit of ``residual(eta2, e_y, mu)`` from ``start`` (eta2, e_y, mu).
+
+    eta^2 is held in ``bounds``; e_y (0.05-1) and mu (0.001-10) vary where ``vary`` says. With
+    e_y and mu fixed, lmfit's own computation without its Parameters (:func:`_lm_eta2_alone`, the
+    same numbers); otherwise lmfit.
     """
+    if not any(vary):
+        try:
+            return _lm_eta2_alone(residual, start, bounds, scale_covar)
+        except ValueError as exc:
+            raise Eta2FitError(f"fit_eta2: the least-squares fit raised {exc!r} ({what})") from exc
     import lmfit
 
     params = lmfit.Parameters()
     params.add("eta2", value=start[0], min=bounds[0], max=bounds[1])
-    params.add("e_y", value=start[1], min=0.05, max=1.0, vary=vary[0])
-    params.add("mu", value=start[2], min=1e-3, max=10.0, vary=vary[1])
+    params.add("e_y", value=start[1], min=E_Y_BOUNDS[0], max=E_Y_BOUNDS[1], vary=vary[0])
+    params.add("mu", value=start[2], min=MU_BOUNDS[0], max=MU_BOUNDS[1], vary=vary[1])
 
     def fcn(p):
         return residual(p["eta2"].value, p["e_y"].value, p["mu"].value)
 
     try:
-        return lmfit.minimize(fcn, params, method="leastsq", scale_covar=scale_covar)
+        res = lmfit.minimize(fcn, params, method="leastsq", scale_covar=scale_covar)
     except (ValueError, RuntimeError) as exc:  # pragma: no cover - lmfit internals
         raise Eta2FitError(f"fit_eta2: lmfit raised {exc!r} ({what})") from exc
+    names = ("eta2", "e_y", "mu")
+    return _LeastSquares(
+        values={k: res.params[k].value for k in names},
+        stderr=_lmfit_errors(res.params),
+        vary=tuple(k for k in names if res.params[k].vary),
+        chisqr=float(res.chisqr),
+        nfree=int(res.nfree),
+        success=bool(res.success),
+        message=str(res.message),
+        params=res.params,
+    )
+
+
+def _lm_eta2_alone(residual, start: tuple, bounds: tuple, scale_covar: bool) -> _LeastSquares:
+    """Fit eta^2 alone (e_y and mu fixed) as lmfit's ``leastsq`` does, without its Parameters.
+
+    lmfit (1.3) varies a parameter bounded on both sides through the internal v with
+    ``eta2 = lo + (sin v + 1)(hi - lo)/2`` (clipped into the bounds), calls
+    ``scipy.optimize.leastsq`` with :data:`LMFIT_LEASTSQ`, evaluates the residual once more at
+    the result and scales MINPACK's covariance by ``(cos v (hi - lo)/2)^2`` and, with
+    ``scale_covar``, the reduced chi^2. These are the same operations on the same numbers, so
+    value, chi^2, standard error and message are lmfit's to the bit (a test compares them);
+    what is left out is the bookkeeping of its Parameters, about 3 ms a fit.
+    """
+    from lmfit.lineshapes import tiny
+    from scipy.optimize import leastsq
+
+    lo, hi = bounds
+    e_y, mu = (min(max(v, b[0]), b[1]) for v, b in zip(start[1:], (E_Y_BOUNDS, MU_BOUNDS), strict=True))
+    v0 = float(np.arcsin(2 * (min(max(start[0], lo), hi) - lo) / (hi - lo) - 1))
+    nfev = [0]
+
+    def external(v) -> float:
+        return min(max(float(lo + (np.sin(v) + 1) * (hi - lo) / 2.0), lo), hi)
+
+    def fcn(fvars):
+        nfev[0] += 1
+        if nfev[0] > LMFIT_MAX_NFEV:
+            raise ValueError(f"fit aborted: too many function evaluations {LMFIT_MAX_NFEV}")
+        r = np.asarray(residual(external(fvars.reshape(1)[0]), e_y, mu), dtype=np.float64).ravel()
+        if not np.isfinite(np.sum(r)):
+            raise ValueError("NaN values detected in the output of the objective function")
+        return r
+
+    best, cov, _info, _msg, ier = leastsq(
+        fcn, [0.0 if abs(v0) < tiny else v0], full_output=1, col_deriv=0, maxfev=2 * LMFIT_MAX_NFEV, **LMFIT_LEASTSQ
+    )
+    r = fcn(best)
+    chisqr, nfree = float((r**2).sum()), r.size - 1
+    message = "Fit succeeded." if ier in {1, 2, 3} else LMFIT_MESSAGES.get(ier, "Tolerance seems to be too small.")
+    err = np.nan
+    if cov is None:
+        message += " Could not estimate error-bars."
+    else:
+        grad = np.cos(best[0]) * (hi - lo) / 2.0
+        covar = cov * np.dot(np.atleast_2d([grad]).T, np.atleast_2d([grad]))
+        if scale_covar:
+            covar *= chisqr / max(1, nfree)
+        err = float(np.sqrt(covar[0, 0]))
+    return _LeastSquares(
+        values={"eta2": external(best[0]), "e_y": e_y, "mu": mu},
+        stderr={"eta2": err, "e_y": np.nan, "mu": np.nan},
+        vary=("eta2",),
+        chisqr=max(chisqr, 1e-250 * r.size),
+        nfree=nfree,
+        success=ier in (1, 2, 3, 4),
+        message=message,
+    )
 
 
 def fit_eta2(
@@ -141,6 +260,7 @@ def fit_eta2(
     robust: bool = False,
     strata: ArrayLike | None = None,
     interval: bool = True,
+    errors: bool = True,
 ) -> Eta2Fit:
     """Fit eta^2 (and optionally e_y, mu) of Stronge's model to Eq. (vtf) data.
 
@@ -163,6 +283,8 @@ def fit_eta2(
     strata : a label per impact (its bat) for ``robust``; None: one uncentred stratum.
     interval : compute the profile-likelihood interval (False: NaN, for fits whose value
         alone is wanted, such as a replicate study's noise-free truth).
+    errors : compute the standard errors and their degrees of freedom (False: NaN; the value
+        alone, e.g. a replicate study's noise-free truth; needs ``interval=False``).
 
     Returns
     -------
@@ -184,30 +306,23 @@ def fit_eta2(
     least-squares fit (lmfit, Levenberg-Marquardt) starts there.
     """
     psi = np.asarray(psi, dtype=float).ravel()
-    what = _describe(psi, e_y, mu, vary_e_y, vary_mu)
+    what = _Described(psi, e_y, mu, vary_e_y, vary_mu)
     x, y, r_x, r_y, alpha, sig = _checked_inputs(psi, x, y, r_x, r_y, alpha, sigma, vary_e_y, vary_mu, what)
 
-    def residual(eta2_, e_, mu_):
-        ex = stronge_ex(psi, ContactParams(eta2_, e_, mu_, r_x, r_y, alpha))
-        return (y - (1.0 + ex) * x) / sig
-
+    geometry = ImpactGeometry(psi, r_x, r_y, alpha)
+    residual = _Residual(geometry, x, y, sig)
     bounds = (float(eta2_bounds[0]), float(eta2_bounds[1]))
-    start = _scan_start(psi, x, y, r_x, r_y, alpha, sig, e_y, mu, bounds)
+    start = _scan_start(geometry, x, y, sig, e_y, mu, bounds)
     res = _least_squares(residual, (start, e_y, mu), bounds, (vary_e_y, vary_mu), scale_covar, what)
-    best = res.params["eta2"].value
+    best = res.values["eta2"]
     if not res.success or not np.isfinite(best):
         raise Eta2FitError(f"fit_eta2: fit failed ({res.message}) ({what})")
 
-    chi_min, nfree = float(res.chisqr), int(res.nfree)
+    chi_min, nfree = res.chisqr, res.nfree
     redchi = chi_min / nfree
-    e_best, mu_best = res.params["e_y"].value, res.params["mu"].value
-    if robust:
-        if strata is not None and np.shape(strata) != psi.shape:
-            raise ValueError(f"fit_eta2: strata must have one label per impact ({what})")
-        errs, dof, delta = _robust_errors(res.params, residual, strata, level)
-    else:
-        errs, dof = _lmfit_errors(res.params), float(nfree)
-        delta = _chi2_rise(level, redchi if scale_covar else 1.0)
+    e_best, mu_best = res.values["e_y"], res.values["mu"]
+    options = {"robust": robust, "errors": errors, "interval": interval, "scale_covar": scale_covar, "n": psi.size}
+    errs, dof, delta = _fit_errors(res, residual, strata, level, options, what)
 
     if vary_e_y or vary_mu:
 
@@ -278,11 +393,40 @@ def _checked_inputs(psi, x, y, r_x, r_y, alpha, sigma, vary_e_y, vary_mu, what):
     return x, y, r_x, r_y, alpha, sig
 
 
-def _scan_start(psi, x, y, r_x, r_y, alpha, sig, e_y, mu, bounds: tuple[float, float]) -> float:
+class _Residual:
+    """The weighted residual ``(y - (1 + e_x) x) / sigma`` of the impacts at (eta2, e_y, mu), and its calls.
+
+    The model is evaluated on the impacts' :class:`ImpactGeometry` (prepared once per fit).
+    lmfit asks for the residual at the same point more than once (its checks before the fit,
+    MINPACK's first call and the result's residual): a call at a point already evaluated
+    (scalar parameters equal to the bit) returns the stored residual, the same numbers,
+    without running the model again. ``calls`` counts the model's evaluations.
+    """
+
+    def __init__(self, geometry: ImpactGeometry, x, y, sig) -> None:
+        self.geometry, self.x, self.y, self.sig = geometry, x, y, sig
+        self.seen: dict[tuple[float, float, float], np.ndarray] = {}
+        self.calls = 0
+
+    def __call__(self, eta2, e_y, mu) -> np.ndarray:
+        key = None
+        if np.ndim(eta2) == np.ndim(e_y) == np.ndim(mu) == 0:
+            key = (float(eta2), float(e_y), float(mu))
+            if key in self.seen:
+                return self.seen[key].copy()
+        self.calls += 1
+        ex = self.geometry.e_x(eta2, e_y, mu)
+        r = (self.y - (1.0 + ex) * self.x) / self.sig
+        if key is not None:
+            self.seen[key] = r.copy()
+        return r
+
+
+def _scan_start(geometry: ImpactGeometry, x, y, sig, e_y, mu, bounds: tuple[float, float]) -> float:
     """Return the starting eta^2: the lowest chi^2 of a logarithmic scan of ``bounds`` (48 values)."""
     scan = np.geomspace(bounds[0], bounds[1], 48)
     # one call of the closed-form model for the whole scan (elementwise: the same numbers as one call per value)
-    ex_scan = stronge_ex(psi, ContactParams(scan[:, None], e_y, mu, r_x, r_y, alpha))
+    ex_scan = geometry.e_x(scan[:, None], e_y, mu)
     res_scan = (y - (1.0 + ex_scan) * x) / sig
     return scan[int(np.argmin([float(r @ r) for r in res_scan]))]
 
@@ -304,24 +448,42 @@ def _chi2_rise(level: float, scale: float) -> float:
     return float(chi2.ppf(level, 1)) * scale
 
 
-def _robust_errors(params, residual, strata, level: float) -> tuple[dict[str, float], float, float]:
+def _fit_errors(res: _LeastSquares, residual, strata, level: float, options: dict, what) -> tuple[dict, float, float]:
+    """Return the standard errors, their degrees of freedom and the interval's chi^2 rise (``options``: fit_eta2's).
+
+    ``errors=False``: NaN (and no interval); ``robust``: the sandwich (:func:`_robust_errors`);
+    otherwise lmfit's, with n - p degrees of freedom.
+    """
+    if not options["errors"]:
+        if options["interval"]:
+            raise ValueError(f"fit_eta2: the profile interval needs the standard errors (errors=False) ({what})")
+        return dict.fromkeys(("eta2", "e_y", "mu"), np.nan), np.nan, np.nan
+    if options["robust"]:
+        if strata is not None and np.shape(strata) != (options["n"],):
+            raise ValueError(f"fit_eta2: strata must have one label per impact ({what})")
+        return _robust_errors(res, residual, strata, level)
+    redchi = res.chisqr / res.nfree
+    return dict(res.stderr), float(res.nfree), _chi2_rise(level, redchi if options["scale_covar"] else 1.0)
+
+
+def _robust_errors(res: _LeastSquares, residual, strata, level: float) -> tuple[dict[str, float], float, float]:
     """Sandwich standard errors, their Bell-McCaffrey dof and the chi^2 rise of the interval.
 
     The errors of the free parameters are the HC3 sandwich's centred within ``strata``; the
     rise is t_nu^2 times the ratio of the robust to the unscaled variance of eta^2.
     """
-    from scipy.stats import t as t_dist
+    from scipy.special import stdtrit  # Student's t quantile: scipy.stats.t.ppf's own, without its checks
 
     from ..linefit import sandwich_cov, sandwich_dof
 
-    errs = _lmfit_errors(params)
-    names = [k for k in ("eta2", "e_y", "mu") if params[k].vary]
-    J, r = _jacobian(residual, {k: params[k].value for k in ("eta2", "e_y", "mu")}, names)
+    errs = dict(res.stderr)
+    names = list(res.vary)
+    J, r = _jacobian(residual, dict(res.values), names)
     cov = sandwich_cov(J, r, strata)
     errs.update({k: float(np.sqrt(cov[i, i])) for i, k in enumerate(names)})
     dof = sandwich_dof(J, strata, 0)
     var_unscaled = float(np.linalg.inv(J.T @ J)[0, 0])
-    delta = float(t_dist.ppf(0.5 + level / 2.0, dof)) ** 2 * errs["eta2"] ** 2 / var_unscaled
+    delta = float(stdtrit(dof, 0.5 + level / 2.0)) ** 2 * errs["eta2"] ** 2 / var_unscaled
     return errs, dof, delta
 
 

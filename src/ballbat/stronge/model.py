@@ -36,6 +36,7 @@ References
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import NamedTuple
 
@@ -44,6 +45,7 @@ from numpy.typing import ArrayLike, NDArray
 
 __all__ = [
     "ContactParams",
+    "ImpactGeometry",
     "StrongeSolution",
     "omega_ratio",
     "stronge_ex",
@@ -171,28 +173,71 @@ class _Params:
     eta2: NDArray
 
 
+class ImpactGeometry:
+    """Impacts whose e_x is wanted at many parameters: psi, r_x, r_y and alpha checked and prepared once.
+
+    A fit evaluates the model at the same impacts for one eta^2 after another; what does not
+    depend on (eta2, e_y, mu) (the checks of psi, r_x, r_y and alpha, ``|tan psi|`` and the
+    effective masses' factors of Omega_t/Omega_n) is computed here once. :func:`stronge_ex`
+    is ``ImpactGeometry(psi, r_x, r_y, alpha).e_x(eta2, e_y, mu)``, the same numbers.
+
+    Parameters
+    ----------
+    psi : incidence angles, rad, |psi| < pi/2.
+    r_x, r_y, alpha : as in :class:`ContactParams`; they broadcast against psi.
+    """
+
+    def __init__(self, psi: ArrayLike, r_x: ArrayLike = 0.0, r_y: ArrayLike = 0.0, alpha: ArrayLike = 0.4) -> None:
+        psi, r_x, r_y, alpha = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in (psi, r_x, r_y, alpha)))
+        with np.errstate(invalid="ignore"):
+            _check("psi", psi, np.abs(psi) < HALF_PI, "|psi| < pi/2 (radians)")
+            _check("r_x", r_x, (r_x > -1) & np.isfinite(r_x), "-1 < r_x < inf")
+            _check("r_y", r_y, (r_y > -1) & np.isfinite(r_y), "-1 < r_y < inf")
+            _check("alpha", alpha, (alpha > 0) & np.isfinite(alpha), "0 < alpha < inf")
+        self.shape = psi.shape
+        self.tan_psi = np.abs(np.tan(psi))
+        # Omega_t/Omega_n = sqrt(mass_num / (mass_den eta2)), the operations of omega_ratio in its order
+        self.mass_num = (1.0 + alpha) * (1.0 + r_x)
+        self.mass_den = alpha * (1.0 + r_y)
+
+    def e_x(self, eta2: ArrayLike, e_y: ArrayLike, mu: ArrayLike) -> NDArray[np.float64] | float:
+        """e_x of these impacts at (eta2, e_y, mu), which broadcast against them (:func:`stronge_ex`)."""
+        return _solve_ex(self.params(eta2, e_y, mu))
+
+    def params(self, eta2: ArrayLike, e_y: ArrayLike, mu: ArrayLike) -> _Params:
+        """Return the broadcast, flattened, dimensionless parameters of these impacts at (eta2, e_y, mu)."""
+        eta2, e_y, mu = (np.asarray(a, dtype=float) for a in (eta2, e_y, mu))
+        shape = np.broadcast_shapes(self.shape, eta2.shape, e_y.shape, mu.shape)
+        with np.errstate(invalid="ignore"):
+            _check("eta2", eta2, (eta2 > 0) & np.isfinite(eta2), "0 < eta2 < inf")
+            _check("e_y", e_y, (e_y > 0) & (e_y <= 1), "0 < e_y <= 1")
+            _check("mu", mu, (mu >= 0) & np.isfinite(mu), "0 <= mu < inf")
+        size = math.prod(shape)
+        flat = [_flat(a, shape, size) for a in (self.tan_psi, self.mass_num, self.mass_den, eta2, e_y, mu)]
+        T, num, den, eta2, e_y, mu = flat
+        rho = np.sqrt(num / (den * eta2))
+        rho = np.where(np.abs(rho - 1.0) < 1e-14, 1.0, rho)  # e.g. the superball, eta2 = 3.5
+        lam = mu * eta2
+        with np.errstate(divide="ignore", invalid="ignore"):
+            Lam = np.where(T > 0, lam / T, np.inf)
+        Lam = np.where((T == 0) | (Lam > 1e300), np.inf, Lam)
+        thf = HALF_PI * (1.0 + e_y)
+        return _Params(shape, T, rho, lam, Lam, e_y.copy(), thf, eta2.copy())
+
+
+def _flat(a: NDArray, shape: tuple, size: int) -> NDArray:
+    """Return ``a`` broadcast to ``shape`` and flattened (a scalar filled in, an array of that shape as it is)."""
+    if a.shape == shape:
+        return a.ravel()
+    if a.ndim == 0:
+        return np.full(size, a)
+    return np.broadcast_to(a, shape).ravel()
+
+
 def _prepare(psi: ArrayLike, contact: ContactParams) -> _Params:
-    psi, eta2, e_y, mu, r_x, r_y, alpha = contact.broadcast(psi)
-    with np.errstate(invalid="ignore"):
-        _check("psi", psi, np.abs(psi) < HALF_PI, "|psi| < pi/2 (radians)")
-        _check("eta2", eta2, (eta2 > 0) & np.isfinite(eta2), "0 < eta2 < inf")
-        _check("e_y", e_y, (e_y > 0) & (e_y <= 1), "0 < e_y <= 1")
-        _check("mu", mu, (mu >= 0) & np.isfinite(mu), "0 <= mu < inf")
-        _check("r_x", r_x, (r_x > -1) & np.isfinite(r_x), "-1 < r_x < inf")
-        _check("r_y", r_y, (r_y > -1) & np.isfinite(r_y), "-1 < r_y < inf")
-        _check("alpha", alpha, (alpha > 0) & np.isfinite(alpha), "0 < alpha < inf")
-    shape = psi.shape
-    f = [a.ravel() for a in (psi, eta2, e_y, mu, r_x, r_y, alpha)]
-    psi, eta2, e_y, mu, r_x, r_y, alpha = f
-    T = np.abs(np.tan(psi))
-    rho = omega_ratio(eta2, r_x, r_y, alpha)
-    rho = np.where(np.abs(rho - 1.0) < 1e-14, 1.0, rho)  # e.g. the superball, eta2 = 3.5
-    lam = mu * eta2
-    with np.errstate(divide="ignore", invalid="ignore"):
-        Lam = np.where(T > 0, lam / T, np.inf)
-    Lam = np.where((T == 0) | (Lam > 1e300), np.inf, Lam)
-    thf = HALF_PI * (1.0 + e_y)
-    return _Params(shape, T, rho, lam, Lam, e_y.copy(), thf, eta2.copy())
+    """Return the dimensionless parameters of the impacts psi at ``contact`` (:class:`ImpactGeometry`)."""
+    c = contact
+    return ImpactGeometry(psi, c.r_x, c.r_y, c.alpha).params(c.eta2, c.e_y, c.mu)
 
 
 def _sincos(x):
@@ -266,7 +311,8 @@ def _root_loading(rho, Lam, iters=60):
         lo = np.where(pos, lo, th)
         new = th - P / dP
         bad = ~((new >= lo) & (new <= hi))
-        new = np.where(bad, 0.5 * (lo + hi), new)
+        if bad.any():
+            new = np.where(bad, 0.5 * (lo + hi), new)
         step = np.max(np.abs(new - th))
         th = new
         if step < NEWTON_TOL:  # Newton's error after a step h is O(h^2)
@@ -286,19 +332,20 @@ def _root_unloading(rho, Lam, e, thf, x0, iters=60):
     hi = np.full_like(rho, HALF_PI)
     x = np.clip(np.arcsin(np.minimum(x0, 1.0)), 1e-300, HALF_PI)
     lr = np.log(rho * Lam)
+    er = e * rho
     with np.errstate(divide="ignore", invalid="ignore"):
         for _ in range(iters):
             sr, cr = _sincos(rho * (thf - e * x))
             sx, cx = _sincos(x)
             Q = np.log(sr / sx) - lr
-            dQdy = -x * (e * rho * cr / sr + cx / sx)
+            dQdy = -x * (er * cr / sr + cx / sx)
             pos = Q > 0
             lo = np.where(pos, x, lo)
             hi = np.where(pos, hi, x)
             new = x * np.exp(-Q / dQdy)
             bad = ~((new >= lo) & (new <= hi))
-            mid = np.where(lo > 0, np.sqrt(lo * hi), 0.5 * hi)
-            new = np.where(bad, mid, new)
+            if bad.any():  # bisect (geometrically) where Newton left the bracket
+                new = np.where(bad, np.where(lo > 0, np.sqrt(lo * hi), 0.5 * hi), new)
             step = np.max(np.abs(new - x) / new)
             x = new
             if step < NEWTON_TOL:
@@ -335,7 +382,8 @@ def _newton_bracketed(fun, x, lo, hi, iters=100, tol=None):
         with np.errstate(divide="ignore", invalid="ignore"):
             new = x - F / dF
         bad = ~((new >= lo) & (new <= hi))
-        new = np.where(bad, 0.5 * (lo + hi), new)
+        if bad.any():
+            new = np.where(bad, 0.5 * (lo + hi), new)
         step = np.max(np.abs(new - x), initial=0.0)
         x = new
         if step < (NEWTON_TOL if tol is None else tol):
@@ -351,33 +399,20 @@ def _stick_event(piece: _StickPiece, end):
     the crossing; in addition every local maximum of g between two negative samples is
     located (Newton on g') and checked, so that a near-tangential excursion of g above zero
     between grid points is not missed. The bracketed root is refined by safeguarded Newton.
+    The grid is sampled in blocks of GRID_BLOCK impacts (:func:`_sample_stick`); the maxima
+    and the roots of all of them are found together.
     """
-    th0, u0, s0, rho, Lam, e, thf = piece
+    th0, rho = piece.th0, piece.rho
+    if _stuck_through_loading(piece, end):
+        return np.full(th0.shape, np.nan), np.zeros(th0.shape)
     K = max(STICK_GRID, int(np.ceil(np.max(rho * (end - th0), initial=0.0) / STICK_DPHASE)))
     k = np.arange(0, K + 1) / K
-    grid = th0[:, None] + (end - th0)[:, None] * k
-    r_, L_, e_, f_ = rho[:, None], Lam[:, None], e[:, None], thf[:, None]
-    U, S = _stick_state(th0[:, None], u0[:, None], s0[:, None], r_, grid)
-    N, dN, _ = _normal(grid, e_, f_)
-    with np.errstate(invalid="ignore"):
-        g = np.abs(S) - L_ * N
-        gp = np.sign(S) * U - L_ * dN
-    g[:, 0] = np.minimum(g[:, 0], 0.0)  # the piece starts in (or on the edge of) stick
-    # a crossing must stand clear of rounding (g can sit at 0 +- 1e-16 for a whole short
-    # piece that starts with a re-stick, e.g. just before t_c)
-    with np.errstate(invalid="ignore"):
-        amp = np.hypot(s0, u0 / rho)[:, None]  # amplitude of S in this stick piece
-        cross = g > ROUND_TOL * (np.abs(S) + L_ * N + amp)
-    has = cross.any(axis=1)
-    first = np.where(has, np.argmax(cross, axis=1), K + 1)
-    rows = np.arange(th0.size)
-    lo = np.where(has, grid[rows, np.maximum(first - 1, 0)], np.nan)
-    hi = np.where(has, grid[rows, np.minimum(first, K)], np.nan)
-    sg = np.where(has, np.sign(S[rows, np.minimum(first, K)]), 0.0)
-    # local maxima of g strictly before the first sampled crossing
-    jj = np.arange(K)[None, :]
-    cand = (gp[:, :-1] > 0) & (gp[:, 1:] < 0) & (jj + 1 < first[:, None]) & np.isfinite(L_)
-    _crossings_at_maxima(piece, np.nonzero(cand), grid, S, has, lo, hi, sg)
+    starts = range(0, max(th0.size, 1), GRID_BLOCK)
+    blocks = [_sample_stick(piece.take(slice(a, a + GRID_BLOCK)), end[a : a + GRID_BLOCK], k) for a in starts]
+    has, lo, hi, sg = (np.concatenate([b[q] for b in blocks]) for q in range(4))
+    ci = np.concatenate([b[4][0] + a for a, b in zip(starts, blocks, strict=True)])
+    cand = (ci, *(np.concatenate([b[4][q] for b in blocks]) for q in range(1, 5)))
+    _crossings_at_maxima(piece, cand, has, lo, hi, sg)
     out = np.full(th0.shape, np.nan)
     sig = np.zeros(th0.shape)
     i = np.flatnonzero(has)
@@ -393,6 +428,88 @@ def _stick_event(piece: _StickPiece, end):
     out[i] = _newton_bracketed(F, hi[i].copy(), lo[i], hi[i])
     sig[i] = sign_s
     return out, sig
+
+
+def _stuck_through_loading(piece: _StickPiece, end) -> bool:
+    """Whether every impact of the batch starts sticking from rest and provably sticks through loading.
+
+    From theta = 0 with U = 1, S = 0 the stick is S = sin(rho theta)/rho, and for rho >= 1
+    ``|sin(rho theta)| <= rho sin(theta)`` on [0, pi/2] (sin x / x falls on (0, pi]; beyond pi,
+    rho sin(theta) > 2 rho theta / pi > 2), so |S| <= N < Lam N when Lam > 1: g stays below zero
+    and the grid would find no crossing up to t_c. Such a batch (every impact's first piece
+    when Omega_t >= Omega_n, all of the general engine's in :func:`stronge_ex`) is not sampled;
+    a batch with any other piece is, whole, as before.
+    """
+    first = (piece.th0 == 0.0) & (piece.u0 == 1.0) & (piece.s0 == 0.0) & (end <= HALF_PI)
+    return bool(np.all(first & (piece.rho >= 1.0) & (piece.Lam > 1.0)))
+
+
+#: Impacts per block whose stick grids :func:`_stick_event` samples at once: the work arrays
+#: (GRID_BLOCK x the grid's points) stay in the cache, about twice as fast as a few thousand
+#: impacts at once (the same numbers: each impact's grid is its own).
+GRID_BLOCK = 256
+
+
+def _sample_stick(piece: _StickPiece, end, k):
+    """Sample g = |S| - Lam N of stick pieces on their grids ``th0 + (end - th0) k`` (:func:`_stick_event`).
+
+    Returns, per impact, whether g crosses zero on the grid and the bracket (lo, hi) of the
+    first crossing with the sign of S there (NaN, NaN, 0: none), and the grid intervals before
+    it where g' goes from + to - (a local maximum between two samples): their rows, the
+    interval's ends and S at them.
+    """
+    th0, u0, s0, rho, Lam, e, thf = piece
+    K = k.size - 1
+    grid = th0[:, None] + (end - th0)[:, None] * k
+    r_, L_ = rho[:, None], Lam[:, None]
+    U, S = _stick_state(th0[:, None], u0[:, None], s0[:, None], r_, grid)
+    N, dN = _normal_on_grid(grid, e, thf, end)
+    with np.errstate(invalid="ignore"):
+        abs_s, lam_n = np.abs(S), L_ * N
+        g = abs_s - lam_n
+        gp = np.sign(S) * U - L_ * dN
+    g[:, 0] = np.minimum(g[:, 0], 0.0)  # the piece starts in (or on the edge of) stick
+    # a crossing must stand clear of rounding (g can sit at 0 +- 1e-16 for a whole short
+    # piece that starts with a re-stick, e.g. just before t_c)
+    with np.errstate(invalid="ignore"):
+        amp = np.hypot(s0, u0 / rho)[:, None]  # amplitude of S in this stick piece
+        cross = g > ROUND_TOL * (abs_s + lam_n + amp)
+    has = cross.any(axis=1)
+    first = np.where(has, np.argmax(cross, axis=1), K + 1)
+    rows = np.arange(th0.size)
+    lo = np.where(has, grid[rows, np.maximum(first - 1, 0)], np.nan)
+    hi = np.where(has, grid[rows, np.minimum(first, K)], np.nan)
+    sg = np.where(has, np.sign(S[rows, np.minimum(first, K)]), 0.0)
+    # local maxima of g strictly before the first sampled crossing
+    jj = np.arange(K)[None, :]
+    ci, cj = np.nonzero((gp[:, :-1] > 0) & (gp[:, 1:] < 0) & (jj + 1 < first[:, None]) & np.isfinite(L_))
+    return has, lo, hi, sg, (ci, grid[ci, cj], grid[ci, cj + 1], S[ci, cj], S[ci, cj + 1])
+
+
+def _normal_on_grid(grid, e, thf, end):
+    """N/N_max and its derivative on a stick piece's grid (n, K + 1), computed once per distinct row.
+
+    Row i of the grid is ``th0_i + (end_i - th0_i) k``, so impacts with the same (th0, end,
+    e_y, theta_f) share their N on it: in a fit (one e_y) the first piece of every impact
+    runs from 0 to t_c, and impacts that stuck through loading all start unloading at t_c.
+    When end, e_y and theta_f are common and at most half the starts distinct, N is computed
+    on the distinct rows (one row, returned as (1, K + 1), broadcasts against the grid). The
+    numbers are :func:`_normal`'s on the whole grid (elementwise, the same operations on the
+    same values).
+    """
+    shared = end.size > 1 and bool(np.all((end == end[0]) & (e == e[0]) & (thf == thf[0])))
+    if shared and bool(np.all(grid[:, 0] == grid[0, 0])):
+        N, dN, _ = _normal(grid[:1], e[:1, None], thf[:1, None])
+        return N, dN
+    if shared:
+        uniq, first, inv = np.unique(grid[:, 0], return_index=True, return_inverse=True)
+        shared = 2 * uniq.size <= end.size
+    if not shared:  # mostly distinct rows: the whole grid
+        N, dN, _ = _normal(grid, e[:, None], thf[:, None])
+        return N, dN
+    N, dN, _ = _normal(grid[first], e[first, None], thf[first, None])
+    inv = inv.reshape(-1)
+    return N[inv], dN[inv]
 
 
 class _StickPiece(NamedTuple):
@@ -419,18 +536,18 @@ class _StickPiece(NamedTuple):
         return _normal(th, self.e, self.thf)
 
 
-def _crossings_at_maxima(piece: _StickPiece, cand, grid, S, has, lo, hi, sg) -> None:
+def _crossings_at_maxima(piece: _StickPiece, cand, has, lo, hi, sg) -> None:
     """Check the local maxima of g = |S| - Lam N between two grid points; mark the crossings.
 
-    ``cand`` (rows, columns) are the grid intervals where g' changes from + to -. Each maximum
-    is located by Newton on g'; one that stands clear of zero is a crossing, and the first
-    per impact replaces that impact's bracket (``has``, ``lo``, ``hi``, ``sg``, in place).
+    ``cand`` (rows, the intervals' ends ga and gb, S at them) are the grid intervals where g'
+    changes from + to -. Each maximum is located by Newton on g'; one that stands clear of
+    zero is a crossing, and the first per impact replaces that impact's bracket (``has``,
+    ``lo``, ``hi``, ``sg``, in place).
     """
-    ci, cj = cand
+    ci, ga, gb, Sa, Sb = cand
     if ci.size == 0:
         return
     at_max = piece.take(ci)
-    Sa, Sb = S[ci, cj], S[ci, cj + 1]
     sgc = np.sign(np.where(np.abs(Sa) > np.abs(Sb), Sa, Sb))
 
     def dg(x):
@@ -440,7 +557,7 @@ def _crossings_at_maxima(piece: _StickPiece, cand, grid, S, has, lo, hi, sg) -> 
         # minus g' so that the bracket convention f(lo) <= 0 < f(hi) holds
         return -(sgc * U1 - at_max.Lam * dN1), -(-sgc * at_max.rho * at_max.rho * S1 - at_max.Lam * d2N)
 
-    xm = _newton_bracketed(dg, 0.5 * (grid[ci, cj] + grid[ci, cj + 1]), grid[ci, cj], grid[ci, cj + 1])
+    xm = _newton_bracketed(dg, 0.5 * (ga + gb), ga, gb)
     _, S1 = at_max.state(xm)
     N1, _, _ = at_max.normal(xm)
     # a maximum that only touches zero (the edge of stick, e.g. at a re-stick) is not a
@@ -450,7 +567,7 @@ def _crossings_at_maxima(piece: _StickPiece, cand, grid, S, has, lo, hi, sg) -> 
         ui, first_idx = np.unique(ci[up], return_index=True)
         pick = np.flatnonzero(up)[first_idx]
         has[ui] = True
-        lo[ui] = grid[ci[pick], cj[pick]]
+        lo[ui] = ga[pick]
         hi[ui] = xm[pick]
         sg[ui] = sgc[pick]
 
@@ -503,9 +620,9 @@ class _Pieces:
     uf: NDArray  # (n,) final U
 
 
-def _engine(p: _Params, idx) -> _Pieces:
-    """Run the phase machine for the impacts ``idx`` (flat indices into ``p``), in blocks."""
-    blocks = [_engine_block(p, idx[a : a + CHUNK]) for a in range(0, max(idx.size, 1), CHUNK)]
+def _engine(p: _Params, idx, record: bool = True) -> _Pieces:
+    """Run the phase machine for the impacts ``idx`` (flat indices into ``p``), in blocks (:func:`_engine_block`)."""
+    blocks = [_engine_block(p, idx[a : a + CHUNK], record) for a in range(0, max(idx.size, 1), CHUNK)]
     if len(blocks) == 1:
         return blocks[0]
     P = max(b.start.shape[1] for b in blocks)
@@ -550,15 +667,20 @@ def _end_of_slip(piece: _StickPiece, slip_mode):
     return tnew, U1, S1, np.where(ev, 0, slip_mode).astype(np.int8)
 
 
-def _engine_block(p: _Params, idx) -> _Pieces:
-    """Run the phase machine for one block of impacts."""
+def _engine_block(p: _Params, idx, record: bool = True) -> _Pieces:
+    """Run the phase machine for one block of impacts.
+
+    ``record=False``: only the final U (:func:`stronge_ex`); the pieces' records are left empty
+    (width 0), the same ``uf``.
+    """
     rho, Lam, e, thf = p.rho[idx], p.Lam[idx], p.e[idx], p.thf[idx]
     n = idx.size
     P = MAX_PIECES
-    start = np.full((n, P), np.inf)
-    mode_rec = np.zeros((n, P), dtype=np.int8)
-    u_rec = np.zeros((n, P))
-    s_rec = np.zeros((n, P))
+    width = P if record else 0
+    start = np.full((n, width), np.inf)
+    mode_rec = np.zeros((n, width), dtype=np.int8)
+    u_rec = np.zeros((n, width))
+    s_rec = np.zeros((n, width))
     npieces = np.zeros(n, dtype=int)
     th = np.zeros(n)
     u = np.ones(n)
@@ -569,10 +691,11 @@ def _engine_block(p: _Params, idx) -> _Pieces:
     for k in range(P):
         if act.size == 0:
             break
-        start[act, k] = th[act]
-        mode_rec[act, k] = mode[act]
-        u_rec[act, k] = u[act]
-        s_rec[act, k] = s[act]
+        if record:
+            start[act, k] = th[act]
+            mode_rec[act, k] = mode[act]
+            u_rec[act, k] = u[act]
+            s_rec[act, k] = s[act]
         npieces[act] = k + 1
         piece = _StickPiece(th[act], u[act], s[act], rho[act], Lam[act], e[act], thf[act])
         piece_mode = mode[act]
@@ -597,7 +720,7 @@ def _engine_block(p: _Params, idx) -> _Pieces:
             f" e.g. tan(psi)={p.tan_psi[k]:g}, eta2={p.eta2[k]:g}, e_y={p.e[k]:g},"
             f" mu*eta2={p.lam[k]:g}, Omega_t/Omega_n={p.rho[k]:g}"
         )
-    P = max(int(npieces.max(initial=1)), 1)
+    P = min(max(int(npieces.max(initial=1)), 1), width)
     return _Pieces(start[:, :P], mode_rec[:, :P], u_rec[:, :P], s_rec[:, :P], npieces, uf)
 
 
@@ -630,7 +753,11 @@ def stronge_ex(psi: ArrayLike, contact: ContactParams) -> NDArray[np.float64]:
     I(theta_1))`` with theta_1 the end of the initial stick, found by Newton iteration;
     other cases run the general phase machine of :func:`stronge_solve`.
     """
-    p = _prepare(psi, contact)
+    return _solve_ex(_prepare(psi, contact))
+
+
+def _solve_ex(p: _Params) -> NDArray[np.float64] | float:
+    """e_x of the prepared impacts ``p`` (:func:`stronge_ex`): the fast path where rho <= 1, else the engine."""
     uf = np.empty(p.rho.size)
     soft = p.rho <= 1.0
     for a in range(0, uf.size, CHUNK):
@@ -644,7 +771,7 @@ def stronge_ex(psi: ArrayLike, contact: ContactParams) -> NDArray[np.float64]:
             if i.size:
                 uf[i] = _uf_soft(p.rho[i], p.Lam[i], p.e[i], p.thf[i])
             j = np.flatnonzero(~m) + a
-            uf[j] = _engine(p, j).uf
+            uf[j] = _engine(p, j, record=False).uf
     ex = -uf
     return ex.reshape(p.shape) if p.shape else float(ex[0])
 

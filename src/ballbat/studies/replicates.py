@@ -99,13 +99,17 @@ def replicate_source(
 
 
 def _truth_source(src: xr.Dataset) -> xr.Dataset:
-    """Return the same impacts with their noise-free truth in place of the measured values."""
+    """Return the same impacts with their noise-free truth in place of the measured values.
+
+    Built once from the variables (each measured one replaced by its ``truth_*``, attributes and
+    all, in its place), not by assigning them one after the other: the same Dataset, without an
+    xarray merge per variable.
+    """
     from ..designs import MEASURED
 
-    out = src.copy()
-    for k in MEASURED:
-        out[k] = src[f"truth_{k}"]
-    return out
+    swap = {k: f"truth_{k}" for k in MEASURED}
+    variables = {k: src.variables[swap.get(k, k)] for k in src.data_vars}
+    return xr.Dataset(variables, coords=src.coords, attrs=src.attrs)
 
 
 def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> tuple[float, float, float, float]:
@@ -113,7 +117,7 @@ def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> t
     from ..linefit import MIN_FIT_IMPACTS
     from ..stronge.analysis import fit_ball, vtf_data
 
-    sel = (rec["flag"].values == 0) & (rec["ball"].values.astype(str) == ball)
+    sel = (rec.variables["flag"].values == 0) & (rec.variables["ball"].values.astype(str) == ball)
     if sel.sum() < MIN_FIT_IMPACTS:
         return math.nan, math.nan, math.nan, 0
     kw = {k: stronge[k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")}
@@ -124,6 +128,7 @@ def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> t
             vtf_data(rec_truth, sel),
             sigma=d.sigma,
             interval=False,
+            errors=False,  # the truth is a value; its error and dof are never read
             errors_in_variables=False,
             finite_sample=False,
             **kw,
@@ -329,7 +334,8 @@ def fit_quantity_rows(fit: xr.Dataset, effect: xr.Dataset | None = None) -> list
     for q in STUDY_QUANTITIES:
         if q not in fit:  # eta2: Stronge's fit (_eta2)
             continue
-        per_bat = "bat" in fit[q].dims
+        per_bat = "bat" in fit.variables[q].dims
+        units = str(fit.variables[q].attrs["units"])
         for ball in balls:
             for bat in bats if per_bat else [""]:
                 val = at(q, ball, bat)
@@ -349,7 +355,7 @@ def fit_quantity_rows(fit: xr.Dataset, effect: xr.Dataset | None = None) -> list
                         "uncertainty": at(f"{q}_err", ball, bat),
                         "truth": at(f"truth_{q}", ball, bat),
                         "dof": dof,
-                        "units": str(fit[q].attrs["units"]),
+                        "units": units,
                         "systematic": _systematic(fit, at, q, ball, bat),
                         "calibration_effect": math.nan if effect_at is None else effect_at(q, ball, bat),
                     }
