@@ -230,3 +230,40 @@ def summary_figure(red: xr.Dataset) -> Figure:
     ax.set_xlabel("impacts")
     ax.set_title(f"{int(ok.sum())} usable of {ok.size}", fontsize=9)
     return fig
+
+
+#: Marker of each point on the contact sheet.
+SHEET_MARKERS = {"ball": ("o", "tab:orange"), "bat_tip": ("s", "tab:cyan"), "dot_a": ("+", "tab:red")}
+SHEET_MARKERS["dot_b"] = ("x", "tab:green")
+
+
+def contact_sheet(rows: list) -> Figure:
+    """Draw a contact sheet of clips: a few frames of each clip (a row), with the points tracked in each.
+
+    Parameters
+    ----------
+    rows : list of :class:`ballbat.video.qa.SheetRow`
+        Each clip's label and frames (frame number, image, point -> (x, y) in pixels).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+    """
+    ncol = max((len(r.frames) for r in rows), default=1) or 1
+    fig = Figure(figsize=(2.6 * ncol, 1.7 * max(len(rows), 1)), layout="constrained")
+    axes = fig.subplots(max(len(rows), 1), ncol, squeeze=False)
+    for ax in axes.ravel():
+        ax.set_axis_off()
+    for r, row in enumerate(rows):
+        for c, (frame, img, points) in enumerate(row.frames):
+            ax = axes[r, c]
+            ax.imshow(img, cmap="gray", interpolation="nearest")
+            for p, (x, y) in points.items():
+                marker, color = SHEET_MARKERS.get(p, (".", "k"))
+                ax.plot(x, y, marker, color=color, ms=5, mfc="none", mew=1.0, label=p)
+            ax.set_title(f"{row.label}, frame {frame}", fontsize=7)
+    handles = {
+        p: axes[0, 0].plot([], [], m, color=col, mfc="none", label=p)[0] for p, (m, col) in SHEET_MARKERS.items()
+    }
+    fig.legend(handles.values(), handles.keys(), loc="outside lower center", ncol=4, fontsize=7)
+    return fig

@@ -121,6 +121,11 @@ class WorkflowInputs:
         d = self.config["datasets"][name]
         return "tracks" in d or renders(d)
 
+    def from_clips(self, name: str) -> bool:
+        """Return whether a dataset's tracks come from clips (a ``format: video`` folder, or filmed impacts)."""
+        d = self.config["datasets"][name]
+        return films(d) or d.get("tracks", {}).get("format") == "video"
+
     def dataset_kind(self, name: str) -> str:
         """Return what a dataset is, in words (the report's front page)."""
         if self.uses_tracks(name):
@@ -275,6 +280,7 @@ class WorkflowInputs:
         r, imp = self.results, f"{self.results}/implications"
         targets = [self.get_source(Namespace(dataset=d)) for d in self.datasets]
         targets += [f"{r}/{d}/figures/tracks_{fig}.png" for d in self.tracked for fig in ("impacts", "summary")]
+        targets += [f"{r}/{d}/figures/clips_contact_sheet.png" for d in self.tracked if self.from_clips(d)]
         targets += [f"{r}/{d}/{f}" for d in self.datasets for f in per_dataset]
         targets += [f"{imp}/{s}.nc" for s in self.scenarios]
         targets += [f"{imp}/results.xlsx"] if self.scenarios else []

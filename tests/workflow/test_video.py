@@ -8,7 +8,7 @@ import yaml
 from video_clips import LAB_CAMERAS, LAB_RIG, LAB_TRUTH
 
 from ballbat.units import DEGREE, MPH, RPM
-from workflow_helpers import make_workdir, snakemake, write_config
+from workflow_helpers import assert_not_blank, make_workdir, snakemake, write_config
 
 
 @pytest.mark.slow
@@ -52,8 +52,10 @@ def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_pa
     example["synthetic"]["impacts"] = {"baseball": {"wood": 4}}
     example["synthetic"]["e_x"] = {"baseball": {"wood": 0.464}}
     write_config(wd, lambda cfg: cfg["datasets"].update(filmed=example))
-    snakemake(wd, "-c2", "--", "results/filmed/reduce.nc")
+    sheet = "results/filmed/figures/clips_contact_sheet.png"
+    snakemake(wd, "-c2", "--", "results/filmed/reduce.nc", sheet)
     res = wd / "results" / "filmed"
+    assert_not_blank(wd / sheet)
     names = sorted(p.name for p in (res / "clips").iterdir())
     assert len([n for n in names if n.endswith(".mkv")]) == 8 and "impacts.csv" in names
     assert not [p for p in res.iterdir() if p.name.startswith(".clips.")]  # no temporary folder left
@@ -63,5 +65,5 @@ def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_pa
     for name in ("v_bat", "v_ball", "theta", "omega"):
         got, err, true = red[name].values, red[f"{name}_err"].values, truth[f"truth_{name}"].values
         assert np.all(np.abs(got - true) < 4 * err), (name, got, true, err)
-    again = snakemake(wd, "-c2", "-n", "--", "results/filmed/reduce.nc")
+    again = snakemake(wd, "-c2", "-n", "--", "results/filmed/reduce.nc", sheet)
     assert "Nothing to be done" in again.stdout + again.stderr

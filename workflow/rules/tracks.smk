@@ -142,3 +142,28 @@ rule tracks_qa:
         ENV
     script:
         "../scripts/tracks_qa.py"
+
+
+rule clips_qa:
+    """Contact sheet of a dataset's clips: a few frames of a few impacts, with the points tracked in them."""
+    input:
+        unpack(get_tool_files),
+        tracks=f"{R}/{{dataset}}/imported_tracks.nc",
+        reduced=rules.reduce.output.impacts,
+        code=code("clips_qa.py"),
+    output:
+        sheet=report(
+            f"{R}/{{dataset}}/figures/clips_contact_sheet.png",
+            caption="../report/clips_contact_sheet.rst",
+            category="Dataset {dataset}",
+            subcategory="Camera tracks",
+            labels={"figure": "clips contact sheet", "shows": "frames of a few impacts with the points tracked"},
+        ),
+    log:
+        f"{R}/{{dataset}}/logs/clips_qa.log",
+    conda:
+        ENV
+    params:
+        settings=get_import_settings,
+    script:
+        "../scripts/clips_qa.py"
