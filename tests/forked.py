@@ -211,6 +211,10 @@ def _run_job(conn: socket.socket) -> None:
     os.environ.clear()
     os.environ.update(job["env"])
     resource.setrlimit(resource.RLIMIT_AS, tuple(job["as"]))
+    # a fresh interpreter is no daemon: the job may start processes of its own (a clip import's pool)
+    import multiprocessing
+
+    multiprocessing.current_process()._config["daemon"] = False
     script = job["argv"][0]
     sys.argv = list(job["argv"])
     extra = [p for p in job["env"].get("PYTHONPATH", "").split(os.pathsep) if p]

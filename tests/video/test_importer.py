@@ -98,3 +98,21 @@ def test_markers_given_for_a_folder_of_tool_files_are_named(tmp_path):
     block = {**_block(tmp_path), "format": "tracker", "points": {p: p for p in ("ball", "bat_tip", "dot_a", "dot_b")}}
     with pytest.raises(InputError, match=r"datasets\.vid\.tracks\.video: given, but only a folder of clips"):
         import_block(block, "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
+
+
+@pytest.mark.slow
+def test_clips_tracked_side_by_side_give_the_same_tracks(one_impact):
+    """ClipReader.many in two processes (the import job's threads) gives one clip at a time's tracks, in order."""
+    from functools import partial
+
+    folder, _ = one_impact
+    got = [
+        import_block(_block(folder), "datasets.vid.tracks", *_tables(), clip_reader=partial(clip_reader, workers=w))[0]
+        for w in (1, 2)
+    ]
+    for cam in ("swing", "spin"):
+        one, two = got[0].cameras[cam], got[1].cameras[cam]
+        np.testing.assert_array_equal(one.frame0, two.frame0)
+        for p in one.x:
+            np.testing.assert_array_equal(one.x[p], two.x[p])
+            np.testing.assert_array_equal(one.y[p], two.y[p])

@@ -77,6 +77,7 @@ get_tracks_inputs = INPUTS.get_tracks_inputs
 get_tool_files = INPUTS.get_tool_files
 tool_file_hashes = INPUTS.tool_file_hashes
 get_import_settings = INPUTS.get_import_settings
+get_import_threads = INPUTS.get_import_threads
 get_reduce_settings = INPUTS.get_reduce_settings
 get_reduce_where = INPUTS.get_reduce_where
 dataset_mem_mb = INPUTS.dataset_mem_mb

@@ -73,7 +73,7 @@ rule import_tracks:
         "dataset"
     conda:
         ENV
-    threads: 1
+    threads: get_import_threads
     resources:
         mem_mb=dataset_mem_mb,
         runtime=10,

@@ -1,5 +1,7 @@
 """Rule import_tracks: adapter around ballbat.tracks.formats.layout.import_block (clips: ballbat.video.importer)."""
 
+from functools import partial
+
 import yaml
 
 from ballbat.pipeline.ncio import atomic_write_text, write_dataset
@@ -17,7 +19,7 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         snakemake.params.where,
         load_balls(inp.balls),
         load_bats(inp.bats),
-        clip_reader=clip_reader,
+        clip_reader=partial(clip_reader, workers=snakemake.threads),  # clips tracked side by side
     )
     found = imported.settings_yaml()
     log.info("%d files, %d impacts, %d tracked points", found["files"], tracks.n, found["rows"])

@@ -15,7 +15,6 @@ both radii and the ``m_per_px`` the clip implies.
 
 from __future__ import annotations
 
-from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
@@ -68,15 +67,59 @@ def clip_tracks(path: Path, camera: str, m_per_px: float, ball_radius_m: float, 
     return FileTracks(str(path), tracks, fps=info.fps, source={"fps": info.source.get("fps", "the clip")})
 
 
-def clip_reader(block: dict, ball_radius_m: dict[str, float]) -> Callable[[Path, str, str, dict], FileTracks]:
-    """Return the reader of a ``format: video`` block's clips: (path, impact id, camera, camera config) -> FileTracks.
+def _track(job: tuple) -> FileTracks | FormatError:
+    """Track one clip (a job of :meth:`ClipReader.many`; module-level, so a process pool can run it)."""
+    try:
+        return clip_tracks(*job)
+    except FormatError as exc:
+        return exc
 
-    ``ball_radius_m`` maps each impact id to its ball's radius (the balls table's).
+
+class ClipReader:
+    """The reader of a ``format: video`` block's clips: (path, impact id, camera, camera config) -> FileTracks.
+
+    :meth:`many` tracks several clips side by side in ``workers`` processes (the import job's
+    threads); the clips are independent, so the tracks are those of one clip at a time.
     """
 
-    def read(path: Path, impact_id: str, camera: str, cam: dict) -> FileTracks:
-        if impact_id not in ball_radius_m:
-            raise FormatError([f"{path}: impact {impact_id!r} has no ball in the impacts table"])
-        return clip_tracks(path, camera, float(cam["m_per_px"]), ball_radius_m[impact_id], block["video"])
+    def __init__(self, block: dict, ball_radius_m: dict[str, float], workers: int = 1) -> None:
+        self.video = block["video"]
+        self.ball_radius_m = ball_radius_m
+        self.workers = max(int(workers), 1)
 
-    return read
+    def _job(self, path: Path, impact_id: str, camera: str, cam: dict) -> tuple:
+        if impact_id not in self.ball_radius_m:
+            raise FormatError([f"{path}: impact {impact_id!r} has no ball in the impacts table"])
+        return (path, camera, float(cam["m_per_px"]), self.ball_radius_m[impact_id], self.video)
+
+    def __call__(self, path: Path, impact_id: str, camera: str, cam: dict) -> FileTracks:
+        """Track one clip."""
+        return clip_tracks(*self._job(path, impact_id, camera, cam))
+
+    def many(self, items: list[tuple[Path, str, str, dict]]) -> list[FileTracks | FormatError]:
+        """Track every (path, impact id, camera, camera config), in order; a clip's problems as its FormatError."""
+        jobs: list = []
+        for item in items:
+            try:
+                jobs.append(self._job(*item))
+            except FormatError as exc:
+                jobs.append(exc)
+        todo = [j for j in jobs if not isinstance(j, FormatError)]
+        if self.workers > 1 and len(todo) > 1:
+            import multiprocessing
+            from concurrent.futures import ProcessPoolExecutor
+
+            ctx = multiprocessing.get_context("fork")
+            with ProcessPoolExecutor(min(self.workers, len(todo)), mp_context=ctx) as pool:
+                done = iter(list(pool.map(_track, todo)))
+        else:
+            done = iter([_track(j) for j in todo])
+        return [j if isinstance(j, FormatError) else next(done) for j in jobs]
+
+
+def clip_reader(block: dict, ball_radius_m: dict[str, float], workers: int = 1) -> ClipReader:
+    """Return the reader of a ``format: video`` block's clips (``ball_radius_m``: each impact id's ball radius).
+
+    ``workers``: processes that track clips side by side (the import job's threads).
+    """
+    return ClipReader(block, ball_radius_m, workers)

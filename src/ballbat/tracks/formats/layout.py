@@ -253,18 +253,34 @@ def import_files(
 def _read_files(files, fmt, units, cameras: dict, reader, problems: list[str]) -> list[tuple[str, str, FileTracks]]:
     """Read every (impact id, camera, path) of ``files``; each file's problems go to ``problems``."""
     read: list[tuple[str, str, FileTracks]] = []
+    if fmt == "video":  # the clips tracked together (side by side where the reader can: ClipReader.many)
+        if reader is None:
+            problems += [f"{p}: a clip, and no clip reader was given (ballbat.video.importer)" for _, _, p in files]
+            return read
+        items = [(path, iid, cam, cameras.get(cam) or {}) for iid, cam, path in files]
+        many = getattr(reader, "many", None)
+        out = many(items) if many else [_call(reader, item) for item in items]
+        for (iid, cam, _), got in zip(files, out, strict=True):
+            if isinstance(got, FormatError):
+                problems += got.problems
+            else:
+                read.append((iid, cam, got))
+        return read
     for iid, cam, path in files:
         f = fmt or BY_EXTENSION[path.suffix.lower()]
         try:
-            if f == "video":
-                if reader is None:
-                    raise FormatError([f"{path}: a clip, and no clip reader was given (ballbat.video.importer)"])
-                read.append((iid, cam, reader(path, iid, cam, cameras.get(cam) or {})))
-            else:
-                read.append((iid, cam, _read(path, f, units, cameras.get(cam) or {})))
+            read.append((iid, cam, _read(path, f, units, cameras.get(cam) or {})))
         except FormatError as exc:
             problems += exc.problems
     return read
+
+
+def _call(reader, item: tuple) -> FileTracks | FormatError:
+    """Return ``reader(*item)``, or its FormatError."""
+    try:
+        return reader(*item)
+    except FormatError as exc:
+        return exc
 
 
 def _block_problems(points: dict, fmt: str | None, units: dict | None, cameras: dict, where: str) -> list[str]:
