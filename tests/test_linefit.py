@@ -299,6 +299,22 @@ def test_eiv_line_without_scatter_is_unchanged_where_tau_is_zero():
     assert np.isnan(plain.scatter)
 
 
+def test_a_misfit_no_scatter_explains_leaves_the_term_out():
+    """Points at x ~ 0 (no room for scatter: g = 0) whose residuals alone exceed the dof: tau^2 unbounded.
+
+    Found by the intervals grid (a study batch stopped in the root search): the fit is made
+    without the term, and its scatter is NaN, not a crash.
+    """
+    x, y, jx, jy, sigma = _scattered_line(np.random.default_rng(5), 12, 1.3, 0.0)
+    x[:3], y[:3] = 0.01, np.array([0.6, -0.6, 0.7])  # at x ~ 0 with 12 sigma residuals
+    fit = eiv_line(x, y, jx, jy, sigma, scatter=True)
+    plain = eiv_line(x, y, jx, jy, sigma)
+    assert fit.success and np.isnan(fit.scatter)
+    assert fit.slope == pytest.approx(plain.slope, rel=1e-12) and fit.slope_err == pytest.approx(
+        plain.slope_err, rel=1e-12
+    )
+
+
 def _coverage(scatter: bool, reps: int = 400) -> float:
     rng = np.random.default_rng(4)
     hits = 0

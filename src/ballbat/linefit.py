@@ -246,6 +246,10 @@ def eiv_line(
             return LineFit.not_fitted(n)
         if scatter and it >= iterations - 1:
             tau2 = paule_mandel(y - X @ beta, var0, g, n - p)
+            if not np.isfinite(tau2):
+                # the points whose true x is about 0 (g = 0) alone exceed the residuals' dof: no scatter
+                # term brings the fit to it; fitted without the term (its estimate NaN)
+                scatter, tau2 = False, 0.0
         W = 1.0 / (var0 + tau2 * g)
         xwx = X.T @ (W[:, None] * X)
         A = xwx.copy()
