@@ -20,7 +20,7 @@ from .datasets import films, renders
 from .pipeline.codedeps import module_files
 from .pipeline.guards import results_root
 from .pipeline.provenance import sha256_file
-from .tracks.data import camera_block, tool_file_extensions
+from .tracks.data import camera_block, clips_block, tool_file_extensions
 
 if TYPE_CHECKING:
     from .studies.settings import StudySettings
@@ -200,9 +200,7 @@ class WorkflowInputs:
         """Return the dataset's ``tracks`` block (the import rule's params); filmed impacts: the block of the clips."""
         d = self.dataset_config(wildcards)
         if films(d):
-            from .stages.clips import clip_block
-
-            return clip_block(d["render"], self.clips_dir(wildcards))
+            return clips_block(d["render"], self.clips_dir(wildcards))
         return d["tracks"]
 
     def clips_dir(self, wildcards: Namespace) -> str:

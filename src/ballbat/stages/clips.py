@@ -27,31 +27,10 @@ if TYPE_CHECKING:
     from ..tracks.render import RenderSettings
     from ..video.render import Look
 
-__all__ = ["clip_block", "clip_look", "render_clips"]
+__all__ = ["clip_look", "render_clips"]
 
 #: The file each ``video.format`` writes (docs/video.md, "Files").
 EXTENSIONS = {"tif": ".tif", "mkv": ".mkv", "mp4": ".mp4"}
-
-
-def clip_block(render: dict, clips_dir: str) -> dict:
-    """Return the ``tracks`` block (``format: video``) that reads a rendered dataset's clips back.
-
-    The cameras' scales, mirrors and uncertainties, the rig and the frame limits are the
-    ``render`` block's: the lab's settings, as it would state them for its own clips.
-    """
-    from ..tracks.data import camera_block
-
-    block = camera_block(render)
-    block.update(
-        {
-            "dir": clips_dir,
-            "format": "video",
-            "pattern": "{impact_id}_{camera}.{ext}",
-            "impacts": f"{clips_dir}/impacts.csv",
-            "video": {k: render["video"][k] for k in ("dot_radius_mm", "marker_radius_mm")},
-        }
-    )
-    return block
 
 
 def clip_look(video: dict, seed: int) -> Look:

@@ -228,6 +228,25 @@ def camera_block(cfg: dict) -> dict:
     }
 
 
+def clips_block(render: dict, clips_dir: str) -> dict:
+    """Return the ``tracks`` block (``format: video``) that reads a rendered dataset's clips back.
+
+    The cameras' scales, mirrors and uncertainties, the rig and the frame limits are the
+    ``render`` block's: the lab's settings, as it would state them for its own clips.
+    """
+    block = camera_block(render)
+    block.update(
+        {
+            "dir": clips_dir,
+            "format": "video",
+            "pattern": "{impact_id}_{camera}.{ext}",
+            "impacts": f"{clips_dir}/impacts.csv",
+            "video": {k: render["video"][k] for k in ("dot_radius_mm", "marker_radius_mm")},
+        }
+    )
+    return block
+
+
 def with_found_settings(block: dict, found: dict) -> dict:
     """Return the reduce rule's settings block with the frame rates and pixel scales found in the files."""
     out = {**block, "cameras": {c: dict(v) for c, v in block["cameras"].items()}}
