@@ -102,7 +102,7 @@ def test_markers_given_for_a_folder_of_tool_files_are_named(tmp_path):
 
 @pytest.mark.slow
 def test_clips_tracked_side_by_side_give_the_same_tracks(one_impact):
-    """ClipReader.many in two processes (the import job's threads) gives one clip at a time's tracks, in order."""
+    """ClipReader in two processes (the import job's threads) gives one clip at a time's tracks, in order."""
     from functools import partial
 
     folder, _ = one_impact

@@ -68,7 +68,7 @@ def clip_tracks(path: Path, camera: str, m_per_px: float, ball_radius_m: float, 
 
 
 def _track(job: tuple) -> FileTracks | FormatError:
-    """Track one clip (a job of :meth:`ClipReader.many`; module-level, so a process pool can run it)."""
+    """Track one clip (a job of :class:`ClipReader`; module-level, so a process pool can run it)."""
     try:
         return clip_tracks(*job)
     except FormatError as exc:
@@ -76,10 +76,10 @@ def _track(job: tuple) -> FileTracks | FormatError:
 
 
 class ClipReader:
-    """The reader of a ``format: video`` block's clips: (path, impact id, camera, camera config) -> FileTracks.
+    """The reader of a ``format: video`` block's clips: (path, impact id, camera, camera config) each -> FileTracks.
 
-    :meth:`many` tracks several clips side by side in ``workers`` processes (the import job's
-    threads); the clips are independent, so the tracks are those of one clip at a time.
+    Called with the folder's clips, it tracks them side by side in ``workers`` processes (the
+    import job's threads); the clips are independent, so the tracks are those of one clip at a time.
     """
 
     def __init__(self, block: dict, ball_radius_m: dict[str, float], workers: int = 1) -> None:
@@ -87,23 +87,14 @@ class ClipReader:
         self.ball_radius_m = ball_radius_m
         self.workers = max(int(workers), 1)
 
-    def _job(self, path: Path, impact_id: str, camera: str, cam: dict) -> tuple:
+    def _job(self, path: Path, impact_id: str, camera: str, cam: dict) -> tuple | FormatError:
         if impact_id not in self.ball_radius_m:
-            raise FormatError([f"{path}: impact {impact_id!r} has no ball in the impacts table"])
+            return FormatError([f"{path}: impact {impact_id!r} has no ball in the impacts table"])
         return (path, camera, float(cam["m_per_px"]), self.ball_radius_m[impact_id], self.video)
 
-    def __call__(self, path: Path, impact_id: str, camera: str, cam: dict) -> FileTracks:
-        """Track one clip."""
-        return clip_tracks(*self._job(path, impact_id, camera, cam))
-
-    def many(self, items: list[tuple[Path, str, str, dict]]) -> list[FileTracks | FormatError]:
+    def __call__(self, items: list[tuple[Path, str, str, dict]]) -> list[FileTracks | FormatError]:
         """Track every (path, impact id, camera, camera config), in order; a clip's problems as its FormatError."""
-        jobs: list = []
-        for item in items:
-            try:
-                jobs.append(self._job(*item))
-            except FormatError as exc:
-                jobs.append(exc)
+        jobs = [self._job(*item) for item in items]
         todo = [j for j in jobs if not isinstance(j, FormatError)]
         if self.workers > 1 and len(todo) > 1:
             import multiprocessing

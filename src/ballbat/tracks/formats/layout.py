@@ -170,7 +170,7 @@ def import_files(
     units: dict | None = None,
     cameras: dict | None = None,
     where: str = "tracks",
-    reader: Callable[[Path, str, str, dict], FileTracks] | None = None,
+    reader: Callable[[list[tuple[Path, str, str, dict]]], list[FileTracks | FormatError]] | None = None,
 ) -> Imported:
     """Read a lab's tool files into long rows; camera settings from the files, checked against ``cameras``.
 
@@ -189,8 +189,9 @@ def import_files(
     where : str
         Config key of the block, for messages.
     reader : callable, optional
-        Reader of the ``video`` format's clips, ``(path, impact id, camera, camera config) ->
-        FileTracks`` (:func:`ballbat.video.importer.clip_reader`; the clips are tracked there).
+        Reader of the ``video`` format's clips: a list of (path, impact id, camera, camera config)
+        in, each clip's FileTracks or FormatError out, in order
+        (:func:`ballbat.video.importer.clip_reader`; the clips are tracked there).
 
     Raises
     ------
@@ -253,18 +254,16 @@ def import_files(
 def _read_files(files, fmt, units, cameras: dict, reader, problems: list[str]) -> list[tuple[str, str, FileTracks]]:
     """Read every (impact id, camera, path) of ``files``; each file's problems go to ``problems``."""
     read: list[tuple[str, str, FileTracks]] = []
-    if fmt == "video":  # the clips tracked together (side by side where the reader can: ClipReader.many)
+    if fmt == "video":  # the clips tracked together (side by side: ClipReader)
         if reader is None:
             problems += [f"{p}: a clip, and no clip reader was given (ballbat.video.importer)" for _, _, p in files]
             return read
-        items = [(path, iid, cam, cameras.get(cam) or {}) for iid, cam, path in files]
-        many = getattr(reader, "many", None)
-        out = many(items) if many else [_call(reader, item) for item in items]
-        for (iid, cam, _), got in zip(files, out, strict=True):
-            if isinstance(got, FormatError):
-                problems += got.problems
+        got = reader([(path, iid, cam, cameras.get(cam) or {}) for iid, cam, path in files])
+        for (iid, cam, _), ft in zip(files, got, strict=True):
+            if isinstance(ft, FormatError):
+                problems += ft.problems
             else:
-                read.append((iid, cam, got))
+                read.append((iid, cam, ft))
         return read
     for iid, cam, path in files:
         f = fmt or BY_EXTENSION[path.suffix.lower()]
@@ -273,14 +272,6 @@ def _read_files(files, fmt, units, cameras: dict, reader, problems: list[str]) -
         except FormatError as exc:
             problems += exc.problems
     return read
-
-
-def _call(reader, item: tuple) -> FileTracks | FormatError:
-    """Return ``reader(*item)``, or its FormatError."""
-    try:
-        return reader(*item)
-    except FormatError as exc:
-        return exc
 
 
 def _block_problems(points: dict, fmt: str | None, units: dict | None, cameras: dict, where: str) -> list[str]:
