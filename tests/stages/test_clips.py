@@ -49,7 +49,7 @@ def experiment(config, balls, bats):
 def test_clips_are_written_whole_in_the_format_asked(tmp_path, experiment, balls, fmt, crf):
     block = checked_block({**copy.deepcopy(RENDER), "video": {"format": fmt, "crf": crf}}, "render")
     out = tmp_path / "clips"
-    written = clips.render_clips(render.from_params(block), block["video"], experiment, balls, out)
+    written, n_frames = clips.render_clips(render.from_params(block), block["video"], experiment, balls, out)
     ids = [str(i) for i in experiment["impact"].values]
     assert sorted(p.name for p in written) == sorted(f"{i}_{c}.{fmt}" for i in ids for c in ("swing", "spin"))
     assert (out / "impacts.csv").read_text().splitlines() == [
@@ -57,6 +57,7 @@ def test_clips_are_written_whole_in_the_format_asked(tmp_path, experiment, balls
         *(f"{i},wood,baseball" for i in ids),
     ]
     assert [p.name for p in tmp_path.iterdir()] == ["clips"]  # no temporary folder left
+    assert n_frames == sum(open_clip(p).info.n_frames for p in written)
     info = open_clip(out / f"{ids[0]}_swing.{fmt}").info
     assert info.fps == 3000.0 and (info.width, info.height) == (512, 320)
     frame = next(open_clip(out / f"{ids[0]}_spin.{fmt}").frames())[2]

@@ -7,9 +7,9 @@ import pytest
 from video_clips import LAB_CAMERAS
 
 from ballbat.plotting_tracks import contact_sheet
-from ballbat.tracks.formats.layout import find_files, import_block
+from ballbat.tracks.formats.layout import import_block
 from ballbat.video.importer import clip_reader
-from ballbat.video.qa import sheet_rows
+from ballbat.video.qa import block_clips, sheet_rows
 
 
 @pytest.mark.slow
@@ -24,8 +24,7 @@ def test_the_sheet_shows_each_clips_frames_with_the_points_tracked_in_them(lab_c
         "video": {"dot_radius_mm": 4.0, "marker_radius_mm": 6.0},
     }
     tracks, _ = import_block(block, "datasets.vid.tracks", balls, bats, clip_reader=clip_reader)
-    files, _ = find_files([folder], block["pattern"], "video")
-    rows = sheet_rows({(i, c): p for i, c, p in files}, tracks, [0, 2], n=4)
+    rows = sheet_rows(block_clips(block), tracks, [0, 2], n=4)
     assert [r.label for r in rows] == ["W1 swing", "W1 spin", "W3 swing", "W3 spin"]
     truth = {(c.impact_id, c.camera): c for c in true}
     for row in rows:

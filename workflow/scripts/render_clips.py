@@ -7,11 +7,11 @@ from ballbat.stages import clips, render
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     block = snakemake.params.settings
-    written = clips.render_clips(
+    written, n_frames = clips.render_clips(
         render.from_params(block),
         block["video"],
         read_dataset(snakemake.input.truth),
         load_balls(snakemake.input.balls),
         snakemake.output.clips,
     )
-    log.info("%d clips, %d frames (%s)", len(written), clips.n_frames(written), block["video"]["format"])
+    log.info("%d clips, %d frames (%s)", len(written), n_frames, block["video"]["format"])

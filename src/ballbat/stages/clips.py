@@ -16,8 +16,6 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 from .render import render_inputs
 
 if TYPE_CHECKING:
@@ -31,6 +29,9 @@ __all__ = ["clip_look", "render_clips"]
 
 #: The file each ``video.format`` writes (docs/video.md, "Files").
 EXTENSIONS = {"tif": ".tif", "mkv": ".mkv", "mp4": ".mp4"}
+#: Clip k of a render seed s draws its background and noise from seed s * CLIP_SEED_STRIDE + k: a
+#: prime larger than any dataset's clip count, so that no two (seed, clip) pairs share a stream.
+CLIP_SEED_STRIDE = 100_003
 
 
 def clip_look(video: dict, seed: int) -> Look:
@@ -48,8 +49,10 @@ def clip_look(video: dict, seed: int) -> Look:
 
 def render_clips(
     settings: RenderSettings, video: dict, simulated: xr.Dataset, balls: dict[str, Ball], out: str | os.PathLike[str]
-) -> list[Path]:
+) -> tuple[list[Path], int]:
     """Write every impact's two clips and ``impacts.csv`` into the folder ``out``, whole or not at all.
+
+    Returns the clips written and their frames in all.
 
     ``video`` is the ``render.video`` block: the file format (and H.264's ``crf``), the exposure,
     the bit depth and the markers' sizes. The clips are written into a temporary folder beside
@@ -64,14 +67,15 @@ def render_clips(
     out = Path(out)
     tmp = Path(tempfile.mkdtemp(prefix=f".{out.name}.", dir=out.parent))
     try:
-        written = []
+        written, n_frames = [], 0
         for i, c in enumerate(clips):
-            look = clip_look(video, settings.seed * 100_003 + i)  # each clip its own background and noise
+            look = clip_look(video, settings.seed * CLIP_SEED_STRIDE + i)  # each clip its own background and noise
             m = getattr(settings, c.camera).camera.m_per_px
             name = f"{c.impact_id}_{c.camera}{EXTENSIONS[video['format']]}"
             frames = render_frames(c, look, m)
             write_clip(tmp / name, frames, c.fps, exposure_s=look.exposure_s, frame_numbers=c.frames, crf=video["crf"])
             written.append(out / name)
+            n_frames += c.frames.size
         rows = "".join(f"{a},{t},{b}\n" for a, t, b in zip(ids, bat.astype(str), ball.astype(str), strict=True))
         (tmp / "impacts.csv").write_text("impact_id,bat,ball\n" + rows)
         if out.exists():
@@ -80,11 +84,4 @@ def render_clips(
     except BaseException:
         shutil.rmtree(tmp, ignore_errors=True)
         raise
-    return written
-
-
-def n_frames(paths: list[Path]) -> int:
-    """Frames in the clips written (the job's log)."""
-    from ..video.io import open_clip
-
-    return int(np.sum([open_clip(p).info.n_frames or 0 for p in paths]))
+    return written, n_frames

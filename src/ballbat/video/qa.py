@@ -38,6 +38,14 @@ def _tracked(tracks: Tracks, i: int, camera: str) -> dict[int, dict[str, tuple[f
     return out
 
 
+def block_clips(block: dict) -> dict[tuple[str, str], Path]:
+    """Return the clips of a ``format: video`` block's folder by (impact id, camera), found as the import finds them."""
+    from ..tracks.formats.layout import find_files
+
+    files, _ = find_files([block["dir"]], block["pattern"], "video")
+    return {(iid, cam): path for iid, cam, path in files}
+
+
 def sheet_rows(clips: dict[tuple[str, str], Path], tracks: Tracks, impacts: list[int], n: int = 5) -> list[SheetRow]:
     """Return the sheet's rows: for each of ``impacts`` (indices into ``tracks``), each camera's clip, ``n`` frames.
 
