@@ -418,3 +418,10 @@ def paper(cfg, balls, bats):
 @pytest.fixture(scope="module")
 def rows():
     return read_long_csv(EXAMPLE / "tracked_tracks.csv")
+
+
+def assert_cases_have_tests(cases: dict, module_globals: dict) -> None:
+    """Check a red-team table: every case names its outcome and tests of the module (``globals()``) that exist."""
+    names = {name for name, obj in module_globals.items() if name.startswith("test_") and callable(obj)}
+    for case, (outcome, tests) in cases.items():
+        assert outcome and tests and set(tests) <= names, case

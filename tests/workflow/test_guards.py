@@ -17,6 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import xarray as xr
+from helpers import assert_cases_have_tests
 
 from ballbat import compare
 from ballbat.pipeline import guards
@@ -79,9 +80,7 @@ RED_TEAM = {
 
 
 def test_every_case_has_its_tests():
-    names = {name for name, obj in globals().items() if name.startswith("test_") and callable(obj)}
-    for case, (outcome, tests) in RED_TEAM.items():
-        assert outcome and tests and set(tests) <= names, case
+    assert_cases_have_tests(RED_TEAM, globals())
 
 
 # --- unit tests of the guards ----------------------------------------------------------------

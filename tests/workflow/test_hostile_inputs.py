@@ -24,6 +24,7 @@ import numpy as np
 import pytest
 import xarray as xr
 import yaml
+from helpers import assert_cases_have_tests
 from track_files import TOOL_NAMES, kva_text, read_long_csv, trk_text, write_lab_folder, write_trz
 
 from ballbat import cli
@@ -121,9 +122,7 @@ RED_TEAM = {
 
 
 def test_every_case_has_its_tests():
-    names = {name for name, obj in globals().items() if name.startswith("test_") and callable(obj)}
-    for case, (outcome, tests) in RED_TEAM.items():
-        assert outcome and tests and set(tests) <= names, case
+    assert_cases_have_tests(RED_TEAM, globals())
 
 
 def ballbat(*args, cwd: Path = ROOT, mem_gib: float | None = None) -> subprocess.CompletedProcess:
