@@ -4,9 +4,11 @@ Each set-up's replicate experiments are simulated, rendered and reduced once
 (:func:`ballbat.chain.source`, cached per seeds) and fitted once per estimator variant on the same
 replicates: implied e_y's sandwich form (:data:`ballbat.fitting.E_Y_SANDWICH`: ``hc0k``, the
 first version; ``hc2``, shipped; ``hc3``) and the e_x fits with or without the intrinsic-scatter
-term (:data:`ballbat.linefit.SCATTER_TERM`). Variants: ``before`` (hc0k, no term), ``hc2`` (no
-term), ``after`` (hc3 and the term), ``shipped`` (hc2 and the term); name some on the command
-line to run only those. Stronge's eta^2 is not fitted (it is not judged here).
+term (:data:`ballbat.linefit.SCATTER_TERM`; for the pooled e_x and the Eq. ratio slope, the
+scatter within bats, :data:`ballbat.fitting.WITHIN_BAT_SCATTER`). Variants: ``before`` (hc0k,
+no term), ``hc2`` (no term), ``after`` (hc3 and the term per bat), ``per_bat`` (hc2 and the term
+per bat), ``shipped`` (hc2, the term per bat and within bats for the pooled fits); name some on
+the command line to run only those. Stronge's eta^2 is not fitted (it is not judged here).
 The calibration is not drawn (statistical intervals; the combined ones need the drawn
 calibration of the robustness grid).
 
@@ -58,8 +60,15 @@ SETUPS = {
     "scatter0.01": lambda ds: _scatter(ds, 0.01),
 }
 
-#: variant -> (E_Y_SANDWICH, SCATTER_TERM)
-VARIANTS = {"before": ("hc0k", False), "hc2": ("hc2", False), "after": ("hc3", True), "shipped": ("hc2", True)}
+#: variant -> (E_Y_SANDWICH, SCATTER_TERM, WITHIN_BAT_SCATTER): ``per_bat`` is the shipped form before
+#: the pooled e_x and the Eq. ratio slope got the scatter within bats
+VARIANTS = {
+    "before": ("hc0k", False, False),
+    "hc2": ("hc2", False, False),
+    "after": ("hc3", True, False),
+    "per_bat": ("hc2", True, False),
+    "shipped": ("hc2", True, True),
+}
 
 
 def table(cov, label: str) -> list[str]:
@@ -105,11 +114,12 @@ def main() -> None:
             mock.patch.object(replicates, "STUDY_QUANTITIES", quantities),
         ):
             for label in variants:
-                form, term = VARIANTS[label]
+                form, term, within = VARIANTS[label]
                 t0 = time.perf_counter()
                 with (
                     mock.patch.object(fitting, "E_Y_SANDWICH", form),
                     mock.patch.object(linefit, "SCATTER_TERM", term),
+                    mock.patch.object(fitting, "WITHIN_BAT_SCATTER", within),
                 ):
                     rep = study_batch.run(s, 0, balls, bats)
                     truth_v = [population_truth(s, 0, balls, bats)] if term else truth

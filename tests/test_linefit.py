@@ -346,3 +346,42 @@ def test_t_and_chi2_quantiles_are_scipy_stats_numbers():
             assert linefit.chi2_quantile(q, dof) == float(stats.chi2.ppf(q, dof))
     for dof, q in ((0, 0.975), (-1, 0.975), (5, 0.0), (5, 1.0)):
         assert np.isnan(linefit.t_quantile(q, dof)) and np.isnan(linefit.chi2_quantile(q, dof))
+
+
+def _bats_of_different_slopes(rng, tau, n_each=1500, slopes=(1.25, 1.3, 1.35)):
+    """Three strata (bats) with slopes of their own, each point's slope scattered by ``tau`` about its bat's."""
+    parts = [_scattered_line(rng, n_each, s, tau) for s in slopes]
+    x, y, jx, jy, sigma = (np.concatenate([p[k] for p in parts]) for k in range(5))
+    return x, y, jx, jy, sigma, np.repeat(np.array(["a", "b", "c"]), n_each)
+
+
+def test_the_scatter_within_strata_is_the_scatter_about_each_strata_own_slope():
+    """A line pooled over bats of different slopes (the pooled e_x, the Eq. ratio slope): tau is the bats' own.
+
+    Without strata the bats' differences (+-0.05 in slope) are counted as scatter and tau comes
+    out too large (0.047 on these points); with them it is the 0.03 drawn (0.028), inside its
+    Q-profile interval.
+    """
+    x, y, jx, jy, sigma, bat = _bats_of_different_slopes(np.random.default_rng(11), 0.03)
+    within = eiv_line(x, y, jx, jy, sigma, scatter=True, strata=bat)
+    pooled = eiv_line(x, y, jx, jy, sigma, scatter=True)
+    assert within.scatter == pytest.approx(0.03, abs=0.004)
+    assert within.scatter_ci_low < 0.03 < within.scatter_ci_high
+    assert pooled.scatter > 1.3 * within.scatter
+    assert within.slope == pytest.approx(1.3, abs=0.01)
+
+
+def test_strata_without_scatter_give_no_term_and_one_stratum_is_no_strata():
+    x, y, jx, jy, sigma, bat = _bats_of_different_slopes(np.random.default_rng(12), 0.0, n_each=200)
+    within = eiv_line(x, y, jx, jy, sigma, scatter=True, strata=bat)
+    assert within.scatter < 0.01 < within.scatter_ci_high  # the bats' 0.05 differences are not scatter
+    one = eiv_line(x[:200], y[:200], jx[:200], jy[:200], sigma[:200], scatter=True, strata=bat[:200])
+    plain = eiv_line(x[:200], y[:200], jx[:200], jy[:200], sigma[:200], scatter=True)
+    assert (one.slope, one.slope_err, one.scatter) == (plain.slope, plain.slope_err, plain.scatter)
+
+
+def test_strata_of_one_point_each_leave_no_degree_of_freedom_for_the_scatter():
+    x, y, jx, jy, sigma = _scattered_line(np.random.default_rng(13), 6, 1.3, 0.05)
+    fit = eiv_line(x, y, jx, jy, sigma, scatter=True, strata=np.arange(6).astype(str))
+    plain = eiv_line(x, y, jx, jy, sigma)
+    assert np.isnan(fit.scatter) and fit.slope == plain.slope  # fitted without the term, not a crash

@@ -107,6 +107,11 @@ class Sec4:
     systematics: object = None  # every calibration source to every quantity (ballbat.systematics)
 
 
+#: The pooled e_x and the Eq. ratio slope of a ball carry the intrinsic scatter within its bats
+#: (``linefit.eiv_line`` with the bats as strata; docs/model.md). False: fitted without the term,
+#: as before issue 36's last step (the studies' comparison, bench/intervals_study.py).
+WITHIN_BAT_SCATTER = True
+
 #: Per-ball quantities that are not line fits (values of :attr:`Sec4.per_ball`).
 PER_BALL = (
     "e_y_implied",
@@ -161,14 +166,16 @@ def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool)
     bat_of = ds["bat"].values.astype(str)
     per_bat, pooled = FitGrid.empty((len(balls), len(bats))), FitGrid.empty((len(balls),))
 
-    def spin_fit(sel, scatter):
+    def spin_fit(sel, strata=None):
         n = int(np.sum(sel))
         if n < MIN_FIT_IMPACTS:  # too few for a slope and its error: report, do not fit
             return LineFit.not_fitted(n), np.nan
         r, r_x, alpha = (ds[k].values[sel] for k in ("r", "r_x", "alpha"))
         x, y, jx, jy = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
         sig = measured_sigma(ds, sel)
-        fit = fit_line(x, y, jx, jy, sig, errors_in_variables=True, scatter=scatter)
+        fit = fit_line(
+            x, y, jx, jy, sig, errors_in_variables=True, strata=strata, scatter=strata is None or WITHIN_BAT_SCATTER
+        )
         t = np.nan
         if with_truth and fit.success:
             xt, yt, _, _ = spin_design(Measured.from_dataset(ds, sel, "truth_"), r, r_x, alpha)
@@ -179,9 +186,10 @@ def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool)
         in_ball = usable & (ball_of == ball)
         for bat in sorted(set(bat_of[ball_of == ball])):
             j = bats.index(bat)
-            per_bat.fits[i, j], per_bat.truth[i, j] = spin_fit(in_ball & (bat_of == bat), True)
-        # pooled: the bats' differences are the design's (the same bats in every repetition), not scatter
-        pooled.fits[i], pooled.truth[i] = spin_fit(in_ball, False)
+            per_bat.fits[i, j], per_bat.truth[i, j] = spin_fit(in_ball & (bat_of == bat))
+        # pooled: the bats' differences are the design's (the same bats in every repetition), not
+        # scatter; the intrinsic scatter is the one within bats (linefit.eiv_line with strata)
+        pooled.fits[i], pooled.truth[i] = spin_fit(in_ball, bat_of[in_ball])
     return per_bat, pooled
 
 
@@ -273,7 +281,7 @@ def implied_e_y(
     r, r_x, r_y, alpha = (ds[k].values[sel] for k in ("r", "r_x", "r_y", "alpha"))
     bat_of = ds["bat"].values.astype(str)[sel]
     n = x.size
-    w_r = _weights(jx, jy, sig, rfit.slope)
+    w_r = _weights(jx, jy, sig, rfit.slope, rfit, x)  # the fit's weights, its scatter term included
     W = np.ones(n) if w_r is None else w_r**2
     # each impact's e_x (its bat's; the pooled one where the bat has no fit) and its influence
     xs, ys, jxs, jys = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
@@ -483,7 +491,8 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
         r, r_x, alpha = (ds[k].values[in_ball] for k in ("r", "r_x", "alpha"))
         x, y, jx, jy = tan_ratio_design(Measured.from_dataset(ds, in_ball), r, alpha)
         sig = measured_sigma(ds, in_ball)
-        rfit = fit_line(x, y, jx, jy, sig, errors_in_variables=True)
+        bats_in_ball = ds["bat"].values[in_ball].astype(str)  # the strata of the scatter and the sandwiches
+        rfit = fit_line(x, y, jx, jy, sig, errors_in_variables=True, strata=bats_in_ball, scatter=WITHIN_BAT_SCATTER)
         res.tan_ratio_slope.fits[i] = rfit
         exf = res.e_x_pooled.fits[i]
         a = float(np.mean(alpha))
@@ -496,13 +505,12 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
         pb["gross_slip_psi"][i], pb["gross_slip_theta"][i], pb["gross_slip_omega"][i] = psi_g, theta_g, omega_g
         if has_truth:
             xt, yt, _, _ = tan_ratio_design(Measured.from_dataset(ds, in_ball, "truth_"), r, alpha)
-            res.tan_ratio_slope.truth[i] = wls_slope(xt, yt, _weights(jx, jy, sig, rfit.slope))[0]
+            res.tan_ratio_slope.truth[i] = wls_slope(xt, yt, _weights(jx, jy, sig, rfit.slope, rfit, x))[0]
             pb["truth_e_y_implied"][i] = float(np.mean(ds["truth_e_y"].values[in_ball]))
             pb["truth_mu_k_lower_bound"][i] = float(np.max(yt))
 
         v_bat, _, theta, _ = Measured.from_dataset(ds, in_ball)
         tv = Measured.from_dataset(ds, in_ball, "truth_") if has_truth else None
-        bats_in_ball = ds["bat"].values[in_ball].astype(str)  # the sandwich's strata (fit_line)
         for grid, which in ((res.spin_theta_slope, "omega"), (res.speed_theta_slope, "v_ball")):
             y_norm = ds[f"{which}_norm"].values[in_ball].astype(float)
             x, y, jx, jy = normalized_theta_design(v_bat, y_norm, theta, which, v_ref)

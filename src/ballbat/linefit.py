@@ -222,7 +222,10 @@ def eiv_line(
     of Paule and Mandel (:func:`paule_mandel`: the weighted residuals' chi-square equals its
     n - p degrees of freedom; 0 where it is below them), iterated with the slope. tau and its
     95 % Q-profile interval are in the fit's ``scatter*`` fields. Where tau is 0 the fit is the
-    one without the term.
+    one without the term. With ``strata`` (a line pooled over bats, each with a slope of its
+    own that every repetition keeps), tau is the scatter *within* them: the residuals about each
+    stratum's own moment-corrected slope, with n minus the number of strata degrees of freedom
+    (:func:`_scatter_residuals`); the bats' differences are the design's, not scatter.
     A corrected spread of x that is not positive (noise as large as the spread of the
     abscissa) gives a fit not made (NaN).
     """
@@ -245,10 +248,12 @@ def eiv_line(
         if (var0 <= 0).any():
             return LineFit.not_fitted(n)
         if scatter and it >= iterations - 1:
-            tau2 = paule_mandel(y - X @ beta, var0, g, n - p)
+            r_s, dof_s = _scatter_residuals(y - X @ beta, x, y, var_x, cov_xy, var0 + tau2 * g, strata, n - p)
+            tau2 = paule_mandel(r_s, var0, g, dof_s) if dof_s >= 1 else np.inf
             if not np.isfinite(tau2):
-                # the points whose true x is about 0 (g = 0) alone exceed the residuals' dof: no scatter
-                # term brings the fit to it; fitted without the term (its estimate NaN)
+                # the points whose true x is about 0 (g = 0) alone exceed the residuals' dof (or the
+                # strata leave none): no scatter term brings the fit to it; fitted without the term
+                # (its estimate NaN)
                 scatter, tau2 = False, 0.0
         W = 1.0 / (var0 + tau2 * g)
         xwx = X.T @ (W[:, None] * X)
@@ -270,7 +275,10 @@ def eiv_line(
     cov = Ainv @ inner @ Ainv
     slope, err = float(beta[0]), float(np.sqrt(cov[0, 0]))
     tq = t_quantile(0.975, n - p)
-    tau = (np.sqrt(tau2), *scatter_interval(r, var0, g, n - p)) if scatter else (np.nan, np.nan, np.nan)
+    tau = (np.nan, np.nan, np.nan)
+    if scatter:
+        r_s, dof_s = _scatter_residuals(r, x, y, var_x, cov_xy, 1.0 / W, strata, n - p)
+        tau = (np.sqrt(tau2), *scatter_interval(r_s, var0, g, dof_s))
     return LineFit(
         slope=slope,
         slope_err=err,
@@ -285,6 +293,39 @@ def eiv_line(
         scatter_ci_low=float(tau[1]),
         scatter_ci_high=float(tau[2]),
     )
+
+
+def _scatter_residuals(
+    r: np.ndarray,
+    x: np.ndarray,
+    y: np.ndarray,
+    var_x: np.ndarray,
+    cov_xy: np.ndarray,
+    v: np.ndarray,
+    strata: ArrayLike | None,
+    dof: int,
+) -> tuple[np.ndarray, int]:
+    """Return the residuals and degrees of freedom that the intrinsic scatter is estimated from.
+
+    Without strata (or with one): the line's own residuals ``r`` and ``dof``. With strata:
+    each point's residual about its stratum's own slope through the origin, moment-corrected
+    as the line is (sum W (x y - cov) / sum W (x^2 - var x), weights W = 1 / ``v``), and one
+    degree of freedom per stratum so fitted. A stratum whose corrected spread of x is not
+    positive keeps the line's slope and costs no degree of freedom.
+    """
+    if strata is None:
+        return r, dof
+    labels = np.asarray(strata)
+    _, idx = np.unique(labels, return_inverse=True)
+    if idx.max() == 0:
+        return r, dof
+    w = 1.0 / v
+    num = np.bincount(idx, w * (x * y - cov_xy))
+    den = np.bincount(idx, w * (x * x - var_x))
+    own = den > 0
+    slope = np.where(own, num / np.where(own, den, 1.0), np.nan)
+    out = np.where(own[idx], y - slope[idx] * x, r)
+    return out, int(x.size - own.sum())
 
 
 #: Fit the intrinsic-scatter term where a fit asks for it (:func:`eiv_line`'s ``scatter``).

@@ -55,12 +55,34 @@ def test_truth_of_ratio_and_e_y(default_settings, balls, bats):
         assert abs(f.tan_ratio_slope - f.truth_tan_ratio_slope) < 3 * f.tan_ratio_slope_err
 
 
-def test_fit_ex_declares_the_scatter_with_units_and_words():
+@pytest.mark.parametrize(
+    "fit, dims", [("e_x", ("ball", "bat")), ("e_x_pooled", ("ball",)), ("tan_ratio_slope", ("ball",))]
+)
+def test_fit_ex_declares_the_scatter_with_units_and_words(fit, dims):
     table = fit_ex_table(False, 0.5)
-    for name in ("e_x_scatter", "e_x_scatter_ci_low", "e_x_scatter_ci_high"):
+    for name in (f"{fit}_scatter", f"{fit}_scatter_ci_low", f"{fit}_scatter_ci_high"):
         assert table[name].units == "1"
-        assert table[name].dims == ("ball", "bat")
-        assert "e_x_scatter" in table[name].long_name or "tau" in table[name].long_name
+        assert table[name].dims == dims
+        assert f"{fit}_scatter" in table[name].long_name or "tau" in table[name].long_name
+
+
+def test_the_pooled_fits_report_the_scatter_within_bats(default_settings, balls, bats):
+    """The pooled e_x and the Eq. ratio slope carry a scatter term estimated within bats, with its interval.
+
+    Drawn with e_x scattering by 0.03 from impact to impact, the pooled e_x's interval of tau holds
+    0.03 (the bats' own e_x differ by up to 0.11, which is not scatter), and the Eq. ratio slope's
+    tau is positive (its scatter is e_x's, scaled by the recoil factors); drawn without, both
+    intervals reach down to 0.
+    """
+    impacts = {ball: {bat: 5 * n for bat, n in per.items()} for ball, per in default_settings["impacts"].items()}
+    fit = run(default_settings, balls, bats, e_x_scatter=0.03, impacts=impacts)
+    pooled, ratio = fit["e_x_pooled_scatter_ci_low"].values, fit["tan_ratio_slope_scatter_ci_low"].values
+    assert np.all(pooled < 0.03) and np.all(fit["e_x_pooled_scatter_ci_high"].values > 0.03)
+    assert np.all(ratio > 0.0)
+    plain = run(default_settings, balls, bats)
+    for name in ("e_x_pooled", "tan_ratio_slope"):
+        tau, lo, hi = (plain[f"{name}_scatter{k}"].values for k in ("", "_ci_low", "_ci_high"))
+        assert np.all(lo == 0.0) and np.all(tau <= hi) and np.all(hi > 0.0), name
 
 
 # ---------------------------------------------------------------------------------------

@@ -136,21 +136,29 @@ def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) 
     return table
 
 
+#: The fits with an intrinsic-scatter term (``linefit.eiv_line``): name -> (dims, what scatters).
+SCATTER_FITS = {
+    "e_x": (("ball", "bat"), "e_x from impact to impact (per bat and ball)"),
+    "e_x_pooled": (("ball",), "e_x from impact to impact within a bat (pooled over the ball's bats)"),
+    "tan_ratio_slope": (("ball",), "the Eq. ratio slope from impact to impact within a bat (pooled over bats)"),
+}
+
+
 def scatter_vars() -> dict[str, Var]:
-    """Declare the intrinsic scatter of e_x per bat and ball and its 95 % interval (``linefit.eiv_line``)."""
-    table = {
-        "e_x_scatter": Var(
-            ("ball", "bat"),
+    """Declare each fit's intrinsic scatter and its 95 % interval (``linefit.eiv_line``; :data:`SCATTER_FITS`)."""
+    table = {}
+    for name, (dims, what) in SCATTER_FITS.items():
+        table[f"{name}_scatter"] = Var(
+            dims,
             "1",
-            "intrinsic impact-to-impact standard deviation tau of e_x, fitted with e_x (Paule-Mandel; 0: the "
+            f"intrinsic standard deviation tau of {what}, fitted with the slope (Paule-Mandel; 0: the "
             "measurement errors explain the scatter)",
-            {"ancillary_variables": "e_x_scatter_ci_low e_x_scatter_ci_high"},
+            {"ancillary_variables": f"{name}_scatter_ci_low {name}_scatter_ci_high"},
         )
-    }
-    for side, bound in (("low", "lower"), ("high", "upper")):
-        table[f"e_x_scatter_ci_{side}"] = Var(
-            ("ball", "bat"), "1", f"{bound} bound of the 95 % interval of e_x_scatter (Q-profile)"
-        )
+        for side, bound in (("low", "lower"), ("high", "upper")):
+            table[f"{name}_scatter_ci_{side}"] = Var(
+                dims, "1", f"{bound} bound of the 95 % interval of {name}_scatter (Q-profile)"
+            )
     return table
 
 
@@ -170,8 +178,9 @@ def results_dataset(res: Sec4) -> xr.Dataset:
             values[f"truth_{name}"] = grid.truth
     for name in ("spin_theta_slope", "speed_theta_slope"):
         values[f"{name}_intercept"] = getattr(res, name).field("intercept")
-    for k in ("scatter", "scatter_ci_low", "scatter_ci_high"):
-        values[f"e_x_{k}"] = res.e_x.field(k)
+    for name in SCATTER_FITS:
+        for k in ("scatter", "scatter_ci_low", "scatter_ci_high"):
+            values[f"{name}_{k}"] = getattr(res, name).field(k)
     for name in _SLOPE_IS_ONE_PLUS:
         values[f"{name}_status"] = np.vectorize(lambda f: int(fit_status(f)), otypes=[np.int8])(getattr(res, name).fits)
     values.update({k: v for k, v in res.per_ball.items() if res.has_truth or not k.startswith("truth_")})
