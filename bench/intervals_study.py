@@ -7,8 +7,9 @@ first version; ``hc2``, shipped; ``hc3``) and the e_x fits with or without the i
 term (:data:`ballbat.linefit.SCATTER_TERM`; for the pooled e_x and the Eq. ratio slope, the
 scatter within bats, :data:`ballbat.fitting.WITHIN_BAT_SCATTER`). Variants: ``before`` (hc0k,
 no term), ``hc2`` (no term), ``after`` (hc3 and the term per bat), ``per_bat`` (hc2 and the term
-per bat), ``shipped`` (hc2, the term per bat and within bats for the pooled fits); name some on
-the command line to run only those. Stronge's eta^2 is not fitted (it is not judged here).
+per bat), ``within_redchi`` (and the term within bats for the pooled fits), ``shipped`` (and the
+pooled e_x's error from the sandwich centred within bats); name some on the command line to
+run only those. Stronge's eta^2 is not fitted (it is not judged here).
 The calibration is not drawn (statistical intervals; the combined ones need the drawn
 calibration of the robustness grid).
 
@@ -60,14 +61,16 @@ SETUPS = {
     "scatter0.01": lambda ds: _scatter(ds, 0.01),
 }
 
-#: variant -> (E_Y_SANDWICH, SCATTER_TERM, WITHIN_BAT_SCATTER): ``per_bat`` is the shipped form before
-#: the pooled e_x and the Eq. ratio slope got the scatter within bats
+#: variant -> (E_Y_SANDWICH, SCATTER_TERM, WITHIN_BAT_SCATTER, POOLED_SANDWICH): ``per_bat`` is the
+#: shipped form before the pooled e_x and the Eq. ratio slope got the scatter within bats,
+#: ``within_redchi`` that term with the pooled e_x's error still scaled by the reduced chi-square
 VARIANTS = {
-    "before": ("hc0k", False, False),
-    "hc2": ("hc2", False, False),
-    "after": ("hc3", True, False),
-    "per_bat": ("hc2", True, False),
-    "shipped": ("hc2", True, True),
+    "before": ("hc0k", False, False, False),
+    "hc2": ("hc2", False, False, False),
+    "after": ("hc3", True, False, False),
+    "per_bat": ("hc2", True, False, False),
+    "within_redchi": ("hc2", True, True, False),
+    "shipped": ("hc2", True, True, True),
 }
 
 
@@ -114,12 +117,13 @@ def main() -> None:
             mock.patch.object(replicates, "STUDY_QUANTITIES", quantities),
         ):
             for label in variants:
-                form, term, within = VARIANTS[label]
+                form, term, within, robust = VARIANTS[label]
                 t0 = time.perf_counter()
                 with (
                     mock.patch.object(fitting, "E_Y_SANDWICH", form),
                     mock.patch.object(linefit, "SCATTER_TERM", term),
                     mock.patch.object(fitting, "WITHIN_BAT_SCATTER", within),
+                    mock.patch.object(fitting, "POOLED_SANDWICH", robust),
                 ):
                     rep = study_batch.run(s, 0, balls, bats)
                     truth_v = [population_truth(s, 0, balls, bats)] if term else truth

@@ -111,6 +111,11 @@ class Sec4:
 #: (``linefit.eiv_line`` with the bats as strata; docs/model.md). False: fitted without the term,
 #: as before issue 36's last step (the studies' comparison, bench/intervals_study.py).
 WITHIN_BAT_SCATTER = True
+#: The pooled e_x's standard error is the HC3 sandwich centred within bats (the bats' own e_x differ
+#: by design, not by chance), not the covariance scaled by the reduced chi-square, which counts
+#: those differences as noise (with the scatter term it covered 97-98 %; docs/model.md). False:
+#: the scaled covariance (bench/intervals_study.py's comparison).
+POOLED_SANDWICH = True
 
 #: Per-ball quantities that are not line fits (values of :attr:`Sec4.per_ball`).
 PER_BALL = (
@@ -174,7 +179,15 @@ def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool)
         x, y, jx, jy = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
         sig = measured_sigma(ds, sel)
         fit = fit_line(
-            x, y, jx, jy, sig, errors_in_variables=True, strata=strata, scatter=strata is None or WITHIN_BAT_SCATTER
+            x,
+            y,
+            jx,
+            jy,
+            sig,
+            errors_in_variables=True,
+            strata=strata,
+            scatter=strata is None or WITHIN_BAT_SCATTER,
+            robust=strata is not None and POOLED_SANDWICH,
         )
         t = np.nan
         if with_truth and fit.success:
