@@ -235,9 +235,11 @@ def to_long(tracks: Tracks) -> dict[str, np.ndarray]:
 MAX_TRACK_FRAMES = 20_000
 #: The most bytes the padded tracks of one block of impacts may take (impacts x frames x points
 #: x 2 coordinates x 8 bytes, both cameras): a dataset within it is one block, as all shipped
-#: ones are; a larger one is split (:func:`plan_blocks`). One impact alone is never above it
-#: (:data:`MAX_TRACK_FRAMES` x 5 points x 16 bytes is 1.6 MB).
-BLOCK_BYTES = 256 * 2**20
+#: ones are (the default run's 108 impacts: 0.6 MB); a larger one is split (:func:`plan_blocks`).
+#: The reduction of a block takes about ten times its padded size at its peak
+#: (``bench/bench_track_blocks.py``), so a block costs at most some 350 MB. One impact alone is
+#: never above it (:data:`MAX_TRACK_FRAMES` x 5 points x 16 bytes is 1.6 MB).
+BLOCK_BYTES = 32 * 2**20
 
 
 def track_spans(
