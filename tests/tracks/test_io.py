@@ -109,3 +109,19 @@ def test_a_track_too_long_is_named(long_file, monkeypatch):
     (line,) = err.value.problems
     assert line.startswith(f"{long_file}: impact '4' spans 330 frames in the swing camera (")
     assert "more than the 300 one impact's track may span" in line
+
+
+def test_tracks_too_large_even_in_blocks_are_named(long_file, monkeypatch):
+    """Past MAX_DENSE_BYTES (lowered here) of a camera's tracks in their blocks, the dataset is refused by name."""
+    from helpers import BALLS, BATS
+
+    from ballbat.tracks import data
+
+    monkeypatch.setattr(data, "BLOCK_BYTES", 100_000)
+    # the swing camera's blocks: (25 x 73 + 330 + 4 x 82 columns) x 2 points x 16 bytes = 79 456 bytes
+    monkeypatch.setattr(data, "MAX_DENSE_BYTES", 50_000)
+    with pytest.raises(InputError) as err:
+        tio.load_tracks(long_file, balls=BALLS, bats=BATS)
+    (line,) = err.value.problems
+    assert line.startswith(f"{long_file}: the swing camera's tracks of 30 impacts would take 7.4e-05 GiB (in 3 block")
+    assert line.endswith(f"more than {50_000 / 2**30:g} GiB: track fewer frames per impact, or split the dataset")

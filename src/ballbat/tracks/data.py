@@ -236,10 +236,15 @@ MAX_TRACK_FRAMES = 20_000
 #: The most bytes the padded tracks of one block of impacts may take (impacts x frames x points
 #: x 2 coordinates x 8 bytes, both cameras): a dataset within it is one block, as all shipped
 #: ones are (the default run's 108 impacts: 0.6 MB); a larger one is split (:func:`plan_blocks`).
-#: The reduction of a block takes about ten times its padded size at its peak
-#: (``bench/bench_track_blocks.py``), so a block costs at most some 350 MB. One impact alone is
-#: never above it (:data:`MAX_TRACK_FRAMES` x 5 points x 16 bytes is 1.6 MB).
+#: It bounds the working arrays of one block's fits; the reduction keeps every block's fits for
+#: the cross-checks, about ten times the padded tracks at its peak (``bench/bench_track_blocks.py``).
+#: One impact alone is never above it (:data:`MAX_TRACK_FRAMES` x 5 points x 16 bytes is 1.6 MB).
 BLOCK_BYTES = 32 * 2**20
+#: The most bytes one camera's tracks may take in their blocks (the sum over the blocks of
+#: impacts x frames x points x 2 x 8 bytes): past it the dataset is refused by name (split it),
+#: before any array is made. The same 2 GiB as when every impact was padded to the longest track,
+#: now of the blocks, at most twice the tracks' own size.
+MAX_DENSE_BYTES = 2 * 2**30
 
 
 def track_spans(
@@ -275,6 +280,21 @@ def dense_problems(
                 f"{source}: impact {str(ids[k])!r} spans {int(span[k])} frames in the {cam} camera "
                 f"({lo[k]}-{hi[k]}), more than the {MAX_TRACK_FRAMES} one impact's track may span: track only "
                 "the frames around the impact (a rest position held for long, or a wrong frame number?)"
+            )
+    return problems
+
+
+def blocks_problems(spans: dict[str, np.ndarray], plan: list[np.ndarray], source: str) -> list[str]:
+    """Name each camera whose tracks, in the blocks of ``plan``, would take more than :data:`MAX_DENSE_BYTES`."""
+    problems = []
+    for cam, span in spans.items():
+        size = sum(idx.size * int(np.maximum(span[idx], 1).max()) for idx in plan) * len(POINTS[cam]) * 2 * 8
+        if size > MAX_DENSE_BYTES:
+            n = sum(idx.size for idx in plan)
+            problems.append(
+                f"{source}: the {cam} camera's tracks of {n} impacts would take {size / 2**30:.2g} GiB (in "
+                f"{len(plan)} block(s) of impacts), more than {MAX_DENSE_BYTES / 2**30:g} GiB: track fewer "
+                "frames per impact, or split the dataset"
             )
     return problems
 

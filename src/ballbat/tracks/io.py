@@ -20,7 +20,18 @@ import xarray as xr
 from ..properties import NETCDF_SUFFIXES as _NC
 from ..properties import InputError, read_table
 from .checks import check_frame_runs
-from .data import POINTS, Camera, Rig, TrackBlocks, Tracks, dense_problems, plan_blocks, to_dense, track_spans
+from .data import (
+    POINTS,
+    Camera,
+    Rig,
+    TrackBlocks,
+    Tracks,
+    blocks_problems,
+    dense_problems,
+    plan_blocks,
+    to_dense,
+    track_spans,
+)
 from .validate import (
     IMPACT_COLUMNS,
     TRACK_COLUMNS,
@@ -288,7 +299,11 @@ def _assemble(cols: dict, irows, truth_path, source: str = "tracks") -> Tracks |
         cameras={},
         truth=_truth_from_nc(truth_path) if truth_path is not None else {},
     )
-    plan = plan_blocks({c: v[2] for c, v in track_spans(impact_index, camera, frame, n).items()})
+    spans = {c: v[2] for c, v in track_spans(impact_index, camera, frame, n).items()}
+    plan = plan_blocks(spans)
+    too_large = blocks_problems(spans, plan, source)
+    if too_large:
+        raise InputError(too_large)
     if len(plan) == 1:
         tracks.cameras = to_dense(impact_index, camera, point, frame, x, y, n)
         return tracks
