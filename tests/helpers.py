@@ -97,6 +97,39 @@ def render(ds, cfg, truth_over=None):
     return tr, s
 
 
+def one_long_track(path: Path, factor: int = 5, long: int = 4, seed: int = 3, per_bat: int = 10):
+    """Write rendered tracks of 3 x ``per_bat`` impacts as a NetCDF tracks file, one track ``factor`` times as long.
+
+    Impact ``long``'s swing-camera ball track gets ``factor - 1`` times its frames more, at rest
+    before its first (its first position, 0.5 px noise): a lab that started tracking early.
+    Returns the render settings.
+    """
+    from ballbat.pipeline.ncio import write_dataset
+    from ballbat.stages.render import tracks_dataset
+
+    tr, s = render(experiment(seed, per_bat=per_bat), render_cfg(tilted_fraction=0.2))
+    ds = tracks_dataset(tr)
+    cols = ("impact_id", "camera", "point", "frame", "x_px", "y_px")
+    rows = {k: ds[k].values for k in cols}
+    sel = (rows["impact_id"] == tr.impact_id[long]) & (rows["camera"] == "swing") & (rows["point"] == "ball")
+    first = np.argmin(np.where(sel, rows["frame"], np.iinfo(np.int64).max))
+    k = (factor - 1) * int(sel.sum())
+    noise = 0.5 * np.random.default_rng(seed).standard_normal((2, k))
+    extra = {
+        "impact_id": np.full(k, tr.impact_id[long]),
+        "camera": np.full(k, "swing"),
+        "point": np.full(k, "ball"),
+        "frame": rows["frame"][first] - 1 - np.arange(k),
+        "x_px": rows["x_px"][first] + noise[0],
+        "y_px": rows["y_px"][first] + noise[1],
+    }
+    out = ds.drop_dims("row").assign(
+        {c: ("row", np.concatenate([rows[c], extra[c]]).astype(rows[c].dtype), ds[c].attrs) for c in cols}
+    )
+    write_dataset(out, path, title="tracks, one long", rule="test", inputs={}, config={})
+    return s
+
+
 def fake_replicates(n, se, spread, truth=1.0, dof=np.inf, seed=0):
     """Return n replicates of one quantity: estimates truth + N(0, spread) reporting ``se``."""
     rng = np.random.default_rng(seed)

@@ -19,7 +19,7 @@ import xarray as xr
 from matplotlib.figure import Figure
 
 from .plotting import save_figure
-from .tracks.data import Camera, Tracks
+from .tracks.data import Camera, TrackBlocks, Tracks
 from .tracks.reduce import FLAG_VAR, ReduceFlag, physical
 from .units import G
 
@@ -51,15 +51,15 @@ def _to_px(X, Y, cam: Camera):
     return cam.sign * X / cam.m_per_px, -Y / cam.m_per_px
 
 
-def impacts_figure(red: xr.Dataset, tracks: Tracks, impacts: list[int] | None = None) -> Figure:
+def impacts_figure(red: xr.Dataset, tracks: Tracks | TrackBlocks, impacts: list[int] | None = None) -> Figure:
     """Both camera views and the dot angles of a few impacts, with the fitted motions.
 
     Parameters
     ----------
     red : xarray.Dataset
         ``reduce.nc``.
-    tracks : Tracks
-        The tracks it was reduced from (same impact order).
+    tracks : Tracks or TrackBlocks
+        The tracks it was reduced from (same impact order); only the shown impacts' blocks are read.
     impacts : list of int, optional
         Impact indices to show (default :func:`pick_impacts`).
 
@@ -72,9 +72,10 @@ def impacts_figure(red: xr.Dataset, tracks: Tracks, impacts: list[int] | None = 
     fig = Figure(figsize=(13, 3.4 * max(len(idx), 1)), layout="constrained")
     axes = fig.subplots(max(len(idx), 1), 3, squeeze=False)
     for row, i in enumerate(idx):
-        _swing_panel(axes[row, 0], red, tracks, cams["swing"], i)
-        _spin_panel(axes[row, 1], red, tracks, cams["spin"], i)
-        _dot_angle_panel(axes[row, 2], red, tracks, cams["spin"], i)
+        block, k = tracks.locate(i)  # the impact's block of the tracks (all of them when one)
+        _swing_panel(axes[row, 0], red, block, cams["swing"], i, k)
+        _spin_panel(axes[row, 1], red, block, cams["spin"], i, k)
+        _dot_angle_panel(axes[row, 2], red, block, cams["spin"], i, k)
     return fig
 
 
@@ -88,8 +89,11 @@ def _camera_axes(ax, title: str) -> None:
     ax.legend(fontsize=7, loc="best")
 
 
-def _swing_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int) -> None:
-    """Swing camera: tracked tip dot and ball, the fitted pre-impact tip motion and the ball flight."""
+def _swing_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int, k: int) -> None:
+    """Swing camera: tracked tip dot and ball, the fitted pre-impact tip motion and the ball flight.
+
+    ``i``: the impact in ``red``; ``k``: its row in ``tracks`` (its block).
+    """
     flag = int(red[FLAG_VAR].values[i])
     status = "usable" if flag == 0 else f"EXCLUDED ({ReduceFlag(flag).name.lower()})"
     ct = tracks.cameras["swing"]
@@ -99,8 +103,8 @@ def _swing_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int) -> No
         ("ball", dict(color="tab:blue", marker="o")),
     ):
         ax.scatter(
-            ct.x[p][i],
-            ct.y[p][i],
+            ct.x[p][k],
+            ct.y[p][k],
             s=9,
             facecolors="none",
             edgecolors=style["color"],
@@ -119,7 +123,7 @@ def _swing_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int) -> No
         Y = red["tip_centroid_y"].values[i] + along * np.sin(plane_angle)
         x, y = _to_px(X, Y, cam)
         ax.plot(x[used], y[used], color="tab:brown", lw=1.2, label="tip fit (pre-impact)")
-    _flight_line(ax, red, i, "swing", t, cam, ct.x["ball"][i])
+    _flight_line(ax, red, i, "swing", t, cam, ct.x["ball"][k])
     iid = red["impact_id"].values[i]
     contact = ""
     if "contact_time" in red and np.isfinite(red["contact_time"].values[i]):
@@ -128,17 +132,17 @@ def _swing_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int) -> No
     _camera_axes(ax, f"impact {iid}: swing camera ({cam.fps:g} fps) — {status}{contact}")
 
 
-def _spin_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int) -> None:
+def _spin_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int, k: int) -> None:
     """Spin camera: tracked ball and dots, and the fitted path of the ball's centre."""
     ct = tracks.cameras["spin"]
     t = np.arange(ct.n_columns) / cam.fps
     for p, c in (("ball", "tab:blue"), ("dot_a", "tab:red"), ("dot_b", "tab:green")):
-        ax.scatter(ct.x[p][i], ct.y[p][i], s=9, color=c, label=p)
-    _flight_line(ax, red, i, "spin", t, cam, ct.x["ball"][i])
+        ax.scatter(ct.x[p][k], ct.y[p][k], s=9, color=c, label=p)
+    _flight_line(ax, red, i, "spin", t, cam, ct.x["ball"][k])
     _camera_axes(ax, f"spin camera ({cam.fps:g} fps)")
 
 
-def _dot_angle_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int) -> None:
+def _dot_angle_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int, k: int) -> None:
     """Each dot's unwrapped angle about the fitted centre against time, with the fitted spin."""
     ct = tracks.cameras["spin"]
     t = np.arange(ct.n_columns) / cam.fps
@@ -147,7 +151,7 @@ def _dot_angle_panel(ax, red: xr.Dataset, tracks: Tracks, cam: Camera, i: int) -
     omega = red["omega"].values[i]
     for p, c in (("dot_a", "tab:red"), ("dot_b", "tab:green")):
         X, Y = physical(ct, cam, p)
-        phi = np.arctan2(Y[i] - cy, X[i] - cx)
+        phi = np.arctan2(Y[k] - cy, X[k] - cx)
         ok = np.isfinite(phi) & (np.arange(t.size) >= sep)
         if ok.sum() < 2:
             continue

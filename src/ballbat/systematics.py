@@ -52,7 +52,7 @@ import xarray as xr
 from .instruments import INSTRUMENT_SOURCES
 
 if TYPE_CHECKING:
-    from .tracks.data import Camera, Rig, Tracks
+    from .tracks.data import Camera, Rig, TrackBlocks, Tracks
     from .tracks.reduce import ReduceOptions, Reduction
 
 #: The calibration sources, in the order of the ``systematic`` dimension: name -> what.
@@ -126,13 +126,17 @@ class Shifts:
 
 
 def reduce_shifts(
-    tracks: Tracks, cameras: dict[str, Camera], rig: Rig, options: ReduceOptions | None, nominal: Reduction
+    tracks: Tracks | TrackBlocks,
+    cameras: dict[str, Camera],
+    rig: Rig,
+    options: ReduceOptions | None,
+    nominal: Reduction,
 ) -> Shifts:
     """Reduce ``tracks`` again at +-1 sigma of each source with a stated uncertainty; return the shifts.
 
     Parameters
     ----------
-    tracks : Tracks
+    tracks : Tracks or TrackBlocks
         The tracks as read (the reduction removes its glitches itself).
     cameras, rig, options
         The settings of the nominal reduction.

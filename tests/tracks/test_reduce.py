@@ -306,3 +306,45 @@ def test_contact_time_tracks_the_true_one():
     assert abs(d.mean()) < 30e-6, d.mean()
     assert abs(z.mean()) < 0.2 and 0.7 < z.std() < 1.3, (z.mean(), z.std())
     assert np.mean(np.abs(z) < 2) > 0.9
+
+
+def _one_and_blocks(tmp_path, monkeypatch):
+    """The tracks of 30 impacts, one track 5x longer, read as one block and (budget lowered) in three."""
+    from helpers import one_long_track
+
+    from ballbat.tracks import data
+
+    s = one_long_track(tmp_path / "tracks.nc", factor=5)
+    one = load_tracks(tmp_path / "tracks.nc", balls=BALLS, bats=BATS)
+    monkeypatch.setattr(data, "BLOCK_BYTES", 100_000)
+    blocks = load_tracks(tmp_path / "tracks.nc", balls=BALLS, bats=BATS)
+    assert isinstance(one, data.Tracks) and [idx.size for idx in blocks.index] == [25, 1, 4]
+    return s, one, blocks
+
+
+def test_blocks_reduce_as_one_block(tmp_path, monkeypatch):
+    """Every impact's numbers reduced block by block are those of one block: flags, reasons, counts and frames bit for
+    bit; fitted values to 1e-12 (sums over frame columns group their terms by the padded width: last bits).
+
+    The pooled steps (the glitch and misplaced-mark noise, the contact times' prior) run on all impacts: a
+    block reduced by itself gets other contact times.
+    """
+    s, one, blocks = _one_and_blocks(tmp_path, monkeypatch)
+    a, b = reduce(one, s), reduce(blocks, s)
+    assert b.blocks is not None and len(b.blocks) == 3 and a.blocks is None
+    np.testing.assert_array_equal(b.flag, a.flag)
+    np.testing.assert_array_equal(b.reason, a.reason)
+    assert (a.flag != 0).sum() >= 3  # some exclusions, the same
+    for cam in ("swing", "spin"):
+        np.testing.assert_array_equal(b.n_outliers[cam], a.n_outliers[cam])
+        np.testing.assert_array_equal(b.onset[cam].onset, a.onset[cam].onset)
+        np.testing.assert_array_equal(b.flight[cam].separation, a.flight[cam].separation)
+        np.testing.assert_array_equal(b.flight[cam].n, a.flight[cam].n)
+    np.testing.assert_array_equal(b.swing.n, a.swing.n)
+    np.testing.assert_array_equal(b.spin.n, a.spin.n)
+    for k, v in a.values.items():
+        np.testing.assert_allclose(b.values[k], v, rtol=1e-12, atol=0, err_msg=k)
+    alone = reduce(blocks.blocks[0], s)  # the first block by itself: its own contact prior
+    idx = blocks.index[0]
+    assert np.nanmax(np.abs(alone.contact.duration - a.contact.duration[idx]) / a.contact.duration[idx]) > 1e-6
+    np.testing.assert_allclose(b.contact.duration[idx], a.contact.duration[idx], rtol=1e-12)

@@ -94,6 +94,11 @@ RED_TEAM = {
         "exit 1 naming the impact, the frames it spans and the limit, before the arrays are sized",
         ["test_long_rest_in_a_lab_csv"],
     ),
+    "thousands of impacts and one track 10x longer than the rest (every impact padded to it; past 2 GiB refused)": (
+        "accepted and reduced in blocks of impacts, padding at most as much again as the tracks "
+        "(memory: bench/bench_track_blocks.py)",
+        ["test_one_long_track_among_many"],
+    ),
     "a YAML alias bomb in a config (the schema check hangs)": (
         "a one-line config error, at once",
         ["test_yaml_alias_bomb"],
@@ -406,6 +411,35 @@ def test_long_rest_in_a_lab_csv(tmp_path):
     assert f"{path}: impact 'W03' spans" in out.stdout and "more than the 20000 one impact's track may span" in (
         out.stdout
     ), out.stdout
+
+
+def test_one_long_track_among_many(tmp_path, monkeypatch):
+    """30 impacts, one track 10x longer, a block budget lowered to a fifth of one block: reduced in blocks, the
+    padding bounded by the tracks' own size, the same flags as one block (a dataset of thousands, scaled down).
+    """
+    from helpers import BALLS, BATS, one_long_track
+
+    from ballbat.stages import reduce
+    from ballbat.tracks import data
+    from ballbat.tracks.io import load_tracks
+    from ballbat.tracks.reduce import ReduceOptions
+
+    s = one_long_track(tmp_path / "tracks.nc", factor=10)
+    one = load_tracks(tmp_path / "tracks.nc", balls=BALLS, bats=BATS)
+
+    def nbytes(tr):
+        return sum(a.nbytes for b in tr.blocks for ct in b.cameras.values() for a in (*ct.x.values(), *ct.y.values()))
+
+    tracked = sum(int(np.isfinite(ct.x[p]).sum()) * 16 for ct in one.cameras.values() for p in ct.x)
+    monkeypatch.setattr(data, "BLOCK_BYTES", nbytes(one) // 5)
+    blocks = load_tracks(tmp_path / "tracks.nc", balls=BALLS, bats=BATS)
+    assert nbytes(one) > 4 * tracked and nbytes(blocks) < 2 * tracked
+    settings = reduce.ReduceSettings(
+        {"swing": s.swing.camera, "spin": s.spin.camera}, s.rig, ReduceOptions.schema_defaults(), "tracks", True, True
+    )
+    a, b = (reduce.run(settings, tr, BALLS, BATS) for tr in (one, blocks))
+    assert b.sizes["impact"] == 30 and np.isfinite(b["v_bat"].values).sum() >= 25
+    np.testing.assert_array_equal(b["ingest_flag"].values, a["ingest_flag"].values)
 
 
 def test_yaml_alias_bomb(tmp_path, raw):

@@ -164,7 +164,7 @@ def _check_tracks(path: Path | None, args: argparse.Namespace, defaults: dict) -
             print(problem)
         print(f"{path}: not usable: {len(exc.problems)} problem(s)", file=sys.stderr)
         return 1
-    cams = ", ".join(sorted(tracks.cameras))
+    cams = ", ".join(sorted(tracks.blocks[0].cameras))
     print(
         f"{path}: read and validated: {tracks.n} impacts tracked by the cameras {cams}; not reduced: give --config "
         "(the dataset's camera settings and rig) for the reduction and its cross-checks"

@@ -25,7 +25,7 @@ if TYPE_CHECKING:
     import xarray as xr
 
     from ..properties import Ball, Bat
-    from ..tracks.data import Camera, CameraTracks, Rig, Tracks
+    from ..tracks.data import Camera, Rig, TrackBlocks, Tracks
 
 
 @dataclass(frozen=True)
@@ -88,7 +88,7 @@ def reduce_options(cfg: dict) -> ReduceOptions:
 
 
 def reduce_and_check(
-    settings: ReduceSettings, tracks: Tracks, balls: dict[str, Ball], bats: dict[str, Bat]
+    settings: ReduceSettings, tracks: Tracks | TrackBlocks, balls: dict[str, Ball], bats: dict[str, Bat]
 ) -> tuple[Reduction, Verdict | None]:
     """Reduce tracks and cross-check them (the verdict None where ``settings.cross_check`` is off).
 
@@ -104,8 +104,8 @@ def reduce_and_check(
     return red, verdict
 
 
-def _frame(ct: CameraTracks, col):
-    return np.where(col >= 0, ct.frame0 + col, -1).astype(np.int64)
+def _frame(frame0: np.ndarray, col):
+    return np.where(col >= 0, frame0 + col, -1).astype(np.int64)
 
 
 def _v(units, long_name, role=None, **extra):
@@ -213,16 +213,16 @@ def reduction_dataset(red: Reduction) -> xr.Dataset:
     tr = red.tracks
     values = dict(red.values)
     for cam in ("swing", "spin"):
-        ct = tr.cameras[cam]
-        values[f"impact_frame_{cam}"] = _frame(ct, red.onset[cam].onset)
-        values[f"separation_frame_{cam}"] = _frame(ct, red.flight[cam].separation)
+        frame0 = tr.frame0(cam)
+        values[f"impact_frame_{cam}"] = _frame(frame0, red.onset[cam].onset)
+        values[f"separation_frame_{cam}"] = _frame(frame0, red.flight[cam].separation)
         values[f"n_frames_flight_{cam}"] = red.flight[cam].n
         values[f"flight_rms_{cam}"] = red.flight[cam].sigma * np.sqrt(
             2 * np.maximum(red.flight[cam].n - 2, 0) / np.maximum(red.flight[cam].n, 1)
         )
     for cam in ("swing", "spin"):
         fl = red.flight[cam]
-        values[f"frame0_{cam}"] = tr.cameras[cam].frame0.astype(np.int64)
+        values[f"frame0_{cam}"] = tr.frame0(cam).astype(np.int64)
         values[f"flight_t_ref_{cam}"] = fl.t_ref
         values[f"flight_x0_{cam}"], values[f"flight_y0_{cam}"] = fl.x0, fl.y0
         values[f"flight_vx_{cam}"], values[f"flight_vy_{cam}"] = fl.vx, fl.vy
@@ -269,7 +269,7 @@ def reduction_dataset(red: Reduction) -> xr.Dataset:
 
 def run(
     settings: ReduceSettings,
-    tracks: Tracks,
+    tracks: Tracks | TrackBlocks,
     balls: dict[str, Ball],
     bats: dict[str, Bat],
     source_file: str | None = None,

@@ -42,7 +42,7 @@ if TYPE_CHECKING:
 
     from numpy.typing import ArrayLike
 
-    from .data import CameraTracks, Tracks
+    from .data import CameraTracks, TrackBlocks, Tracks
 
 #: False-alarm probability of the glitch test per tracked point (2-D Gaussian noise:
 #: P(|r| > Z s) = exp(-Z^2 / 2)); 10^4 impacts of 200 points make 2e6 points.
@@ -151,7 +151,9 @@ def _mad_sd(values: np.ndarray) -> float:
     return float(1.4826 * np.median(np.abs(v))) if v.size else math.nan
 
 
-def glitch_mask(x: np.ndarray, y: np.ndarray, skip: np.ndarray | None = None) -> np.ndarray:
+def glitch_mask(
+    x: np.ndarray, y: np.ndarray, skip: np.ndarray | None = None, pooled: float | None = None
+) -> np.ndarray:
     """Single-frame glitches of one point's tracks, (impact, column) pixels, NaN untracked.
 
     A point at frame k is a glitch when it lies far from the midpoint of its neighbours
@@ -167,7 +169,8 @@ def glitch_mask(x: np.ndarray, y: np.ndarray, skip: np.ndarray | None = None) ->
     Only points with two tracked frames on each side are tested (not a track's first or last
     two frames, nor those next to an untracked frame), and not the frames ``skip`` marks
     (the ball's and its dots' around the impact, where the motion itself has a kink that a
-    noisy point can turn into a spike).
+    noisy point can turn into a spike). ``pooled``: the noise of all impacts
+    (:func:`pooled_noise`) when ``x``, ``y`` hold a block of them; default: of the impacts given.
     """
     ok = np.isfinite(x) & np.isfinite(y)
     n, m = x.shape
@@ -175,7 +178,7 @@ def glitch_mask(x: np.ndarray, y: np.ndarray, skip: np.ndarray | None = None) ->
     if m < 3:
         return out
     sh = _shifter(m)
-    rx, ry, sd = _midpoint_noise(x, y)
+    rx, ry, sd = _midpoint_noise(x, y, pooled)
     with np.errstate(invalid="ignore"):
         lx, ly = x - 2 * sh(x, -1) + sh(x, -2), y - 2 * sh(y, -1) + sh(y, -2)
         qx, qy = x - 2 * sh(x, 1) + sh(x, 2), y - 2 * sh(y, 1) + sh(y, 2)
@@ -211,18 +214,35 @@ def _shifter(m: int):
     return sh
 
 
-def _midpoint_noise(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
+def _midpoint_offsets(x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Return each point's offset from the midpoint of its neighbours (rx, ry), NaN without two."""
+    sh = _shifter(x.shape[1])
+    with np.errstate(invalid="ignore"):
+        return x - 0.5 * (sh(x, -1) + sh(x, 1)), y - 0.5 * (sh(y, -1) + sh(y, 1))
+
+
+def pooled_noise(blocks: Sequence[tuple[np.ndarray, np.ndarray]]) -> float:
+    """Return the robust sd (1.4826 MAD) of the midpoint offsets' components of one point over all impacts.
+
+    ``blocks``: the point's (x, y) of each block of impacts; the median of the same values
+    however they are blocked (:func:`glitch_mask`'s and :func:`misplaced_starts`' pooled noise).
+    """
+    parts = [np.concatenate(_midpoint_offsets(x, y), axis=1).ravel() for x, y in blocks]
+    return _mad_sd(np.concatenate(parts))
+
+
+def _midpoint_noise(
+    x: np.ndarray, y: np.ndarray, pooled: float | None = None
+) -> tuple[np.ndarray, np.ndarray, np.ndarray | None]:
     """Return each point's offset from the midpoint of its neighbours (rx, ry) and the robust sd per impact.
 
     The sd of the offsets' components is the track's own (1.4826 MAD, from 10 values) or, if larger,
-    that of all impacts (None when no point has two neighbours).
+    that of all impacts (``pooled``, default: of the impacts given; None when no point has two neighbours).
     """
-    sh = _shifter(x.shape[1])
-    with np.errstate(invalid="ignore"):
-        rx = x - 0.5 * (sh(x, -1) + sh(x, 1))
-        ry = y - 0.5 * (sh(y, -1) + sh(y, 1))
+    rx, ry = _midpoint_offsets(x, y)
     comps = np.concatenate([rx, ry], axis=1)
-    pooled = _mad_sd(comps.ravel())
+    if pooled is None:
+        pooled = _mad_sd(comps.ravel())
     if not np.isfinite(pooled):
         return rx, ry, None
     with np.errstate(invalid="ignore"), warnings.catch_warnings():
@@ -247,7 +267,7 @@ class MisplacedStart:
     noise: np.ndarray
 
 
-def misplaced_starts(x: np.ndarray, y: np.ndarray) -> MisplacedStart:
+def misplaced_starts(x: np.ndarray, y: np.ndarray, pooled: float | None = None) -> MisplacedStart:
     """Test the first :data:`START_MARKS` marks of each track against the straight line through the next two.
 
     A mark at column k of a track whose first mark is at f is predicted from the marks at f + 2 and
@@ -258,12 +278,13 @@ def misplaced_starts(x: np.ndarray, y: np.ndarray) -> MisplacedStart:
     the offsets of each mark from its neighbours' midpoint (sd 1.5^0.5 s: :func:`glitch_mask`'s
     robust noise); the threshold is the glitch test's z. A misplaced first click (hundreds of
     pixels off) is found; a track with fewer than four marks from its start is not tested.
+    ``pooled``: as for :func:`glitch_mask`.
     """
     n, m = x.shape
     found = np.zeros(n, dtype=bool)
     column = np.zeros(n, dtype=np.int64)
     distance = np.zeros(n)
-    _, _, sd = _midpoint_noise(x, y)
+    _, _, sd = _midpoint_noise(x, y, pooled)
     if sd is None or m < START_MARKS + 2:
         return MisplacedStart(found, column, distance, np.full(n, np.nan))
     ok = np.isfinite(x) & np.isfinite(y)
@@ -650,27 +671,30 @@ def _length_unit_hypotheses() -> list[tuple[str, dict]]:
     return out
 
 
-def frame_steps(tracks: Tracks, largest: int = 10) -> dict[str, int]:
+def frame_steps(tracks: Tracks | TrackBlocks, largest: int = 10) -> dict[str, int]:
     """Return, per camera, the step d (2 to ``largest``) that every impact's tracked frames share; 1 if none.
 
     An impact counts when it has at least three tracked frames; a camera steps by d when each such
-    impact's tracked frames (any point) are all its first frame plus a multiple of d.
+    impact's tracked frames (any point) are all its first frame plus a multiple of d (in every block).
     """
     out = {}
-    for cam, ct in tracks.cameras.items():
-        tracked = np.any([np.isfinite(v) for v in ct.x.values()], axis=0)
-        rows = tracked.sum(axis=1) >= 3
-        out[cam] = 1
-        if not rows.any():
-            continue
-        tracked = tracked[rows]
-        first = np.argmax(tracked, axis=1)[:, None]
-        cols = np.arange(tracked.shape[1])[None, :]
-        for d in range(largest, 1, -1):
-            if not np.any(tracked & ((cols - first) % d != 0)):
-                out[cam] = d
-                break
+    for cam in tracks.blocks[0].cameras:
+        steps = [_steps_of(blk.cameras[cam], largest) for blk in tracks.blocks]
+        shared = set.intersection(*[s for s in steps if s is not None]) if any(s is not None for s in steps) else set()
+        out[cam] = max(shared, default=1)
     return out
+
+
+def _steps_of(ct: CameraTracks, largest: int) -> set[int] | None:
+    """Return the steps 2 to ``largest`` every impact of ``ct`` with three tracked frames keeps (None: none)."""
+    tracked = np.any([np.isfinite(v) for v in ct.x.values()], axis=0)
+    rows = tracked.sum(axis=1) >= 3
+    if not rows.any():
+        return None
+    tracked = tracked[rows]
+    first = np.argmax(tracked, axis=1)[:, None]
+    cols = np.arange(tracked.shape[1])[None, :]
+    return {d for d in range(2, largest + 1) if not np.any(tracked & ((cols - first) % d != 0))}
 
 
 def predict(h: dict) -> dict:

@@ -7,7 +7,9 @@ downward; the swing goes towards +x, or towards -x when the camera is ``mirror``
 
 In memory the tracks of one camera are dense arrays ``(impact, frame column)`` with NaN
 where a point was not tracked; column ``k`` of impact ``i`` is frame ``frame0[i] + k`` of
-that camera (frame origins are arbitrary and the cameras are not synchronised).
+that camera (frame origins are arbitrary and the cameras are not synchronised). A dataset
+whose impacts, padded to its longest track, would take more than :data:`BLOCK_BYTES` is held
+in blocks of impacts (:class:`TrackBlocks`), each padded only to its own longest track.
 """
 
 from __future__ import annotations
@@ -121,6 +123,90 @@ class Tracks:
         """Number of impacts."""
         return len(self.impact_id)
 
+    @property
+    def blocks(self) -> list[Tracks]:
+        """The blocks the tracks are held in: this one (:class:`TrackBlocks` holds several)."""
+        return [self]
+
+    @property
+    def index(self) -> list[np.ndarray]:
+        """Each block's impacts, as positions in the dataset: all, in order."""
+        return [np.arange(self.n)]
+
+    def frame0(self, camera: str) -> np.ndarray:
+        """Frame number of column 0 of each impact in ``camera``, (impact,)."""
+        return self.cameras[camera].frame0
+
+    def locate(self, i: int) -> tuple[Tracks, int]:
+        """Return the block holding impact ``i`` and its row there."""
+        return self, int(i)
+
+
+@dataclass
+class TrackBlocks:
+    """Tracks of a set of impacts held in blocks of impacts, each padded only to its own longest track.
+
+    ``blocks[b]`` is a :class:`Tracks` of the impacts at positions ``index[b]`` of the dataset
+    (ascending); every impact is in exactly one block. The per-impact fields (``impact_id``,
+    ``ball``, ``bat``, ``truth``, :meth:`frame0`) are the dataset's, in its order; the frames
+    are the blocks' (:meth:`locate`). Made by :func:`ballbat.tracks.io.load_tracks` when one
+    block would take more than :data:`BLOCK_BYTES` (:func:`plan_blocks`).
+    """
+
+    blocks: list[Tracks]
+    index: list[np.ndarray]
+
+    @property
+    def n(self) -> int:
+        """Number of impacts."""
+        return sum(len(i) for i in self.index)
+
+    def gather(self, parts: list[np.ndarray]) -> np.ndarray:
+        """One array per block (impact first) as one array in the dataset's order."""
+        return gather(parts, self.index, self.n)
+
+    @property
+    def impact_id(self) -> np.ndarray:
+        """Impact ids, (impact,)."""
+        return self.gather([b.impact_id for b in self.blocks])
+
+    @property
+    def ball(self) -> np.ndarray:
+        """Ball of each impact, (impact,)."""
+        return self.gather([b.ball for b in self.blocks])
+
+    @property
+    def bat(self) -> np.ndarray:
+        """Bat of each impact, (impact,)."""
+        return self.gather([b.bat for b in self.blocks])
+
+    @property
+    def truth(self) -> dict[str, np.ndarray]:
+        """True values of rendered tracks, (impact,) each (:attr:`Tracks.truth`)."""
+        return {k: self.gather([b.truth[k] for b in self.blocks]) for k in self.blocks[0].truth}
+
+    def frame0(self, camera: str) -> np.ndarray:
+        """Frame number of column 0 of each impact in ``camera``, (impact,)."""
+        return self.gather([b.cameras[camera].frame0 for b in self.blocks])
+
+    def locate(self, i: int) -> tuple[Tracks, int]:
+        """Return the block holding impact ``i`` and its row there."""
+        for blk, idx in zip(self.blocks, self.index, strict=True):
+            k = int(np.searchsorted(idx, i))
+            if k < idx.size and idx[k] == i:
+                return blk, k
+        raise IndexError(f"impact {i} of {self.n}")
+
+
+def gather(parts: list[np.ndarray], index: list[np.ndarray], n: int) -> np.ndarray:
+    """Return the blocks' arrays ``parts`` (impact first, rows ``index[b]`` of the dataset) as one, in its order."""
+    if len(parts) == 1 and np.array_equal(index[0], np.arange(n)):
+        return parts[0]
+    out = np.empty((n, *parts[0].shape[1:]), dtype=np.result_type(*parts))
+    for p, idx in zip(parts, index, strict=True):
+        out[idx] = p
+    return out
+
 
 def to_long(tracks: Tracks) -> dict[str, np.ndarray]:
     """Long-format rows ``impact_id, camera, point, frame, x_px, y_px`` (untracked cells omitted)."""
@@ -141,47 +227,108 @@ def to_long(tracks: Tracks) -> dict[str, np.ndarray]:
     return {k: v[order] for k, v in out.items()}
 
 
-#: The most frames one impact's track may span in one camera (first to last tracked frame): every
-#: impact's tracks are stored padded to the longest (one array per camera), so a track of 1e6 rest
-#: frames would make every impact that long. 20 000 frames are 6.7 s at 3000 frames per second.
+#: The most frames one impact's track may span in one camera (first to last tracked frame): 20 000
+#: frames are 6.7 s at 3000 frames per second, where the reduction fits some tens of frames
+#: around the impact. Longer is a mistake (a rest position held through the whole session, a
+#: wrong frame number), named before any array is made. Blocks (:data:`BLOCK_BYTES`) keep a long
+#: track from costing the other impacts anything; this limit is a sanity check, not a memory one.
 MAX_TRACK_FRAMES = 20_000
-#: The most bytes the padded tracks of one camera may take (impacts x frames x points x 2 x 8 bytes).
+#: The most bytes the padded tracks of one block of impacts may take (impacts x frames x points
+#: x 2 coordinates x 8 bytes, both cameras): a dataset within it is one block, as all shipped
+#: ones are (the default run's 108 impacts: 0.6 MB); a larger one is split (:func:`plan_blocks`).
+#: It bounds the working arrays of one block's fits; the reduction keeps every block's fits for
+#: the cross-checks, about ten times the padded tracks at its peak (``bench/bench_track_blocks.py``).
+#: One impact alone is never above it (:data:`MAX_TRACK_FRAMES` x 5 points x 16 bytes is 1.6 MB).
+BLOCK_BYTES = 32 * 2**20
+#: The most bytes one camera's tracks may take in their blocks (the sum over the blocks of
+#: impacts x frames x points x 2 x 8 bytes): past it the dataset is refused by name (split it),
+#: before any array is made. The same 2 GiB as when every impact was padded to the longest track,
+#: now of the blocks, at most twice the tracks' own size.
 MAX_DENSE_BYTES = 2 * 2**30
+
+
+def track_spans(
+    impact_index: np.ndarray, camera: np.ndarray, frame: np.ndarray, n: int
+) -> dict[str, tuple[np.ndarray, np.ndarray, np.ndarray]]:
+    """Per camera, each impact's first and last tracked frame and the frames spanned (0: no rows), (impact,) each."""
+    out = {}
+    for cam in POINTS:
+        sel = camera == cam
+        ii, ff = impact_index[sel], frame[sel].astype(np.int64)
+        lo = np.full(n, np.iinfo(np.int64).max, dtype=np.int64)
+        hi = np.full(n, np.iinfo(np.int64).min, dtype=np.int64)
+        np.minimum.at(lo, ii, ff)
+        np.maximum.at(hi, ii, ff)
+        out[cam] = (lo, hi, np.where(hi >= lo, hi - lo + 1, 0))
+    return out
 
 
 def dense_problems(
     ids: np.ndarray, impact_index: np.ndarray, camera: np.ndarray, frame: np.ndarray, source: str
 ) -> list[str]:
-    """Name what would make the padded arrays of :func:`to_dense` too large, before they are sized.
+    """Name each camera's longest track if it spans more than :data:`MAX_TRACK_FRAMES` frames (before any array).
 
-    The longest track of each camera (impact id, frames spanned) against :data:`MAX_TRACK_FRAMES`,
-    and the padded size against :data:`MAX_DENSE_BYTES`. ``ids``: the impact ids by index.
+    ``ids``: the impact ids by index; ``source``: the file, for messages.
     """
     problems = []
-    for cam, points in POINTS.items():
-        sel = camera == cam
-        if not sel.any():
+    for cam, (lo, hi, span) in track_spans(impact_index, camera, frame, ids.size).items():
+        if not span.any():
             continue
-        ii, ff = impact_index[sel], frame[sel].astype(np.int64)
-        lo = np.full(ids.size, np.iinfo(np.int64).max, dtype=np.int64)
-        hi = np.full(ids.size, np.iinfo(np.int64).min, dtype=np.int64)
-        np.minimum.at(lo, ii, ff)
-        np.maximum.at(hi, ii, ff)
-        span = np.where(hi >= lo, hi - lo + 1, 0)
         k = int(np.argmax(span))
-        size = ids.size * int(span[k]) * len(points) * 2 * 8
-        what = f"{source}: impact {str(ids[k])!r} spans {int(span[k])} frames in the {cam} camera ({lo[k]}-{hi[k]})"
         if span[k] > MAX_TRACK_FRAMES:
             problems.append(
-                f"{what}, more than the {MAX_TRACK_FRAMES} one impact's track may span: track only the "
-                "frames around the impact (a rest position held for long, or a wrong frame number?)"
-            )
-        elif size > MAX_DENSE_BYTES:
-            problems.append(
-                f"{what}: {ids.size} impacts padded to it would take {size / 2**30:.1f} GiB, more than "
-                f"{MAX_DENSE_BYTES // 2**30} GiB; track fewer frames per impact, or split the dataset"
+                f"{source}: impact {str(ids[k])!r} spans {int(span[k])} frames in the {cam} camera "
+                f"({lo[k]}-{hi[k]}), more than the {MAX_TRACK_FRAMES} one impact's track may span: track only "
+                "the frames around the impact (a rest position held for long, or a wrong frame number?)"
             )
     return problems
+
+
+def blocks_problems(spans: dict[str, np.ndarray], plan: list[np.ndarray], source: str) -> list[str]:
+    """Name each camera whose tracks, in the blocks of ``plan``, would take more than :data:`MAX_DENSE_BYTES`."""
+    problems = []
+    for cam, span in spans.items():
+        size = sum(idx.size * int(np.maximum(span[idx], 1).max()) for idx in plan) * len(POINTS[cam]) * 2 * 8
+        if size > MAX_DENSE_BYTES:
+            n = sum(idx.size for idx in plan)
+            problems.append(
+                f"{source}: the {cam} camera's tracks of {n} impacts would take {size / 2**30:.2g} GiB (in "
+                f"{len(plan)} block(s) of impacts), more than {MAX_DENSE_BYTES / 2**30:g} GiB: track fewer "
+                "frames per impact, or split the dataset"
+            )
+    return problems
+
+
+def plan_blocks(spans: dict[str, np.ndarray], budget: int | None = None) -> list[np.ndarray]:
+    """Group the impacts into blocks whose padded tracks take at most ``budget`` bytes each.
+
+    ``spans``: per camera, the frames each impact's track spans, (impact,). One block of every
+    impact when padding them all to the longest fits ``budget`` (default :data:`BLOCK_BYTES`).
+    Otherwise the impacts, in order of their own size, fill blocks while a block's padded size
+    stays within ``budget`` and within twice its tracks' own size, so that padding costs at most
+    as much again as the tracks: a track ten times longer than the rest gets a block of its own
+    (or of its like), not every impact padded to it. Each block lists its impacts in the
+    dataset's order.
+    """
+    budget = BLOCK_BYTES if budget is None else budget
+    cams = list(spans)
+    per = np.array([len(POINTS[c]) * 2 * 8 for c in cams], dtype=np.int64)  # bytes per frame column
+    s = np.stack([np.maximum(np.asarray(spans[c], dtype=np.int64), 1) for c in cams], axis=1)  # to_dense: >= 1
+    n = s.shape[0]
+    if n * int(s.max(axis=0) @ per) <= budget:
+        return [np.arange(n)]
+    own = s @ per
+    blocks, cur, hi, size = [], [], np.zeros(len(cams), dtype=np.int64), 0
+    for i in np.argsort(own, kind="stable"):
+        top = np.maximum(hi, s[i])
+        padded = (len(cur) + 1) * int(top @ per)
+        if cur and (padded > budget or padded > 2 * (size + int(own[i]))):
+            blocks.append(np.sort(np.array(cur)))
+            cur, top, size = [], s[i].copy(), 0
+        cur.append(i)
+        hi, size = top, size + int(own[i])
+    blocks.append(np.sort(np.array(cur)))
+    return sorted(blocks, key=lambda b: int(b[0]))
 
 
 def to_dense(

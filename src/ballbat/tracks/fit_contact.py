@@ -173,6 +173,28 @@ def fit_contact(
     Contact
         NaN where no impact was found.
     """
+    cl = contact_likelihood(X, Y, t, onset, flight)
+    return contact_posterior(cl, contact_prior(cl.lik, cl.found, groups))
+
+
+@dataclass
+class ContactLikelihood:
+    """Per impact, what its own frames say of its contact (:func:`contact_likelihood`)."""
+
+    lik: np.ndarray  # (impact, grid): likelihood of each contact time of the grid, 1 at its largest
+    t_mid: np.ndarray  # the free flight extrapolated back to the rest position (s)
+    t_mid_err: np.ndarray
+    n_rest: np.ndarray  # frames at rest the rest position is the mean of
+    n: np.ndarray  # frames within the widest contact about t_mid
+    found: np.ndarray  # an impact found (onset)
+
+
+def contact_likelihood(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, flight: Flight) -> ContactLikelihood:
+    """Each impact's contact middle and the likelihood of each contact time (:func:`fit_contact`'s first step).
+
+    Row by row: an impact's numbers depend on its own frames alone (the contact times' prior,
+    :func:`contact_prior`, pools the impacts).
+    """
     X = np.asarray(X, dtype=float)
     Y = np.asarray(Y, dtype=float)
     t = np.asarray(t, dtype=float)
@@ -204,22 +226,41 @@ def fit_contact(
         idx = np.minimum(first[:, None] + np.arange(width)[None, :], X.shape[1] - 1)
         dtw, sw = np.take_along_axis(dt, idx, axis=1), np.take_along_axis(s, idx, axis=1)
         ww = np.take_along_axis(win, idx, axis=1) & (first[:, None] + np.arange(width)[None, :] < X.shape[1])
-        grid = np.linspace(lo, hi, CONTACT_GRID)
-        logl = _contact_loglik(dtw, sw, ww, v, flight.sigma, grid)
+        logl = _contact_loglik(dtw, sw, ww, v, flight.sigma, np.linspace(lo, hi, CONTACT_GRID))
         logl -= np.max(logl, axis=1, keepdims=True)
         lik = np.exp(logl)
-        grp = np.zeros(X.shape[0], dtype=int) if groups is None else np.unique(groups, return_inverse=True)[1]
-        post = lik * _contact_population(lik, np.where(onset.found, grp, -1), grid)
+    return ContactLikelihood(lik, t_mid, t_mid_err, n_rest, win.sum(axis=1), onset.found)
+
+
+def contact_prior(lik: np.ndarray, found: np.ndarray, groups: ArrayLike | None = None) -> np.ndarray:
+    """Return per impact the distribution of contact times among its group's impacts, (impact, grid).
+
+    :func:`_contact_population`, pooled over every impact given (all of a dataset's, whatever blocks they are held in);
+    ``groups``: each impact's ball type, one group if None; impacts without ``found`` are left out.
+    """
+    lo, hi = CONTACT_PRIOR
+    grp = np.zeros(lik.shape[0], dtype=int) if groups is None else np.unique(groups, return_inverse=True)[1]
+    with np.errstate(all="ignore"):
+        return _contact_population(lik, np.where(found, grp, -1), np.linspace(lo, hi, CONTACT_GRID))
+
+
+def contact_posterior(cl: ContactLikelihood, prior: np.ndarray) -> Contact:
+    """Each impact's contact from its likelihood and its group's prior (:func:`fit_contact`'s last step, row by row)."""
+    lo, hi = CONTACT_PRIOR
+    grid = np.linspace(lo, hi, CONTACT_GRID)
+    with np.errstate(all="ignore"):
+        post = cl.lik * prior
         post /= post.sum(axis=1, keepdims=True)
         tc_mean = post @ grid
         tc_err = np.sqrt(np.maximum(post @ grid**2 - tc_mean**2, 0.0))
-    ok = onset.found & (n_rest > 0) & np.isfinite(t_mid) & np.isfinite(tc_mean)
-    nan = np.full(X.shape[0], np.nan)
+    t_mid = cl.t_mid
+    ok = cl.found & (cl.n_rest > 0) & np.isfinite(t_mid) & np.isfinite(tc_mean)
+    nan = np.full(t_mid.shape[0], np.nan)
     return Contact(
         t_mid=np.where(ok, t_mid, nan),
         t_start=np.where(ok, t_mid - 0.5 * tc_mean, nan),
-        t_start_err=np.where(ok, np.hypot(t_mid_err, 0.5 * tc_err), nan),
+        t_start_err=np.where(ok, np.hypot(cl.t_mid_err, 0.5 * tc_err), nan),
         duration=np.where(ok, tc_mean, nan),
         duration_err=np.where(ok, tc_err, nan),
-        n=np.where(ok, win.sum(axis=1), 0).astype(int),
+        n=np.where(ok, cl.n, 0).astype(int),
     )

@@ -20,7 +20,18 @@ import xarray as xr
 from ..properties import NETCDF_SUFFIXES as _NC
 from ..properties import InputError, read_table
 from .checks import check_frame_runs
-from .data import POINTS, Camera, Rig, Tracks, dense_problems, to_dense
+from .data import (
+    POINTS,
+    Camera,
+    Rig,
+    TrackBlocks,
+    Tracks,
+    blocks_problems,
+    dense_problems,
+    plan_blocks,
+    to_dense,
+    track_spans,
+)
 from .validate import (
     IMPACT_COLUMNS,
     TRACK_COLUMNS,
@@ -130,8 +141,8 @@ def load_tracks(
     impacts_path: str | os.PathLike[str] | None = None,
     balls: dict | None = None,
     bats: dict | None = None,
-) -> Tracks:
-    """Read and check a tracks file and its impacts file; return dense tracks.
+) -> Tracks | TrackBlocks:
+    """Read and check a tracks file and its impacts file; return dense tracks (in blocks when one would be too large).
 
     Parameters
     ----------
@@ -145,7 +156,9 @@ def load_tracks(
 
     Returns
     -------
-    Tracks
+    Tracks or TrackBlocks
+        One :class:`~ballbat.tracks.data.Tracks` when padding every impact to the longest track
+        is cheap (:data:`~ballbat.tracks.data.BLOCK_BYTES`), else blocks of impacts.
 
     Raises
     ------
@@ -262,31 +275,47 @@ def _fast_checked(cols: dict, impacts: dict) -> dict | None:
     return {"impact_id": iid, "camera": cam, "point": point, "frame": f, "x_px": x, "y_px": y}
 
 
-def _assemble(cols: dict, irows, truth_path, source: str = "tracks") -> Tracks:
-    """Lay checked long rows out as dense tracks; too large a layout is named first (``source``: the file)."""
-    ids = [row["impact_id"] for _, row in irows]
-    index = {iid: i for i, iid in enumerate(ids)}
+def _assemble(cols: dict, irows, truth_path, source: str = "tracks") -> Tracks | TrackBlocks:
+    """Lay checked long rows out as dense tracks; a track too long is named first (``source``: the file).
+
+    One :class:`Tracks` when padding every impact to the longest track fits
+    :data:`~ballbat.tracks.data.BLOCK_BYTES`, else :class:`TrackBlocks` (:func:`~ballbat.tracks.data.plan_blocks`).
+    """
+    ids = np.array([row["impact_id"] for _, row in irows], dtype=str)
+    index = {iid: i for i, iid in enumerate(ids.tolist())}
     n = len(ids)
     uniq, inv = np.unique(np.asarray(cols["impact_id"]).astype(str), return_inverse=True)
     impact_index = np.array([index[u] for u in uniq], dtype=np.int64)[inv]
     camera, frame = np.asarray(cols["camera"]).astype(str), np.asarray(cols["frame"], dtype=np.int64)
-    too_large = dense_problems(np.array(ids, dtype=str), impact_index, camera, frame, source)
+    too_large = dense_problems(ids, impact_index, camera, frame, source)
     if too_large:
         raise InputError(too_large)
-    cams = to_dense(
-        impact_index,
-        camera,
-        np.asarray(cols["point"]).astype(str),
-        frame,
-        np.asarray(cols["x_px"], dtype=float),
-        np.asarray(cols["y_px"], dtype=float),
-        n,
-    )
-    truth = _truth_from_nc(truth_path) if truth_path is not None else {}
-    return Tracks(
-        impact_id=np.array(ids, dtype=str),
+    point = np.asarray(cols["point"]).astype(str)
+    x, y = np.asarray(cols["x_px"], dtype=float), np.asarray(cols["y_px"], dtype=float)
+    tracks = Tracks(
+        impact_id=ids,
         ball=np.array([row["ball"] for _, row in irows], dtype=str),
         bat=np.array([row["bat"] for _, row in irows], dtype=str),
-        cameras=cams,
-        truth=truth,
+        cameras={},
+        truth=_truth_from_nc(truth_path) if truth_path is not None else {},
     )
+    spans = {c: v[2] for c, v in track_spans(impact_index, camera, frame, n).items()}
+    plan = plan_blocks(spans)
+    too_large = blocks_problems(spans, plan, source)
+    if too_large:
+        raise InputError(too_large)
+    if len(plan) == 1:
+        tracks.cameras = to_dense(impact_index, camera, point, frame, x, y, n)
+        return tracks
+    blocks = []
+    position = np.empty(n, dtype=np.int64)
+    for idx in plan:
+        position[idx] = np.arange(idx.size)
+        rows = np.isin(impact_index, idx)
+        sub = Tracks(
+            tracks.impact_id[idx], tracks.ball[idx], tracks.bat[idx], {}, {k: v[idx] for k, v in tracks.truth.items()}
+        )
+        ii = position[impact_index[rows]]
+        sub.cameras = to_dense(ii, camera[rows], point[rows], frame[rows], x[rows], y[rows], idx.size)
+        blocks.append(sub)
+    return TrackBlocks(blocks, plan)

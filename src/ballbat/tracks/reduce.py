@@ -1,6 +1,8 @@
 """Reduce raw camera tracks to the impacts the chain analyses (Sec. II).
 
-Per impact, all impacts at once (dense arrays, masked sums; no Python loop over impacts); each
+Per impact, all impacts of a block at once (dense arrays, masked sums; no Python loop over
+impacts; a dataset held in blocks, :class:`~ballbat.tracks.data.TrackBlocks`, block by block,
+with every step that pools impacts run on all of them together: :func:`reduce_tracks`); each
 step's fit is a module of its own (:mod:`~ballbat.tracks.fit_flight` steps 1-2,
 :mod:`~ballbat.tracks.fit_contact` and :mod:`~ballbat.tracks.fit_swing` step 3,
 :mod:`~ballbat.tracks.fit_spin` step 4), and this module runs them and marks the exclusions:
@@ -45,15 +47,15 @@ rate to unwrap. Exclude, never drop.
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, is_dataclass, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..units import G
-from .checks import IMPACT_Z, START_MARKS, camera_agreement, glitch_mask, misplaced_starts
-from .data import POINTS, Camera, CameraTracks, Rig, Tracks
-from .fit_contact import Contact, fit_contact
+from .checks import IMPACT_Z, START_MARKS, camera_agreement, glitch_mask, misplaced_starts, pooled_noise
+from .data import POINTS, Camera, CameraTracks, Rig, TrackBlocks, Tracks, gather
+from .fit_contact import Contact, ContactLikelihood, contact_likelihood, contact_posterior, contact_prior
 from .fit_flight import CONTACT_MAX, Flight, find_onset, fit_flight
 from .fit_spin import OFFSET_FALSE_ALARM, RADIUS_TOLERANCE, UNWRAP_LIMIT, Spin, fit_spin, radius_scatter_limit
 from .fit_swing import Swing, fit_swing
@@ -126,15 +128,30 @@ class Reduction:
     agreement: object = None
     contact: Contact | None = None
     shifts: object = None  # calibration systematics (ballbat.systematics.reduce_shifts), when asked for
+    #: A dataset held in blocks (``tracks`` a :class:`TrackBlocks`): each block's own reduction, in
+    #: the order of ``tracks.blocks``, holding the arrays along frame columns (``times``, ``phys``,
+    #: the fits' masks), which are empty or None here; the per-impact arrays here are the dataset's.
+    blocks: list[Reduction] | None = None
+
+    def parts(self) -> list[tuple[Reduction, np.ndarray]]:
+        """Each block's reduction and its impacts' positions in the dataset (one block: this one, all)."""
+        if self.blocks is None:
+            return [(self, np.arange(self.tracks.n))]
+        return list(zip(self.blocks, self.tracks.index, strict=True))
 
 
-def remove_glitches(tracks: Tracks, cameras: dict[str, Camera]) -> tuple[Tracks, dict[str, np.ndarray]]:
+def remove_glitches(
+    tracks: Tracks, cameras: dict[str, Camera], noise: dict | None = None
+) -> tuple[Tracks, dict[str, np.ndarray]]:
     """Return the tracks without their single-frame glitches (:func:`.checks.glitch_mask`), and the count per impact.
 
     The ball's and the dots' frames from the last at rest to the end of the longest contact
     (:data:`CONTACT_MAX`) after the impact frame (:func:`find_onset` on the raw track) are
     not tested. The input is not changed. Counts are per camera (all its points), shape (impact,).
+    ``noise``: each (camera, point)'s noise over all impacts when ``tracks`` is a block of them
+    (:func:`pooled_noises`); default: of the impacts given.
     """
+    noise = noise or {}
     cams, counts = {}, {}
     for name, ct in tracks.cameras.items():
         xs, ys = {}, {}
@@ -144,7 +161,7 @@ def remove_glitches(tracks: Tracks, cameras: dict[str, Camera]) -> tuple[Tracks,
         cols = np.arange(ct.n_columns)[None, :]
         kink = on.found[:, None] & (cols >= on.rest[:, None] - 1) & (cols <= on.onset[:, None] + n_c + 1)
         for p in POINTS[name]:
-            bad = glitch_mask(ct.x[p], ct.y[p], None if p == "bat_tip" else kink)
+            bad = glitch_mask(ct.x[p], ct.y[p], None if p == "bat_tip" else kink, noise.get((name, p)))
             xs[p], ys[p] = np.where(bad, np.nan, ct.x[p]), np.where(bad, np.nan, ct.y[p])
             count += bad.sum(axis=1)
         cams[name] = CameraTracks(ct.frame0, xs, ys)
@@ -157,15 +174,34 @@ def physical(ct: CameraTracks, cam: Camera, point: str) -> tuple[np.ndarray, np.
     return cam.sign * ct.x[point] * cam.m_per_px, -ct.y[point] * cam.m_per_px
 
 
+def pooled_noises(blocks: list[Tracks]) -> dict[tuple[str, str], float]:
+    """Each (camera, point)'s midpoint noise over the impacts of every block (:func:`.checks.pooled_noise`).
+
+    Empty for one block: the checks then pool the impacts they are given, all of them.
+    """
+    if len(blocks) == 1:
+        return {}
+    return {
+        (c, p): pooled_noise([(b.cameras[c].x[p], b.cameras[c].y[p]) for b in blocks])
+        for c in POINTS
+        for p in POINTS[c]
+    }
+
+
 def reduce_tracks(
-    tracks: Tracks, cameras: dict[str, Camera], rig: Rig, options: ReduceOptions | None = None
+    tracks: Tracks | TrackBlocks, cameras: dict[str, Camera], rig: Rig, options: ReduceOptions | None = None
 ) -> Reduction:
     """Reduce every impact's tracks to v_bat, v_ball, theta, omega with fitted uncertainties.
 
+    Block by block for tracks held in blocks; the steps that pool the impacts (the glitch and
+    misplaced-mark tests' noise of all impacts, :func:`pooled_noises`; the contact times' prior
+    per ball type, :func:`~ballbat.tracks.fit_contact.contact_prior`) run on all impacts
+    together, so that every impact's numbers do not depend on the blocks.
+
     Parameters
     ----------
-    tracks : Tracks
-        Dense tracks of both cameras.
+    tracks : Tracks or TrackBlocks
+        Dense tracks of both cameras (:func:`ballbat.tracks.io.load_tracks`).
     cameras : dict
         ``swing`` and ``spin`` :class:`Camera` settings.
     rig : Rig
@@ -176,13 +212,58 @@ def reduce_tracks(
     Returns
     -------
     Reduction
-        The fits, the values (SI) and the flag and reason of every impact.
+        The fits, the values (SI) and the flag and reason of every impact, in the dataset's
+        order (tracks in blocks: the blocks' own reductions in ``blocks``).
     """
     opt = options or ReduceOptions.schema_defaults()
-    tracks, n_outliers = remove_glitches(tracks, cameras)
-    onset, flight, times, phys, contact, swing, spin = _fit_motions(tracks, cameras, rig)
+    blocks = tracks.blocks
+    glitch_noise = pooled_noises(blocks)
+    cleaned = [remove_glitches(b, cameras, glitch_noise) for b in blocks]
+    start_noise = pooled_noises([tr for tr, _ in cleaned])
+    balls = [_fit_ball(tr, cameras) for tr, _ in cleaned]
+    lik = [m[-1] for m in balls]
+    prior = contact_prior(
+        gather([c.lik for c in lik], tracks.index, tracks.n),
+        gather([c.found for c in lik], tracks.index, tracks.n),
+        tracks.ball,
+    )
+    parts = [
+        _finish(tr, counts, ball, prior[idx], cameras, rig, opt, start_noise)
+        for (tr, counts), ball, idx in zip(cleaned, balls, tracks.index, strict=True)
+    ]
+    if len(parts) == 1:
+        return parts[0]
+    merged = _gathered(parts, tracks)
+    return replace(merged, tracks=tracks, cameras=cameras, rig=rig, times={}, phys={}, blocks=parts)
+
+
+def _gathered(objs: list, tracks: TrackBlocks):
+    """Return the blocks' results ``objs`` (arrays, dicts, dataclasses of them) in the dataset's order.
+
+    Arrays of one dimension (impact) are gathered; arrays along frame columns, whose widths
+    differ between blocks, are None (each block's are in its own result).
+    """
+    first = objs[0]
+    if isinstance(first, np.ndarray):
+        return tracks.gather(objs) if first.ndim == 1 else None
+    if isinstance(first, dict):
+        return {k: _gathered([o[k] for o in objs], tracks) for k in first}
+    if isinstance(first, tuple):
+        return tuple(_gathered(list(v), tracks) for v in zip(*objs, strict=True))
+    if is_dataclass(first) and not isinstance(first, (Tracks, Camera, Rig)):
+        return replace(first, **{f.name: _gathered([getattr(o, f.name) for o in objs], tracks) for f in fields(first)})
+    return first
+
+
+def _finish(
+    tracks: Tracks, n_outliers: dict, ball: tuple, prior: np.ndarray, cameras, rig: Rig, opt, start_noise: dict
+) -> Reduction:
+    """Reduce one block from its ball fits (:func:`_fit_ball`) and its rows of the contact times' prior."""
+    onset, flight, times, phys, lik = ball
+    contact = contact_posterior(lik, prior)
+    swing, spin = _fit_bat_and_spin(tracks, cameras, rig, onset, flight, times, phys, contact)
     values = _measured_values(flight["swing"], swing, spin, contact, cameras, rig)
-    flag, reason, agree = _exclusions(tracks, onset, flight, swing, spin, cameras, opt)
+    flag, reason, agree = _exclusions(tracks, onset, flight, swing, spin, cameras, opt, start_noise)
     return Reduction(
         tracks,
         cameras,
@@ -202,10 +283,11 @@ def reduce_tracks(
     )
 
 
-def _fit_motions(tracks: Tracks, cameras: dict[str, Camera], rig: Rig) -> tuple:
-    """Fit every impact: the ball's onset and free flight in each camera, the contact, the swing, the spin.
+def _fit_ball(tracks: Tracks, cameras: dict[str, Camera]) -> tuple:
+    """Fit the ball of every impact: its onset and free flight in each camera, its contact's likelihood.
 
-    Returns ``onset, flight, times, phys, contact, swing, spin`` (:class:`Reduction`'s fields).
+    Returns ``onset, flight, times, phys`` (:class:`Reduction`'s fields) and the
+    :class:`~ballbat.tracks.fit_contact.ContactLikelihood`.
     """
     n = tracks.n
     onset, flight, times, phys = {}, {}, {}, {}
@@ -217,9 +299,18 @@ def _fit_motions(tracks: Tracks, cameras: dict[str, Camera], rig: Rig) -> tuple:
         X, Y = physical(ct, cam, "ball")
         phys[(name, "ball")] = (X, Y)
         flight[name] = fit_flight(X, Y, t, onset[name], cam.fps)
+    lik: ContactLikelihood = contact_likelihood(
+        *phys[("swing", "ball")], times["swing"], onset["swing"], flight["swing"]
+    )
+    return onset, flight, times, phys, lik
+
+
+def _fit_bat_and_spin(
+    tracks: Tracks, cameras: dict[str, Camera], rig: Rig, onset: dict, flight: dict, times: dict, phys: dict, contact
+) -> tuple[Swing, Spin]:
+    """Fit every impact's swing (before the contact's start) and spin; ``phys`` gets the tip's and dots' tracks."""
     Xt, Yt = physical(tracks.cameras["swing"], cameras["swing"], "bat_tip")
     phys[("swing", "bat_tip")] = (Xt, Yt)
-    contact = fit_contact(*phys[("swing", "ball")], times["swing"], onset["swing"], flight["swing"], tracks.ball)
     swing = fit_swing(
         Xt,
         Yt,
@@ -241,7 +332,7 @@ def _fit_motions(tracks: Tracks, cameras: dict[str, Camera], rig: Rig) -> tuple:
         cameras["spin"],
         phys[("spin", "ball")],
     )
-    return onset, flight, times, phys, contact, swing, spin
+    return swing, spin
 
 
 def _measured_values(
@@ -307,21 +398,31 @@ class _Marks:
 
 
 def _exclusions(
-    tracks: Tracks, onset: dict, flight: dict, swing: Swing, spin: Spin, cameras: dict[str, Camera], opt: ReduceOptions
+    tracks: Tracks,
+    onset: dict,
+    flight: dict,
+    swing: Swing,
+    spin: Spin,
+    cameras: dict[str, Camera],
+    opt: ReduceOptions,
+    noise: dict | None = None,
 ) -> tuple[np.ndarray, np.ndarray, object]:
-    """Return the flag and reason of every impact (the first reason that applies), and the cameras' agreement."""
+    """Return the flag and reason of every impact (the first reason that applies), and the cameras' agreement.
+
+    ``noise``: the misplaced-mark test's noise of all impacts (:func:`pooled_noises`) for a block.
+    """
     mark = _Marks(tracks.n)
-    _start_exclusions(mark, tracks)
+    _start_exclusions(mark, tracks, noise or {})
     agree = _motion_exclusions(mark, onset, flight, swing, cameras, opt)
     _spin_exclusions(mark, flight, spin, cameras["spin"].fps, opt)
     return mark.flag, mark.reason, agree
 
 
-def _start_exclusions(mark: _Marks, tracks: Tracks) -> None:
+def _start_exclusions(mark: _Marks, tracks: Tracks, noise: dict) -> None:
     """Mark impacts with a track whose first marks lie far off its run (:func:`.checks.misplaced_starts`)."""
     for cam, ct in tracks.cameras.items():
         for p in POINTS[cam]:
-            ms = misplaced_starts(ct.x[p], ct.y[p])
+            ms = misplaced_starts(ct.x[p], ct.y[p], noise.get((cam, p)))
             mark(
                 ms.found,
                 ReduceFlag.MISPLACED_MARK,

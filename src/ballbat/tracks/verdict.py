@@ -9,7 +9,7 @@ called by the reduction itself, so this module, not :mod:`.checks`, sits above :
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, fields
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -21,6 +21,7 @@ from .checks import (
     DATASET_Z,
     FLIP_Z,
     IMPACT_Z,
+    FreeFall,
     diagnose,
     frame_steps,
     free_fall,
@@ -100,7 +101,14 @@ def _check_free_fall(red: Reduction, pool, r, m, where: str, found: _Findings) -
     """Check g, fitted free in each camera's ball flight, against G (allowing for Magnus lift)."""
     observed, lines, failed = found.observed, found.lines, found.failed
     for c in ("swing", "spin"):
-        ff = free_fall(*red.phys[(c, "ball")], red.times[c], red.flight[c], r, m, red.values["omega"])
+        ff = FreeFall(
+            *_per_impact(
+                red,
+                lambda b, idx, c=c: _fields(
+                    free_fall(*b.phys[(c, "ball")], b.times[c], b.flight[c], r[idx], m[idx], b.values["omega"])
+                ),
+            )
+        )
         sel = pool & np.isfinite(ff.g)
         g, se, k = weighted_mean(ff.g[sel], ff.g_err[sel])
         if k == 0:
@@ -149,19 +157,7 @@ def _check_two_cameras(red: Reduction, pool, disagreeing, n_test: int, setting_w
 def _check_tip_arc(red: Reduction, pool, where: str, found: _Findings) -> None:
     """Check the radius of the bat tip's arc in the swing camera against the rig's pivot_to_tip."""
     observed, lines, failed = found.observed, found.lines, found.failed
-    cams = red.cameras
-    contact = red.contact or fit_contact(
-        *red.phys[("swing", "ball")], red.times["swing"], red.onset["swing"], red.flight["swing"], red.tracks.ball
-    )
-    kap, kap_err = tip_arc(
-        red.swing,
-        *red.phys[("swing", "bat_tip")],
-        red.times["swing"],
-        contact.t_start,
-        red.rig.pivot_to_tip,
-        cams["swing"].fps,
-        np.hypot(TAU_PRIOR_FRAMES, np.nan_to_num(contact.t_start_err) * cams["swing"].fps),
-    )
+    kap, kap_err = _per_impact(red, _tip_arc)
     sel = pool & np.isfinite(kap)
     kh, se, k = weighted_mean(kap[sel], kap_err[sel])
     if k:
@@ -184,6 +180,41 @@ def _check_tip_arc(red: Reduction, pool, where: str, found: _Findings) -> None:
                 f"{where}.rig / {where}.cameras.swing.m_per_px: {line}: the radius seen scales with m_per_px, "
                 "not with fps"
             )
+
+
+def _tip_arc(red: Reduction, idx) -> tuple[np.ndarray, np.ndarray]:
+    """Return kappa and its error of each impact of one block (:func:`.checks.tip_arc`)."""
+    cams = red.cameras
+    contact = red.contact or fit_contact(
+        *red.phys[("swing", "ball")], red.times["swing"], red.onset["swing"], red.flight["swing"], red.tracks.ball
+    )
+    return tip_arc(
+        red.swing,
+        *red.phys[("swing", "bat_tip")],
+        red.times["swing"],
+        contact.t_start,
+        red.rig.pivot_to_tip,
+        cams["swing"].fps,
+        np.hypot(TAU_PRIOR_FRAMES, np.nan_to_num(contact.t_start_err) * cams["swing"].fps),
+    )
+
+
+def _fields(obj) -> tuple:
+    """Return a dataclass' fields as a tuple (the arrays themselves, not copies)."""
+    return tuple(getattr(obj, f.name) for f in fields(obj))
+
+
+def _per_impact(red: Reduction, fn):
+    """Return ``fn(block's reduction, its impacts' positions)`` of every block, in the dataset's order.
+
+    ``fn`` returns an array or a tuple of arrays, impact first. One block: ``fn(red, all)`` as it is.
+    """
+    parts = [fn(b, idx) for b, idx in red.parts()]
+    if red.blocks is None:
+        return parts[0]
+    if isinstance(parts[0], tuple):
+        return tuple(red.tracks.gather([p[k] for p in parts]) for k in range(len(parts[0])))
+    return red.tracks.gather(parts)
 
 
 def _check_spin_dots(red: Reduction, pool, ball_ids, balls: dict, where: str, found: _Findings) -> None:
@@ -227,7 +258,13 @@ def dot_aspect(red: Reduction) -> np.ndarray:
 
     Fits A dx^2 + B dy^2 = 1 (an ellipse along the image axes) to the dot's offsets from the fitted
     centre after separation; the stretch is (A / B)^0.5 (1: a circle; NaN: fewer than 6 frames).
+    Block by block for tracks held in blocks.
     """
+    return _per_impact(red, lambda b, idx: _dot_aspect(b))
+
+
+def _dot_aspect(red: Reduction) -> np.ndarray:
+    """:func:`dot_aspect` of one block."""
     t = red.times["spin"]
     fl = red.flight["spin"]
     cx, cy = fl.centre(t)

@@ -15,7 +15,7 @@ import numpy as np
 from .io import open_clip
 
 if TYPE_CHECKING:
-    from ..tracks.data import Tracks
+    from ..tracks.data import TrackBlocks, Tracks
 
 
 @dataclass
@@ -26,9 +26,10 @@ class SheetRow:
     frames: list[tuple[int, np.ndarray, dict[str, tuple[float, float]]]]  # (frame number, image, point -> x, y)
 
 
-def _tracked(tracks: Tracks, i: int, camera: str) -> dict[int, dict[str, tuple[float, float]]]:
+def _tracked(tracks: Tracks | TrackBlocks, i: int, camera: str) -> dict[int, dict[str, tuple[float, float]]]:
     """Frame number -> the points tracked in it, for impact ``i`` of ``tracks`` in ``camera``."""
-    ct = tracks.cameras[camera]
+    block, i = tracks.locate(i)
+    ct = block.cameras[camera]
     frames = ct.frames()[i]
     out: dict[int, dict[str, tuple[float, float]]] = {}
     for p in ct.x:
@@ -46,7 +47,9 @@ def block_clips(block: dict) -> dict[tuple[str, str], Path]:
     return {(iid, cam): path for iid, cam, path in files}
 
 
-def sheet_rows(clips: dict[tuple[str, str], Path], tracks: Tracks, impacts: list[int], n: int = 5) -> list[SheetRow]:
+def sheet_rows(
+    clips: dict[tuple[str, str], Path], tracks: Tracks | TrackBlocks, impacts: list[int], n: int = 5
+) -> list[SheetRow]:
     """Return the sheet's rows: for each of ``impacts`` (indices into ``tracks``), each camera's clip, ``n`` frames.
 
     The frames are spread evenly over the clip's frames in which a point was tracked; each
