@@ -248,13 +248,9 @@ def eiv_line(
         if (var0 <= 0).any():
             return LineFit.not_fitted(n)
         if scatter and it >= iterations - 1:
-            r_s, dof_s = _scatter_residuals(y - X @ beta, x, y, var_x, cov_xy, var0 + tau2 * g, strata, n - p)
-            tau2 = paule_mandel(r_s, var0, g, dof_s) if dof_s >= 1 else np.inf
-            if not np.isfinite(tau2):
-                # the points whose true x is about 0 (g = 0) alone exceed the residuals' dof (or the
-                # strata leave none): no scatter term brings the fit to it; fitted without the term
-                # (its estimate NaN)
-                scatter, tau2 = False, 0.0
+            tau2 = _paule_mandel_within(y - X @ beta, x, y, var_x, cov_xy, var0, tau2 * g, g, strata, n - p)
+            if not np.isfinite(tau2):  # the points at x ~ 0 (g = 0) alone exceed the residuals' dof,
+                scatter, tau2 = False, 0.0  # or no dof is left: fitted without the term (tau NaN)
         W = 1.0 / (var0 + tau2 * g)
         xwx = X.T @ (W[:, None] * X)
         A = xwx.copy()
@@ -276,7 +272,7 @@ def eiv_line(
     slope, err = float(beta[0]), float(np.sqrt(cov[0, 0]))
     tq = t_quantile(0.975, n - p)
     tau = (np.nan, np.nan, np.nan)
-    if scatter:
+    if scatter:  # tau and its interval from the final residuals (within strata where given)
         r_s, dof_s = _scatter_residuals(r, x, y, var_x, cov_xy, 1.0 / W, strata, n - p)
         tau = (np.sqrt(tau2), *scatter_interval(r_s, var0, g, dof_s))
     return LineFit(
@@ -293,6 +289,16 @@ def eiv_line(
         scatter_ci_low=float(tau[1]),
         scatter_ci_high=float(tau[2]),
     )
+
+
+def _paule_mandel_within(r, x, y, var_x, cov_xy, var0, extra, g, strata, dof) -> float:
+    """Return Paule-Mandel's tau^2 from the residuals within ``strata`` (inf where no degree of freedom is left).
+
+    ``extra``: each point's intrinsic variance so far (the weights of the strata's own slopes
+    are 1 / (``var0`` + ``extra``)); the other arguments as :func:`_scatter_residuals`'.
+    """
+    r_s, dof_s = _scatter_residuals(r, x, y, var_x, cov_xy, var0 + extra, strata, dof)
+    return paule_mandel(r_s, var0, g, dof_s) if dof_s >= 1 else np.inf
 
 
 def _scatter_residuals(
