@@ -28,11 +28,11 @@ from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import ndimage
 
 from .clip import VideoError
 from .edge import fit_ball
 from .io import Clip
+from .search import find_balls, find_dots, find_marker, find_marker_whole, roi
 
 
 @dataclass(frozen=True)
@@ -75,94 +75,13 @@ def _noise_sigma(img: np.ndarray) -> float:
     return max(float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2)), 1 / np.sqrt(12))
 
 
-def find_balls(img: np.ndarray, radius: float, tol: float) -> list[tuple[float, float]]:
-    """Rough centres of every bright disc of about ``radius`` in the frame (quarter resolution)."""
-    s = 4 if radius >= 12 else 2
-    h, w = (img.shape[0] // s) * s, (img.shape[1] // s) * s
-    small = img[:h, :w].reshape(h // s, s, w // s, s).mean(axis=(1, 3))
-    med, top = np.median(small), np.percentile(small, 99.9)
-    lab, n = ndimage.label(small > med + 0.6 * (top - med))
-    if n == 0:
-        return []
-    idx = np.arange(1, n + 1)
-    area = ndimage.sum_labels(np.ones_like(small), lab, idx) * s * s
-    expect = np.pi * radius**2
-    ok = (area > (1 - tol) ** 2 * expect * 0.5) & (area < (1 + tol) ** 2 * expect)
-    for j, sl in enumerate(ndimage.find_objects(lab)):  # round: a box about as wide as high, at most 2r
-        bh, bw = (sl[0].stop - sl[0].start) * s, (sl[1].stop - sl[1].start) * s
-        ok[j] &= max(bh, bw) <= 2 * radius * (1 + tol) + 2 * s and min(bh, bw) >= 0.5 * max(bh, bw)
-    return [((c[1] + 0.5) * s - 0.5, (c[0] + 0.5) * s - 0.5) for c in ndimage.center_of_mass(small, lab, idx[ok])]
-
-
-def _roi(img: np.ndarray, cx: float, cy: float, half: float) -> tuple[np.ndarray, int, int]:
-    """Return the square of half-side ``half`` about (cx, cy), clipped to the frame, and its origin."""
-    x0, y0 = max(int(cx - half), 0), max(int(cy - half), 0)
-    return img[y0 : int(cy + half) + 1, x0 : int(cx + half) + 1], x0, y0
-
-
-def find_dots(img: np.ndarray, ball: tuple, dot_r: float, sigma: float) -> tuple[list, str | None]:
-    """Dark spots inside the ball: [(x, y, contrast)], or the reason they are left out."""
-    cx, cy, r = ball[:3]
-    sub, x0, y0 = _roi(img, cx, cy, r + 2)
-    sub = sub.astype(np.float32)  # the region only, not the whole frame
-    size = int(2 * np.ceil(2 * dot_r) + 1)
-    dark = ndimage.grey_closing(sub, size=(size, size)) - sub
-    yy, xx = np.mgrid[0 : sub.shape[0], 0 : sub.shape[1]]
-    inside = np.hypot(xx + x0 - cx, yy + y0 - cy) < r - 2
-    # a dot is dark: more than 5 noise sigma and a third of the ball's own level below the shading
-    level = max(5 * sigma, float(np.median(sub[inside])) / 3) if inside.any() else 5 * sigma
-    lab, n = ndimage.label((dark > level) & inside)
-    if n == 0:
-        return [], "no dot seen on the ball"
-    idx = np.arange(1, n + 1)
-    area = ndimage.sum_labels(np.ones_like(dark), lab, idx)
-    big = idx[area >= max(0.25 * np.pi * dot_r**2, 3)]
-    out = []
-    for j in big:
-        m = lab == j
-        m = ndimage.binary_dilation(m, iterations=2) & inside
-        wgt = np.where(m, np.clip(dark, 0, None), 0)
-        tot = wgt.sum()
-        x, y = (wgt * xx).sum() / tot + x0, (wgt * yy).sum() / tot + y0
-        out.append((float(x), float(y), float(dark[lab == j].max()), float(np.hypot(x - cx, y - cy) / r)))
-    return out, None
-
-
-def find_marker(img: np.ndarray, cx: float, cy: float, half: float, mr: float, sigma: float) -> tuple | None:
-    """Return the tip marker (a bright disc of radius ``mr`` in a dark surround) nearest (cx, cy): (x, y, contrast)."""
-    sub, x0, y0 = _roi(img, cx, cy, half)
-    sub = sub.astype(np.float32)  # the region only, not the whole frame
-    if min(sub.shape) < 2 * mr:
-        return None
-    local = ndimage.uniform_filter(sub, size=int(4 * mr + 1))
-    lab, n = ndimage.label(sub - local > 8 * sigma)
-    if n == 0:
-        return None
-    idx = np.arange(1, n + 1)
-    area = ndimage.sum_labels(np.ones_like(sub), lab, idx)
-    ok = idx[(area > 0.3 * np.pi * mr**2) & (area < 2.0 * np.pi * mr**2)]
-    best = None
-    gy, gx = np.mgrid[0 : sub.shape[0], 0 : sub.shape[1]]
-    for j, (my, mx) in zip(ok, ndimage.center_of_mass(sub, lab, ok), strict=True):
-        d = np.hypot(gx - mx, gy - my)
-        level = float(np.median(sub[(d > 1.5 * mr) & (d < 2.5 * mr)]))  # the end cap round the marker
-        core = d < 1.3 * mr
-        wgt = np.clip(sub[core] - level, 0, None)
-        if wgt.sum() <= 0:
-            continue
-        x, y = (wgt * gx[core]).sum() / wgt.sum() + x0, (wgt * gy[core]).sum() / wgt.sum() + y0
-        contrast = float(sub[lab == j].mean() - level)
-        if contrast > 0.3 * (float(sub.max()) - level) and (best is None or np.hypot(x - cx, y - cy) < best[3]):
-            best = (float(x), float(y), contrast, float(np.hypot(x - cx, y - cy)))
-    return best[:3] if best else None
-
-
 @dataclass
 class _Trail:
     """Last two positions of a point (frame, x, y), for the prediction of the next, and the contrasts found."""
 
     last: list = field(default_factory=list)
     contrasts: list = field(default_factory=list)
+    radius: float = 0.0  # the ball's, last fitted (0: none yet)
 
     def push(self, k: int, x: float, y: float) -> None:
         """Add a position."""
@@ -191,7 +110,7 @@ def _ball_candidates(img, guess, opt: TrackOptions) -> list:
     r = opt.ball_radius_px
     if guess is None:
         return find_balls(img, r, opt.radius_tolerance)
-    sub, x0, y0 = _roi(img, guess[0], guess[1], 4 * r)
+    sub, x0, y0 = roi(img, guess[0], guess[1], 4 * r)
     return [(x + x0, y + y0) for x, y in find_balls(sub, r, opt.radius_tolerance)]
 
 
@@ -200,7 +119,8 @@ def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found, 
     guess = trail.predict(k)
     v = trail.velocity()
     blur = (v[0] * exposure_frames, v[1] * exposure_frames)
-    fit, reason = fit_ball(img, *guess, r, sigma, blur) if guess is not None else ((), "")
+    start = trail.radius or r  # the last radius fitted: fewer passes
+    fit, reason = fit_ball(img, *guess, start, sigma, blur) if guess is not None else ((), "")
     if not fit:  # no prediction yet, or the fit failed there: look for the disc in the region
         cands = _ball_candidates(img, guess, opt)
         if len(cands) != 1:
@@ -213,6 +133,7 @@ def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found, 
         found.leave_out("ball", k, reason)
         return None
     trail.push(k, fit[0], fit[1])
+    trail.radius = fit[2]
     found.add("ball", k, fit[0], fit[1], fit[3], fit[4])
     found.ball_radii.append(fit[2])
     return fit
@@ -283,9 +204,8 @@ def _dots(img, k, ball, opt: TrackOptions, sigma, mem: _DotMemory, found: Found)
 
 def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -> None:
     guess = trail.predict(k)
-    if guess is None:
-        h, w = img.shape
-        m = find_marker(img, w / 2, h / 2, max(h, w), opt.marker_radius_px, sigma)
+    if guess is None:  # lost, or not found yet: the whole frame
+        m = find_marker_whole(img, opt.marker_radius_px, sigma)
     else:
         m = find_marker(img, guess[0], guess[1], 4 * opt.marker_radius_px + 20, opt.marker_radius_px, sigma)
     if m is None:
