@@ -15,8 +15,10 @@ squares are solved from their 3 x 3 normal equations.
 from __future__ import annotations
 
 import functools
+import itertools
 
 import numpy as np
+from scipy import ndimage
 
 N_RAYS = 48
 _ANGLES = np.linspace(0, 2 * np.pi, N_RAYS, endpoint=False)
@@ -26,11 +28,10 @@ _COS, _SIN = np.cos(_ANGLES), np.sin(_ANGLES)
 _SAMPLES = np.arange(-5.0, 5.01, 0.5)
 _CAND = np.arange(-3.0, 3.0001, 0.1)
 _WIDE = np.arange(-10.0, 10.01, 0.5)
+_TRIO = np.array([-1, 0, 1])
 #: The fine grid the model's terms are smoothed on (px), and where the samples fall on it.
 _FINE = np.arange(-9.0, 9.0, 0.05)
 _AT = np.round((_SAMPLES - _FINE[0]) / 0.05).astype(int)
-#: The bilinear interpolation's four neighbours (dy, dx).
-_DY, _DX = np.array([0, 0, 1, 1]), np.array([0, 1, 0, 1])
 
 
 def _kernel(blur: float) -> np.ndarray:
@@ -80,15 +81,13 @@ def edge_bases(radius: float, blur: float = 0.0) -> np.ndarray:
     return np.ascontiguousarray(np.swapaxes(u, 0, 1).reshape(_SAMPLES.size, -1))
 
 
-def profiles(img: np.ndarray, cx: float, cy: float, r: float, rad: np.ndarray) -> np.ndarray:
-    """Return the frame on the 48 rays at radii r + rad from (cx, cy), interpolated bilinearly: (rays, rad)."""
+def profiles(img: np.ndarray, cx: float, cy: float, r: float, rad: np.ndarray, cos=_COS, sin=_SIN) -> np.ndarray:
+    """Return the frame on the rays (``cos``, ``sin``) at radii r + rad from (cx, cy), bilinear: (rays, rad)."""
     rr = r + rad
-    xs, ys = cx + _COS[:, None] * rr, cy + _SIN[:, None] * rr
-    x0, y0 = np.floor(xs), np.floor(ys)
-    fx, fy = (xs - x0)[..., None], (ys - y0)[..., None]
-    v = img[y0.astype(np.intp)[..., None] + _DY, x0.astype(np.intp)[..., None] + _DX]
-    w = np.concatenate([(1 - fx) * (1 - fy), fx * (1 - fy), (1 - fx) * fy, fx * fy], axis=-1)
-    return (v * w).sum(axis=-1)
+    xs, ys = cx + cos[:, None] * rr, cy + sin[:, None] * rr
+    return ndimage.map_coordinates(img, [ys.ravel(), xs.ravel()], output=np.float64, order=1, prefilter=False).reshape(
+        xs.shape
+    )
 
 
 def _edges_gradient(prof: np.ndarray, rad: np.ndarray) -> np.ndarray:
@@ -102,31 +101,38 @@ def _edges_gradient(prof: np.ndarray, rad: np.ndarray) -> np.ndarray:
 
 
 def _edges_model(prof: np.ndarray, r: float, sigma, groups: list) -> tuple[np.ndarray, np.ndarray]:
-    """Edge on each ray by the ray model (:func:`edge_bases`): offsets and the fit's chi-square per sample.
+    """Return the edge on each ray by the ray model (:func:`edge_bases`): offsets and the fit's chi-square per sample.
 
-    ``sigma`` is the scale of the residuals (per ray or one); ``groups`` the rays of each motion blur (px).
+    ``sigma`` is the scale of the residuals (per ray or one); ``groups`` the rays (a slice) of each motion blur (px).
     """
     y = prof - prof.mean(axis=1, keepdims=True)  # the constant is in the model: its residual is unchanged
     rss = np.empty((y.shape[0], _CAND.size))
+    yy = np.einsum("ij,ij->i", y, y)[:, None]
     for sel, b in groups:
         p = y[sel] @ edge_bases(round(2 * r) / 2, b)
-        rss[sel] = (y[sel] * y[sel]).sum(axis=1)[:, None] - (p * p).reshape(-1, _CAND.size, 5).sum(axis=2)
+        p *= p
+        np.subtract(yy[sel], p.reshape(-1, _CAND.size, 5).sum(axis=2), out=rss[sel])
     k = np.clip(np.argmin(rss, axis=1), 1, _CAND.size - 2)
-    i = np.arange(prof.shape[0])
-    r0, r1, r2 = rss[i, k - 1], rss[i, k], rss[i, k + 1]
+    r0, r1, r2 = np.take_along_axis(rss, k[:, None] + _TRIO, axis=1).T
     den = r0 - 2 * r1 + r2
     off = np.clip(0.5 * (r0 - r2) / np.where(den > 0, den, np.inf), -0.5, 0.5)
     return _CAND[k] + off * (_CAND[1] - _CAND[0]), r1 / (sigma**2 * (_SAMPLES.size - 5))
 
 
 def _circle_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
-    """Least-squares circle (Kasa, about the points' mean): centre and radius."""
+    """Least-squares circle (Kasa): centre and radius.
+
+    About the points' mean the normal equations of x^2 + y^2 = a x + b y + c split: c is the
+    mean of x^2 + y^2, and (a, b) solve a 2 x 2 system.
+    """
     mx, my = x.mean(), y.mean()
     u, v = x - mx, y - my
-    a = np.stack([u, v, np.ones_like(u)])
-    sol = np.linalg.solve(a @ a.T, a @ (u * u + v * v))
-    cx, cy = sol[0] / 2, sol[1] / 2
-    return cx + mx, cy + my, float(np.sqrt(max(sol[2] + cx * cx + cy * cy, 0)))
+    z = u * u + v * v
+    suu, suv, svv, suz, svz = u @ u, u @ v, v @ v, u @ z, v @ z
+    det = suu * svv - suv * suv
+    a, b = (suz * svv - svz * suv) / det, (svz * suu - suz * suv) / det
+    c = z.mean()
+    return a / 2 + mx, b / 2 + my, float(np.sqrt(max(c + a * a / 4 + b * b / 4, 0)))
 
 
 def _median(v: np.ndarray) -> float:
@@ -148,10 +154,18 @@ def _fit_circle_robust(px, py, keep):
     return (fx, fy, fr, res), keep
 
 
-def _blur_groups(blur: tuple[float, float]) -> list:
-    """Return the rays of each motion blur along them (px, to 0.5 px): [(ray indices, blur)]."""
+def _rays(blur: tuple[float, float]) -> tuple[np.ndarray, np.ndarray, list]:
+    """Return the rays' directions (cos, sin), ordered by the motion blur along them, and each blur's rays (a slice).
+
+    The blur is taken to 0.5 px (the model's bases are cached per blur).
+    """
     buckets = np.round(2 * np.abs(_COS * blur[0] + _SIN * blur[1])) / 2
-    return [(np.flatnonzero(buckets == b), float(b)) for b in np.unique(buckets)]
+    order = np.argsort(buckets, kind="stable")
+    b = buckets[order]
+    cut = np.flatnonzero(np.diff(b)) + 1
+    edges = [0, *cut.tolist(), N_RAYS]
+    groups = [(slice(i, j), float(b[i])) for i, j in itertools.pairwise(edges)]
+    return _COS[order], _SIN[order], groups
 
 
 def fit_ball(
@@ -164,14 +178,14 @@ def fit_ball(
     then the ray model (:func:`_edges_model`) until it moves by under 0.01 px (at most 8 passes).
     ``blur`` is the ball's travel during the exposure (px, x and y), where known.
     """
-    groups = _blur_groups(blur)
+    cos, sin, groups = _rays(blur)
     h, w = img.shape
     wide, moved, kept = True, np.inf, np.ones(N_RAYS, bool)
     for _ in range(8):
         rad = _WIDE if wide else _SAMPLES
         if min(cx - r, cy - r, w - 1 - cx - r, h - 1 - cy - r) < rad[-1] + 1:
             return (), "ball touches the frame's border"
-        prof = profiles(img, cx, cy, r, rad)
+        prof = profiles(img, cx, cy, r, rad, cos, sin)
         step = np.abs(prof[:, :4].mean(axis=1) - prof[:, -4:].mean(axis=1))
         keep = step > 6 * sigma
         if wide:
@@ -180,7 +194,7 @@ def fit_ball(
             # the model's own mismatch grows with the edge's contrast: 2 % of the step counts as noise
             edge, chi2 = _edges_model(prof, r, np.maximum(sigma, 0.02 * step), groups)
             keep &= (chi2 < 2.0) & kept  # a ray once dropped stays dropped: the passes settle
-        fit, keep = _fit_circle_robust(cx + _COS * (r + edge), cy + _SIN * (r + edge), keep)
+        fit, keep = _fit_circle_robust(cx + cos * (r + edge), cy + sin * (r + edge), keep)
         if fit is None:
             return (), f"ball edge seen on {int(keep.sum())} of {N_RAYS} rays (occluded, blurred or on clutter)"
         moved = max(abs(fit[0] - cx), abs(fit[1] - cy), abs(fit[2] - r))
