@@ -48,17 +48,21 @@ def _median_top(v: np.ndarray, q: float) -> tuple[float, float]:
     return mid, top
 
 
-def _label_stats(lab: np.ndarray, n: int, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Return each label's pixel count, and its ``weights``-weighted centroid (x, y) in the labelled array."""
-    flat = lab.ravel()
-    area = np.bincount(flat, minlength=n + 1)[1:]
-    yy, xx = np.indices(lab.shape)
-    wv = weights.ravel()
-    tot = np.bincount(flat, wv, n + 1)[1:]
-    with np.errstate(invalid="ignore", divide="ignore"):
-        mx = np.bincount(flat, wv * xx.ravel(), n + 1)[1:] / tot
-        my = np.bincount(flat, wv * yy.ravel(), n + 1)[1:] / tot
-    return area, mx, my
+def _centroids(lab: np.ndarray, labels: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, list]:
+    """Return the ``weights``-weighted centroids (x, y) of ``labels`` in the labelled array, and their boxes.
+
+    Each label's work is in its own box (``ndimage.find_objects``), not the whole array.
+    """
+    objs = ndimage.find_objects(lab)
+    mx, my, boxes = np.empty(labels.size), np.empty(labels.size), []
+    for i, j in enumerate(labels):
+        sl = objs[j - 1]
+        wv = np.where(lab[sl] == j, weights[sl], 0)
+        tot = wv.sum()
+        mx[i] = (wv.sum(axis=0) @ np.arange(sl[1].start, sl[1].stop)) / tot
+        my[i] = (wv.sum(axis=1) @ np.arange(sl[0].start, sl[0].stop)) / tot
+        boxes.append(sl)
+    return mx, my, boxes
 
 
 def find_balls(img: np.ndarray, radius: float, tol: float) -> list[tuple[float, float]]:
@@ -69,16 +73,15 @@ def find_balls(img: np.ndarray, radius: float, tol: float) -> list[tuple[float, 
     lab, n = ndimage.label(sums > med + 0.6 * (top - med))
     if n == 0:
         return []
-    area, mx, my = _label_stats(lab, n, sums.astype(np.float64))
-    area = area * s * s
+    area = np.bincount(lab.ravel(), minlength=n + 1)[1:] * s * s
     expect = np.pi * radius**2
-    ok = (area > (1 - tol) ** 2 * expect * 0.5) & (area < (1 + tol) ** 2 * expect)
-    objs = ndimage.find_objects(lab)
-    for j in np.flatnonzero(ok):  # round: a box about as wide as high, at most 2r
-        sl = objs[j]
+    ok = np.flatnonzero((area > (1 - tol) ** 2 * expect * 0.5) & (area < (1 + tol) ** 2 * expect)) + 1
+    out = []
+    for x, y, sl in zip(*_centroids(lab, ok, sums), strict=True):  # round: about as wide as high, at most 2r
         bh, bw = (sl[0].stop - sl[0].start) * s, (sl[1].stop - sl[1].start) * s
-        ok[j] &= max(bh, bw) <= 2 * radius * (1 + tol) + 2 * s and min(bh, bw) >= 0.5 * max(bh, bw)
-    return [((x + 0.5) * s - 0.5, (y + 0.5) * s - 0.5) for x, y in zip(mx[ok], my[ok], strict=True)]
+        if max(bh, bw) <= 2 * radius * (1 + tol) + 2 * s and min(bh, bw) >= 0.5 * max(bh, bw):
+            out.append(((x + 0.5) * s - 0.5, (y + 0.5) * s - 0.5))
+    return out
 
 
 def find_dots(img: np.ndarray, ball: tuple, dot_r: float, sigma: float) -> tuple[list, str | None]:
@@ -142,16 +145,16 @@ def find_marker(
     lab, n = ndimage.label(sub - local > 8 * sigma)
     if n == 0:
         return None
-    area, mxs, mys = _label_stats(lab, n, sub)
-    sums = np.bincount(lab.ravel(), sub.ravel(), n + 1)[1:]
+    area = np.bincount(lab.ravel(), minlength=n + 1)[1:]
+    ok = np.flatnonzero((area > 0.3 * np.pi * mr**2) & (area < 2.0 * np.pi * mr**2)) + 1
     top = float(sub.max()) if top is None else top
     best = None
-    for j in np.flatnonzero((area > 0.3 * np.pi * mr**2) & (area < 2.0 * np.pi * mr**2)):
-        level, c = _marker_at(sub, mxs[j], mys[j], mr)
+    for j, mx, my, sl in zip(ok, *_centroids(lab, ok, sub), strict=True):
+        level, c = _marker_at(sub, mx, my, mr)
         if c is None:
             continue
         x, y = c[0] + x0, c[1] + y0
-        contrast = float(sums[j] / area[j] - level)
+        contrast = float(sub[sl][lab[sl] == j].mean() - level)
         if contrast > 0.3 * (top - level) and (best is None or np.hypot(x - cx, y - cy) < best[3]):
             best = (float(x), float(y), contrast, float(np.hypot(x - cx, y - cy)))
     return best[:3] if best else None
@@ -171,12 +174,13 @@ def find_marker_whole(img: np.ndarray, mr: float, sigma: float) -> tuple | None:
     lab, n = ndimage.label(small - local > 2 * sigma)
     if n == 0:
         return None
-    area, mx, my = _label_stats(lab, n, small)
-    ok = (area * s * s > 0.1 * np.pi * mr**2) & (area * s * s < 4.0 * np.pi * mr**2)
+    area = np.bincount(lab.ravel(), minlength=n + 1)[1:] * s * s
+    ok = np.flatnonzero((area > 0.1 * np.pi * mr**2) & (area < 4.0 * np.pi * mr**2)) + 1
+    mx, my, _ = _centroids(lab, ok, small)
     h, w = img.shape
     top = float(img.max())
     best = None
-    for x, y in zip((mx[ok] + 0.5) * s - 0.5, (my[ok] + 0.5) * s - 0.5, strict=True):
+    for x, y in zip((mx + 0.5) * s - 0.5, (my + 0.5) * s - 0.5, strict=True):
         m = find_marker(img, x, y, 4 * mr + 20, mr, sigma, top)
         if m is None or np.hypot(m[0] - x, m[1] - y) > 2 * mr:  # another spot's, near the region's border
             continue
