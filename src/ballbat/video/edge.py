@@ -84,7 +84,9 @@ def edge_bases(radius: float, blur: float = 0.0) -> np.ndarray:
     return np.ascontiguousarray(np.swapaxes(q, 0, 1).reshape(_SAMPLES.size, -1))
 
 
-def profiles(img: np.ndarray, cx: float, cy: float, r: float, rad: np.ndarray, cos=_COS, sin=_SIN) -> np.ndarray:
+def profiles(
+    img: np.ndarray, cx: float, cy: float, r: float, rad: np.ndarray, cos: np.ndarray = _COS, sin: np.ndarray = _SIN
+) -> np.ndarray:
     """Return the frame on the rays (``cos``, ``sin``) at radii r + rad from (cx, cy), bilinear: (rays, rad)."""
     rr = r + rad
     xs, ys = cx + cos[:, None] * rr, cy + sin[:, None] * rr
