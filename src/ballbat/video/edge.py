@@ -178,7 +178,7 @@ def fit_ball(
 ) -> tuple[tuple, str | None]:
     """Return the ball's sub-pixel centre near (cx, cy): ((x, y, r, rms, contrast), None) or ((), reason left out).
 
-    ``r`` is where the edge is looked for first (the expected radius, or the last one fitted).
+    ``r`` is where the edge is looked for first (the expected radius).
     The rough edges (gradient peaks on a wide window) until the circle moves by under a pixel,
     then the ray model (:func:`_edges_model`) until it moves by under 0.01 px (at most 8 passes).
     ``blur`` is the ball's travel during the exposure (px, x and y), where known.

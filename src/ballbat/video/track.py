@@ -81,7 +81,6 @@ class _Trail:
 
     last: list = field(default_factory=list)
     contrasts: list = field(default_factory=list)
-    radius: float = 0.0  # the ball's, last fitted (0: none yet)
 
     def push(self, k: int, x: float, y: float) -> None:
         """Add a position."""
@@ -119,8 +118,7 @@ def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found, 
     guess = trail.predict(k)
     v = trail.velocity()
     blur = (v[0] * exposure_frames, v[1] * exposure_frames)
-    start = trail.radius or r  # the last radius fitted: fewer passes
-    fit, reason = fit_ball(img, *guess, start, sigma, blur) if guess is not None else ((), "")
+    fit, reason = fit_ball(img, *guess, r, sigma, blur) if guess is not None else ((), "")
     if not fit:  # no prediction yet, or the fit failed there: look for the disc in the region
         cands = _ball_candidates(img, guess, opt)
         if len(cands) != 1:
@@ -133,7 +131,6 @@ def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found, 
         found.leave_out("ball", k, reason)
         return None
     trail.push(k, fit[0], fit[1])
-    trail.radius = fit[2]
     found.add("ball", k, fit[0], fit[1], fit[3], fit[4])
     found.ball_radii.append(fit[2])
     return fit
