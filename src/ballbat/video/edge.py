@@ -87,10 +87,13 @@ def edge_bases(radius: float, blur: float = 0.0) -> np.ndarray:
 def profiles(
     img: np.ndarray, cx: float, cy: float, r: float, rad: np.ndarray, cos: np.ndarray = _COS, sin: np.ndarray = _SIN
 ) -> np.ndarray:
-    """Return the frame on the rays (``cos``, ``sin``) at radii r + rad from (cx, cy), bilinear: (rays, rad)."""
+    """Return the frame on the rays (``cos``, ``sin``) at radii r + rad from (cx, cy), bilinear: (rays, rad).
+
+    In float32, as the tracker has always sampled them (float64 moved marginal frames of lossy clips).
+    """
     rr = r + rad
     xs, ys = cx + cos[:, None] * rr, cy + sin[:, None] * rr
-    return ndimage.map_coordinates(img, [ys.ravel(), xs.ravel()], output=np.float64, order=1, prefilter=False).reshape(
+    return ndimage.map_coordinates(img, [ys.ravel(), xs.ravel()], output=np.float32, order=1, prefilter=False).reshape(
         xs.shape
     )
 
@@ -110,7 +113,8 @@ def _edges_model(prof: np.ndarray, r: float, sigma, groups: list) -> tuple[np.nd
 
     ``sigma`` is the scale of the residuals (per ray or one); ``groups`` the rays (a slice) of each motion blur (px).
     """
-    y = prof - prof.mean(axis=1, keepdims=True)  # the constant is in the model: its residual is unchanged
+    y = prof.astype(np.float64)
+    y -= y.mean(axis=1, keepdims=True)  # the constant is in the model: its residual is unchanged
     rss = np.empty((y.shape[0], _CAND.size))
     yy = np.einsum("ij,ij->i", y, y)[:, None]
     for sel, b in groups:
