@@ -1,13 +1,15 @@
 """Find the ball, its two dots and the bat's tip marker in each frame of a clip, and link them (docs/video.md).
 
 Streamed: one frame at a time, each searched near where the previous frames predict (a
-region of interest), the whole frame (at half or quarter resolution) only until a point is
-found. Per point:
+region of interest), the whole frame (at half or quarter resolution) only where no
+prediction is at hand (not found yet, or lost for more than 3 frames). The searches are
+:mod:`ballbat.video.search`, the ball's edge fit :mod:`ballbat.video.edge`. Per point:
 
 * **ball** -- a bright disc of about the expected radius. Its edge is found on 48 rays from
-  the rough centre, each at the peak of the intensity gradient (sub-pixel, parabolic); a
-  circle is fitted to the edge points by least squares, rays more than 3 robust standard
-  deviations off rejected (the barrel in front, a dot on the limb), twice. Quality: the RMS
+  the rough centre, first at the peak of the intensity gradient, then by a model of each
+  ray's profile (a shaded sphere on a background, blurred by the motion); a circle is fitted
+  to the edge points by least squares, rays more than 3 robust standard deviations off
+  rejected (the barrel in front, a dot on the limb), twice. Quality: the RMS
   residual of the edge (px) and the contrast of the edge. Left out: fewer than half of the
   rays kept (occluded), the disc touching the frame's border, no such disc, or two.
 * **dot_a, dot_b** -- dark spots inside the disc: the ball's own shading (a grey closing,
