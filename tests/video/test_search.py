@@ -64,3 +64,8 @@ def test_a_ball_lost_for_longer_than_the_prediction_holds_is_found_again(tmp_pat
     assert sorted(got) == [100, 101, 102, *range(108, 112)]
     for k, (x, y) in got.items():
         assert np.hypot(x - truth.x["ball"][k - 100], y - truth.y["ball"][k - 100]) < 0.3
+
+
+def test_no_ball_in_a_region_off_the_frame_or_smaller_than_a_block():
+    img = next(render_frames(spin_truth(n=1), PLAIN, M_PER_PX))
+    assert find_balls(img[:, 400:], RADIUS_PX, 0.3) == [] and find_balls(img[:3, :3], RADIUS_PX, 0.3) == []

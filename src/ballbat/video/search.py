@@ -69,6 +69,8 @@ def find_balls(img: np.ndarray, radius: float, tol: float) -> list[tuple[float, 
     """Return the rough centres of every bright disc of about ``radius`` in the frame (quarter resolution)."""
     s = 4 if radius >= 12 else 2
     sums = block_sum(img, s)
+    if sums.size == 0:  # a region (about a prediction) that is off the frame
+        return []
     med, top = _median_top(sums, 99.9)
     lab, n = ndimage.label(sums > med + 0.6 * (top - med))
     if n == 0:
