@@ -1,13 +1,15 @@
 """Find the ball, its two dots and the bat's tip marker in each frame of a clip, and link them (docs/video.md).
 
 Streamed: one frame at a time, each searched near where the previous frames predict (a
-region of interest), the whole frame (at half or quarter resolution) only until a point is
-found. Per point:
+region of interest), the whole frame (at half or quarter resolution) only where no
+prediction is at hand (not found yet, or lost for more than 3 frames). The searches are
+:mod:`ballbat.video.search`, the ball's edge fit :mod:`ballbat.video.edge`. Per point:
 
 * **ball** -- a bright disc of about the expected radius. Its edge is found on 48 rays from
-  the rough centre, each at the peak of the intensity gradient (sub-pixel, parabolic); a
-  circle is fitted to the edge points by least squares, rays more than 3 robust standard
-  deviations off rejected (the barrel in front, a dot on the limb), twice. Quality: the RMS
+  the rough centre, first at the peak of the intensity gradient, then by a model of each
+  ray's profile (a shaded sphere on a background, blurred by the motion); a circle is fitted
+  to the edge points by least squares, rays more than 3 robust standard deviations off
+  rejected (the barrel in front, a dot on the limb), twice. Quality: the RMS
   residual of the edge (px) and the contrast of the edge. Left out: fewer than half of the
   rays kept (occluded), the disc touching the frame's border, no such disc, or two.
 * **dot_a, dot_b** -- dark spots inside the disc: the ball's own shading (a grey closing,
@@ -24,19 +26,15 @@ Nothing is guessed: a point that fails a test is left out, with the reason.
 
 from __future__ import annotations
 
-import functools
 from collections import Counter
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy import ndimage
 
 from .clip import VideoError
+from .edge import fit_ball
 from .io import Clip
-
-_N_RAYS = 48
-_ANGLES = np.linspace(0, 2 * np.pi, _N_RAYS, endpoint=False)
-_COS, _SIN = np.cos(_ANGLES), np.sin(_ANGLES)
+from .search import find_balls, find_dots, find_marker, find_marker_whole, roi
 
 
 @dataclass(frozen=True)
@@ -79,225 +77,6 @@ def _noise_sigma(img: np.ndarray) -> float:
     return max(float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2)), 1 / np.sqrt(12))
 
 
-def find_balls(img: np.ndarray, radius: float, tol: float) -> list[tuple[float, float]]:
-    """Rough centres of every bright disc of about ``radius`` in the frame (quarter resolution)."""
-    s = 4 if radius >= 12 else 2
-    h, w = (img.shape[0] // s) * s, (img.shape[1] // s) * s
-    small = img[:h, :w].reshape(h // s, s, w // s, s).mean(axis=(1, 3))
-    med, top = np.median(small), np.percentile(small, 99.9)
-    lab, n = ndimage.label(small > med + 0.6 * (top - med))
-    if n == 0:
-        return []
-    idx = np.arange(1, n + 1)
-    area = ndimage.sum_labels(np.ones_like(small), lab, idx) * s * s
-    expect = np.pi * radius**2
-    ok = (area > (1 - tol) ** 2 * expect * 0.5) & (area < (1 + tol) ** 2 * expect)
-    for j, sl in enumerate(ndimage.find_objects(lab)):  # round: a box about as wide as high, at most 2r
-        bh, bw = (sl[0].stop - sl[0].start) * s, (sl[1].stop - sl[1].start) * s
-        ok[j] &= max(bh, bw) <= 2 * radius * (1 + tol) + 2 * s and min(bh, bw) >= 0.5 * max(bh, bw)
-    return [((c[1] + 0.5) * s - 0.5, (c[0] + 0.5) * s - 0.5) for c in ndimage.center_of_mass(small, lab, idx[ok])]
-
-
-def _circle_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
-    """Least-squares circle (Kasa): centre and radius."""
-    a = np.column_stack([x, y, np.ones_like(x)])
-    sol = np.linalg.lstsq(a, x * x + y * y, rcond=None)[0]
-    cx, cy = sol[0] / 2, sol[1] / 2
-    return cx, cy, float(np.sqrt(max(sol[2] + cx * cx + cy * cy, 0)))
-
-
-#: Radial samples of a ray about the current edge (px) and the edge positions tried among them.
-_SAMPLES = np.arange(-5.0, 5.01, 0.5)
-_CAND = np.arange(-3.0, 3.0001, 0.1)
-
-
-@functools.lru_cache(maxsize=256)
-def _edge_projectors(radius: float, blur: float = 0.0) -> np.ndarray:
-    """For each tried edge position e, I - P_e: the residual maker of the ray model with its edge at e.
-
-    The model of a ray's profile about the radius ``radius`` (px, to 0.5 px), linear in its
-    five coefficients: the background (a constant and a slope outside) and the ball inside as
-    a Lambert sphere of radius ``radius`` + e lit from anywhere in front: a constant, the normal's
-    component towards the camera (sqrt(1 - (rho / R)^2)) and the one along the ray (rho / R).
-    Each is smoothed as the pixels sample it (a 1-px box, then the bilinear interpolation of
-    the rays: a triangle of half-width 1 px) and by the motion blur along the ray (a box of
-    ``blur`` px: the ball's travel during the exposure, projected on the ray).
-    """
-    fine = np.arange(-9.0, 9.0, 0.05)
-    box = np.ones(20) / 20
-    kern = np.convolve(box, np.convolve(box, box))
-    if blur >= 0.5:
-        kern = np.convolve(kern, np.ones(round(blur / 0.05)))
-    kern /= kern.sum()
-    out = np.empty((_CAND.size, _SAMPLES.size, _SAMPLES.size))
-    for j, e in enumerate(_CAND):
-        inside = fine < e
-        rho = (radius + fine) / (radius + e)
-        basis = [
-            np.ones_like(fine),
-            np.where(inside, 0.0, fine - e),
-            inside * 1.0,
-            np.sqrt(np.clip(1 - rho * rho, 0, None)),
-            inside * rho,
-        ]
-        cols = [np.interp(_SAMPLES, fine, np.convolve(b, kern, mode="same")) for b in basis]
-        d = np.column_stack(cols)
-        out[j] = np.eye(_SAMPLES.size) - d @ np.linalg.pinv(d)
-    return out
-
-
-def _profiles(img, cx, cy, r, rad):
-    rr = r + rad[None, :]
-    xs, ys = cx + _COS[:, None] * rr, cy + _SIN[:, None] * rr
-    return ndimage.map_coordinates(img, [ys.ravel(), xs.ravel()], output=np.float32, order=1, prefilter=False).reshape(
-        xs.shape
-    )
-
-
-def _edges_gradient(prof: np.ndarray, rad: np.ndarray) -> np.ndarray:
-    """Rough edge on each ray: the peak of the radial gradient (offsets from the radius)."""
-    sign = np.sign(prof[:, :4].mean(axis=1) - prof[:, -4:].mean(axis=1))
-    g = ndimage.convolve1d(-np.gradient(prof, axis=1) * sign[:, None], [0.25, 0.5, 0.25], axis=1, mode="nearest")
-    return rad[np.argmax(g, axis=1)]
-
-
-def _edges_model(prof: np.ndarray, r: float, sigma, blur: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Edge on each ray by the ray model (:func:`_edge_projectors`): offsets and the fit's chi-square per sample.
-
-    ``sigma`` is the scale of the residuals (per ray or one), ``blur`` each ray's motion blur (px), taken to 0.5 px.
-    """
-    y = prof.astype(np.float64)
-    rss = np.empty((y.shape[0], _CAND.size))
-    buckets = np.round(2 * blur) / 2
-    for b in np.unique(buckets):
-        sel = buckets == b
-        m = _edge_projectors(round(2 * r) / 2, float(b))
-        rss[sel] = (np.matmul(y[sel][None], m) * y[sel][None]).sum(axis=2).T  # y^T (I - P_e) y
-    k = np.clip(np.argmin(rss, axis=1), 1, _CAND.size - 2)
-    i = np.arange(prof.shape[0])
-    r0, r1, r2 = rss[i, k - 1], rss[i, k], rss[i, k + 1]
-    den = r0 - 2 * r1 + r2
-    off = np.clip(0.5 * (r0 - r2) / np.where(den > 0, den, np.inf), -0.5, 0.5)
-    return _CAND[k] + off * (_CAND[1] - _CAND[0]), r1 / (sigma**2 * (_SAMPLES.size - 5))
-
-
-def _fit_circle_robust(px, py, keep):
-    """Circle through the kept edge points, points off by more than 3 robust sigma dropped (twice)."""
-    for _ in range(2):
-        if keep.sum() < _N_RAYS // 2:
-            return None, keep
-        fx, fy, fr = _circle_fit(px[keep], py[keep])
-        res = np.hypot(px - fx, py - fy) - fr
-        mad = 1.4826 * np.median(np.abs(res[keep] - np.median(res[keep]))) + 0.05  # a clean edge: 0.15 px
-        keep = keep & (np.abs(res) < 3 * mad)
-    return (fx, fy, fr, res), keep
-
-
-def fit_ball(
-    img: np.ndarray, cx: float, cy: float, r: float, sigma: float, blur: tuple[float, float] = (0.0, 0.0)
-) -> tuple[tuple, str | None]:
-    """Return the ball's sub-pixel centre near (cx, cy): ((x, y, r, rms, contrast), None) or ((), reason left out).
-
-    The rough edges (gradient peaks on a wide window) until the circle moves by under a pixel,
-    then the ray model (:func:`_edges_model`) until it moves by under 0.01 px (at most 8 passes).
-    ``blur`` is the ball's travel during the exposure (px, x and y), where known.
-    """
-    ray_blur = np.abs(_COS * blur[0] + _SIN * blur[1])
-    h, w = img.shape
-    wide, moved, kept = True, np.inf, np.ones(_N_RAYS, bool)
-    for _ in range(8):
-        rad = np.arange(-10.0, 10.01, 0.5) if wide else _SAMPLES
-        if min(cx - r, cy - r, w - 1 - cx - r, h - 1 - cy - r) < rad[-1] + 1:
-            return (), "ball touches the frame's border"
-        prof = _profiles(img, cx, cy, r, rad)
-        step = np.abs(prof[:, :4].mean(axis=1) - prof[:, -4:].mean(axis=1))
-        keep = step > 6 * sigma
-        if wide:
-            edge = _edges_gradient(prof, rad)
-        else:
-            # the model's own mismatch grows with the edge's contrast: 2 % of the step counts as noise
-            edge, chi2 = _edges_model(prof, r, np.maximum(sigma, 0.02 * step), ray_blur)
-            keep &= (chi2 < 2.0) & kept  # a ray once dropped stays dropped: the passes settle
-        fit, keep = _fit_circle_robust(cx + _COS * (r + edge), cy + _SIN * (r + edge), keep)
-        if fit is None:
-            return (), f"ball edge seen on {int(keep.sum())} of {_N_RAYS} rays (occluded, blurred or on clutter)"
-        moved = max(abs(fit[0] - cx), abs(fit[1] - cy), abs(fit[2] - r))
-        cx, cy, r, res = fit
-        if not wide and moved < 0.01:
-            break
-        kept = keep if not wide else kept
-        wide = wide and moved > 1.0
-    if wide or moved > 0.05:
-        return (), f"ball edge fit did not settle (last step {moved:.2f} px)"
-    rms = float(np.sqrt(np.mean(res[keep] ** 2)))
-    if rms > 0.5:  # edge points that no circle fits: the ball half hidden, or an edge of the clutter taken
-        return (), f"ball edge not round (residual {rms:.2f} px; occluded or on clutter)"
-    return (cx, cy, r, rms, float(np.median(step[keep]))), None
-
-
-def _roi(img: np.ndarray, cx: float, cy: float, half: float) -> tuple[np.ndarray, int, int]:
-    """Return the square of half-side ``half`` about (cx, cy), clipped to the frame, and its origin."""
-    x0, y0 = max(int(cx - half), 0), max(int(cy - half), 0)
-    return img[y0 : int(cy + half) + 1, x0 : int(cx + half) + 1], x0, y0
-
-
-def find_dots(img: np.ndarray, ball: tuple, dot_r: float, sigma: float) -> tuple[list, str | None]:
-    """Dark spots inside the ball: [(x, y, contrast)], or the reason they are left out."""
-    cx, cy, r = ball[:3]
-    sub, x0, y0 = _roi(img, cx, cy, r + 2)
-    sub = sub.astype(np.float32)  # the region only, not the whole frame
-    size = int(2 * np.ceil(2 * dot_r) + 1)
-    dark = ndimage.grey_closing(sub, size=(size, size)) - sub
-    yy, xx = np.mgrid[0 : sub.shape[0], 0 : sub.shape[1]]
-    inside = np.hypot(xx + x0 - cx, yy + y0 - cy) < r - 2
-    # a dot is dark: more than 5 noise sigma and a third of the ball's own level below the shading
-    level = max(5 * sigma, float(np.median(sub[inside])) / 3) if inside.any() else 5 * sigma
-    lab, n = ndimage.label((dark > level) & inside)
-    if n == 0:
-        return [], "no dot seen on the ball"
-    idx = np.arange(1, n + 1)
-    area = ndimage.sum_labels(np.ones_like(dark), lab, idx)
-    big = idx[area >= max(0.25 * np.pi * dot_r**2, 3)]
-    out = []
-    for j in big:
-        m = lab == j
-        m = ndimage.binary_dilation(m, iterations=2) & inside
-        wgt = np.where(m, np.clip(dark, 0, None), 0)
-        tot = wgt.sum()
-        x, y = (wgt * xx).sum() / tot + x0, (wgt * yy).sum() / tot + y0
-        out.append((float(x), float(y), float(dark[lab == j].max()), float(np.hypot(x - cx, y - cy) / r)))
-    return out, None
-
-
-def find_marker(img: np.ndarray, cx: float, cy: float, half: float, mr: float, sigma: float) -> tuple | None:
-    """Return the tip marker (a bright disc of radius ``mr`` in a dark surround) nearest (cx, cy): (x, y, contrast)."""
-    sub, x0, y0 = _roi(img, cx, cy, half)
-    sub = sub.astype(np.float32)  # the region only, not the whole frame
-    if min(sub.shape) < 2 * mr:
-        return None
-    local = ndimage.uniform_filter(sub, size=int(4 * mr + 1))
-    lab, n = ndimage.label(sub - local > 8 * sigma)
-    if n == 0:
-        return None
-    idx = np.arange(1, n + 1)
-    area = ndimage.sum_labels(np.ones_like(sub), lab, idx)
-    ok = idx[(area > 0.3 * np.pi * mr**2) & (area < 2.0 * np.pi * mr**2)]
-    best = None
-    gy, gx = np.mgrid[0 : sub.shape[0], 0 : sub.shape[1]]
-    for j, (my, mx) in zip(ok, ndimage.center_of_mass(sub, lab, ok), strict=True):
-        d = np.hypot(gx - mx, gy - my)
-        level = float(np.median(sub[(d > 1.5 * mr) & (d < 2.5 * mr)]))  # the end cap round the marker
-        core = d < 1.3 * mr
-        wgt = np.clip(sub[core] - level, 0, None)
-        if wgt.sum() <= 0:
-            continue
-        x, y = (wgt * gx[core]).sum() / wgt.sum() + x0, (wgt * gy[core]).sum() / wgt.sum() + y0
-        contrast = float(sub[lab == j].mean() - level)
-        if contrast > 0.3 * (float(sub.max()) - level) and (best is None or np.hypot(x - cx, y - cy) < best[3]):
-            best = (float(x), float(y), contrast, float(np.hypot(x - cx, y - cy)))
-    return best[:3] if best else None
-
-
 @dataclass
 class _Trail:
     """Last two positions of a point (frame, x, y), for the prediction of the next, and the contrasts found."""
@@ -332,7 +111,7 @@ def _ball_candidates(img, guess, opt: TrackOptions) -> list:
     r = opt.ball_radius_px
     if guess is None:
         return find_balls(img, r, opt.radius_tolerance)
-    sub, x0, y0 = _roi(img, guess[0], guess[1], 4 * r)
+    sub, x0, y0 = roi(img, guess[0], guess[1], 4 * r)
     return [(x + x0, y + y0) for x, y in find_balls(sub, r, opt.radius_tolerance)]
 
 
@@ -424,9 +203,8 @@ def _dots(img, k, ball, opt: TrackOptions, sigma, mem: _DotMemory, found: Found)
 
 def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -> None:
     guess = trail.predict(k)
-    if guess is None:
-        h, w = img.shape
-        m = find_marker(img, w / 2, h / 2, max(h, w), opt.marker_radius_px, sigma)
+    if guess is None:  # lost, or not found yet: the whole frame
+        m = find_marker_whole(img, opt.marker_radius_px, sigma)
     else:
         m = find_marker(img, guess[0], guess[1], 4 * opt.marker_radius_px + 20, opt.marker_radius_px, sigma)
     if m is None:

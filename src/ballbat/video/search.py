@@ -1,0 +1,191 @@
+"""Where the ball, its dots and the tip marker are in a frame or a region of it (docs/video.md, "The tracker").
+
+The searches of :mod:`ballbat.video.track`, each written for speed (issue 38): label statistics
+by ``np.bincount`` (one pass for every label), each spot's own work in a window about it (not
+the whole region), and the whole frame searched at quarter resolution (:func:`block_mean`),
+only where no prediction is at hand.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy import ndimage
+
+
+def roi(img: np.ndarray, cx: float, cy: float, half: float) -> tuple[np.ndarray, int, int]:
+    """Return the square of half-side ``half`` about (cx, cy), clipped to the frame, and its origin."""
+    x0, y0 = max(int(cx - half), 0), max(int(cy - half), 0)
+    return img[y0 : int(cy + half) + 1, x0 : int(cx + half) + 1], x0, y0
+
+
+def block_sum(img: np.ndarray, s: int) -> np.ndarray:
+    """Return the sums of the frame's s x s blocks (the last rows and columns short of a block dropped)."""
+    h, w = (img.shape[0] // s) * s, (img.shape[1] // s) * s
+    acc = np.uint16 if img.dtype == np.uint8 and s <= 16 else np.float64
+    rows = img[0:h:s, :w].astype(acc)
+    for i in range(1, s):
+        rows += img[i:h:s, :w]
+    out = rows[:, 0::s].copy()
+    for i in range(1, s):
+        out += rows[:, i::s]
+    return out
+
+
+def _median_top(v: np.ndarray, q: float) -> tuple[float, float]:
+    """Return the median and the ``q`` percentile (linear, as numpy's) of ``v``; exact, by a histogram for integers."""
+    if v.dtype != np.uint16:
+        return float(np.median(v)), float(np.percentile(v, q))
+    cum = np.cumsum(np.bincount(v.ravel()))
+    n = cum[-1]
+
+    def at(k):  # the k-th smallest value (from 0)
+        return float(np.searchsorted(cum, k + 1))
+
+    mid = at(n // 2) if n % 2 else 0.5 * (at(n // 2 - 1) + at(n // 2))
+    pos = q / 100 * (n - 1)
+    lo = int(np.floor(pos))
+    top = at(lo) + (pos - lo) * (at(min(lo + 1, n - 1)) - at(lo))
+    return mid, top
+
+
+def _centroids(lab: np.ndarray, labels: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, list]:
+    """Return the ``weights``-weighted centroids (x, y) of ``labels`` in the labelled array, and their boxes.
+
+    Each label's work is in its own box (``ndimage.find_objects``), not the whole array.
+    """
+    objs = ndimage.find_objects(lab)
+    mx, my, boxes = np.empty(labels.size), np.empty(labels.size), []
+    for i, j in enumerate(labels):
+        sl = objs[j - 1]
+        wv = np.where(lab[sl] == j, weights[sl], 0)
+        tot = wv.sum()
+        mx[i] = (wv.sum(axis=0) @ np.arange(sl[1].start, sl[1].stop)) / tot
+        my[i] = (wv.sum(axis=1) @ np.arange(sl[0].start, sl[0].stop)) / tot
+        boxes.append(sl)
+    return mx, my, boxes
+
+
+def find_balls(img: np.ndarray, radius: float, tol: float) -> list[tuple[float, float]]:
+    """Return the rough centres of every bright disc of about ``radius`` in the frame (quarter resolution)."""
+    s = 4 if radius >= 12 else 2
+    sums = block_sum(img, s)
+    if sums.size == 0:  # a region (about a prediction) that is off the frame
+        return []
+    med, top = _median_top(sums, 99.9)
+    lab, n = ndimage.label(sums > med + 0.6 * (top - med))
+    if n == 0:
+        return []
+    area = np.bincount(lab.ravel(), minlength=n + 1)[1:] * s * s
+    expect = np.pi * radius**2
+    ok = np.flatnonzero((area > (1 - tol) ** 2 * expect * 0.5) & (area < (1 + tol) ** 2 * expect)) + 1
+    out = []
+    for x, y, sl in zip(*_centroids(lab, ok, sums), strict=True):  # round: about as wide as high, at most 2r
+        bh, bw = (sl[0].stop - sl[0].start) * s, (sl[1].stop - sl[1].start) * s
+        if max(bh, bw) <= 2 * radius * (1 + tol) + 2 * s and min(bh, bw) >= 0.5 * max(bh, bw):
+            out.append(((x + 0.5) * s - 0.5, (y + 0.5) * s - 0.5))
+    return out
+
+
+def find_dots(img: np.ndarray, ball: tuple, dot_r: float, sigma: float) -> tuple[list, str | None]:
+    """Return the dark spots inside the ball: [(x, y, contrast, distance / radius)], or the reason they are left out."""
+    cx, cy, r = ball[:3]
+    sub, x0, y0 = roi(img, cx, cy, r + 2)
+    sub = sub.astype(np.float32)  # the region only, not the whole frame
+    size = int(2 * np.ceil(2 * dot_r) + 1)
+    dark = ndimage.grey_closing(sub, size=(size, size)) - sub
+    yy, xx = np.ogrid[0 : sub.shape[0], 0 : sub.shape[1]]
+    inside = np.hypot(xx + x0 - cx, yy + y0 - cy) < r - 2
+    # a dot is dark: more than 5 noise sigma and a third of the ball's own level below the shading
+    level = max(5 * sigma, float(np.median(sub[inside])) / 3) if inside.any() else 5 * sigma
+    lab, n = ndimage.label((dark > level) & inside)
+    if n == 0:
+        return [], "no dot seen on the ball"
+    area = np.bincount(lab.ravel(), minlength=n + 1)[1:]
+    out = []
+    objs = ndimage.find_objects(lab)
+    for j in np.flatnonzero(area >= max(0.25 * np.pi * dot_r**2, 3)) + 1:
+        win = tuple(slice(max(q.start - 2, 0), q.stop + 2) for q in objs[j - 1])  # the spot grown by 2 px
+        spot = lab[win] == j
+        m = ndimage.binary_dilation(spot, iterations=2) & inside[win]
+        wgt = np.where(m, np.clip(dark[win], 0, None), 0)
+        tot = wgt.sum()
+        x = (wgt * xx[:, win[1]]).sum() / tot + x0
+        y = (wgt * yy[win[0], :]).sum() / tot + y0
+        out.append((float(x), float(y), float(dark[win][spot].max()), float(np.hypot(x - cx, y - cy) / r)))
+    return out, None
+
+
+def _marker_at(sub, mx, my, mr):
+    """Return the end cap's level round a spot centred at (mx, my), and the brightness-weighted centroid above it."""
+    ws = int(np.ceil(2.5 * mr)) + 1
+    ya, xa = max(int(my) - ws, 0), max(int(mx) - ws, 0)
+    win = sub[ya : int(my) + ws + 1, xa : int(mx) + ws + 1]
+    gy, gx = np.ogrid[ya : ya + win.shape[0], xa : xa + win.shape[1]]
+    d = np.hypot(gx - mx, gy - my)
+    level = float(np.median(win[(d > 1.5 * mr) & (d < 2.5 * mr)]))  # the end cap round the marker
+    core = d < 1.3 * mr
+    wgt = np.clip(win - level, 0, None) * core
+    tot = wgt.sum()
+    if tot <= 0:
+        return level, None
+    return level, ((wgt * gx).sum() / tot, (wgt * gy).sum() / tot)
+
+
+def find_marker(
+    img: np.ndarray, cx: float, cy: float, half: float, mr: float, sigma: float, top: float | None = None
+) -> tuple | None:
+    """Return the tip marker (a bright disc of radius ``mr`` in a dark surround) nearest (cx, cy): (x, y, contrast).
+
+    A spot's contrast must be over 0.3 of the brightest value's above its surround (``top``:
+    the region's brightest, unless given).
+    """
+    sub, x0, y0 = roi(img, cx, cy, half)
+    sub = sub.astype(np.float32)  # the region only, not the whole frame
+    if min(sub.shape) < 2 * mr:
+        return None
+    local = ndimage.uniform_filter(sub, size=int(4 * mr + 1))
+    lab, n = ndimage.label(sub - local > 8 * sigma)
+    if n == 0:
+        return None
+    area = np.bincount(lab.ravel(), minlength=n + 1)[1:]
+    ok = np.flatnonzero((area > 0.3 * np.pi * mr**2) & (area < 2.0 * np.pi * mr**2)) + 1
+    top = float(sub.max()) if top is None else top
+    best = None
+    for j, mx, my, sl in zip(ok, *_centroids(lab, ok, sub), strict=True):
+        level, c = _marker_at(sub, mx, my, mr)
+        if c is None:
+            continue
+        x, y = c[0] + x0, c[1] + y0
+        contrast = float(sub[sl][lab[sl] == j].mean() - level)
+        if contrast > 0.3 * (top - level) and (best is None or np.hypot(x - cx, y - cy) < best[3]):
+            best = (float(x), float(y), contrast, float(np.hypot(x - cx, y - cy)))
+    return best[:3] if best else None
+
+
+def find_marker_whole(img: np.ndarray, mr: float, sigma: float) -> tuple | None:
+    """Return the tip marker nearest the frame's centre, searched in the whole frame: (x, y, contrast).
+
+    Bright spots of about the marker's size are looked for at quarter resolution (block means:
+    2 sigma above their surround, 0.1 to 4 times the marker's area), and each is then searched
+    for at full resolution in a region about it, as a predicted marker is (:func:`find_marker`,
+    against the frame's brightest value).
+    """
+    s = 4 if mr >= 6 else 2
+    small = block_sum(img, s).astype(np.float32) / (s * s)
+    local = ndimage.uniform_filter(small, size=int((4 * mr + 1) / s) | 1)
+    lab, n = ndimage.label(small - local > 2 * sigma)
+    if n == 0:
+        return None
+    area = np.bincount(lab.ravel(), minlength=n + 1)[1:] * s * s
+    ok = np.flatnonzero((area > 0.1 * np.pi * mr**2) & (area < 4.0 * np.pi * mr**2)) + 1
+    mx, my, _ = _centroids(lab, ok, small)
+    h, w = img.shape
+    top = float(img.max())
+    best = None
+    for x, y in zip((mx + 0.5) * s - 0.5, (my + 0.5) * s - 0.5, strict=True):
+        m = find_marker(img, x, y, 4 * mr + 20, mr, sigma, top)
+        if m is None or np.hypot(m[0] - x, m[1] - y) > 2 * mr:  # another spot's, near the region's border
+            continue
+        if best is None or np.hypot(m[0] - w / 2, m[1] - h / 2) < best[3]:
+            best = (*m, float(np.hypot(m[0] - w / 2, m[1] - h / 2)))
+    return best[:3] if best else None

@@ -1,0 +1,71 @@
+"""The tracker's searches (ballbat.video.search; issue 38's speed, docs/video.md) against the slow ways they replaced.
+
+The quarter resolution search's block sums and histogram median against numpy's; a ball found
+in a region or the whole frame, fitted alike; the whole-frame search for the tip marker against
+the search in a region about it; and a ball lost for longer than the prediction holds, found
+again by the whole-frame search.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from video_clips import BUSY, M_PER_PX, PLAIN, RADIUS_PX, spin_truth, swing_truth
+
+from ballbat.video.edge import fit_ball
+from ballbat.video.io import open_clip, write_clip
+from ballbat.video.render import render_frames
+from ballbat.video.search import _median_top, block_sum, find_balls, find_marker, find_marker_whole
+from ballbat.video.track import TrackOptions, track_clip
+
+
+@pytest.mark.parametrize("dtype", [np.uint8, np.uint16])
+def test_block_sums_and_histogram_median_are_numpys(dtype):
+    rng = np.random.default_rng(2)
+    img = rng.integers(0, 255 if dtype == np.uint8 else 4000, (130, 259), dtype=dtype)
+    sums = block_sum(img, 4)
+    np.testing.assert_array_equal(sums, img[:128, :256].reshape(32, 4, 64, 4).sum(axis=(1, 3)))
+    for v in (sums, sums[:, :-1], img[:5, :7]):  # an even and an odd number of values
+        med, top = _median_top(v, 99.9)
+        assert med == pytest.approx(np.median(v), abs=1e-9) and top == pytest.approx(np.percentile(v, 99.9), abs=1e-9)
+
+
+def test_a_ball_found_in_a_region_or_in_the_whole_frame_is_fitted_to_the_same_point():
+    truth = spin_truth(n=1)
+    img = next(render_frames(truth, BUSY, M_PER_PX))
+    (whole,) = find_balls(img, RADIUS_PX, 0.3)
+    x0, y0 = 30, 41  # a region about the ball, its blocks not the whole frame's
+    (part,) = find_balls(img[y0 : y0 + 100, x0 : x0 + 120], RADIUS_PX, 0.3)
+    assert np.hypot(part[0] + x0 - whole[0], part[1] + y0 - whole[1]) < 2
+    a = fit_ball(img, *whole, RADIUS_PX, 1.0)[0]
+    b = fit_ball(img, part[0] + x0, part[1] + y0, RADIUS_PX, 1.0)[0]
+    assert a[:3] == pytest.approx(b[:3], abs=0.005)
+    assert np.hypot(a[0] - truth.x["ball"][0], a[1] - truth.y["ball"][0]) < 0.5
+
+
+def test_the_whole_frame_search_finds_the_tip_marker_the_predicted_search_finds():
+    truth = swing_truth(n=6, width=480, height=240)
+    mr = 0.006 / M_PER_PX
+    for k, img in enumerate(render_frames(truth, BUSY, M_PER_PX)):
+        x, y = truth.x["bat_tip"][k], truth.y["bat_tip"][k]
+        near = find_marker(img, x + 3, y - 2, 4 * mr + 20, mr, 1.0, float(img.max()))
+        whole = find_marker_whole(img, mr, 1.0)
+        assert near is not None and whole == pytest.approx(near, abs=1e-9)
+        assert np.hypot(whole[0] - x, whole[1] - y) < 0.2
+
+
+def test_a_ball_lost_for_longer_than_the_prediction_holds_is_found_again(tmp_path):
+    truth = spin_truth(n=12, width=320)
+    truth.x["ball"][3:8] = np.nan  # not drawn for 5 frames: more than the 3 a prediction holds
+    clip = write_clip(tmp_path / "c.tif", render_frames(truth, PLAIN, M_PER_PX), truth.fps, frame_numbers=truth.frames)
+    found = track_clip(open_clip(clip), TrackOptions(RADIUS_PX))
+    assert [(k, why) for _, k, why in found.left_out] == [(k, "no ball found") for k in range(103, 108)]
+    got = dict(zip(found.rows["frame"], zip(found.rows["x_px"], found.rows["y_px"], strict=True), strict=True))
+    assert sorted(got) == [100, 101, 102, *range(108, 112)]
+    for k, (x, y) in got.items():
+        assert np.hypot(x - truth.x["ball"][k - 100], y - truth.y["ball"][k - 100]) < 0.3
+
+
+def test_no_ball_in_a_region_off_the_frame_or_smaller_than_a_block():
+    img = next(render_frames(spin_truth(n=1), PLAIN, M_PER_PX))
+    assert find_balls(img[:, 400:], RADIUS_PX, 0.3) == [] and find_balls(img[:3, :3], RADIUS_PX, 0.3) == []
