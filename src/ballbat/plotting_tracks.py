@@ -320,6 +320,7 @@ def _contrast_panel(ax, q) -> None:
     have = {t: v for t, v in q.contrast.items() if v.size}
     if have:
         ax.boxplot(list(have.values()), orientation="horizontal", tick_labels=list(have), widths=0.6)
+        ax.invert_yaxis()  # the point types top down, as the counts' bars
         for k, v in enumerate(have.values(), start=1):
             ax.text(float(np.max(v)), k, f"  {v.size}", va="center", fontsize=7)
     else:

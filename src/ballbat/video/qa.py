@@ -91,11 +91,12 @@ _ASIDE = re.compile(r"\s*\([^)]*\)")
 
 
 def reason_kind(reason: str) -> str:
-    """Return the kind of a reason a point was left out: without its numbers (``n``) and its asides in brackets.
+    """Return the kind of a reason a point was left out: without its numbers (``n``), asides in brackets, positions.
 
     "ball edge not round (residual 0.61 px; ...)" -> "ball edge not round"; "2 balls found" -> "n balls found".
     """
-    return _NUMBER.sub("n", _ASIDE.sub("", reason)).strip()
+    kind = _NUMBER.sub("n", _ASIDE.sub("", reason)).strip()
+    return kind.replace(" at n, n ", " ")  # "spot at 312.4, 190.0 on the limb" -> "spot on the limb"
 
 
 @dataclass
