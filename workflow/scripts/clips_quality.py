@@ -10,5 +10,7 @@ from ballbat.video.qa import camera_quality
 with logged(snakemake.log[0], snakemake.rule) as log:
     cams = camera_quality(quality_columns(read_dataset(snakemake.input.quality, require=tuple(QUALITY_TABLE))))
     for q in cams:
-        log.info("%s: %d clips, %d frames, %d points found, %d left out", q.camera, q.clips, q.frames, q.found, q.left_out)
+        log.info(
+            "%s: %d clips, %d frames, %d points found, %d left out", q.camera, q.clips, q.frames, q.found, q.left_out
+        )
     save_figure(quality_figure(cams), snakemake.output.figure, png_text(*job_provenance(snakemake)))
