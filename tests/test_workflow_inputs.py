@@ -58,7 +58,7 @@ def test_only_a_dataset_of_clips_gets_the_clips_qa_figures(config, tmp_path):
     cfg["datasets"]["trk"] = {"tracks": {"dir": str(tmp_path), "impacts": "imp.csv"}}
     cfg["datasets"]["vid"] = {"tracks": {"dir": str(tmp_path), "impacts": "imp.csv", "format": "video"}}
     inputs = WorkflowInputs(cfg, ROOT)
-    assert inputs.filmed == ["vid"] and inputs.tracked == ["synthetic", "trk", "vid"]
+    assert inputs.filmed == ["vid"] and inputs.not_filmed == ["synthetic", "trk"]
     clips = sorted(t for t in inputs.final_targets() if "/figures/clips_" in t)
     assert clips == ["results/vid/figures/clips_contact_sheet.png", "results/vid/figures/clips_quality.png"]
 

@@ -66,6 +66,7 @@ class WorkflowInputs:
         self.tracked = [d for d in self.datasets if self.uses_tracks(d)]
         #: The datasets whose tracks come from clips (rule import_clips); the others' tool files: import_tracks.
         self.filmed = [d for d in self.tracked if self.from_clips(d)]
+        self.not_filmed = [d for d in self.datasets if d not in self.filmed]
         self.scenarios = sorted(config.get("implications", {}).get("scenarios", {}))
         scenarios = config.get("implications", {}).get("scenarios", {})
         self.sweep_scenarios = [s for s in self.scenarios if "sweep" in scenarios[s]]

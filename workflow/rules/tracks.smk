@@ -195,7 +195,10 @@ rule clips_quality:
             caption="../report/clips_quality.rst",
             category="Dataset {dataset}",
             subcategory="Camera tracks",
-            labels={"figure": "clips tracking quality", "shows": "the tracker's residuals, contrasts and points left out per camera"},
+            labels={
+                "figure": "clips tracking quality",
+                "shows": "tracking residuals, contrasts, points left out per camera",
+            },
         ),
     log:
         f"{R}/{{dataset}}/logs/clips_quality.log",
