@@ -47,6 +47,7 @@ localrules:
     plot_fig11,
     plot_launch,
     tracks_qa,
+    clips_quality,
     studies,
     study_design,
     plot_study_coverage,

@@ -52,6 +52,17 @@ def test_a_measured_and_a_tool_file_dataset(config, tmp_path):
     )
 
 
+def test_only_a_dataset_of_clips_gets_the_clips_qa_figures(config, tmp_path):
+    """A folder of clips: import_clips (the tracker's quality) and the clips' figures; tool files: neither."""
+    cfg = copy.deepcopy(config)
+    cfg["datasets"]["trk"] = {"tracks": {"dir": str(tmp_path), "impacts": "imp.csv"}}
+    cfg["datasets"]["vid"] = {"tracks": {"dir": str(tmp_path), "impacts": "imp.csv", "format": "video"}}
+    inputs = WorkflowInputs(cfg, ROOT)
+    assert inputs.filmed == ["vid"] and inputs.not_filmed == ["synthetic", "trk"]
+    clips = sorted(t for t in inputs.final_targets() if "/figures/clips_" in t)
+    assert clips == ["results/vid/figures/clips_contact_sheet.png", "results/vid/figures/clips_quality.png"]
+
+
 def test_tool_file_content_is_in_the_params(config, tmp_path):
     """A tool file replaced by other content changes the import's params, whatever its timestamp."""
     cfg = copy.deepcopy(config)

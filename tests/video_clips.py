@@ -1,4 +1,4 @@
-"""Small clips made in the tests (tests/test_video_*.py): a truth by hand, drawn by ballbat.video.render."""
+"""Small clips made in the tests (tests/video/): a truth by hand, drawn by ballbat.video.render; a quality table."""
 
 from __future__ import annotations
 
@@ -6,6 +6,7 @@ import numpy as np
 
 from ballbat.video.render import Look
 from ballbat.video.scene import ClipTruth
+from ballbat.video.track import Found, found_columns
 
 #: A small camera: 0.0025 m per px puts a baseball's radius (36.6 mm) at 14.6 px.
 M_PER_PX = 0.0025
@@ -84,3 +85,34 @@ def render_clip_folder(folder, seed: int = 3, n: int | None = None) -> list[Clip
     rows = "".join(f"{i},wood,baseball\n" for i in ids)
     (folder / "impacts.csv").write_text("impact_id,bat,ball\n" + rows)
     return true
+
+
+def quality_clip(impact_id: str, camera: str, n: int, seed: int) -> dict:
+    """A tracker's quality table of one clip of ``n`` frames, as the tracker lays it out (found_columns of a Found)."""
+    rng = np.random.default_rng(seed)
+    found = Found()
+    points = ("ball", "bat_tip") if camera == "swing" else ("ball", "dot_a", "dot_b")
+    for k in range(100, 100 + n):
+        if k % 5 == 0:
+            found.leave_out("ball", k, f"ball edge not round (residual {0.5 + rng.random():.2f} px; occluded)")
+            for p in points[1:]:
+                found.leave_out(p, k, "no ball" if p != "bat_tip" else "no tip marker found")
+            continue
+        found.add("ball", k, 300 + k, 200.0, 0.05 + 0.1 * rng.random(), 150 + 10 * rng.random())
+        for p in points[1:]:
+            if p == "dot_b" and k % 3 == 0:
+                found.leave_out(p, k, "not seen inside the ball (hidden or on the limb)")
+                found.leave_out("dot", k, f"spot at {300 + k:.1f}, 190.0 on the limb (0.9{k % 10} of the radius)")
+            else:
+                found.add(p, k, 300 + k, 190.0, np.nan, 60 + 20 * rng.random())
+    return found_columns(found, impact_id, camera)[1]
+
+
+def quality_table() -> dict:
+    """A quality table of three impacts' clips in both cameras (12, 16, 20 frames), every kind of row."""
+    tables = [
+        quality_clip(f"W{i}", cam, 12 + 4 * i, seed=10 * i + (cam == "spin"))
+        for i in range(3)
+        for cam in ("swing", "spin")
+    ]
+    return {k: np.concatenate([t[k] for t in tables]) for k in tables[0]}

@@ -5,6 +5,9 @@
   frames used marked), the spin camera's view (ball and dots, fitted centre path), and
   each dot's unwrapped angle about the fitted centre against time with the fitted spin.
 * :func:`summary_figure` — residuals of every fit across impacts, and the flags.
+* :func:`contact_sheet` (rule ``clips_qa``) — a few frames of a few clips with the points tracked in them.
+* :func:`quality_figure` (rule ``clips_quality``) — the video tracker's quality per camera: the
+  ball's edge-fit residuals, the points' contrasts, the points found and left out per reason.
 
 Drawn from ``reduce.nc`` (the fitted parameters) and the tracks (the points); nothing is
 refitted. Part of the plotting layer (with :mod:`ballbat.plotting`, which sets matplotlib's
@@ -23,7 +26,7 @@ from .tracks.data import Camera, TrackBlocks, Tracks
 from .tracks.reduce import FLAG_VAR, ReduceFlag, physical
 from .units import G
 
-__all__ = ["impacts_figure", "pick_impacts", "save_figure", "summary_figure"]
+__all__ = ["contact_sheet", "impacts_figure", "pick_impacts", "quality_figure", "save_figure", "summary_figure"]
 
 
 def _cameras(red: xr.Dataset) -> dict[str, Camera]:
@@ -271,3 +274,69 @@ def contact_sheet(rows: list) -> Figure:
     }
     fig.legend(handles.values(), handles.keys(), loc="outside lower center", ncol=4, fontsize=7)
     return fig
+
+
+def quality_figure(cameras: list) -> Figure:
+    """Draw the video tracker's quality per camera (a row each): residuals, contrasts, points found and left out.
+
+    Parameters
+    ----------
+    cameras : list of :class:`ballbat.video.qa.CameraQuality`
+        Each camera's quality (:func:`ballbat.video.qa.camera_quality`).
+
+    Returns
+    -------
+    matplotlib.figure.Figure
+        Per camera: the histogram of the ball's edge-fit RMS residual (px), the contrast of each
+        point type (box plots), and the points found and left out per reason (bars, counts written).
+    """
+    n_bars = max((len(q.counts) for q in cameras), default=1)
+    fig = Figure(figsize=(15, max(2.6, 0.22 * n_bars + 1.2) * max(len(cameras), 1)), layout="constrained")
+    axes = fig.subplots(max(len(cameras), 1), 3, squeeze=False, width_ratios=(1, 1, 1.4))
+    for row, q in zip(axes, cameras, strict=False):
+        _residual_panel(row[0], q)
+        _contrast_panel(row[1], q)
+        _counts_panel(row[2], q)
+    clips = sum(q.clips for q in cameras)
+    frames = sum(q.frames for q in cameras)
+    fig.suptitle(f"Tracking quality per camera: {clips} clips, {frames} frames", fontsize=11)
+    return fig
+
+
+def _residual_panel(ax, q) -> None:
+    r = q.residual_px
+    if r.size:
+        ax.hist(r, bins=np.linspace(0.0, max(float(r.max()) * 1.05, 0.05), 30), color="tab:blue")
+        ax.axvline(float(np.median(r)), color="k", lw=0.8, ls="--", label=f"median {np.median(r):.3f} px")
+        ax.legend(fontsize=7)
+    else:
+        ax.text(0.5, 0.5, "no ball found", ha="center", va="center", transform=ax.transAxes)
+    ax.set_xlabel("ball edge-fit RMS residual (px)")
+    ax.set_ylabel("balls found")
+    ax.set_title(f"{q.camera}: {q.clips} clips, {q.frames} frames", fontsize=9)
+
+
+def _contrast_panel(ax, q) -> None:
+    have = {t: v for t, v in q.contrast.items() if v.size}
+    if have:
+        ax.boxplot(list(have.values()), orientation="horizontal", tick_labels=list(have), widths=0.6)
+        ax.invert_yaxis()  # the point types top down, as the counts' bars
+        for k, v in enumerate(have.values(), start=1):
+            ax.text(float(np.max(v)), k, f"  {v.size}", va="center", fontsize=7)
+    else:
+        ax.text(0.5, 0.5, "no point found", ha="center", va="center", transform=ax.transAxes)
+    ax.set_xlabel("contrast (grey levels of the clip)")
+    ax.set_title(f"{q.camera}: contrast of the points found", fontsize=9)
+
+
+def _counts_panel(ax, q) -> None:
+    labels = [f"{p}: {what}" for p, what in q.counts]
+    counts = list(q.counts.values())
+    colors = ["tab:blue" if what == "found" else "tab:red" for _, what in q.counts]
+    ax.barh(range(len(counts)), counts, color=colors)
+    ax.set_yticks(range(len(counts)), labels, fontsize=7)
+    ax.invert_yaxis()
+    for k, c in enumerate(counts):
+        ax.text(c, k, f" {c}", va="center", fontsize=7)
+    ax.set_xlabel("points")
+    ax.set_title(f"{q.camera}: {q.found} found, {q.left_out} left out", fontsize=9)

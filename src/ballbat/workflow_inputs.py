@@ -64,6 +64,9 @@ class WorkflowInputs:
         self.results = results_root(config)
         self.datasets = sorted(config["datasets"])
         self.tracked = [d for d in self.datasets if self.uses_tracks(d)]
+        #: The datasets whose tracks come from clips (rule import_clips); the others' tool files: import_tracks.
+        self.filmed = [d for d in self.tracked if self.from_clips(d)]
+        self.not_filmed = [d for d in self.datasets if d not in self.filmed]
         self.scenarios = sorted(config.get("implications", {}).get("scenarios", {}))
         scenarios = config.get("implications", {}).get("scenarios", {})
         self.sweep_scenarios = [s for s in self.scenarios if "sweep" in scenarios[s]]
@@ -289,7 +292,7 @@ class WorkflowInputs:
         r, imp = self.results, f"{self.results}/implications"
         targets = [self.get_source(Namespace(dataset=d)) for d in self.datasets]
         targets += [f"{r}/{d}/figures/tracks_{fig}.png" for d in self.tracked for fig in ("impacts", "summary")]
-        targets += [f"{r}/{d}/figures/clips_contact_sheet.png" for d in self.tracked if self.from_clips(d)]
+        targets += [f"{r}/{d}/figures/clips_{fig}.png" for d in self.filmed for fig in ("contact_sheet", "quality")]
         targets += [f"{r}/{d}/{f}" for d in self.datasets for f in per_dataset]
         targets += [f"{imp}/{s}.nc" for s in self.scenarios]
         targets += [f"{imp}/results.xlsx"] if self.scenarios else []

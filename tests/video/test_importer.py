@@ -14,7 +14,7 @@ from video_clips import LAB_CAMERAS, render_clip_folder
 
 from ballbat.properties import InputError, load_balls, load_bats
 from ballbat.tracks.formats.layout import import_block
-from ballbat.video.importer import clip_reader
+from ballbat.video.importer import ClipImport, clip_reader
 
 ROOT = Path(__file__).parents[2]
 
@@ -44,10 +44,18 @@ def _tables():
     return load_balls(ROOT / "config" / "balls.csv"), load_bats(ROOT / "config" / "bats.csv")
 
 
+@pytest.fixture(scope="module")
+def lab_import(lab_clips):
+    """The lab's folder of clips imported once (as rule import_clips does): tracks, what was read, the reader."""
+    clips = ClipImport()
+    tracks, imported = import_block(_block(lab_clips[0]), "datasets.vid.tracks", *_tables(), clip_reader=clips)
+    return tracks, imported, clips
+
+
 @pytest.mark.slow
-def test_clips_are_tracked_into_the_tracks_the_reduction_reads(lab_clips):
-    folder, true = lab_clips
-    tracks, imported = import_block(_block(folder), "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
+def test_clips_are_tracked_into_the_tracks_the_reduction_reads(lab_clips, lab_import):
+    true = lab_clips[1]
+    tracks, imported, _ = lab_import
     assert list(tracks.impact_id) == ["W1", "W2", "W3"] and imported.settings_yaml()["files"] == 6
     # the frame rates from the clips (the config gives none)
     assert imported.cameras["swing"]["fps"] == 3000.0 and "file(s)" in imported.cameras["swing"]["fps_from"]
@@ -58,6 +66,56 @@ def test_clips_are_tracked_into_the_tracks_the_reduction_reads(lab_clips):
             names = ("dot_a", "dot_b") if p.startswith("dot") else (p,)
             n, err = min((_rms(tracks.cameras[c.camera], i, p, c, q) for q in names), key=lambda r: r[1])
             assert n > 3 and err < 0.5, (c.impact_id, c.camera, p, n, err)
+
+
+@pytest.mark.slow
+def test_the_trackers_quality_of_every_point_is_kept_and_written_with_units_and_provenance(
+    lab_clips, lab_import, tmp_path
+):
+    """imported_quality.nc: every point found (as in the tracks) with its quality, every point left out with why."""
+    from ballbat.pipeline.ncio import read_dataset, write_dataset
+    from ballbat.stages.quality import QUALITY_TABLE, quality_columns, quality_dataset
+    from ballbat.tracks.data import to_long
+
+    tracks, _, clips = lab_import
+    q = clips.quality()
+    found = q["left_out"] == ""
+    # the points found are the tracks' rows, point for point
+    long = to_long(tracks)
+    assert _rows(q, found) == _rows(long, np.isfinite(long["x_px"]))
+    ball = found & (q["point"] == "ball")
+    assert np.all((q["residual_px"][ball] > 0) & (q["residual_px"][ball] < 0.5))  # the edge's RMS residual, px
+    assert np.all(np.isnan(q["residual_px"][found & (q["point"] != "ball")]))  # centroids: no residual
+    assert np.all(q["contrast"][found] > 0) and np.all(np.isnan(q["contrast"][~found]))
+    assert (~found).sum() > 0 and np.all(np.isnan(q["x_px"][~found]))  # left out: no position, a reason
+    # every frame of every clip has its ball, found or left out
+    assert {(i, c) for i, c in zip(q["impact_id"], q["camera"], strict=True)} == {
+        (f"W{k}", c) for k in (1, 2, 3) for c in ("swing", "spin")
+    }
+    inputs = {"files": sorted(str(p) for p in lab_clips[0].glob("*.tif"))}
+    path = write_dataset(
+        quality_dataset(q),
+        tmp_path / "imported_quality.nc",
+        title="quality",
+        rule="import_clips",
+        inputs=inputs,
+        config={"settings": {"format": "video"}},
+    )
+    ds = read_dataset(path, require=tuple(QUALITY_TABLE))
+    assert ds.attrs["provenance_rule"] == "import_clips" and '"format": "video"' in ds.attrs["provenance_config"]
+    assert ds.attrs["n_clips"] == 6 and ds.attrs["n_found"] == int(found.sum())
+    for name in ("frame", "x_px", "y_px", "residual_px", "contrast"):
+        assert ds[name].attrs["units"] == "1" and ds[name].attrs["long_name"], name
+    back = quality_columns(ds)
+    assert list(back["left_out"]) == list(q["left_out"])
+    np.testing.assert_array_equal(back["residual_px"], q["residual_px"])
+
+
+def _rows(cols: dict, sel: np.ndarray) -> list[tuple]:
+    """The rows ``sel`` of long columns as sorted (impact, camera, point, frame, x to 1e-6 px)."""
+    names = ("impact_id", "camera", "point")
+    text = [cols[k][sel].astype(str) for k in names]
+    return sorted(zip(*text, cols["frame"][sel].astype(int), np.round(cols["x_px"][sel].astype(float), 6), strict=True))
 
 
 def _rms(ct, i: int, p: str, c, q: str) -> tuple[int, float]:

@@ -25,6 +25,9 @@ def test_tool_files_run_end_to_end_with_the_long_csvs_e_x(lab_run):
     flags = xr.open_dataset(res / "trk" / "reduce.nc")["ingest_flag"].values
     np.testing.assert_array_equal(flags, ref_flags)  # the same impact excluded (tilted spin axis)
     assert (res / "trk" / "figures" / "tracks_impacts.png").is_file()
+    # tool files are read by import_tracks: no tracker's quality, no clips' figures (those are import_clips')
+    assert not list((res / "trk").glob("imported_quality*")) and not list((res / "trk").glob("figures/clips_*"))
+    assert xr.open_dataset(res / "trk" / "imported_tracks.nc").attrs["provenance_rule"] == "import_tracks"
     found = yaml.safe_load((res / "trk" / "imported_cameras.yaml").read_text())
     assert found["cameras"]["swing"]["fps"] == pytest.approx(3000.0)
     assert found["cameras"]["spin"]["m_per_px"] == pytest.approx(0.00125, rel=1e-6)

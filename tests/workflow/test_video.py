@@ -31,6 +31,7 @@ def test_a_folder_of_clips_is_tracked_and_reduced_to_its_impacts(tmp_path, lab_c
     snakemake(wd, "-c2", "--", "results/vid/reduce.nc")
     found = yaml.safe_load((wd / "results" / "vid" / "imported_cameras.yaml").read_text())
     assert found["files"] == 6 and found["cameras"]["swing"]["fps"] == 3000.0  # the frame rate from the clips
+    assert (wd / "results" / "vid" / "imported_quality.nc").is_file()  # import_clips: the tracker's quality kept
     red = xr.open_dataset(wd / "results" / "vid" / "reduce.nc")
     assert list(red["impact_id"].values) == ["W1", "W2", "W3"]
     # the clips' true impacts, within a few of the reduction's own standard errors (SI units)
@@ -42,9 +43,12 @@ def test_a_folder_of_clips_is_tracked_and_reduced_to_its_impacts(tmp_path, lab_c
 
 @pytest.mark.slow
 def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_path):
-    """render.video: the clips drawn (render_clips), tracked (import_tracks) and reduced: within 4 standard
-    errors of the experiment's truth; the folder of clips is written whole, and a rerun does nothing.
+    """render.video: the clips drawn (render_clips), tracked (import_clips) and reduced: within 4 standard
+    errors of the experiment's truth; the folder of clips is written whole, and a rerun does nothing. The
+    tracker's quality is kept (imported_quality.nc, in the run's crate) and drawn (clips_quality.png).
     """
+    import json
+
     import xarray as xr
 
     wd = make_workdir(tmp_path)
@@ -53,9 +57,19 @@ def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_pa
     example["synthetic"]["e_x"] = {"baseball": {"wood": 0.464}}
     write_config(wd, lambda cfg: cfg["datasets"].update(filmed=example))
     sheet = "results/filmed/figures/clips_contact_sheet.png"
-    snakemake(wd, "-c2", "--", "results/filmed/reduce.nc", sheet)
+    quality = "results/filmed/figures/clips_quality.png"
+    snakemake(wd, "-c2", "--", "results/filmed/reduce.nc", sheet, quality)
     res = wd / "results" / "filmed"
     assert_not_blank(wd / sheet)
+    assert_not_blank(wd / quality)
+    q = xr.open_dataset(res / "imported_quality.nc")
+    assert q.attrs["provenance_rule"] == "import_clips" and q.attrs["n_clips"] == 8
+    assert q["residual_px"].attrs["units"] == "1" and q.attrs["n_found"] > 0 and q.attrs["n_left_out"] > 0
+    tracked = xr.open_dataset(res / "imported_tracks.nc")
+    assert q.attrs["n_found"] == tracked.attrs["n_rows"]  # every point found is a row of the tracks
+    crate = json.loads((wd / "results" / "ro-crate-metadata.json").read_text())
+    made = [e for e in crate["@graph"] if e["@id"].endswith("filmed/imported_quality.nc")]
+    assert made and "File" in made[0]["@type"]
     names = sorted(p.name for p in (res / "clips").iterdir())
     assert len([n for n in names if n.endswith(".mkv")]) == 8 and "impacts.csv" in names
     assert not [p for p in res.iterdir() if p.name.startswith(".clips.")]  # no temporary folder left
@@ -65,5 +79,5 @@ def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_pa
     for name in ("v_bat", "v_ball", "theta", "omega"):
         got, err, true = red[name].values, red[f"{name}_err"].values, truth[f"truth_{name}"].values
         assert np.all(np.abs(got - true) < 4 * err), (name, got, true, err)
-    again = snakemake(wd, "-c2", "-n", "--", "results/filmed/reduce.nc", sheet)
+    again = snakemake(wd, "-c2", "-n", "--", "results/filmed/reduce.nc", sheet, quality)
     assert "Nothing to be done" in again.stdout + again.stderr

@@ -44,6 +44,8 @@ R = INPUTS.results
 for _line in unwritable_folders([R, ".snakemake"]):
     sys.exit(f"ballbat: {_line}")
 DATASETS, TRACKED = INPUTS.datasets, INPUTS.tracked
+#: The datasets whose tracks come from clips (imported by import_clips, with the tracker's quality), and the others.
+FILMED, NOT_FILMED = INPUTS.filmed, INPUTS.not_filmed
 SCENARIOS, SWEEP_SCENARIOS, LAUNCH_SCENARIOS = INPUTS.scenarios, INPUTS.sweep_scenarios, INPUTS.launch_scenarios
 # Replicate studies (studies.smk). STUDIES: those of `snakemake studies` (`make study`); the studies marked
 # on_request are built by `snakemake studies_on_request` only.

@@ -69,6 +69,8 @@ rule import_tracks:
         cameras=f"{R}/{{dataset}}/imported_cameras.yaml",
     log:
         f"{R}/{{dataset}}/logs/import_tracks.log",
+    wildcard_constraints:
+        dataset="|".join(NOT_FILMED) or "^$",
     group:
         "dataset"
     conda:
@@ -83,6 +85,19 @@ rule import_tracks:
         sha256=tool_file_hashes,
     script:
         "../scripts/import_tracks.py"
+
+
+# A folder of clips (tracks.format: video, or a filmed synthetic dataset): tracked as import_tracks reads
+# tool files, and the tracker's quality of every point kept beside the tracks (docs/video.md).
+use rule import_tracks as import_clips with:
+    output:
+        tracks=f"{R}/{{dataset}}/imported_tracks.nc",
+        cameras=f"{R}/{{dataset}}/imported_cameras.yaml",
+        quality=f"{R}/{{dataset}}/imported_quality.nc",
+    log:
+        f"{R}/{{dataset}}/logs/import_clips.log",
+    wildcard_constraints:
+        dataset="|".join(FILMED) or "^$",
 
 
 rule reduce:
@@ -167,3 +182,27 @@ rule clips_qa:
         settings=get_import_settings,
     script:
         "../scripts/clips_qa.py"
+
+
+rule clips_quality:
+    """The video tracker's quality per camera: the ball's edge-fit residuals, contrasts, points left out and why."""
+    input:
+        quality=f"{R}/{{dataset}}/imported_quality.nc",
+        code=code("clips_quality.py"),
+    output:
+        figure=report(
+            f"{R}/{{dataset}}/figures/clips_quality.png",
+            caption="../report/clips_quality.rst",
+            category="Dataset {dataset}",
+            subcategory="Camera tracks",
+            labels={
+                "figure": "clips tracking quality",
+                "shows": "tracking residuals, contrasts, points left out per camera",
+            },
+        ),
+    log:
+        f"{R}/{{dataset}}/logs/clips_quality.log",
+    conda:
+        ENV
+    script:
+        "../scripts/clips_quality.py"

@@ -1,6 +1,8 @@
-"""Rule import_tracks: adapter around ballbat.tracks.formats.layout.import_block (clips: ballbat.video.importer)."""
+"""Rules import_tracks and import_clips: adapter around ballbat.tracks.formats.layout.import_block.
 
-from functools import partial
+Clips (import_clips): tracked by ballbat.video.importer, whose quality table goes to imported_quality.nc
+(ballbat.stages.quality).
+"""
 
 import yaml
 
@@ -8,18 +10,20 @@ from ballbat.pipeline.ncio import atomic_write_text, write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls, load_bats
+from ballbat.stages.quality import quality_dataset
 from ballbat.stages.render import tracks_dataset
 from ballbat.tracks.formats.layout import import_block
-from ballbat.video.importer import clip_reader
+from ballbat.video.importer import ClipImport
 
 with logged(snakemake.log[0], snakemake.rule) as log:
-    inp = snakemake.input
+    inp, out = snakemake.input, snakemake.output
+    clips = ClipImport(workers=snakemake.threads)  # clips tracked side by side
     tracks, imported = import_block(
         snakemake.params.settings,
         snakemake.params.where,
         load_balls(inp.balls),
         load_bats(inp.bats),
-        clip_reader=partial(clip_reader, workers=snakemake.threads),  # clips tracked side by side
+        clip_reader=clips,
     )
     found = imported.settings_yaml()
     log.info("%d files, %d impacts, %d tracked points", found["files"], tracks.n, found["rows"])
@@ -27,12 +31,17 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         log.info("camera %s: %s", cam, vals)
     for path, names in imported.ignored.items():
         log.info("%s: tracks left out (not in points): %s", path, ", ".join(names))
+    provenance = {"rule": snakemake.rule, "inputs": data_inputs(inp), "config": dict(snakemake.params)}
+    name = snakemake.wildcards.dataset
+    if hasattr(out, "quality"):  # import_clips: the tracker's quality of every point
+        quality = quality_dataset(clips.quality())
+        log.info("tracker: %d points found, %d left out", quality.attrs["n_found"], quality.attrs["n_left_out"])
+        title = f"The video tracker's quality of every point of dataset {name}'s clips, found or left out"
+        write_dataset(quality, out.quality, title=title, **provenance)
     write_dataset(
         tracks_dataset(tracks),
-        snakemake.output.tracks,
-        title=f"Camera tracks of dataset {snakemake.wildcards.dataset} read from the lab's tracking-tool files",
-        rule=snakemake.rule,
-        inputs=data_inputs(inp),
-        config=dict(snakemake.params),
+        out.tracks,
+        title=f"Camera tracks of dataset {name} read from the lab's tracking-tool files",
+        **provenance,
     )
-    atomic_write_text(snakemake.output.cameras, yaml.safe_dump(found, sort_keys=False))
+    atomic_write_text(out.cameras, yaml.safe_dump(found, sort_keys=False))

@@ -12,6 +12,8 @@ one ``run`` and write its Dataset (:func:`~ballbat.pipeline.ncio.write_job_outpu
 * :mod:`.ingest`: ``ingest.nc`` (:mod:`ballbat.ingest`)
 * :mod:`.render`: ``tracks.nc`` (:mod:`ballbat.tracks.render`); its :func:`.render.tracks_dataset` also
   lays out ``imported_tracks.nc`` (:mod:`ballbat.tracks.formats`)
+* :mod:`.quality`: ``imported_quality.nc``, the video tracker's quality of every point of a dataset's clips
+  (the import's :class:`ballbat.video.importer.ClipImport` keeps it)
 * :mod:`.reduce`: ``reduce.nc`` (:mod:`ballbat.tracks.io`, :mod:`ballbat.tracks.reduce`, :mod:`ballbat.tracks.checks`)
 * :mod:`.normalize`: ``normalize.nc`` (:mod:`ballbat.analysis`)
 * :mod:`.reconstruct`: ``reconstruct.nc`` (:mod:`ballbat.analysis`)

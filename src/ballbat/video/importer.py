@@ -11,6 +11,11 @@ over the camera's ``m_per_px``, the dots' and the tip marker's from ``video.dot_
 ``video.marker_radius_mm``. The clip then checks the scale: the ball's fitted radius (median of
 its frames) more than :data:`RADIUS_LIMIT` from the expected one is an error naming the clip,
 both radii and the ``m_per_px`` the clip implies.
+
+The tracker's quality of every point (each point found with its edge-fit residual and
+contrast, each left out with its reason: :func:`ballbat.video.track.found_columns`) is kept
+by the reader, clip by clip (:attr:`ClipReader.quality`); :class:`ClipImport` hands it to the
+import's rule, which writes it beside the tracks (:mod:`ballbat.stages.quality`).
 """
 
 from __future__ import annotations
@@ -23,7 +28,7 @@ from ..tracks.data import POINTS
 from ..tracks.formats import FileTracks, FormatError
 from .clip import VideoError
 from .io import open_clip
-from .track import TrackOptions, require_ball, track_clip
+from .track import Found, TrackOptions, found_columns, require_ball, track_clip
 
 #: Largest relative difference of the ball's measured radius from the one the config implies
 #: (Table I's radius / m_per_px). The fitted radius is within 1 % of the truth on rendered clips
@@ -34,6 +39,11 @@ RADIUS_LIMIT = 0.05
 
 def clip_tracks(path: Path, camera: str, m_per_px: float, ball_radius_m: float, video: dict) -> FileTracks:
     """Track one clip into the tracks of its camera's points; a :class:`FormatError` naming what is wrong."""
+    return clip_found(path, camera, m_per_px, ball_radius_m, video)[0]
+
+
+def clip_found(path: Path, camera: str, m_per_px: float, ball_radius_m: float, video: dict) -> tuple[FileTracks, Found]:
+    """Track one clip: its tracks (as :func:`clip_tracks`) and the tracker's :class:`Found` (the quality)."""
     opt = TrackOptions(
         ball_radius_m / m_per_px,
         POINTS[camera],
@@ -64,15 +74,20 @@ def clip_tracks(path: Path, camera: str, m_per_px: float, ball_radius_m: float, 
             np.array(rows[k], dtype=t)[sel] for k, t in (("frame", np.int64), ("x_px", float), ("y_px", float))
         )
     info = clip.info
-    return FileTracks(str(path), tracks, fps=info.fps, source={"fps": info.source.get("fps", "the clip")})
+    return FileTracks(str(path), tracks, fps=info.fps, source={"fps": info.source.get("fps", "the clip")}), found
 
 
-def _track(job: tuple) -> FileTracks | FormatError:
-    """Track one clip (a job of :class:`ClipReader`; module-level, so a process pool can run it)."""
+def _track(job: tuple) -> tuple[FileTracks, dict] | FormatError:
+    """Track one clip: its tracks and its quality table's columns (a job of :class:`ClipReader`).
+
+    Module-level, so a process pool can run it.
+    """
+    path, impact_id, camera, *rest = job
     try:
-        return clip_tracks(*job)
+        tracks, found = clip_found(path, camera, *rest)
     except FormatError as exc:
         return exc
+    return tracks, found_columns(found, impact_id, camera)[1]
 
 
 class ClipReader:
@@ -80,17 +95,19 @@ class ClipReader:
 
     Called with the folder's clips, it tracks them side by side in ``workers`` processes (the
     import job's threads); the clips are independent, so the tracks are those of one clip at a time.
+    ``quality`` holds the quality table's columns of each clip tracked (in the order tracked).
     """
 
     def __init__(self, block: dict, ball_radius_m: dict[str, float], workers: int = 1) -> None:
         self.video = block["video"]
         self.ball_radius_m = ball_radius_m
         self.workers = max(int(workers), 1)
+        self.quality: list[dict[str, np.ndarray]] = []
 
     def _job(self, path: Path, impact_id: str, camera: str, cam: dict) -> tuple | FormatError:
         if impact_id not in self.ball_radius_m:
             return FormatError([f"{path}: impact {impact_id!r} has no ball in the impacts table"])
-        return (path, camera, float(cam["m_per_px"]), self.ball_radius_m[impact_id], self.video)
+        return (path, impact_id, camera, float(cam["m_per_px"]), self.ball_radius_m[impact_id], self.video)
 
     def __call__(self, items: list[tuple[Path, str, str, dict]]) -> list[FileTracks | FormatError]:
         """Track every (path, impact id, camera, camera config), in order; a clip's problems as its FormatError."""
@@ -102,9 +119,11 @@ class ClipReader:
 
             ctx = multiprocessing.get_context("fork")
             with ProcessPoolExecutor(min(self.workers, len(todo)), mp_context=ctx) as pool:
-                done = iter(list(pool.map(_track, todo)))
+                got = list(pool.map(_track, todo))
         else:
-            done = iter([_track(j) for j in todo])
+            got = [_track(j) for j in todo]
+        self.quality += [g[1] for g in got if not isinstance(g, FormatError)]
+        done = iter(g if isinstance(g, FormatError) else g[0] for g in got)
         return [j if isinstance(j, FormatError) else next(done) for j in jobs]
 
 
@@ -114,3 +133,24 @@ def clip_reader(block: dict, ball_radius_m: dict[str, float], workers: int = 1) 
     ``workers``: processes that track clips side by side (the import job's threads).
     """
     return ClipReader(block, ball_radius_m, workers)
+
+
+class ClipImport:
+    """A ``clip_reader`` for :func:`~ballbat.tracks.formats.layout.import_block` that keeps the reader it makes.
+
+    So the import's caller gets the tracker's quality of every clip (:meth:`quality`) beside the tracks.
+    """
+
+    def __init__(self, workers: int = 1) -> None:
+        self.workers = workers
+        self.readers: list[ClipReader] = []
+
+    def __call__(self, block: dict, ball_radius_m: dict[str, float]) -> ClipReader:
+        """Return the reader of a block's clips (:func:`clip_reader`), kept."""
+        self.readers.append(clip_reader(block, ball_radius_m, self.workers))
+        return self.readers[-1]
+
+    def quality(self) -> dict[str, np.ndarray]:
+        """Return the quality table of every clip read (:func:`ballbat.video.track.found_columns`), clip after clip."""
+        tables = [t for r in self.readers for t in r.quality] or [found_columns(Found(), "", "")[1]]
+        return {k: np.concatenate([t[k] for t in tables]) for k in tables[0]}
