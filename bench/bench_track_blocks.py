@@ -22,20 +22,12 @@ import tracemalloc
 from pathlib import Path
 
 import numpy as np
-from impacts import random_impacts  # bench/impacts.py
+from impacts import RENDER_CFG, random_impacts  # bench/impacts.py
 
 from ballbat.pipeline.config import checked_block
 from ballbat.pipeline.ncio import write_dataset
 from ballbat.tracks.render import render_tracks, settings_from_config
 
-CFG = {
-    "cameras": {
-        "swing": {"fps": 3000, "m_per_px": 0.00074, "tee_px": [540, 480]},
-        "spin": {"fps": 1000, "m_per_px": 0.00125, "tee_px": [600, 480], "pre_impact_frames": 5},
-    },
-    "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
-    "seed": 1,
-}
 COLS = ("impact_id", "camera", "point", "frame", "x_px", "y_px")
 
 
@@ -43,7 +35,7 @@ def write_tracks(path: Path, n: int, factor: int) -> int:
     """Write the tracks file; return the tracked points' own size in bytes (x and y, 8 bytes each)."""
     from ballbat.stages.render import tracks_dataset
 
-    s = settings_from_config(checked_block(CFG, "render"))
+    s = settings_from_config(checked_block(RENDER_CFG, "render"))
     tracks = render_tracks(
         random_impacts(n, seed=0),
         np.full(n, 0.0366),
@@ -83,7 +75,7 @@ def run(path: str, mode: str) -> dict:
 
     root = Path(__file__).resolve().parents[1] / "config"
     balls, bats = load_balls(root / "balls.csv"), load_bats(root / "bats.csv")
-    block = checked_block(CFG, "render")
+    block = checked_block(RENDER_CFG, "render")
     settings = reduce.ReduceSettings.from_config(data.camera_block(block), "render", systematics=False)
     if mode == "one":
         data.BLOCK_BYTES = 2**62  # every impact in one block, padded to the longest track

@@ -10,7 +10,7 @@ import sys
 import time
 
 import numpy as np
-from impacts import random_impacts  # bench/impacts.py
+from impacts import RENDER_CFG, random_impacts  # bench/impacts.py
 
 from ballbat.pipeline.config import checked_block
 from ballbat.tracks.data import POINTS, to_dense, to_long
@@ -18,19 +18,11 @@ from ballbat.tracks.reduce import reduce_tracks
 from ballbat.tracks.render import render_tracks, settings_from_config
 
 N = int(sys.argv[1]) if len(sys.argv) > 1 else 10_000
-CFG = {
-    "cameras": {
-        "swing": {"fps": 3000, "m_per_px": 0.00074, "tee_px": [540, 480]},
-        "spin": {"fps": 1000, "m_per_px": 0.00125, "tee_px": [600, 480], "pre_impact_frames": 5},
-    },
-    "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
-    "seed": 1,
-}
 
 truth = random_impacts(N, seed=0)
 r = np.full(N, 0.0366)
 ids = np.arange(N).astype(str)
-s = settings_from_config(checked_block(CFG, "render"))  # the schema's defaults filled
+s = settings_from_config(checked_block(RENDER_CFG, "render"))  # the schema's defaults filled
 
 t0 = time.perf_counter()
 tracks = render_tracks(truth, r, s, ids, np.full(N, "baseball"), np.full(N, "wood"))
