@@ -20,17 +20,23 @@ from .datasets import films, renders
 from .pipeline.codedeps import module_files
 from .pipeline.guards import results_root
 from .pipeline.provenance import sha256_file
-from .tracks.data import camera_block, clips_block, tool_file_extensions
+from .tracks.data import CAMERAS, camera_block, clips_block, tool_file_extensions
+from .video.plan import (
+    LARGEST_FRAME_BYTES,
+    Clip,
+    batch_mem_mb,
+    batch_runtime_min,
+    file_frames,
+    folder_clips,
+    plan_batches,
+    rendered_clips,
+)
 
 if TYPE_CHECKING:
     from .studies.settings import StudySettings
 
 #: Every figure of a dataset ({results}/{dataset}/figures/).
 DATASET_FIGURES = ("fig3", "fig4", "fig5", "fig6", "fig9a", "fig9b", "fig10")
-
-
-#: Clips a dataset's import tracks side by side (its job's threads; tracking is about 15 ms a frame a core).
-CLIP_THREADS = 4
 
 
 def existing(path: str) -> str | list:
@@ -73,6 +79,7 @@ class WorkflowInputs:
         self.launch_scenarios = [s for s in self.scenarios if s not in self.sweep_scenarios]
         self.all_studies = sorted(config.get("studies") or {})
         self.studies = [s for s in self.all_studies if not config["studies"][s]["on_request"]]
+        self._batches: dict[str, list[list[Clip]]] = {}
 
     # -- code and datasets ----------------------------------------------------------------
 
@@ -186,18 +193,13 @@ class WorkflowInputs:
         """Return the sha256 of every tool file of a ``tracks.dir`` folder and of the dataset's tables.
 
         A tool file replaced by other content reruns the import, whatever its timestamp (:func:`file_hashes`).
+        Clips: the dataset's tables only (each clip's sha256 is a param of its batch, :meth:`batch_hashes`,
+        whose new batch file reruns the import).
         """
-        if films(self.dataset_config(wildcards)):  # the clips are the render_clips rule's, rebuilt by their inputs
+        if self.from_clips(wildcards.dataset):
             return self.data_hashes(wildcards)
         files = {Path(f).name: f for f in self.get_tool_files(wildcards)["files"]}
         return {**self.data_hashes(wildcards), **file_hashes(files)}
-
-    def get_import_threads(self, wildcards: Namespace) -> int:
-        """Return the import job's threads: :data:`CLIP_THREADS` clips tracked side by side, 1 for tool files.
-
-        Snakemake gives a job at most ``--cores`` threads (and a cluster job as many CPUs).
-        """
-        return CLIP_THREADS if self.from_clips(wildcards.dataset) else 1
 
     def get_import_settings(self, wildcards: Namespace) -> dict:
         """Return the dataset's ``tracks`` block (the import rule's params); filmed impacts: the block of the clips."""
@@ -209,6 +211,92 @@ class WorkflowInputs:
     def clips_dir(self, wildcards: Namespace) -> str:
         """Return the folder of a filmed dataset's clips (the render_clips rule's output)."""
         return f"{self.results}/{wildcards.dataset}/clips"
+
+    # -- clips tracked in batches (ballbat.video.plan) ---------------------------------------
+
+    def clip_batches(self, name: str) -> list[list[Clip]]:
+        """Return the batches of a dataset's clips (``video.clips_per_job`` each), planned once a run.
+
+        A lab's folder as the import lists it; a filmed experiment's clips named from its config.
+        """
+        if name not in self._batches:
+            d = self.config["datasets"][name]
+            block = self.get_import_settings(Namespace(dataset=name))
+            if films(d):
+                clips = rendered_clips(block["dir"], self._n_impacts(d), d["render"]["video"]["format"])
+            else:
+                clips = folder_clips(block)
+            self._batches[name] = plan_batches(clips, block["video"]["clips_per_job"])
+        return self._batches[name]
+
+    def get_clip_batch_files(self, wildcards: Namespace) -> list[str]:
+        """Return the batch files of a dataset's clips (rule track_clips's outputs; import_clips gathers them)."""
+        n = len(self.clip_batches(wildcards.dataset))
+        return [f"{self.results}/{wildcards.dataset}/clip_tracks/batch_{k}.nc" for k in range(n)]
+
+    def _batch(self, wildcards: Namespace) -> list[Clip]:
+        batches = self.clip_batches(wildcards.dataset)
+        k = int(wildcards.batch)
+        if k >= len(batches):
+            raise ValueError(
+                f"dataset {wildcards.dataset}: no batch {k} of its clips ({len(batches)} batches, numbered from 0)"
+            )
+        return batches[k]
+
+    def get_batch_clips(self, wildcards: Namespace) -> dict:
+        """Return a batch's inputs: its clips (a Photron header's .mraw beside it) and the impacts table.
+
+        A filmed experiment: the folder of clips rule render_clips writes (the impacts table in it).
+        """
+        d = self.dataset_config(wildcards)
+        if films(d):
+            return {"clips": self.clips_dir(wildcards)}
+        paths = [p for _, _, p in self._batch(wildcards)]
+        mraw = [str(Path(p).with_suffix(".mraw")) for p in paths if Path(p).suffix.lower() in (".cih", ".cihx")]
+        return {"clips": paths + [m for m in mraw if Path(m).is_file()], "impacts": existing(d["tracks"]["impacts"])}
+
+    def get_tracker_settings(self, wildcards: Namespace) -> dict:
+        """Return what a batch's tracker reads (rule track_clips's params): clips, scales, markers, impacts table."""
+        block = self.get_import_settings(wildcards)
+        return {
+            "clips": [list(c) for c in self._batch(wildcards)],
+            "m_per_px": {c: (block["cameras"].get(c) or {}).get("m_per_px") for c in CAMERAS},
+            "video": {k: block["video"][k] for k in ("dot_radius_mm", "marker_radius_mm")},
+            "impacts": block["impacts"],
+            "where": self.get_reduce_where(wildcards),
+        }
+
+    def batch_hashes(self, wildcards: Namespace) -> dict[str, str]:
+        """Return the sha256 of a batch's clips and of the dataset's tables: a changed clip reruns its batch only.
+
+        A filmed experiment's clips are rule render_clips's, rebuilt by their own inputs: the tables' only.
+        """
+        if films(self.dataset_config(wildcards)):
+            return self.data_hashes(wildcards)
+        files = {Path(f).name: f for f in self.get_batch_clips(wildcards)["clips"]}
+        return {**self.data_hashes(wildcards), **file_hashes(files)}
+
+    def clip_batch_mem_mb(self, wildcards: Namespace) -> int:
+        """Return a batch job's memory, MB, from its largest frame (the tracker streams: not from a clip's length).
+
+        A filmed experiment's frames are its cameras'; a lab's are not known before the job: the largest assumed.
+        """
+        d = self.dataset_config(wildcards)
+        if not films(d):
+            return batch_mem_mb(LARGEST_FRAME_BYTES)
+        cams, bits = d["render"]["cameras"], d["render"]["video"]["bit_depth"]
+        return batch_mem_mb(max(cams[c]["width_px"] * cams[c]["height_px"] for c in CAMERAS) * (1 if bits <= 8 else 2))
+
+    def clip_batch_runtime(self, wildcards: Namespace) -> int:
+        """Return a batch job's time limit, minutes, from its frames.
+
+        A filmed experiment: its cameras' longest clips; a lab's: bounded by its files' sizes.
+        """
+        d = self.dataset_config(wildcards)
+        if films(d):
+            cams = d["render"]["cameras"]
+            return batch_runtime_min(sum(cams[cam]["max_frames"] + 2 for _, cam, _ in self._batch(wildcards)))
+        return batch_runtime_min(file_frames(self.get_batch_clips(wildcards)["clips"]))
 
     def get_reduce_settings(self, wildcards: Namespace) -> dict:
         """Return the camera block the reduction reads (of ``tracks``, or of ``render``)."""
@@ -229,9 +317,13 @@ class WorkflowInputs:
         tracks (measured 35 kB).
         """
         d = self.dataset_config(wildcards)
-        syn = d.get("synthetic")
-        n = sum(sum(bats.values()) for bats in syn["impacts"].values()) if syn else 10_000
+        n = self._n_impacts(d) if d.get("synthetic") else 10_000
         return 500 + n * impact_bytes(d) // 1_000_000
+
+    @staticmethod
+    def _n_impacts(d: dict) -> int:
+        """Return the impacts of a synthetic dataset's block (its ``synthetic.impacts`` counts)."""
+        return sum(sum(bats.values()) for bats in d["synthetic"]["impacts"].values())
 
     def scenario_mem_mb(self, wildcards: Namespace) -> int:
         """Return the memory a scenario's job may need, MB: 60 kB per case (measured 52-59 kB) over 500 MB."""

@@ -108,6 +108,7 @@ SCRIPTS = {
     "simulate": "simulate",
     "ingest": "ingest",
     "render_tracks": "render",
+    "track_clips": "clip_tracks",
     "reduce": "reduce",
     "normalize": "normalize",
     "reconstruct": "reconstruct",

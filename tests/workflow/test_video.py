@@ -43,9 +43,10 @@ def test_a_folder_of_clips_is_tracked_and_reduced_to_its_impacts(tmp_path, lab_c
 
 @pytest.mark.slow
 def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_path):
-    """render.video: the clips drawn (render_clips), tracked (import_clips) and reduced: within 4 standard
-    errors of the experiment's truth; the folder of clips is written whole, and a rerun does nothing. The
-    tracker's quality is kept (imported_quality.nc, in the run's crate) and drawn (clips_quality.png).
+    """render.video: the clips drawn (render_clips), tracked in three batches (track_clips), gathered
+    (import_clips) and reduced: within 4 standard errors of the experiment's truth; the folder of clips is
+    written whole, and a rerun does nothing. The tracker's quality is kept (imported_quality.nc, in the
+    run's crate) and drawn (clips_quality.png). The gathered files are those of one job tracking every clip.
     """
     import json
 
@@ -58,6 +59,7 @@ def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_pa
     # TIFF stacks rather than the example's FFV1: the same chain, without FFV1's slow decoding (76
     # frames a second of CPU); writing and reading FFV1 are tested in tests/video and tests/stages
     example["render"]["video"]["format"] = "tif"
+    example["render"]["video"]["clips_per_job"] = 3  # 8 clips: three batches (3, 3, 2), two at a time
     write_config(wd, lambda cfg: cfg["datasets"].update(filmed=example))
     sheet = "results/filmed/figures/clips_contact_sheet.png"
     quality = "results/filmed/figures/clips_quality.png"
@@ -73,6 +75,15 @@ def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_pa
     crate = json.loads((wd / "results" / "ro-crate-metadata.json").read_text())
     made = [e for e in crate["@graph"] if e["@id"].endswith("filmed/imported_quality.nc")]
     assert made and "File" in made[0]["@type"]
+    batches = sorted(p.name for p in (res / "clip_tracks").iterdir())
+    assert batches == ["batch_0.nc", "batch_1.nc", "batch_2.nc"]
+    for name in batches:  # each batch file in the crate, made by its own track_clips job
+        entity = [e for e in crate["@graph"] if e["@id"].endswith(f"filmed/clip_tracks/{name}")]
+        assert entity and "File" in entity[0]["@type"]
+        batch = xr.open_dataset(res / "clip_tracks" / name)
+        assert batch.attrs["provenance_rule"] == "track_clips" and batch["clip_fps"].attrs["units"] == "Hz"
+    assert [xr.open_dataset(res / "clip_tracks" / n).sizes["clip"] for n in batches] == [3, 3, 2]
+    _same_as_one_job(wd, res)
     names = sorted(p.name for p in (res / "clips").iterdir())
     assert len([n for n in names if n.endswith(".tif")]) == 8 and "impacts.csv" in names
     assert not [p for p in res.iterdir() if p.name.startswith(".clips.")]  # no temporary folder left
@@ -84,3 +95,35 @@ def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_pa
         assert np.all(np.abs(got - true) < 4 * err), (name, got, true, err)
     again = snakemake(wd, "-c2", "-n", "--", "results/filmed/reduce.nc", sheet, quality)
     assert "Nothing to be done" in again.stdout + again.stderr
+
+
+def _same_as_one_job(wd, res) -> None:
+    """The gathered imported_tracks.nc and imported_quality.nc equal, variable for variable, what tracking every
+    clip in one process gives (the import before batches: ballbat.video.importer.ClipImport).
+    """
+    import xarray as xr
+
+    from ballbat.config_checks import load_config
+    from ballbat.properties import load_balls, load_bats
+    from ballbat.stages.quality import quality_dataset
+    from ballbat.stages.render import tracks_dataset
+    from ballbat.tracks.data import clips_block
+    from ballbat.tracks.formats.layout import import_block
+    from ballbat.video.importer import ClipImport
+
+    cfg = load_config(wd / "config" / "config.yaml")  # with the schema's defaults, as the workflow reads it
+    block = clips_block(cfg["datasets"]["filmed"]["render"], str(res / "clips"))
+    clips = ClipImport()
+    tables = (load_balls(wd / "config" / "balls.csv"), load_bats(wd / "config" / "bats.csv"))
+    tracks, _ = import_block(block, "datasets.filmed.render", *tables, clip_reader=clips)
+    for name, one in (
+        ("imported_tracks.nc", tracks_dataset(tracks)),
+        ("imported_quality.nc", quality_dataset(clips.quality())),
+    ):
+        gathered = xr.open_dataset(res / name)
+        assert sorted(gathered.variables) == sorted(one.variables), name
+        for v in one.variables:
+            a, b = gathered[v].values, one[v].values
+            if a.dtype.kind in "OUS":
+                a, b = a.astype(str), b.astype(str)
+            assert a.shape == b.shape and np.array_equal(a, b, equal_nan=a.dtype.kind == "f"), (name, v)

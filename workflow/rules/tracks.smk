@@ -42,8 +42,6 @@ rule render_clips:
         f"{R}/{{dataset}}/logs/render_clips.log",
     benchmark:
         f"{R}/{{dataset}}/benchmarks/render_clips.tsv"
-    group:
-        "dataset"
     conda:
         ENV
     threads: 1
@@ -75,7 +73,7 @@ rule import_tracks:
         "dataset"
     conda:
         ENV
-    threads: get_import_threads
+    threads: 1
     resources:
         mem_mb=dataset_mem_mb,
         runtime=10,
@@ -87,9 +85,46 @@ rule import_tracks:
         "../scripts/import_tracks.py"
 
 
-# A folder of clips (tracks.format: video, or a filmed synthetic dataset): tracked as import_tracks reads
-# tool files, and the tracker's quality of every point kept beside the tracks (docs/video.md).
+# A folder of clips (tracks.format: video, or a filmed synthetic dataset) is tracked one job per batch
+# of video.clips_per_job clips (ballbat.video.plan: the clips known from the folder, or the config, when
+# the workflow is read), one thread each: `-c2` runs two side by side, a cluster profile submits each
+# as its own job (docs/video.md). Not in the group "dataset", so that they are separate jobs there too.
+rule track_clips:
+    """Track one batch of a dataset's clips: each point found with its quality, each left out with why."""
+    input:
+        unpack(get_batch_clips),
+        balls=get_balls_table,
+        code=code("track_clips.py"),
+    output:
+        batch=f"{R}/{{dataset}}/clip_tracks/batch_{{batch}}.nc",
+    log:
+        f"{R}/{{dataset}}/logs/track_clips_{{batch}}.log",
+    benchmark:
+        f"{R}/{{dataset}}/benchmarks/track_clips_{{batch}}.tsv"
+    wildcard_constraints:
+        dataset="|".join(FILMED) or "^$",
+    conda:
+        ENV
+    threads: 1
+    resources:
+        mem_mb=clip_batch_mem_mb,
+        runtime=clip_batch_runtime,
+    params:
+        tracker=get_tracker_settings,
+        sha256=batch_hashes,
+    script:
+        "../scripts/track_clips.py"
+
+
+# The batches gathered, as import_tracks reads tool files (the same script, one more output): the
+# tracks, the camera settings found, and the tracker's quality of every point (docs/video.md).
 use rule import_tracks as import_clips with:
+    input:
+        unpack(get_tool_files),
+        batches=get_clip_batch_files,
+        balls=get_balls_table,
+        bats=get_bats_table,
+        code=code("import_tracks.py"),
     output:
         tracks=f"{R}/{{dataset}}/imported_tracks.nc",
         cameras=f"{R}/{{dataset}}/imported_cameras.yaml",

@@ -1,23 +1,24 @@
 """Rules import_tracks and import_clips: adapter around ballbat.tracks.formats.layout.import_block.
 
-Clips (import_clips): tracked by ballbat.video.importer, whose quality table goes to imported_quality.nc
+Clips (import_clips): tracked by rule track_clips, one batch a job; their tracks and quality read back from
+the batch files (ballbat.stages.clip_tracks.GatheredClips), the quality table to imported_quality.nc
 (ballbat.stages.quality).
 """
 
 import yaml
 
-from ballbat.pipeline.ncio import atomic_write_text, write_dataset
+from ballbat.pipeline.ncio import atomic_write_text, read_dataset, write_dataset
 from ballbat.pipeline.provenance import data_inputs
 from ballbat.pipeline.runlog import logged
-from ballbat.properties import load_balls, load_bats
+from ballbat.properties import InputError, load_balls, load_bats
+from ballbat.stages.clip_tracks import GatheredClips
 from ballbat.stages.quality import quality_dataset
 from ballbat.stages.render import tracks_dataset
 from ballbat.tracks.formats.layout import import_block
-from ballbat.video.importer import ClipImport
 
 with logged(snakemake.log[0], snakemake.rule) as log:
     inp, out = snakemake.input, snakemake.output
-    clips = ClipImport(workers=snakemake.threads)  # clips tracked side by side
+    clips = GatheredClips(read_dataset(b) for b in inp.batches) if hasattr(inp, "batches") else None
     tracks, imported = import_block(
         snakemake.params.settings,
         snakemake.params.where,
@@ -25,6 +26,8 @@ with logged(snakemake.log[0], snakemake.rule) as log:
         load_bats(inp.bats),
         clip_reader=clips,
     )
+    if clips is not None and clips.unread():
+        raise InputError([f"{p}: tracked by a batch, but no longer in the folder (run again)" for p in clips.unread()])
     found = imported.settings_yaml()
     log.info("%d files, %d impacts, %d tracked points", found["files"], tracks.n, found["rows"])
     for cam, vals in found["cameras"].items():

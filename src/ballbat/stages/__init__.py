@@ -12,8 +12,10 @@ one ``run`` and write its Dataset (:func:`~ballbat.pipeline.ncio.write_job_outpu
 * :mod:`.ingest`: ``ingest.nc`` (:mod:`ballbat.ingest`)
 * :mod:`.render`: ``tracks.nc`` (:mod:`ballbat.tracks.render`); its :func:`.render.tracks_dataset` also
   lays out ``imported_tracks.nc`` (:mod:`ballbat.tracks.formats`)
+* :mod:`.clip_tracks`: ``clip_tracks/batch_{k}.nc``, one batch of a dataset's clips tracked (the batches:
+  :mod:`ballbat.video.plan`); the import gathers them (:class:`.clip_tracks.GatheredClips`)
 * :mod:`.quality`: ``imported_quality.nc``, the video tracker's quality of every point of a dataset's clips
-  (the import's :class:`ballbat.video.importer.ClipImport` keeps it)
+  (gathered from the batches by the import)
 * :mod:`.reduce`: ``reduce.nc`` (:mod:`ballbat.tracks.io`, :mod:`ballbat.tracks.reduce`, :mod:`ballbat.tracks.checks`)
 * :mod:`.normalize`: ``normalize.nc`` (:mod:`ballbat.analysis`)
 * :mod:`.reconstruct`: ``reconstruct.nc`` (:mod:`ballbat.analysis`)

@@ -16,6 +16,7 @@ import tempfile
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+from ..video.plan import clip_name
 from .render import render_inputs
 
 if TYPE_CHECKING:
@@ -27,8 +28,6 @@ if TYPE_CHECKING:
 
 __all__ = ["clip_look", "render_clips"]
 
-#: The file each ``video.format`` writes (docs/video.md, "Files").
-EXTENSIONS = {"tif": ".tif", "mkv": ".mkv", "mp4": ".mp4"}
 #: Clip k of a render seed s draws its background and noise from seed s * CLIP_SEED_STRIDE + k: a
 #: prime larger than any dataset's clip count, so that no two (seed, clip) pairs share a stream.
 CLIP_SEED_STRIDE = 100_003
@@ -71,7 +70,7 @@ def render_clips(
         for i, c in enumerate(clips):
             look = clip_look(video, settings.seed * CLIP_SEED_STRIDE + i)  # each clip its own background and noise
             m = getattr(settings, c.camera).camera.m_per_px
-            name = f"{c.impact_id}_{c.camera}{EXTENSIONS[video['format']]}"
+            name = clip_name(str(c.impact_id), c.camera, video["format"])  # as ballbat.video.plan plans them
             frames = render_frames(c, look, m)
             write_clip(tmp / name, frames, c.fps, exposure_s=look.exposure_s, frame_numbers=c.frames, crf=video["crf"])
             written.append(out / name)

@@ -388,7 +388,7 @@ def clips_block(render: dict, clips_dir: str) -> dict:
             "format": "video",
             "pattern": "{impact_id}_{camera}.{ext}",
             "impacts": f"{clips_dir}/impacts.csv",
-            "video": {k: render["video"][k] for k in ("dot_radius_mm", "marker_radius_mm")},
+            "video": {k: render["video"][k] for k in ("dot_radius_mm", "marker_radius_mm", "clips_per_job")},
         }
     )
     return block

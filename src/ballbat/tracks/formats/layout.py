@@ -369,6 +369,11 @@ def _table_spelling(imp: Imported, impacts: dict[str, str]) -> None:
     imp.columns["impact_id"] = ids.astype(str)
 
 
+def ball_radii(irows: list, balls: dict | None) -> dict[str, float]:
+    """Return each impact id's ball radius (m) of an impacts table's rows; an impact whose ball is unknown has none."""
+    return {row.get("impact_id", ""): balls[row["ball"]].r for _, row in irows if balls and row.get("ball") in balls}
+
+
 def import_block(
     cfg: dict, where: str, balls: dict | None = None, bats: dict | None = None, clip_reader: Callable | None = None
 ) -> tuple[Tracks, Imported]:
@@ -390,10 +395,7 @@ def import_block(
         problems.append(f"{where}.video: given, but only a folder of clips (format: video) is tracked")
     reader = None
     if cfg.get("format") == "video" and clip_reader is not None:
-        radius = {
-            row.get("impact_id", ""): balls[row["ball"]].r for _, row in irows if balls and row.get("ball") in balls
-        }
-        reader = clip_reader(cfg, radius)
+        reader = clip_reader(cfg, ball_radii(irows, balls))
     try:
         imp = import_files(
             [cfg["dir"]],
