@@ -43,7 +43,7 @@ def test_a_folder_of_clips_is_tracked_and_reduced_to_its_impacts(tmp_path, lab_c
 
 @pytest.mark.slow
 def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_path):
-    """render.video: the clips drawn (render_clips), tracked in three batches (track_clips), gathered
+    """render.video: the clips drawn (render_clips), tracked in two batches (track_clips), gathered
     (import_clips) and reduced: within 4 standard errors of the experiment's truth; the folder of clips is
     written whole, and a rerun does nothing. The tracker's quality is kept (imported_quality.nc, in the
     run's crate) and drawn (clips_quality.png). The gathered files are those of one job tracking every clip.
@@ -59,7 +59,7 @@ def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_pa
     # TIFF stacks rather than the example's FFV1: the same chain, without FFV1's slow decoding (76
     # frames a second of CPU); writing and reading FFV1 are tested in tests/video and tests/stages
     example["render"]["video"]["format"] = "tif"
-    example["render"]["video"]["clips_per_job"] = 3  # 8 clips: three batches (3, 3, 2), two at a time
+    example["render"]["video"]["clips_per_job"] = 4  # 8 clips: two batches, side by side
     write_config(wd, lambda cfg: cfg["datasets"].update(filmed=example))
     sheet = "results/filmed/figures/clips_contact_sheet.png"
     quality = "results/filmed/figures/clips_quality.png"
@@ -76,13 +76,13 @@ def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_pa
     made = [e for e in crate["@graph"] if e["@id"].endswith("filmed/imported_quality.nc")]
     assert made and "File" in made[0]["@type"]
     batches = sorted(p.name for p in (res / "clip_tracks").iterdir())
-    assert batches == ["batch_0.nc", "batch_1.nc", "batch_2.nc"]
+    assert batches == ["batch_0.nc", "batch_1.nc"]
     for name in batches:  # each batch file in the crate, made by its own track_clips job
         entity = [e for e in crate["@graph"] if e["@id"].endswith(f"filmed/clip_tracks/{name}")]
         assert entity and "File" in entity[0]["@type"]
         batch = xr.open_dataset(res / "clip_tracks" / name)
         assert batch.attrs["provenance_rule"] == "track_clips" and batch["clip_fps"].attrs["units"] == "Hz"
-    assert [xr.open_dataset(res / "clip_tracks" / n).sizes["clip"] for n in batches] == [3, 3, 2]
+    assert [xr.open_dataset(res / "clip_tracks" / n).sizes["clip"] for n in batches] == [4, 4]
     _same_as_one_job(wd, res)
     names = sorted(p.name for p in (res / "clips").iterdir())
     assert len([n for n in names if n.endswith(".tif")]) == 8 and "impacts.csv" in names
