@@ -315,7 +315,16 @@ def test_schema_takes_a_folder_of_clips_with_its_markers_and_no_points():
         "video": {"dot_radius_mm": 4.0, "marker_radius_mm": 6.0},
     }
     cfg = validate_config({"datasets": {"lab": {"tracks": clips}}}, schema, available=10**12)
-    assert cfg["datasets"]["lab"]["tracks"]["video"] == {"dot_radius_mm": 4.0, "marker_radius_mm": 6.0}
+    # the markers as given; the clips a tracking job takes: the schema's default
+    assert cfg["datasets"]["lab"]["tracks"]["video"] == {
+        "dot_radius_mm": 4.0,
+        "marker_radius_mm": 6.0,
+        "clips_per_job": 8,
+    }
+    zero = copy.deepcopy(clips)
+    zero["video"]["clips_per_job"] = 0
+    with pytest.raises(ConfigError, match=r"clips_per_job"):
+        validate_config({"datasets": {"lab": {"tracks": zero}}}, schema, available=10**12)
     no_markers = {k: v for k, v in clips.items() if k != "video"}
     with pytest.raises(ConfigError, match=r"datasets\.lab\.tracks: 'video' is a required property"):
         validate_config({"datasets": {"lab": {"tracks": no_markers}}}, schema, available=10**12)

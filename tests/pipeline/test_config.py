@@ -412,6 +412,9 @@ WITH = {("tilt_deg",): {("tilted_fraction",): 0.5}}
 OWN_TEST = {("enabled",), ("seed",)}
 #: The clips of a filmed dataset (render.video), not the replicates': tests/stages/test_clips.py changes each.
 OWN_TEST |= {("video", k) for k in ("format", "crf", "exposure_us", "bit_depth", "dot_radius_mm", "marker_radius_mm")}
+#: How many clips a tracking job takes: tests/video/test_plan.py (the batches) and tests/workflow/test_video.py
+#: (two batches give the tracks of one job).
+OWN_TEST |= {("video", "clips_per_job")}
 
 
 def _leaves(kind: str) -> set[tuple]:

@@ -217,3 +217,38 @@ def _video_dataset(folder, per_job: int) -> dict:
             "video": {"dot_radius_mm": 4.0, "marker_radius_mm": 6.0, "clips_per_job": per_job},
         }
     }
+
+
+def _tracker(clips: list, **m_per_px) -> dict:
+    return {
+        "clips": clips,
+        "m_per_px": {"swing": 0.001, "spin": 0.001, **m_per_px},
+        "video": {"dot_radius_mm": 4.0, "marker_radius_mm": 6.0},
+        "impacts": "",
+        "where": "config datasets.vid.tracks",
+    }
+
+
+def test_a_batch_with_a_truncated_clip_fails_naming_the_file_and_the_frame(tmp_path):
+    """A Photron clip cut after 2 of its 15 frames (tests/data/video): the batch stops on frame 2, naming it."""
+    import shutil
+
+    from ballbat.properties import load_balls
+    from ballbat.stages import clip_tracks
+
+    data = ROOT / "tests" / "data" / "video"
+    for ext in (".cihx", ".mraw"):
+        shutil.copy(data / f"ball_12bit_2frames{ext}", tmp_path / f"W1_spin{ext}")
+    (tmp_path / "impacts.csv").write_text("impact_id,bat,ball\nW1,wood,baseball\n")
+    tracker = _tracker([["W1", "spin", str(tmp_path / "W1_spin.cihx")]])
+    tracker["impacts"] = str(tmp_path / "impacts.csv")
+    with pytest.raises(FormatError, match=r"W1_spin\.mraw: frame 2: the file ends .*truncated"):
+        clip_tracks.run(tracker, load_balls(ROOT / "config" / "balls.csv"))
+
+
+def test_a_batch_without_a_cameras_scale_names_the_config_key():
+    from ballbat.properties import InputError
+    from ballbat.stages import clip_tracks
+
+    with pytest.raises(InputError, match=r"datasets\.vid\.tracks\.cameras\.spin\.m_per_px: missing"):
+        clip_tracks.run(_tracker([["W1", "spin", "W1_spin.tif"]], spin=None), {})

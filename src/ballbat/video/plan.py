@@ -71,9 +71,9 @@ def folder_clips(block: dict) -> list[Clip]:
     Files the import would refuse (a name off the pattern, a second clip of one impact and camera)
     are not planned: the import names them.
     """
-    from ..tracks.formats.layout import DEFAULT_PATTERN, find_files
+    from ..tracks.formats.layout import find_files
 
-    files, _ = find_files([block["dir"]], block.get("pattern", DEFAULT_PATTERN), "video")
+    files, _ = find_files([block["dir"]], block["pattern"], "video")
     return [(i, c, str(p)) for i, c, p in files]
 
 
