@@ -8,11 +8,12 @@ import yaml
 from video_clips import LAB_CAMERAS, LAB_RIG, LAB_TRUTH
 
 from ballbat.units import DEGREE, MPH, RPM
-from workflow_helpers import assert_not_blank, make_workdir, snakemake, write_config
+from workflow_helpers import assert_not_blank, make_workdir, planned_logs, snakemake, write_config
 
 
 @pytest.mark.slow
 def test_a_folder_of_clips_is_tracked_and_reduced_to_its_impacts(tmp_path, lab_clips):
+    """Two batches of three clips (track_clips), gathered and reduced; a clip filmed again reruns its batch only."""
     import shutil
 
     import xarray as xr
@@ -25,7 +26,7 @@ def test_a_folder_of_clips_is_tracked_and_reduced_to_its_impacts(tmp_path, lab_c
         "impacts": "lab/clips/impacts.csv",
         "cameras": {c: {"m_per_px": v["m_per_px"], "mirror": False} for c, v in LAB_CAMERAS.items()},
         "rig": LAB_RIG,
-        "video": {"dot_radius_mm": 4.0, "marker_radius_mm": 6.0},
+        "video": {"dot_radius_mm": 4.0, "marker_radius_mm": 6.0, "clips_per_job": 3},
     }
     write_config(wd, lambda cfg: cfg["datasets"].update(vid={"tracks": block}))
     snakemake(wd, "-c2", "--", "results/vid/reduce.nc")
@@ -39,6 +40,13 @@ def test_a_folder_of_clips_is_tracked_and_reduced_to_its_impacts(tmp_path, lab_c
     for name, u in unit.items():
         got, err = red[name].values, red[f"{name}_err"].values
         assert np.all(np.abs(got - LAB_TRUTH[name] * u) < 4 * err), (name, got / u, err / u)
+    # batch 0: W1_spin, W1_swing, W2_spin; batch 1: W2_swing, W3_spin, W3_swing. W3_spin's new content
+    # (bytes after the TIFF's frames: the same frames) reruns batch 1, then the import and the reduction.
+    with open(wd / "lab" / "clips" / "W3_spin.tif", "ab") as fh:
+        fh.write(b"filmed again")
+    jobs = planned_logs(wd, "--", "results/vid/reduce.nc")
+    assert sorted(jobs.values()) == ["import_clips", "reduce", "track_clips"], jobs
+    assert "results/vid/logs/track_clips_1.log" in jobs
 
 
 @pytest.mark.slow
