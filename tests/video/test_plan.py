@@ -69,6 +69,14 @@ def test_the_batches_depend_on_the_names_only_so_a_changed_clip_reruns_its_batch
     after = params(3)
     changed = [k for k in range(4) if before[k] != after[k]]
     assert changed == [1]  # W1_swing, W2_spin, W2_swing: the second batch alone
+    cfg = copy.deepcopy(_config())
+    cfg["datasets"]["vid"] = _video_dataset(lab, 3)
+    inputs, wc = WorkflowInputs(cfg, ROOT), Namespace(dataset="vid", batch="1")
+    # a lab's frames are not known before the job: a 4K frame of 4 bytes a pixel, 16 times over 500 MB
+    assert inputs.clip_batch_mem_mb(wc) == 500 + 531
+    assert inputs.get_batch_clips(wc)["clips"] == [
+        str(lab / n) for n in ("W1_swing.tif", "W2_spin.tif", "W2_swing.tif")
+    ]
     assert after[1]["W2_spin.tif"] != before[1]["W2_spin.tif"]
 
 
