@@ -5,7 +5,7 @@ BIN := $(VENV)/bin
 STAMP := $(VENV)/.ballbat-installed
 CORES ?= 2
 
-.PHONY: install bytecode run test test-slurm test-report test-citation validate-crate study study-robustness report bench lint lock clean
+.PHONY: install bytecode run test test-lab test-all test-slurm test-report test-citation validate-crate study study-robustness report bench lint lock clean
 
 # Create the virtual environment and install the pinned stack plus ballbat (editable).
 $(STAMP): pyproject.toml requirements.lock
@@ -27,10 +27,22 @@ run: bytecode
 	$(BIN)/snakemake -c$(CORES)
 
 # The suite on $(CORES) processes (pytest-xdist), each test module on one, in the order of
-# tests/conftest.py (FIRST); the two shared workflow runs are built once, by whichever process
-# needs them first. `pytest` alone runs the suite in one process.
+# tests/conftest.py (FIRST); the shared workflow runs are built once, by whichever process needs
+# them first. `make test` runs the package's tests and those of the default run; the tests of the
+# lab run (a lab's datasets, scenarios and studies in one folder, its outputs, faults and reruns:
+# marker `lab`, tests/conftest.py) are `make test-lab`; `make test-all` runs both in one session,
+# and `pytest` alone runs everything in one process. CI runs test, then test-lab, on the same
+# shared runs (BALLBAT_TEST_SHARED_RUNS, .ci/run).
+PYTEST_XDIST := -n $(CORES) --dist loadscope --no-loadscope-reorder
+
 test: bytecode
-	$(BIN)/python -m pytest -n $(CORES) --dist loadscope --no-loadscope-reorder
+	$(BIN)/python -m pytest $(PYTEST_XDIST) -m "not lab"
+
+test-lab: bytecode
+	$(BIN)/python -m pytest $(PYTEST_XDIST) -m lab
+
+test-all: bytecode
+	$(BIN)/python -m pytest $(PYTEST_XDIST)
 
 # The default workflow through a real single-node SLURM set up on this machine (Debian's
 # packages; root needed), compared byte for byte with a local run; the daemons are stopped after.

@@ -227,13 +227,14 @@ LAB_STUDIES = {
 }
 
 
-#: The order of the test modules, as paths relative to tests/ (``make test``: ``--dist loadscope
-#: --no-loadscope-reorder``, a module per pytest-xdist process, in this order, each process taking the
-#: next module when it is nearly done), so that both processes stay busy and end together. One process
-#: builds the lab run (workflow/test_outputs.py, its first module) while the other builds the default
-#: run and runs its tests, then the unit tests (no shared run); the lab run's other tests come last
-#: (:data:`LAST`), so that no process waits for the lab run while there is other work, and both share
-#: its reruns.
+#: The order of the test modules, as paths relative to tests/ (``make test`` and ``make test-lab``:
+#: ``--dist loadscope --no-loadscope-reorder``, a module per pytest-xdist process, in this order, each
+#: process taking the next module when it is nearly done), so that both processes stay busy and end
+#: together. In ``make test-all`` one process builds the lab run (workflow/test_outputs.py, its first
+#: module) while the other builds the default run and runs its tests, then the unit tests (no shared
+#: run); the lab run's other tests come last (:data:`LAST`), so that no process waits for the lab run
+#: while there is other work, and both share its reruns. ``make test`` (no lab run) starts with the
+#: default run's build beside the unit tests; ``make test-lab`` with the lab run's.
 FIRST = (
     "workflow/test_outputs.py",
     "workflow/test_crate.py",
@@ -267,7 +268,15 @@ def module_key(path: Path) -> str:
 
 
 def pytest_collection_modifyitems(config, items):
-    """Order the modules: :data:`FIRST`, the rest as collected, then :data:`LAST` (the same order in every process)."""
+    """Mark the lab run's tests ``lab``; order the modules: :data:`FIRST`, the rest as collected, :data:`LAST`.
+
+    A test is ``lab`` when it reads or copies :func:`lab_run` (directly or through another
+    fixture): ``make test`` leaves those to ``make test-lab``, and CI runs both on the same two
+    shared runs (``BALLBAT_TEST_SHARED_RUNS``, ``.ci/run``). The order is the same in every process.
+    """
+    for item in items:
+        if "lab_run" in getattr(item, "fixturenames", ()):
+            item.add_marker(pytest.mark.lab)
     rank = {name: i for i, name in enumerate(FIRST)}
     rank.update({name: len(FIRST) + 1 + i for i, name in enumerate(LAST)})
     items.sort(key=lambda item: rank.get(module_key(item.path), len(FIRST)))
