@@ -33,16 +33,20 @@ run: bytecode
 # marker `lab`, tests/conftest.py) are `make test-lab`; `make test-all` runs both in one session,
 # and `pytest` alone runs everything in one process. CI runs test, then test-lab, on the same
 # shared runs (BALLBAT_TEST_SHARED_RUNS, .ci/run).
+# Bytecode is written during the tests even where PYTHONDONTWRITEBYTECODE is set (as on this machine):
+# pytest then keeps its rewritten test modules (about 4 s of CPU a process to redo), and the jobs
+# of a run with its own copy of the package compile it once, not once a job.
 PYTEST_XDIST := -n $(CORES) --dist loadscope --no-loadscope-reorder
+PYTEST := PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest
 
 test: bytecode
-	$(BIN)/python -m pytest $(PYTEST_XDIST) -m "not lab"
+	$(PYTEST) $(PYTEST_XDIST) -m "not lab"
 
 test-lab: bytecode
-	$(BIN)/python -m pytest $(PYTEST_XDIST) -m lab
+	$(PYTEST) $(PYTEST_XDIST) -m lab
 
 test-all: bytecode
-	$(BIN)/python -m pytest $(PYTEST_XDIST)
+	$(PYTEST) $(PYTEST_XDIST)
 
 # The default workflow through a real single-node SLURM set up on this machine (Debian's
 # packages; root needed), compared byte for byte with a local run; the daemons are stopped after.
