@@ -13,7 +13,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 import xarray as xr
 
-from ..fitting import FitGrid, FitStatus, Sec4, analyze_impacts, check_physical, fit_status
+from ..fitting import (
+    CONTACT_QUANTITIES,
+    FitGrid,
+    FitStatus,
+    Sec4,
+    analyze_impacts,
+    check_physical,
+    fit_status,
+    with_contact_error,
+)
 from ..pipeline.config import SectionSettings
 from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 from ..systematics import FIT_QUANTITIES, SIDES, SOURCES, FitSystematics, has_shifts, shifted_impacts, source_names
@@ -162,6 +171,21 @@ def scatter_vars() -> dict[str, Var]:
     return table
 
 
+def contact_error_vars() -> dict[str, Var]:
+    """Declare each pooled quantity's error from the contact population's estimate (``<q>_err_contact``)."""
+    dims = {"e_x": ("ball", "bat"), "e_y_implied": ("ball",)}
+    return {
+        f"{q}_err_contact": Var(
+            dims.get(q, ("ball",)),
+            "1",
+            f"part of {q}_err from the estimate of the ball type's contact-time population (statistical, shared by "
+            f"its impacts; already in {q}_err in quadrature): half the change of {q} when the tracks are reduced with "
+            "the population's mean contact time at +1 and -1 standard error",
+        )
+        for q in CONTACT_QUANTITIES
+    }
+
+
 def results_dataset(res: Sec4) -> xr.Dataset:
     """fit_ex.nc's contents: the :class:`Sec4` results on the declared table (dims ball, bat)."""
     values: dict[str, np.ndarray] = {}
@@ -186,12 +210,16 @@ def results_dataset(res: Sec4) -> xr.Dataset:
     values.update({k: v for k, v in res.per_ball.items() if res.has_truth or not k.startswith("truth_")})
     if res.systematic is not None:
         values.update(res.systematic)
+    table = fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None)
+    if res.contact_error is not None:
+        table.update(contact_error_vars())
+        values.update({f"{q}_err_contact": v for q, v in res.contact_error.items()})
     coords = {
         "ball": (Var(("ball",), None, "ball type"), np.array(res.balls, dtype=str)),
         "bat": (Var(("bat",), None, "bat"), np.array(res.bats, dtype=str)),
     }
     ds = build_dataset(
-        fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None),
+        table,
         values,
         coords,
         {"mu_k_example": res.mu_k_example},
@@ -211,7 +239,7 @@ def run(settings: FitExSettings, impacts: xr.Dataset) -> xr.Dataset:
 
 def fit(settings: FitExSettings, impacts: xr.Dataset) -> tuple[xr.Dataset, FitSystematics | None]:
     """:func:`run`'s dataset and the calibration systematics it holds, with their signs (None: none fitted)."""
-    res = analyze_impacts(impacts, settings.mu_k_example, systematic=settings.systematic)
+    res = with_contact_error(impacts, analyze_impacts(impacts, settings.mu_k_example, systematic=settings.systematic))
     if settings.systematic and has_shifts(impacts):  # every calibration source, the tracks reduced again
         res.systematics = fit_systematics(impacts, res)
         res.systematic = scale_entries(res.systematics)
