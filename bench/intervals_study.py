@@ -12,7 +12,8 @@ pooled e_x's error from the sandwich centred within bats), ``contact`` (and the 
 estimation error in the statistical errors, :data:`ballbat.fitting.CONTACT_POPULATION_ERROR`), ``kh``
 (the Knapp-Hartung floor of the per-bat scatter fit, :data:`ballbat.linefit.KNAPP_HARTUNG_FLOOR`, without the
 contact term) and ``both``; name some on the command line to run only those. The reductions always
-carry the contact shifts (they are in the cached sources); only the fits use them or not. Stronge's eta^2 is not fitted (it is not judged here).
+carry the contact shifts (they are in the cached sources); only the fits use them or not.
+Stronge's eta^2 is not fitted (it is not judged here).
 The calibration is not drawn (statistical intervals; the combined ones need the drawn
 calibration of the robustness grid).
 

@@ -81,7 +81,8 @@ def test_e_y_variance_forms():
 
 def _with_contact_shift(rec, rel: float, ball: str):
     """``rec`` with contact shifts on the impacts of ``ball`` (0 elsewhere): v_bat by +-``rel`` v_bat, theta by
-    +-``rel`` rad (theta moves psi, hence the Eq. ratio slope; v_bat moves e_x)."""
+    +-``rel`` rad (theta moves psi, hence the Eq. ratio slope; v_bat moves e_x).
+    """
     on = (rec["ball"].values == ball).astype(float)
     sides = np.array([1.0, -1.0])[:, None]
     return rec.assign(

@@ -359,7 +359,8 @@ def _short_contacts():
 
 def test_the_contact_rerun_at_the_nominal_population_moves_nothing(monkeypatch):
     """Solved again with the population as fitted (not shifted), every impact's values come back bit for bit:
-    the rerun moves an impact only through its ball type's shifted population."""
+    the rerun moves an impact only through its ball type's shifted population.
+    """
     from ballbat.tracks import reduce as module
     from ballbat.tracks.fit_contact import contact_population
 
@@ -377,7 +378,8 @@ def test_the_contact_rerun_at_the_nominal_population_moves_nothing(monkeypatch):
 
 def test_the_contact_shifts_move_each_ball_types_impacts_both_ways_and_reach_reduce_nc():
     """At +1 sigma of the population's mean every contact lasts longer on average and the bat's alignment comes
-    earlier: v_bat moves one way at +1 and the other at -1, for both ball types; omega is not touched."""
+    earlier: v_bat moves one way at +1 and the other at -1, for both ball types; omega is not touched.
+    """
     tr, s = _short_contacts()
     red = reduce(tr, s)
     mean, err = red.contact_mean
