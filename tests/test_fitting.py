@@ -146,3 +146,32 @@ def test_the_switch_turns_the_contact_error_off(config, balls, bats, monkeypatch
     xr_equal = fit_ex.run(settings, rec)
     assert "e_x_err_contact" not in got
     np.testing.assert_array_equal(got["e_y_implied_err"], xr_equal["e_y_implied_err"])
+
+
+def test_e_x_per_bat_error_is_the_sandwich_with_the_scatter_terms_weights(config, balls, bats, monkeypatch):
+    """e_x per bat: the value as before, the error the HC3 sandwich of the same fit (``PER_BAT_SANDWICH``);
+    the pooled fits do not change.
+    """
+    from helpers import NORM, REC
+
+    from ballbat.columns import Columns
+    from ballbat.designs import Measured, measured_sigma, spin_design
+    from ballbat.linefit import eiv_line
+    from ballbat.stages import normalize, reconstruct, simulate
+    from ballbat.synthetic import SyntheticSettings
+
+    syn = {**config["datasets"]["synthetic"]["synthetic"], "seed": 7, "e_x_scatter": 0.02}
+    rec = reconstruct.run(REC, normalize.run(NORM, simulate.run(SyntheticSettings(**syn), balls, bats)), balls, bats)
+    res = fitting.analyze_impacts(rec, 0.5, False)
+    monkeypatch.setattr(fitting, "PER_BAT_SANDWICH", False)
+    old = fitting.analyze_impacts(rec, 0.5, False)
+    np.testing.assert_array_equal(res.e_x.field("slope"), old.e_x.field("slope"))
+    np.testing.assert_array_equal(res.e_x_pooled.field("slope_err"), old.e_x_pooled.field("slope_err"))
+    assert not np.allclose(res.e_x.field("slope_err"), old.e_x.field("slope_err"), equal_nan=True)
+    ds = Columns(rec)
+    sel = (ds["flag"].values == 0) & (ds["ball"].values == "softball") & (ds["bat"].values == "wood")
+    r, r_x, alpha = (ds[k].values[sel] for k in ("r", "r_x", "alpha"))
+    x, y, jx, jy = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
+    want = eiv_line(x, y, jx, jy, measured_sigma(ds, sel), scatter=True, robust=True)
+    got = res.e_x.fits[res.balls.index("softball"), res.bats.index("wood")]
+    assert got.slope_err == pytest.approx(want.slope_err, rel=1e-12) and got.scatter == pytest.approx(want.scatter)

@@ -40,6 +40,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from . import linefit
 from .columns import Columns
 from .designs import MEASURED, Measured, measured_sigma, normalized_theta_design, spin_design, tan_ratio_design
 from .kinematics import gross_slip_onset, normalize_to_bat_speed, tan_ratio_slope_model
@@ -120,6 +121,13 @@ WITHIN_BAT_SCATTER = True
 #: the scaled covariance (bench/intervals_study.py's comparison).
 POOLED_SANDWICH = True
 
+#: e_x per bat's standard error is the HC3 sandwich (with the intrinsic-scatter term's weights), not the
+#: covariance scaled by the reduced chi-square: with tau estimated from a bat's few impacts the weights
+#: are themselves uncertain, and the sandwich does not rest on them (softballs on metal_smooth, 12
+#: impacts, e_x scatter 0.02: 88.3 -> 92.3 %; docs/model.md). Only where the fit carries the term
+#: (:data:`ballbat.linefit.SCATTER_TERM`). False: the scaled covariance (bench/intervals_study.py).
+PER_BAT_SANDWICH = True
+
 #: Per-ball quantities that are not line fits (values of :attr:`Sec4.per_ball`).
 PER_BALL = (
     "e_y_implied",
@@ -190,7 +198,7 @@ def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool)
             errors_in_variables=True,
             strata=strata,
             scatter=strata is None or WITHIN_BAT_SCATTER,
-            robust=strata is not None and POOLED_SANDWICH,
+            robust=POOLED_SANDWICH if strata is not None else PER_BAT_SANDWICH and linefit.SCATTER_TERM,
         )
         t = np.nan
         if with_truth and fit.success:
