@@ -9,10 +9,12 @@ omega), so the residual
 y - (a + s x) has variance sum_k (dy/dm_k - s dx/dm_k)^2 sigma_k^2 over the measured
 quantities m_k (correlations between x and y through psi included). The weights depend
 on the slope, so the fit is iterated (three passes converge to far below the standard
-error). Standard errors of the model's own equations (Eq. omega per bat and pooled, Eq.
-ratio) are lmfit's, scaled by the reduced chi-square (as the paper's standard errors come
-from the scatter of the data); the reduced chi-square itself tells whether the stated
-measurement uncertainties explain that scatter. The Figs. 3-4 lines summarise data the
+error). Standard errors come from the scatter of the data (as the paper's do): Eq. ratio's
+is lmfit's, scaled by the reduced chi-square, e_x's per bat and pooled HC3 sandwiches with the
+intrinsic-scatter term's weights (:data:`PER_BAT_SANDWICH`, :data:`POOLED_SANDWICH`); the
+reduced chi-square itself tells whether the stated measurement uncertainties explain that
+scatter. Each quantity that pools impacts also carries the error of the contact-time
+population its impacts share (:func:`with_contact_error`). The Figs. 3-4 lines summarise data the
 model does not describe impact by impact (bats of different e_x, spin and speed not exactly
 linear in theta): their scatter is not the same everywhere, and their standard errors are
 the sandwich (HC3) ones, which the replicate studies (:mod:`ballbat.studies`) find
