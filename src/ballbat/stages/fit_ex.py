@@ -77,11 +77,15 @@ FIT_FAMILIES = {
 _SLOPE_IS_ONE_PLUS = ("e_x", "e_x_pooled")
 
 
-def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) -> dict[str, Var]:
+def fit_ex_table(
+    has_truth: bool, mu_k_example: float, has_scale: bool = False, has_contact: bool = False
+) -> dict[str, Var]:
     """Return the variables of fit_ex.nc, declared once (name -> :class:`Var`).
 
     ``has_scale``: the dataset carries a pixel-scale uncertainty (reduced from camera
-    tracks), so e_x gets a systematic error (``*_err_scale``).
+    tracks), so e_x gets a systematic error (``*_err_scale``). ``has_contact``: its impacts carry
+    the contact population's shifts, so the pooled quantities get ``*_err_contact``
+    (:func:`contact_error_vars`).
     """
     table: dict[str, Var] = {}
     for name, (dims, units, what) in FIT_FAMILIES.items():
@@ -105,7 +109,7 @@ def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) 
         table[f"{name}_status"] = Var(
             dims, "1", f"why {name} has no value (0: it has one; the count is {name}_n)", flag_attrs(FitStatus)
         )
-    table.update(scatter_vars())
+    table.update({**scatter_vars(), **(contact_error_vars() if has_contact else {})})
     table["e_y_implied"] = Var(
         ("ball",),
         "1",
@@ -210,9 +214,8 @@ def results_dataset(res: Sec4) -> xr.Dataset:
     values.update({k: v for k, v in res.per_ball.items() if res.has_truth or not k.startswith("truth_")})
     if res.systematic is not None:
         values.update(res.systematic)
-    table = fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None)
+    table = fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None, res.contact_error is not None)
     if res.contact_error is not None:
-        table.update(contact_error_vars())
         values.update({f"{q}_err_contact": v for q, v in res.contact_error.items()})
     coords = {
         "ball": (Var(("ball",), None, "ball type"), np.array(res.balls, dtype=str)),
