@@ -86,8 +86,8 @@ def _with_contact_shift(rec, rel: float, ball: str):
     on = (rec["ball"].values == ball).astype(float)
     sides = np.array([1.0, -1.0])[:, None]
     return rec.assign(
-        v_bat_contact_shift=(("shift", "impact"), sides * rel * on * rec["v_bat"].values, {"units": "m s-1"}),
-        theta_contact_shift=(("shift", "impact"), sides * rel * on, {"units": "rad"}),
+        contact_shift_v_bat=(("shift", "impact"), sides * rel * on * rec["v_bat"].values, {"units": "m s-1"}),
+        contact_shift_theta=(("shift", "impact"), sides * rel * on, {"units": "rad"}),
     )
 
 

@@ -577,7 +577,7 @@ def contact_population_error(ds: xr.Dataset, res: Sec4) -> dict[str, np.ndarray]
     prior of each impact's contact, :func:`ballbat.tracks.fit_contact.contact_population`); an
     impact whose frames say little takes the population's contact time, so the error of the
     population's mean moves all of them together. The reduction solved again with the mean at
-    +1 and at -1 standard error (reduce.nc's ``<name>_contact_shift``) gives the impacts at both
+    +1 and at -1 standard error (reduce.nc's ``contact_shift_<name>``) gives the impacts at both
     sides; they are normalised, reconstructed and fitted again with the same estimators, and
     half the difference is the quantity's error from the shared estimate. It is statistical (the
     population is estimated from the same impacts and drawn afresh in every repetition).

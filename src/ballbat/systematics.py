@@ -201,14 +201,14 @@ def shifted_impacts(rec: xr.Dataset, source: int, side: int) -> xr.Dataset:
     return out.assign({k: ("impact", v) for k, v in reconstruct_again_values(out).items()})
 
 
-#: reduce.nc's variables of the contact population's shifts: ``<name>_contact_shift`` (shift, impact)
+#: reduce.nc's variables of the contact population's shifts: ``contact_shift_<name>`` (shift, impact)
 #: for the names of :data:`ballbat.tracks.reduce.CONTACT_SHIFTED` (the others do not move).
-CONTACT_SHIFT = "_contact_shift"
+CONTACT_SHIFT = "contact_shift_"
 
 
 def has_contact_shifts(ds: xr.Dataset) -> bool:
     """Return whether ``ds`` carries the contact population's shifts (reduce.nc of camera tracks)."""
-    return any(f"{k}{CONTACT_SHIFT}" in ds for k in SHIFTED)
+    return any(f"{CONTACT_SHIFT}{k}" in ds for k in SHIFTED)
 
 
 def contact_shifted_impacts(rec: xr.Dataset, side: int) -> Columns:
@@ -216,7 +216,7 @@ def contact_shifted_impacts(rec: xr.Dataset, side: int) -> Columns:
 
     As :func:`shifted_impacts` for a calibration source, read as :class:`~ballbat.columns.Columns`
     (plain arrays, no Dataset built: the studies run this twice a replicate): the measured values
-    moved by their ``<name>_contact_shift``, normalised and reconstructed again, without
+    moved by their ``contact_shift_<name>``, normalised and reconstructed again, without
     ``truth_*`` and the shifts themselves.
     """
     from .analysis import normalize_values, reconstruct_again_values
@@ -225,9 +225,9 @@ def contact_shifted_impacts(rec: xr.Dataset, side: int) -> Columns:
     def variables(values: dict) -> dict:
         return {k: xr.Variable(("impact",), v) for k, v in values.items()}
 
-    cols = Columns(rec).dropped(lambda k: k.startswith("truth_") or k.endswith(CONTACT_SHIFT))
+    cols = Columns(rec).dropped(lambda k: k.startswith("truth_") or k.startswith(CONTACT_SHIFT))
     moved = {
-        k: cols[k].values + rec[f"{k}{CONTACT_SHIFT}"].values[side] for k in SHIFTED if f"{k}{CONTACT_SHIFT}" in rec
+        k: cols[k].values + rec[f"{CONTACT_SHIFT}{k}"].values[side] for k in SHIFTED if f"{CONTACT_SHIFT}{k}" in rec
     }
     out = Columns(cols, variables(moved))
     out = Columns(out, variables(normalize_values(out, float(rec.attrs["v_ref"]))))

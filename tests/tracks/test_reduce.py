@@ -392,7 +392,7 @@ def test_the_contact_shifts_move_each_ball_types_impacts_both_ways_and_reach_red
     assert "omega" not in red.contact_shift
     ds = reduction_dataset(red)
     for k in ("v_bat", "v_ball", "theta", "v_bat_err", "theta_err"):
-        var = ds[f"{k}_contact_shift"]
+        var = ds[f"contact_shift_{k}"]
         assert var.dims == ("shift", "impact") and var.attrs["units"] and "contact" in var.attrs["long_name"]
         assert list(ds["shift"].values) == [1, -1]
     assert ds["contact_population_mean_err"].attrs["units"] == "s"

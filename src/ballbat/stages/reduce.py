@@ -209,7 +209,7 @@ def _contact_table(shifts: bool) -> dict[str, Var]:
     for k in CONTACT_SHIFTED:
         base = k.removesuffix("_err")
         what = f"the standard uncertainty of {base}" if k.endswith("_err") else base
-        table[f"{k}_contact_shift"] = Var(
+        table[f"contact_shift_{k}"] = Var(
             ("shift", "impact"),
             SHIFT_UNITS[base],
             f"change of {what} when the reduction is solved again with the ball type's contact population mean at "
@@ -302,7 +302,7 @@ def _contact_values(red: Reduction, values: dict, coords: dict) -> None:
     nan = np.full(red.tracks.n, np.nan)
     values["contact_population_mean"], values["contact_population_mean_err"] = red.contact_mean or (nan, nan)
     for k, sides in (red.contact_shift or {}).items():
-        values[f"{k}_contact_shift"] = np.stack(sides)
+        values[f"contact_shift_{k}"] = np.stack(sides)
     if red.contact_shift is not None:
         what = "calibration or estimate shifted by this many standard uncertainties"
         coords["shift"] = (("shift",), np.array(SIDES, dtype=np.int8), {"units": "1", "long_name": what})

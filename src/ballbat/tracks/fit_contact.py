@@ -138,42 +138,65 @@ def _population_fits(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -> l
 #: Step in the beta parameters (logit of the mean, log of the concentration) of the finite differences
 #: that give the population's information matrix (:func:`_population_error`).
 POPULATION_STEP = 0.02
+#: Newton steps from the Nelder-Mead optimum (found to ``xatol`` 1e-3 only) before the information is taken.
+POPULATION_NEWTON_STEPS = 2
+
+
+def _information(fit: _PopulationFit, p: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Return the Hessian and the gradient of :func:`_population_nll` at ``p`` (central differences)."""
+    h, e = POPULATION_STEP, np.eye(2) * POPULATION_STEP
+
+    def f(d):
+        return _population_nll(p + d, fit.L, grid)
+
+    f0, fp, fm = f(np.zeros(2)), [f(e[i]) for i in range(2)], [f(-e[i]) for i in range(2)]
+    H = np.empty((2, 2))
+    for i in range(2):
+        H[i, i] = (fp[i] - 2 * f0 + fm[i]) / h**2
+    H[0, 1] = H[1, 0] = (f(e[0] + e[1]) - f(e[0] - e[1]) - f(e[1] - e[0]) + f(-e[0] - e[1])) / (4 * h**2)
+    return H, np.array([(fp[i] - fm[i]) / (2 * h) for i in range(2)])
+
+
+def _covariance(H: np.ndarray, p: np.ndarray, n_grid: int) -> np.ndarray | None:
+    """Return the inverse information; the mean's alone where the concentration is capped or H is not definite."""
+    m = 1.0 / (1.0 + np.exp(-p[0]))
+    capped = np.exp(p[1]) >= m * (1 - m) * (n_grid / CONTACT_MIN_SD_STEPS) ** 2
+    if not capped and H[0, 0] > 0 and H[1, 1] > 0 and np.linalg.det(H) > 0:
+        return np.linalg.inv(H)
+    return np.array([[1.0 / H[0, 0], 0.0], [0.0, 0.0]]) if H[0, 0] > 0 else None
 
 
 def _population_error(fit: _PopulationFit, grid: np.ndarray) -> tuple[float, float, np.ndarray]:
     """Return the group's mean contact time, its standard error and the change of ``p`` that moves the mean by +1 sigma.
 
     The covariance of ``p`` is the inverse of the observed information (central second differences of
-    :func:`_population_nll`, step :data:`POPULATION_STEP`); the mean's error its delta-method
+    :func:`_population_nll`, step :data:`POPULATION_STEP`), taken after :data:`POPULATION_NEWTON_STEPS`
+    Newton steps from the Nelder-Mead optimum (which stops anywhere within 1e-3 of it, so that the last
+    bits of the data would move the information by 1e-6); the mean's error is its delta-method
     projection, sigma^2 = grad' C grad; the step C grad / sigma moves ``p`` along the direction
     where the likelihood falls least for a given change of the mean (the concentration follows the
     mean as the data tie them), and changes the mean by sigma to first order. Where the concentration
     is at its cap (:func:`_beta_weights`) or the information is not positive definite, the mean alone
-    (the concentration held). Where the uniform distribution was kept, no estimate: error 0.
+    (the concentration held). Where the uniform distribution was kept, no estimate: error 0. The
+    mean reported is the fitted distribution's, the one the impacts' contacts use.
     """
     mean = float(_beta_weights(grid, fit.p) @ grid)
     if not fit.estimated:
         return mean, 0.0, np.zeros(2)
-    h, e = POPULATION_STEP, np.eye(2) * POPULATION_STEP
-
-    def f(d):
-        return _population_nll(fit.p + d, fit.L, grid)
-
-    f0 = f(np.zeros(2))
-    H = np.empty((2, 2))
-    for i in range(2):
-        H[i, i] = (f(e[i]) - 2 * f0 + f(-e[i])) / h**2
-    H[0, 1] = H[1, 0] = (f(e[0] + e[1]) - f(e[0] - e[1]) - f(e[1] - e[0]) + f(-e[0] - e[1])) / (4 * h**2)
-    grad = np.array([(_beta_weights(grid, fit.p + e[i]) - _beta_weights(grid, fit.p - e[i])) @ grid for i in range(2)])
-    grad /= 2 * h
-    m = 1.0 / (1.0 + np.exp(-fit.p[0]))
-    capped = np.exp(fit.p[1]) >= m * (1 - m) * (grid.size / CONTACT_MIN_SD_STEPS) ** 2
-    if capped or not (H[0, 0] > 0 and H[1, 1] > 0 and np.linalg.det(H) > 0):
-        if not H[0, 0] > 0:
-            return mean, 0.0, np.zeros(2)
-        C = np.array([[1.0 / H[0, 0], 0.0], [0.0, 0.0]])
-    else:
-        C = np.linalg.inv(H)
+    p = fit.p
+    for _ in range(POPULATION_NEWTON_STEPS):
+        H, g = _information(fit, p, grid)
+        C = _covariance(H, p, grid.size)
+        step = None if C is None else C @ g
+        if step is None or not np.all(np.abs(step) < 0.1):  # not near a well-defined optimum: no polish
+            break
+        p = p - step
+    C = _covariance(_information(fit, p, grid)[0], p, grid.size)
+    if C is None:
+        return mean, 0.0, np.zeros(2)
+    e = np.eye(2) * POPULATION_STEP
+    grad = np.array([(_beta_weights(grid, p + e[i]) - _beta_weights(grid, p - e[i])) @ grid for i in range(2)])
+    grad /= 2 * POPULATION_STEP
     var = float(grad @ C @ grad)
     if not var > 0:
         return mean, 0.0, np.zeros(2)
