@@ -8,8 +8,13 @@ term (:data:`ballbat.linefit.SCATTER_TERM`; for the pooled e_x and the Eq. ratio
 scatter within bats, :data:`ballbat.fitting.WITHIN_BAT_SCATTER`). Variants: ``before`` (hc0k,
 no term), ``hc2`` (no term), ``after`` (hc3 and the term per bat), ``per_bat`` (hc2 and the term
 per bat), ``within_redchi`` (and the term within bats for the pooled fits), ``shipped`` (and the
-pooled e_x's error from the sandwich centred within bats); name some on the command line to
-run only those. Stronge's eta^2 is not fitted (it is not judged here).
+pooled e_x's error from the sandwich centred within bats), ``contact`` (and the contact population's
+estimation error in the statistical errors, :data:`ballbat.fitting.CONTACT_POPULATION_ERROR`), ``kh``
+(the Knapp-Hartung floor of the per-bat scatter fit, :data:`ballbat.linefit.KNAPP_HARTUNG_FLOOR`, without the
+contact term), ``both`` and ``hc3_bat`` (the contact term and e_x per bat's error from the HC3 sandwich,
+:data:`ballbat.fitting.PER_BAT_SANDWICH`: shipped); name some on the command line to run only those.
+The reductions always carry the contact shifts (they are in the cached sources); only the fits use them or not.
+Stronge's eta^2 is not fitted (it is not judged here).
 The calibration is not drawn (statistical intervals; the combined ones need the drawn
 calibration of the robustness grid).
 
@@ -33,6 +38,7 @@ from ballbat.studies import replicates
 from ballbat.studies.coverage import coverage
 from ballbat.studies.replicates import STUDY_QUANTITIES
 from ballbat.studies.settings import StudySettings
+from ballbat.studies.sweeps import point_dataset
 from ballbat.studies.truth import population_truth
 
 
@@ -59,18 +65,27 @@ SETUPS = {
     "narrow_psi": _narrow,
     "scatter0.02": lambda ds: _scatter(ds, 0.02),
     "scatter0.01": lambda ds: _scatter(ds, 0.01),
+    # the robustness grid's point where the contact population's error was shown (docs/studies.md)
+    "contact0.5": lambda ds: point_dataset(ds, ("pixel_noise_px", "impacts_per_bat", "contact_ms"), (1.0, 30, 0.5)),
 }
 
-#: variant -> (E_Y_SANDWICH, SCATTER_TERM, WITHIN_BAT_SCATTER, POOLED_SANDWICH): ``per_bat`` is the
-#: shipped form before the pooled e_x and the Eq. ratio slope got the scatter within bats,
-#: ``within_redchi`` that term with the pooled e_x's error still scaled by the reduced chi-square
+#: variant -> (E_Y_SANDWICH, SCATTER_TERM, WITHIN_BAT_SCATTER, POOLED_SANDWICH, CONTACT_POPULATION_ERROR,
+#: KNAPP_HARTUNG_FLOOR, PER_BAT_SANDWICH): ``per_bat`` is the shipped form before the pooled e_x and the Eq.
+#: ratio slope got the scatter within bats, ``within_redchi`` that term with the pooled e_x's error still
+#: scaled by the reduced chi-square, ``shipped`` the form before the contact population's error (issue 36's
+#: last step), ``contact`` and ``kh`` (the Knapp-Hartung floor) each alone, ``both`` the two, ``hc3_bat``
+#: the contact term with e_x per bat's error from the HC3 sandwich (the form now shipped)
 VARIANTS = {
-    "before": ("hc0k", False, False, False),
-    "hc2": ("hc2", False, False, False),
-    "after": ("hc3", True, False, False),
-    "per_bat": ("hc2", True, False, False),
-    "within_redchi": ("hc2", True, True, False),
-    "shipped": ("hc2", True, True, True),
+    "before": ("hc0k", False, False, False, False, False, False),
+    "hc2": ("hc2", False, False, False, False, False, False),
+    "after": ("hc3", True, False, False, False, False, False),
+    "per_bat": ("hc2", True, False, False, False, False, False),
+    "within_redchi": ("hc2", True, True, False, False, False, False),
+    "shipped": ("hc2", True, True, True, False, False, False),
+    "contact": ("hc2", True, True, True, True, False, False),
+    "kh": ("hc2", True, True, True, False, True, False),
+    "both": ("hc2", True, True, True, True, True, False),
+    "hc3_bat": ("hc2", True, True, True, True, False, True),
 }
 
 
@@ -117,13 +132,16 @@ def main() -> None:
             mock.patch.object(replicates, "STUDY_QUANTITIES", quantities),
         ):
             for label in variants:
-                form, term, within, robust = VARIANTS[label]
+                form, term, within, robust, contact, kh, bat_sandwich = VARIANTS[label]
                 t0 = time.perf_counter()
                 with (
                     mock.patch.object(fitting, "E_Y_SANDWICH", form),
                     mock.patch.object(linefit, "SCATTER_TERM", term),
                     mock.patch.object(fitting, "WITHIN_BAT_SCATTER", within),
                     mock.patch.object(fitting, "POOLED_SANDWICH", robust),
+                    mock.patch.object(fitting, "CONTACT_POPULATION_ERROR", contact),
+                    mock.patch.object(linefit, "KNAPP_HARTUNG_FLOOR", kh),
+                    mock.patch.object(fitting, "PER_BAT_SANDWICH", bat_sandwich),
                 ):
                     rep = study_batch.run(s, 0, balls, bats)
                     truth_v = [population_truth(s, 0, balls, bats)] if term else truth

@@ -77,3 +77,101 @@ def test_e_y_variance_forms():
     assert one_part == pytest.approx(np.sum((a / (1 - h1)) ** 2))
     with pytest.raises(ValueError, match="hc3"):
         fitting.e_y_variance(a, b, h1, h2, 4, "hc9")
+
+
+def _with_contact_shift(rec, rel: float, ball: str):
+    """``rec`` with contact shifts on the impacts of ``ball`` (0 elsewhere): v_bat by +-``rel`` v_bat, theta by
+    +-``rel`` rad (theta moves psi, hence the Eq. ratio slope; v_bat moves e_x).
+    """
+    on = (rec["ball"].values == ball).astype(float)
+    sides = np.array([1.0, -1.0])[:, None]
+    return rec.assign(
+        contact_shift_v_bat=(("shift", "impact"), sides * rel * on * rec["v_bat"].values, {"units": "m s-1"}),
+        contact_shift_theta=(("shift", "impact"), sides * rel * on, {"units": "rad"}),
+    )
+
+
+def test_the_contact_error_is_the_refits_half_difference_in_quadrature(config, balls, bats):
+    """A shift common to one ball type's impacts (its contact population at +-1 sigma) is that ball's error alone.
+
+    The other ball's numbers do not move (its shifts are 0); the shifted ball's e_x, pooled e_x,
+    Eq. ratio slope and implied e_y get half the change of the same estimators refitted with
+    every v_bat of that ball at (1 +- 0.2 %) and theta +- 2 mrad, added in quadrature to their statistical errors
+    (the rank-one covariance delta delta' of the shared shift), their intervals widened alike.
+    """
+    from helpers import NORM, REC
+
+    from ballbat.stages import fit_ex, normalize, reconstruct, simulate
+    from ballbat.synthetic import SyntheticSettings
+
+    s = SyntheticSettings(**{**config["datasets"]["synthetic"]["synthetic"], "seed": 5})
+    rec = reconstruct.run(REC, normalize.run(NORM, simulate.run(s, balls, bats)), balls, bats)
+    rec = rec.drop_vars([k for k in rec.data_vars if k.startswith("truth_")])
+    settings = fit_ex.FitExSettings(mu_k_example=0.5, systematic=False, check_physical=True)
+    plain = fit_ex.run(settings, rec)
+    got = fit_ex.run(settings, _with_contact_shift(rec, 2e-3, "softball"))
+    sides = []
+    for sign in (1.0, -1.0):
+        moved = _with_contact_shift(rec, 2e-3, "softball")
+        moved = fitting.contact_shifted_impacts(moved, 0 if sign > 0 else 1)
+        sides.append(fit_ex.results_dataset(fitting.analyze_impacts(moved, 0.5, False, core=True)))
+    for q in fitting.CONTACT_QUANTITIES:
+        extra = 0.5 * np.abs(sides[0][q] - sides[1][q]).sel(ball="softball")
+        assert np.all((extra > 0) | np.isnan(extra))
+        np.testing.assert_allclose(got[f"{q}_err_contact"].sel(ball="softball"), extra, rtol=1e-12)
+        np.testing.assert_allclose(
+            got[f"{q}_err"].sel(ball="softball"), np.hypot(plain[f"{q}_err"].sel(ball="softball"), extra), rtol=1e-12
+        )
+        np.testing.assert_array_equal(got[q], plain[q])  # values never move
+        base = got.sel(ball="baseball")
+        assert np.all((base[f"{q}_err_contact"] == 0) | np.isnan(base[f"{q}_err_contact"]))
+        np.testing.assert_array_equal(base[f"{q}_err"], plain.sel(ball="baseball")[f"{q}_err"])
+        if f"{q}_ci_high" in got:
+            half = (got[f"{q}_ci_high"] - got[q]) / got[f"{q}_err"]
+            np.testing.assert_allclose(half, (plain[f"{q}_ci_high"] - plain[q]) / plain[f"{q}_err"], rtol=1e-9)
+    assert "e_x_err_contact" not in plain
+
+
+def test_the_switch_turns_the_contact_error_off(config, balls, bats, monkeypatch):
+    from helpers import NORM, REC
+
+    from ballbat.stages import fit_ex, normalize, reconstruct, simulate
+    from ballbat.synthetic import SyntheticSettings
+
+    s = SyntheticSettings(**{**config["datasets"]["synthetic"]["synthetic"], "seed": 6})
+    rec = reconstruct.run(REC, normalize.run(NORM, simulate.run(s, balls, bats)), balls, bats)
+    settings = fit_ex.FitExSettings(mu_k_example=0.5, systematic=False, check_physical=True)
+    monkeypatch.setattr(fitting, "CONTACT_POPULATION_ERROR", False)
+    got = fit_ex.run(settings, _with_contact_shift(rec, 2e-3, "softball"))
+    xr_equal = fit_ex.run(settings, rec)
+    assert "e_x_err_contact" not in got
+    np.testing.assert_array_equal(got["e_y_implied_err"], xr_equal["e_y_implied_err"])
+
+
+def test_e_x_per_bat_error_is_the_sandwich_with_the_scatter_terms_weights(config, balls, bats, monkeypatch):
+    """e_x per bat: the value as before, the error the HC3 sandwich of the same fit (``PER_BAT_SANDWICH``);
+    the pooled fits do not change.
+    """
+    from helpers import NORM, REC
+
+    from ballbat.columns import Columns
+    from ballbat.designs import Measured, measured_sigma, spin_design
+    from ballbat.linefit import eiv_line
+    from ballbat.stages import normalize, reconstruct, simulate
+    from ballbat.synthetic import SyntheticSettings
+
+    syn = {**config["datasets"]["synthetic"]["synthetic"], "seed": 7, "e_x_scatter": 0.02}
+    rec = reconstruct.run(REC, normalize.run(NORM, simulate.run(SyntheticSettings(**syn), balls, bats)), balls, bats)
+    res = fitting.analyze_impacts(rec, 0.5, False)
+    monkeypatch.setattr(fitting, "PER_BAT_SANDWICH", False)
+    old = fitting.analyze_impacts(rec, 0.5, False)
+    np.testing.assert_array_equal(res.e_x.field("slope"), old.e_x.field("slope"))
+    np.testing.assert_array_equal(res.e_x_pooled.field("slope_err"), old.e_x_pooled.field("slope_err"))
+    assert not np.allclose(res.e_x.field("slope_err"), old.e_x.field("slope_err"), equal_nan=True)
+    ds = Columns(rec)
+    sel = (ds["flag"].values == 0) & (ds["ball"].values == "softball") & (ds["bat"].values == "wood")
+    r, r_x, alpha = (ds[k].values[sel] for k in ("r", "r_x", "alpha"))
+    x, y, jx, jy = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
+    want = eiv_line(x, y, jx, jy, measured_sigma(ds, sel), scatter=True, robust=True)
+    got = res.e_x.fits[res.balls.index("softball"), res.bats.index("wood")]
+    assert got.slope_err == pytest.approx(want.slope_err, rel=1e-12) and got.scatter == pytest.approx(want.scatter)

@@ -6,7 +6,7 @@ depend on it alone, not on the fits of :mod:`ballbat.fitting`.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Callable, Mapping
 from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:
@@ -44,3 +44,9 @@ class Columns(Mapping):
     def __len__(self) -> int:
         """Return the number of variables."""
         return len(self._vars)
+
+    def dropped(self, drop: Callable[[str], bool]) -> Columns:
+        """Return the columns without those whose name ``drop`` is true of (the same arrays; ``attrs`` kept)."""
+        out = Columns(self)
+        out._vars = {k: v for k, v in self._vars.items() if not drop(k)}
+        return out

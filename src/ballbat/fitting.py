@@ -9,10 +9,12 @@ omega), so the residual
 y - (a + s x) has variance sum_k (dy/dm_k - s dx/dm_k)^2 sigma_k^2 over the measured
 quantities m_k (correlations between x and y through psi included). The weights depend
 on the slope, so the fit is iterated (three passes converge to far below the standard
-error). Standard errors of the model's own equations (Eq. omega per bat and pooled, Eq.
-ratio) are lmfit's, scaled by the reduced chi-square (as the paper's standard errors come
-from the scatter of the data); the reduced chi-square itself tells whether the stated
-measurement uncertainties explain that scatter. The Figs. 3-4 lines summarise data the
+error). Standard errors come from the scatter of the data (as the paper's do): Eq. ratio's
+is lmfit's, scaled by the reduced chi-square, e_x's per bat and pooled HC3 sandwiches with the
+intrinsic-scatter term's weights (:data:`PER_BAT_SANDWICH`, :data:`POOLED_SANDWICH`); the
+reduced chi-square itself tells whether the stated measurement uncertainties explain that
+scatter. Each quantity that pools impacts also carries the error of the contact-time
+population its impacts share (:func:`with_contact_error`). The Figs. 3-4 lines summarise data the
 model does not describe impact by impact (bats of different e_x, spin and speed not exactly
 linear in theta): their scatter is not the same everywhere, and their standard errors are
 the sandwich (HC3) ones, which the replicate studies (:mod:`ballbat.studies`) find
@@ -40,11 +42,12 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
+from . import linefit
 from .columns import Columns
 from .designs import MEASURED, Measured, measured_sigma, normalized_theta_design, spin_design, tan_ratio_design
 from .kinematics import gross_slip_onset, normalize_to_bat_speed, tan_ratio_slope_model
 from .linefit import MIN_FIT_IMPACTS, LineFit, fit_line, scatter_gain, wls_slope
-from .systematics import has_shifts
+from .systematics import SIDES, contact_shifted_impacts, has_contact_shifts, has_shifts
 
 if TYPE_CHECKING:
     import xarray as xr
@@ -105,6 +108,9 @@ class Sec4:
     per_ball: dict[str, np.ndarray] = field(default_factory=dict)
     systematic: dict[str, np.ndarray] | None = None  # pixel-scale systematic of e_x (scale_systematic)
     systematics: object = None  # every calibration source to every quantity (ballbat.systematics)
+    #: Per quantity of :data:`CONTACT_QUANTITIES`, its error from the contact population's estimate
+    #: (:func:`contact_population_error`; included in the statistical errors), None where not carried.
+    contact_error: dict[str, np.ndarray] | None = None
 
 
 #: The pooled e_x and the Eq. ratio slope of a ball carry the intrinsic scatter within its bats
@@ -116,6 +122,13 @@ WITHIN_BAT_SCATTER = True
 #: those differences as noise (with the scatter term it covered 97-98 %; docs/model.md). False:
 #: the scaled covariance (bench/intervals_study.py's comparison).
 POOLED_SANDWICH = True
+
+#: e_x per bat's standard error is the HC3 sandwich (with the intrinsic-scatter term's weights), not the
+#: covariance scaled by the reduced chi-square: with tau estimated from a bat's few impacts the weights
+#: are themselves uncertain, and the sandwich does not rest on them (softballs on metal_smooth, 12
+#: impacts, e_x scatter 0.02: 88.3 -> 92.3 %; docs/model.md). Only where the fit carries the term
+#: (:data:`ballbat.linefit.SCATTER_TERM`). False: the scaled covariance (bench/intervals_study.py).
+PER_BAT_SANDWICH = True
 
 #: Per-ball quantities that are not line fits (values of :attr:`Sec4.per_ball`).
 PER_BALL = (
@@ -187,7 +200,7 @@ def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool)
             errors_in_variables=True,
             strata=strata,
             scatter=strata is None or WITHIN_BAT_SCATTER,
-            robust=strata is not None and POOLED_SANDWICH,
+            robust=POOLED_SANDWICH if strata is not None else PER_BAT_SANDWICH and linefit.SCATTER_TERM,
         )
         t = np.nan
         if with_truth and fit.success:
@@ -470,7 +483,7 @@ def _mu_k_bound(pb: dict, i: int, y: np.ndarray, jy: np.ndarray, sig: np.ndarray
     pb["mu_k_lower_bound_impact"][i] = int(impact[k])
 
 
-def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True) -> Sec4:
+def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True, core: bool = False) -> Sec4:
     """Sec. IV analysis of a normalised and reconstructed dataset (output of ``reconstruct``).
 
     Uses only impacts with ``flag == 0``. The Figs. 3-4 fits read the normalised spin and
@@ -480,7 +493,9 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
     noise-free truth with the same weights. ``systematic=False`` skips the pixel-scale
     systematic (:func:`scale_systematic`, two more e_x fits): a replicate study asks for it only
     where its replicates draw their calibration or their properties, the combined interval's
-    coverage (:func:`ballbat.studies.replicates.run_replicate`).
+    coverage (:func:`ballbat.studies.replicates.run_replicate`). ``core``: only e_x (per bat and
+    pooled), the Eq. ratio slope and implied e_y (:func:`contact_population_error`'s refits); the
+    other per-ball quantities stay NaN.
     """
     ds = Columns(ds)  # plain arrays: the fits read some 200 of them
     usable = ds["flag"].values == 0
@@ -511,6 +526,8 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
         a = float(np.mean(alpha))
         e_y, e_y_err = implied_e_y(ds, in_ball, res, i, (x, y, jx, jy, sig), rfit)
         pb["e_y_implied"][i], pb["e_y_implied_err"][i] = e_y, e_y_err
+        if core:
+            continue
         _mu_k_bound(pb, i, y, jy, sig, ds["impact"].values[in_ball])
         psi_g, theta_g, omega_g = gross_slip_onset(
             mu_k_example, rfit.slope, v_ref, exf.slope - 1.0, float(np.mean(r)), float(np.mean(r_x)), a
@@ -538,6 +555,81 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
     # impacts that carry the calibration shifts get every source by the exact rerun instead
     # (the fit_ex stage: ballbat.stages.systematics)
     res.systematic = scale_systematic(ds, res) if systematic and not has_shifts(ds) else None
+    return res
+
+
+#: Carry the contact population's estimation error into the statistical errors
+#: (:func:`with_contact_error`). False: not (the studies' comparison, bench/intervals_study.py).
+CONTACT_POPULATION_ERROR = True
+#: The quantities that pool impacts and get the contact population's error (fit_ex.nc's names).
+CONTACT_QUANTITIES = ("e_x", "e_x_pooled", "tan_ratio_slope", "e_y_implied")
+
+
+def _quantity(res: Sec4, q: str) -> np.ndarray:
+    """Value of a :data:`CONTACT_QUANTITIES` quantity of ``res`` (the slope for the line fits)."""
+    return res.per_ball[q] if q in res.per_ball else getattr(res, q).field("slope")
+
+
+def contact_population_error(ds: xr.Dataset, res: Sec4) -> dict[str, np.ndarray]:
+    """Each pooled quantity's error from the contact population's estimate: half its change between +-1 sigma.
+
+    Every ball type's contact times are a population fitted to all its impacts (the reduction's
+    prior of each impact's contact, :func:`ballbat.tracks.fit_contact.contact_population`); an
+    impact whose frames say little takes the population's contact time, so the error of the
+    population's mean moves all of them together. The reduction solved again with the mean at
+    +1 and at -1 standard error (reduce.nc's ``contact_shift_<name>``) gives the impacts at both
+    sides; they are normalised, reconstructed and fitted again with the same estimators, and
+    half the difference is the quantity's error from the shared estimate. It is statistical (the
+    population is estimated from the same impacts and drawn afresh in every repetition).
+
+    Parameters
+    ----------
+    ds : xarray.Dataset
+        Reconstructed impacts carrying the shifts (:func:`ballbat.systematics.has_contact_shifts`).
+    res : Sec4
+        The nominal fits.
+
+    Returns
+    -------
+    dict
+        Per name of :data:`CONTACT_QUANTITIES`, the error (>= 0; NaN where the quantity has no value).
+    """
+    fits = [
+        analyze_impacts(contact_shifted_impacts(ds, j), res.mu_k_example, False, core=True) for j in range(len(SIDES))
+    ]
+    return {q: 0.5 * np.abs(_quantity(fits[0], q) - _quantity(fits[1], q)) for q in CONTACT_QUANTITIES}
+
+
+def _widened(fit: LineFit, extra: float) -> LineFit:
+    """``fit`` with ``extra`` added in quadrature to its standard error, its interval widened alike."""
+    from dataclasses import replace
+
+    if not (np.isfinite(extra) and extra > 0 and np.isfinite(fit.slope_err) and fit.slope_err > 0):
+        return fit
+    tq = (fit.slope_ci_high - fit.slope) / fit.slope_err
+    err = float(np.hypot(fit.slope_err, extra))
+    return replace(fit, slope_err=err, slope_ci_low=fit.slope - tq * err, slope_ci_high=fit.slope + tq * err)
+
+
+def with_contact_error(ds: xr.Dataset, res: Sec4) -> Sec4:
+    """``res`` with the contact population's error (:func:`contact_population_error`) in its statistical errors.
+
+    Added in quadrature to each quantity's standard error (and its interval widened with the
+    same Student t): the shift between the two sides is the estimator's own response to the
+    shared error, so its square is exactly what a covariance common to the ball type's impacts
+    (the rank-one term delta delta') adds to the estimator's variance, weights unchanged.
+    ``res`` unchanged where the impacts carry no shifts or :data:`CONTACT_POPULATION_ERROR` is off.
+    """
+    if not (CONTACT_POPULATION_ERROR and has_contact_shifts(ds)):
+        return res
+    err = contact_population_error(ds, res)
+    for q in ("e_x", "e_x_pooled", "tan_ratio_slope"):
+        grid: FitGrid = getattr(res, q)
+        for idx in np.ndindex(grid.fits.shape):
+            grid.fits[idx] = _widened(grid.fits[idx], float(err[q][idx]))
+    extra = np.nan_to_num(err["e_y_implied"])
+    res.per_ball["e_y_implied_err"] = np.hypot(res.per_ball["e_y_implied_err"], extra)
+    res.contact_error = err
     return res
 
 

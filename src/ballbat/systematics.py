@@ -52,6 +52,7 @@ import xarray as xr
 from .instruments import INSTRUMENT_SOURCES
 
 if TYPE_CHECKING:
+    from .columns import Columns
     from .tracks.data import Camera, Rig, TrackBlocks, Tracks
     from .tracks.reduce import ReduceOptions, Reduction
 
@@ -159,7 +160,7 @@ def reduce_shifts(
             continue
         for j, side in enumerate(SIDES):
             cams, rg = shifted_settings(cameras, rig, source, 1.0 + side * rel[i])
-            red = reduce_tracks(tracks, cams, rg, options)
+            red = reduce_tracks(tracks, cams, rg, options, population_shifts=False)
             with np.errstate(invalid="ignore"):
                 for k in SHIFTED:
                     d = red.values[k] - nominal.values[k]
@@ -198,6 +199,39 @@ def shifted_impacts(rec: xr.Dataset, source: int, side: int) -> xr.Dataset:
     # the normalize and reconstruct stages' steps, at the nominal reference speed and properties
     out = out.assign({k: ("impact", v) for k, v in normalize_values(out, float(rec.attrs["v_ref"])).items()})
     return out.assign({k: ("impact", v) for k, v in reconstruct_again_values(out).items()})
+
+
+#: reduce.nc's variables of the contact population's shifts: ``contact_shift_<name>`` (shift, impact)
+#: for the names of :data:`ballbat.tracks.reduce.CONTACT_SHIFTED` (the others do not move).
+CONTACT_SHIFT = "contact_shift_"
+
+
+def has_contact_shifts(ds: xr.Dataset) -> bool:
+    """Return whether ``ds`` carries the contact population's shifts (reduce.nc of camera tracks)."""
+    return any(f"{CONTACT_SHIFT}{k}" in ds for k in SHIFTED)
+
+
+def contact_shifted_impacts(rec: xr.Dataset, side: int) -> Columns:
+    """Reconstructed impacts with every ball type's contact population at one side (index along ``shift``).
+
+    As :func:`shifted_impacts` for a calibration source, read as :class:`~ballbat.columns.Columns`
+    (plain arrays, no Dataset built: the studies run this twice a replicate): the measured values
+    moved by their ``contact_shift_<name>``, normalised and reconstructed again, without
+    ``truth_*`` and the shifts themselves.
+    """
+    from .analysis import normalize_values, reconstruct_again_values
+    from .columns import Columns
+
+    def variables(values: dict) -> dict:
+        return {k: xr.Variable(("impact",), v) for k, v in values.items()}
+
+    cols = Columns(rec).dropped(lambda k: k.startswith("truth_") or k.startswith(CONTACT_SHIFT))
+    moved = {
+        k: cols[k].values + rec[f"{CONTACT_SHIFT}{k}"].values[side] for k in SHIFTED if f"{CONTACT_SHIFT}{k}" in rec
+    }
+    out = Columns(cols, variables(moved))
+    out = Columns(out, variables(normalize_values(out, float(rec.attrs["v_ref"]))))
+    return Columns(out, variables(reconstruct_again_values(out)))
 
 
 @dataclass

@@ -92,8 +92,11 @@ def test_the_pooled_fits_report_the_scatter_within_bats(default_settings, balls,
 def test_fit_ex_stage_gives_the_compute_functions_numbers(chain, config):
     """fit_ex.run on a tiny reduced set: its values are those of fitting.analyze_impacts, nothing lost or added."""
     rec = chain["red_rec"]
-    res = fitting.analyze_impacts(rec, 0.5)
+    res = fitting.with_contact_error(rec, fitting.analyze_impacts(rec, 0.5))
+    assert res.contact_error is not None  # reduced tracks: the contact population's error is carried
     fit = fit_ex.run(fit_ex.FitExSettings.from_config(config), rec)
+    np.testing.assert_array_equal(fit["e_y_implied_err"].values, res.per_ball["e_y_implied_err"])
+    np.testing.assert_array_equal(fit["e_x_err_contact"].values, res.contact_error["e_x"])
     np.testing.assert_array_equal(fit["e_x"].values, res.e_x.field("slope", -1.0))
     np.testing.assert_array_equal(fit["e_x_err"].values, res.e_x.field("slope_err"))
     np.testing.assert_array_equal(fit["e_x_pooled"].values, res.e_x_pooled.field("slope", -1.0))

@@ -71,7 +71,7 @@ def test_each_stage_writes_exactly_its_table(chain, config, balls, bats):
     tracks_ds = render.tracks_dataset(chain["tracks"])
     assert set(tracks_ds.data_vars) == set(render.TRACKS_TABLE) | set(chain["tracks"].truth)
     fit = fit_ex.run(fit_ex.FitExSettings.from_config(config), chain["red_rec"])
-    assert set(fit.data_vars) == set(fit_ex.fit_ex_table(True, 0.5, has_scale=True))
+    assert set(fit.data_vars) == set(fit_ex.fit_ex_table(True, 0.5, has_scale=True, has_contact=True))
     st = stronge.run(stronge.StrongeSettings(**{**config["stronge"], "n_time": 40}), rec)
     assert set(st.data_vars) == set(stronge.stronge_variables())
     assert set(st.coords) == set(stronge.STRONGE_COORDS)

@@ -55,11 +55,11 @@ def test_reduce_nc_from_blocks_is_that_of_one_block(tmp_path, monkeypatch):
     assert len(blocks.blocks) == 3
     b = reduce.run(settings, blocks, BALLS, BATS)
     assert a.attrs == b.attrs and a.attrs["reduce_checks"].count("\n") >= 3
-    assert set(a.variables) == set(b.variables) and "v_bat_shift" in a
+    assert set(a.variables) == set(b.variables) and "v_bat_shift" in a and "contact_shift_v_bat" in a
     for k in a.variables:
         x, y = a[k].values, b[k].values
-        if k.endswith("_shift"):
-            q = a[k.removesuffix("_shift")].values
+        if k.endswith("_shift") or k.startswith("contact_shift_"):
+            q = a[k.removeprefix("contact_shift_").removesuffix("_shift")].values
             np.testing.assert_allclose(q + y, q + x, rtol=1e-9, atol=0, err_msg=k)
         elif x.dtype.kind == "f":
             np.testing.assert_allclose(y, x, rtol=1e-12, atol=0, err_msg=k)

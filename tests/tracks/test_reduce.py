@@ -348,3 +348,51 @@ def test_blocks_reduce_as_one_block(tmp_path, monkeypatch):
     idx = blocks.index[0]
     assert np.nanmax(np.abs(alone.contact.duration - a.contact.duration[idx]) / a.contact.duration[idx]) > 1e-6
     np.testing.assert_allclose(b.contact.duration[idx], a.contact.duration[idx], rtol=1e-12)
+
+
+def _short_contacts():
+    """Rendered tracks at 1 px with contacts of 0.45-0.55 ms, 30 impacts per bat: frames say little of them."""
+    ds = experiment(seed=4, per_bat=30)
+    cfg = render_cfg(contact_ms=[0.45, 0.55], seed=4, swing={"pixel_noise_px": 1.0}, spin={"pixel_noise_px": 1.0})
+    return render(ds, cfg)
+
+
+def test_the_contact_rerun_at_the_nominal_population_moves_nothing(monkeypatch):
+    """Solved again with the population as fitted (not shifted), every impact's values come back bit for bit:
+    the rerun moves an impact only through its ball type's shifted population.
+    """
+    from ballbat.tracks import reduce as module
+    from ballbat.tracks.fit_contact import contact_population
+
+    def unshifted(*args, **kw):
+        pop = contact_population(*args, **kw)
+        return replace(pop, shifted=(pop.prior, pop.prior))
+
+    tr, s = _short_contacts()
+    monkeypatch.setattr(module, "contact_population", unshifted)
+    red = reduce(tr, s)
+    for k, sides in red.contact_shift.items():
+        for d in sides:
+            assert np.all(d == 0.0), k
+
+
+def test_the_contact_shifts_move_each_ball_types_impacts_both_ways_and_reach_reduce_nc():
+    """At +1 sigma of the population's mean every contact lasts longer on average and the bat's alignment comes
+    earlier: v_bat moves one way at +1 and the other at -1, for both ball types; omega is not touched.
+    """
+    tr, s = _short_contacts()
+    red = reduce(tr, s)
+    mean, err = red.contact_mean
+    ok = red.flag == 0
+    for ball in ("baseball", "softball"):
+        k = ok & (tr.ball == ball)
+        assert np.all(err[k] > 0) and np.all(err[k] < 0.2 * mean[k])
+        up, down = (np.mean(d[k]) for d in red.contact_shift["v_bat"])
+        assert up * down < 0 and abs(up + down) < 0.5 * abs(up - down), (ball, up, down)
+    assert "omega" not in red.contact_shift
+    ds = reduction_dataset(red)
+    for k in ("v_bat", "v_ball", "theta", "v_bat_err", "theta_err"):
+        var = ds[f"contact_shift_{k}"]
+        assert var.dims == ("shift", "impact") and var.attrs["units"] and "contact" in var.attrs["long_name"]
+        assert list(ds["shift"].values) == [1, -1]
+    assert ds["contact_population_mean_err"].attrs["units"] == "s"

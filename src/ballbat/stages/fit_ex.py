@@ -13,7 +13,16 @@ from typing import TYPE_CHECKING
 import numpy as np
 import xarray as xr
 
-from ..fitting import FitGrid, FitStatus, Sec4, analyze_impacts, check_physical, fit_status
+from ..fitting import (
+    CONTACT_QUANTITIES,
+    FitGrid,
+    FitStatus,
+    Sec4,
+    analyze_impacts,
+    check_physical,
+    fit_status,
+    with_contact_error,
+)
 from ..pipeline.config import SectionSettings
 from ..pipeline.products import Var, build_dataset, carried_warnings, estimate_vars, flag_attrs
 from ..systematics import FIT_QUANTITIES, SIDES, SOURCES, FitSystematics, has_shifts, shifted_impacts, source_names
@@ -68,11 +77,15 @@ FIT_FAMILIES = {
 _SLOPE_IS_ONE_PLUS = ("e_x", "e_x_pooled")
 
 
-def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) -> dict[str, Var]:
+def fit_ex_table(
+    has_truth: bool, mu_k_example: float, has_scale: bool = False, has_contact: bool = False
+) -> dict[str, Var]:
     """Return the variables of fit_ex.nc, declared once (name -> :class:`Var`).
 
     ``has_scale``: the dataset carries a pixel-scale uncertainty (reduced from camera
-    tracks), so e_x gets a systematic error (``*_err_scale``).
+    tracks), so e_x gets a systematic error (``*_err_scale``). ``has_contact``: its impacts carry
+    the contact population's shifts, so the pooled quantities get ``*_err_contact``
+    (:func:`contact_error_vars`).
     """
     table: dict[str, Var] = {}
     for name, (dims, units, what) in FIT_FAMILIES.items():
@@ -96,7 +109,7 @@ def fit_ex_table(has_truth: bool, mu_k_example: float, has_scale: bool = False) 
         table[f"{name}_status"] = Var(
             dims, "1", f"why {name} has no value (0: it has one; the count is {name}_n)", flag_attrs(FitStatus)
         )
-    table.update(scatter_vars())
+    table.update({**scatter_vars(), **(contact_error_vars() if has_contact else {})})
     table["e_y_implied"] = Var(
         ("ball",),
         "1",
@@ -162,6 +175,21 @@ def scatter_vars() -> dict[str, Var]:
     return table
 
 
+def contact_error_vars() -> dict[str, Var]:
+    """Declare each pooled quantity's error from the contact population's estimate (``<q>_err_contact``)."""
+    dims = {"e_x": ("ball", "bat"), "e_y_implied": ("ball",)}
+    return {
+        f"{q}_err_contact": Var(
+            dims.get(q, ("ball",)),
+            "1",
+            f"part of {q}_err from the estimate of the ball type's contact-time population (statistical, shared by "
+            f"its impacts; already in {q}_err in quadrature): half the change of {q} when the tracks are reduced with "
+            "the population's mean contact time at +1 and -1 standard error",
+        )
+        for q in CONTACT_QUANTITIES
+    }
+
+
 def results_dataset(res: Sec4) -> xr.Dataset:
     """fit_ex.nc's contents: the :class:`Sec4` results on the declared table (dims ball, bat)."""
     values: dict[str, np.ndarray] = {}
@@ -186,12 +214,15 @@ def results_dataset(res: Sec4) -> xr.Dataset:
     values.update({k: v for k, v in res.per_ball.items() if res.has_truth or not k.startswith("truth_")})
     if res.systematic is not None:
         values.update(res.systematic)
+    table = fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None, res.contact_error is not None)
+    if res.contact_error is not None:
+        values.update({f"{q}_err_contact": v for q, v in res.contact_error.items()})
     coords = {
         "ball": (Var(("ball",), None, "ball type"), np.array(res.balls, dtype=str)),
         "bat": (Var(("bat",), None, "bat"), np.array(res.bats, dtype=str)),
     }
     ds = build_dataset(
-        fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None),
+        table,
         values,
         coords,
         {"mu_k_example": res.mu_k_example},
@@ -211,7 +242,7 @@ def run(settings: FitExSettings, impacts: xr.Dataset) -> xr.Dataset:
 
 def fit(settings: FitExSettings, impacts: xr.Dataset) -> tuple[xr.Dataset, FitSystematics | None]:
     """:func:`run`'s dataset and the calibration systematics it holds, with their signs (None: none fitted)."""
-    res = analyze_impacts(impacts, settings.mu_k_example, systematic=settings.systematic)
+    res = with_contact_error(impacts, analyze_impacts(impacts, settings.mu_k_example, systematic=settings.systematic))
     if settings.systematic and has_shifts(impacts):  # every calibration source, the tracks reduced again
         res.systematics = fit_systematics(impacts, res)
         res.systematic = scale_entries(res.systematics)

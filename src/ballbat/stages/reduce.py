@@ -13,8 +13,9 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..pipeline.products import Var, build_dataset, flag_attrs
+from ..systematics import SHIFT_UNITS, SIDES
 from ..tracks.io import cameras_from_config
-from ..tracks.reduce import FLAG_VAR, ReduceFlag, ReduceOptions, Reduction, reduce_tracks
+from ..tracks.reduce import CONTACT_SHIFTED, FLAG_VAR, ReduceFlag, ReduceOptions, Reduction, reduce_tracks
 from ..tracks.verdict import Verdict, cross_check
 from .impacts import IMPACT_COORDS, QUANTITIES, measured, truth_var
 from .systematics import add_shifts
@@ -191,9 +192,36 @@ def _spin_table() -> dict[str, Var]:
     return table
 
 
-def reduction_table(truth_names: Sequence[str] = ()) -> dict[str, Var]:
-    """Return the declared variables of ``reduce.nc``."""
-    table = {**_measured_table(), **_motion_table(), **_spin_table()}
+def _contact_table(shifts: bool) -> dict[str, Var]:
+    """Return the contact population's variables: its mean and error, and (``shifts``) each impact's shifts."""
+    table = {
+        "contact_population_mean": _v(
+            "s", "mean contact time of the impact's ball type (the fitted population of contact times)"
+        ),
+        "contact_population_mean_err": _v(
+            "s",
+            "standard error of that mean (from the pooled fit; 0: the frames say nothing of the contacts and the "
+            "uniform distribution is kept)",
+        ),
+    }
+    if not shifts:
+        return table
+    for k in CONTACT_SHIFTED:
+        base = k.removesuffix("_err")
+        what = f"the standard uncertainty of {base}" if k.endswith("_err") else base
+        table[f"contact_shift_{k}"] = Var(
+            ("shift", "impact"),
+            SHIFT_UNITS[base],
+            f"change of {what} when the reduction is solved again with the ball type's contact population mean at "
+            "+1 and -1 standard error (a statistical error shared by the ball type's impacts)",
+            {"ballbat_role": "statistical"},
+        )
+    return table
+
+
+def reduction_table(truth_names: Sequence[str] = (), contact_shifts: bool = True) -> dict[str, Var]:
+    """Return the declared variables of ``reduce.nc`` (``contact_shifts``: with the contact population's shifts)."""
+    table = {**_measured_table(), **_motion_table(), **_spin_table(), **_contact_table(contact_shifts)}
     for k in truth_names:
         table[k] = truth_var(k)
     return table
@@ -264,7 +292,20 @@ def reduction_dataset(red: Reduction) -> xr.Dataset:
         attrs[f"{cam}_m_per_px_rel_err"] = float(c.m_per_px_err)
     attrs["pivot_to_tip_m"] = float(red.rig.pivot_to_tip)
     attrs["pivot_to_impact_m"] = float(red.rig.pivot_to_impact)
-    return add_shifts(build_dataset(reduction_table(sorted(truth)), values, coords, attrs), red.shifts)
+    _contact_values(red, values, coords)
+    table = reduction_table(sorted(truth), red.contact_shift is not None)
+    return add_shifts(build_dataset(table, values, coords, attrs), red.shifts)
+
+
+def _contact_values(red: Reduction, values: dict, coords: dict) -> None:
+    """Put the contact population's variables (:func:`_contact_table`) in ``values``, its ``shift`` in ``coords``."""
+    nan = np.full(red.tracks.n, np.nan)
+    values["contact_population_mean"], values["contact_population_mean_err"] = red.contact_mean or (nan, nan)
+    for k, sides in (red.contact_shift or {}).items():
+        values[f"contact_shift_{k}"] = np.stack(sides)
+    if red.contact_shift is not None:
+        what = "calibration or estimate shifted by this many standard uncertainties"
+        coords["shift"] = (("shift",), np.array(SIDES, dtype=np.int8), {"units": "1", "long_name": what})
 
 
 def run(

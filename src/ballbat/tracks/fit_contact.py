@@ -77,7 +77,7 @@ def _contact_population(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -
 
     A beta distribution over the grid's range whose mean and concentration maximise the group's
     marginal likelihood, prod_i sum_j lik_ij w_j (Nelder-Mead from the uniform
-    distribution, beta(1, 1)). Smooth on purpose: the nonparametric maximum-likelihood
+    distribution, beta(1, 1); :func:`_population_fits`). Smooth on purpose: the nonparametric maximum-likelihood
     distribution is a few spikes, and posteriors under it understate their spread (by 1.2-1.7x
     in tests). A beta family holds the uniform distribution and ones piled at either end of
     the range, so likelihoods that say little leave it near uniform and many weak ones
@@ -86,28 +86,122 @@ def _contact_population(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -
     5 px and 0.5 ms contacts every duration came out 0.2-0.5 ms long). A group with no finite
     likelihood gets the uniform distribution.
     """
+    prior = np.full(lik.shape, 1.0 / lik.shape[1])
+    for rows, fit in _population_fits(lik, groups, grid):
+        prior[rows] = _beta_weights(grid, fit.p)
+    return prior
+
+
+@dataclass
+class _PopulationFit:
+    """One group's fitted beta parameters ``p`` and its likelihoods ``L`` (rows scaled to 1 at their largest)."""
+
+    p: np.ndarray
+    L: np.ndarray
+    estimated: bool  # False: the likelihoods are flat and the uniform distribution was kept
+
+
+def _population_nll(p, L: np.ndarray, grid: np.ndarray) -> float:
+    """Minus the group's marginal log-likelihood at beta parameters ``p``."""
+    # elementwise and summed along rows, not a BLAS product: the same bits wherever L lies in memory
+    # (ndarray.sum: np.sum's reduction without its wrapper; this runs a hundred times a replicate)
+    return -float(np.log((L * _beta_weights(grid, p)[None, :]).sum(axis=1) + 1e-300).sum())
+
+
+def _population_fits(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -> list[tuple[np.ndarray, _PopulationFit]]:
+    """Each group's rows (a mask over all impacts: its label, finite or not) and its :class:`_PopulationFit`.
+
+    Groups labelled below 0 and groups without a finite likelihood are left out (uniform).
+    """
     from scipy.optimize import minimize
 
-    prior = np.full(lik.shape, 1.0 / lik.shape[1])
+    out = []
     for g in np.unique(groups):
         rows = (groups == g) & np.all(np.isfinite(lik), axis=1)
-        if not rows.any():
+        if g < 0 or not rows.any():
             continue
         L = np.ascontiguousarray(lik[rows] / lik[rows].max(axis=1, keepdims=True))
-
-        def nll(p, L=L):
-            # elementwise and summed along rows, not a BLAS product: the same bits wherever L lies in memory
-            # (ndarray.sum: np.sum's reduction without its wrapper; this runs a hundred times a replicate)
-            return -float(np.log((L * _beta_weights(grid, p)[None, :]).sum(axis=1) + 1e-300).sum())
-
         uniform = np.array([0.0, np.log(2.0)])  # beta(1, 1)
         simplex = uniform + np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
         best = minimize(
-            nll, uniform, method="Nelder-Mead", options={"initial_simplex": simplex, "xatol": 1e-3, "fatol": 1e-6}
+            _population_nll,
+            uniform,
+            args=(L, grid),
+            method="Nelder-Mead",
+            options={"initial_simplex": simplex, "xatol": 1e-3, "fatol": 1e-6},
         )
-        p = best.x if best.fun < nll(uniform) - 1e-9 * len(L) else uniform  # flat: no gain, uniform kept
-        prior[groups == g] = _beta_weights(grid, p)
-    return prior
+        gain = best.fun < _population_nll(uniform, L, grid) - 1e-9 * len(L)
+        out.append((groups == g, _PopulationFit(best.x if gain else uniform, L, bool(gain))))  # flat: uniform kept
+    return out
+
+
+#: Step in the beta parameters (logit of the mean, log of the concentration) of the finite differences
+#: that give the population's information matrix (:func:`_population_error`).
+POPULATION_STEP = 0.02
+#: Newton steps from the Nelder-Mead optimum (found to ``xatol`` 1e-3 only) before the information is taken.
+POPULATION_NEWTON_STEPS = 2
+
+
+def _information(fit: _PopulationFit, p: np.ndarray, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Return the Hessian and the gradient of :func:`_population_nll` at ``p`` (central differences)."""
+    h, e = POPULATION_STEP, np.eye(2) * POPULATION_STEP
+
+    def f(d):
+        return _population_nll(p + d, fit.L, grid)
+
+    f0, fp, fm = f(np.zeros(2)), [f(e[i]) for i in range(2)], [f(-e[i]) for i in range(2)]
+    H = np.empty((2, 2))
+    for i in range(2):
+        H[i, i] = (fp[i] - 2 * f0 + fm[i]) / h**2
+    H[0, 1] = H[1, 0] = (f(e[0] + e[1]) - f(e[0] - e[1]) - f(e[1] - e[0]) + f(-e[0] - e[1])) / (4 * h**2)
+    return H, np.array([(fp[i] - fm[i]) / (2 * h) for i in range(2)])
+
+
+def _covariance(H: np.ndarray, p: np.ndarray, n_grid: int) -> np.ndarray | None:
+    """Return the inverse information; the mean's alone where the concentration is capped or H is not definite."""
+    m = 1.0 / (1.0 + np.exp(-p[0]))
+    capped = np.exp(p[1]) >= m * (1 - m) * (n_grid / CONTACT_MIN_SD_STEPS) ** 2
+    if not capped and H[0, 0] > 0 and H[1, 1] > 0 and np.linalg.det(H) > 0:
+        return np.linalg.inv(H)
+    return np.array([[1.0 / H[0, 0], 0.0], [0.0, 0.0]]) if H[0, 0] > 0 else None
+
+
+def _population_error(fit: _PopulationFit, grid: np.ndarray) -> tuple[float, float, np.ndarray]:
+    """Return the group's mean contact time, its standard error and the change of ``p`` that moves the mean by +1 sigma.
+
+    The covariance of ``p`` is the inverse of the observed information (central second differences of
+    :func:`_population_nll`, step :data:`POPULATION_STEP`), taken after :data:`POPULATION_NEWTON_STEPS`
+    Newton steps from the Nelder-Mead optimum (which stops anywhere within 1e-3 of it, so that the last
+    bits of the data would move the information by 1e-6); the mean's error is its delta-method
+    projection, sigma^2 = grad' C grad; the step C grad / sigma moves ``p`` along the direction
+    where the likelihood falls least for a given change of the mean (the concentration follows the
+    mean as the data tie them), and changes the mean by sigma to first order. Where the concentration
+    is at its cap (:func:`_beta_weights`) or the information is not positive definite, the mean alone
+    (the concentration held). Where the uniform distribution was kept, no estimate: error 0. The
+    mean reported is the fitted distribution's, the one the impacts' contacts use.
+    """
+    mean = float(_beta_weights(grid, fit.p) @ grid)
+    if not fit.estimated:
+        return mean, 0.0, np.zeros(2)
+    p = fit.p
+    for _ in range(POPULATION_NEWTON_STEPS):
+        H, g = _information(fit, p, grid)
+        C = _covariance(H, p, grid.size)
+        step = None if C is None else C @ g
+        if step is None or not np.all(np.abs(step) < 0.1):  # not near a well-defined optimum: no polish
+            break
+        p = p - step
+    C = _covariance(_information(fit, p, grid)[0], p, grid.size)
+    if C is None:
+        return mean, 0.0, np.zeros(2)
+    e = np.eye(2) * POPULATION_STEP
+    grad = np.array([(_beta_weights(grid, p + e[i]) - _beta_weights(grid, p - e[i])) @ grid for i in range(2)])
+    grad /= 2 * POPULATION_STEP
+    var = float(grad @ C @ grad)
+    if not var > 0:
+        return mean, 0.0, np.zeros(2)
+    sigma = np.sqrt(var)
+    return mean, sigma, C @ grad / sigma
 
 
 #: Impacts per block of the contact-time likelihood (its arrays are impacts x grid x window frames).
@@ -238,10 +332,42 @@ def contact_prior(lik: np.ndarray, found: np.ndarray, groups: ArrayLike | None =
     :func:`_contact_population`, pooled over every impact given (all of a dataset's, whatever blocks they are held in);
     ``groups``: each impact's ball type, one group if None; impacts without ``found`` are left out.
     """
+    return contact_population(lik, found, groups).prior
+
+
+@dataclass
+class ContactPopulation:
+    """The contact times' distribution per group (:func:`contact_population`), per impact (its group's)."""
+
+    prior: np.ndarray  # (impact, grid): the fitted distribution
+    shifted: tuple[np.ndarray, np.ndarray]  # the same with every group's mean at +1 and at -1 standard error
+    mean: np.ndarray  # the group's mean contact time (s); NaN for an impact in no group
+    mean_err: np.ndarray  # its standard error (s): 0 where the likelihoods are flat (the uniform kept, not estimated)
+
+
+def contact_population(lik: np.ndarray, found: np.ndarray, groups: ArrayLike | None = None) -> ContactPopulation:
+    """Return the contact times' distribution per group (:func:`_contact_population`), its mean and its error.
+
+    The mean's standard error comes from the pooled fit itself (the inverse of its observed
+    information, :func:`_population_error`); the distributions at +-1 standard error of the
+    mean (``shifted``) are what the reduction is solved again with, so that the error of this
+    estimate, shared by all of a group's impacts, reaches every quantity that pools them
+    (docs/model.md, "The contact population's error").
+    """
     lo, hi = CONTACT_PRIOR
+    grid = np.linspace(lo, hi, CONTACT_GRID)
     grp = np.zeros(lik.shape[0], dtype=int) if groups is None else np.unique(groups, return_inverse=True)[1]
+    n = lik.shape[0]
+    prior = np.full(lik.shape, 1.0 / lik.shape[1])
+    shifted = (prior.copy(), prior.copy())
+    mean, mean_err = np.full(n, np.nan), np.full(n, np.nan)
     with np.errstate(all="ignore"):
-        return _contact_population(lik, np.where(found, grp, -1), np.linspace(lo, hi, CONTACT_GRID))
+        for rows, fit in _population_fits(lik, np.where(found, grp, -1), grid):
+            prior[rows] = _beta_weights(grid, fit.p)
+            mean[rows], mean_err[rows], step = _population_error(fit, grid)
+            for side, out in zip((1.0, -1.0), shifted, strict=True):
+                out[rows] = _beta_weights(grid, fit.p + side * step)
+    return ContactPopulation(prior, shifted, mean, mean_err)
 
 
 def contact_posterior(cl: ContactLikelihood, prior: np.ndarray) -> Contact:

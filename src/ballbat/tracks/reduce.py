@@ -55,7 +55,7 @@ import numpy as np
 from ..units import G
 from .checks import IMPACT_Z, START_MARKS, camera_agreement, glitch_mask, misplaced_starts, pooled_noise
 from .data import POINTS, Camera, CameraTracks, Rig, TrackBlocks, Tracks, gather
-from .fit_contact import Contact, ContactLikelihood, contact_likelihood, contact_posterior, contact_prior
+from .fit_contact import Contact, ContactLikelihood, contact_likelihood, contact_population, contact_posterior
 from .fit_flight import CONTACT_MAX, Flight, find_onset, fit_flight
 from .fit_spin import OFFSET_FALSE_ALARM, RADIUS_TOLERANCE, UNWRAP_LIMIT, Spin, fit_spin, radius_scatter_limit
 from .fit_swing import Swing, fit_swing
@@ -132,6 +132,12 @@ class Reduction:
     #: the order of ``tracks.blocks``, holding the arrays along frame columns (``times``, ``phys``,
     #: the fits' masks), which are empty or None here; the per-impact arrays here are the dataset's.
     blocks: list[Reduction] | None = None
+    #: The contact population's estimation error (:func:`contact_shifts`): per name of
+    #: :data:`CONTACT_SHIFTED`, the change of every impact's value when the reduction is solved
+    #: again with its ball type's population mean at +1 and at -1 standard error (a tuple of the two).
+    contact_shift: dict | None = None
+    #: Each impact's ball type's population mean contact time and its standard error (s).
+    contact_mean: tuple | None = None
 
     def parts(self) -> list[tuple[Reduction, np.ndarray]]:
         """Each block's reduction and its impacts' positions in the dataset (one block: this one, all)."""
@@ -189,7 +195,11 @@ def pooled_noises(blocks: list[Tracks]) -> dict[tuple[str, str], float]:
 
 
 def reduce_tracks(
-    tracks: Tracks | TrackBlocks, cameras: dict[str, Camera], rig: Rig, options: ReduceOptions | None = None
+    tracks: Tracks | TrackBlocks,
+    cameras: dict[str, Camera],
+    rig: Rig,
+    options: ReduceOptions | None = None,
+    population_shifts: bool = True,
 ) -> Reduction:
     """Reduce every impact's tracks to v_bat, v_ball, theta, omega with fitted uncertainties.
 
@@ -208,6 +218,10 @@ def reduce_tracks(
         Pivot-to-tip and pivot-to-impact distances.
     options : ReduceOptions, optional
         Fewest frames per fit (default: the config schema's, :meth:`ReduceOptions.schema_defaults`).
+    population_shifts : bool
+        Solve the contact again at +-1 standard error of each ball type's population mean
+        (:func:`contact_shifts`, where :data:`CONTACT_POPULATION_SHIFTS`); the calibration
+        reruns (:func:`ballbat.systematics.reduce_shifts`) need only the values.
 
     Returns
     -------
@@ -222,19 +236,80 @@ def reduce_tracks(
     start_noise = pooled_noises([tr for tr, _ in cleaned])
     balls = [_fit_ball(tr, cameras) for tr, _ in cleaned]
     lik = [m[-1] for m in balls]
-    prior = contact_prior(
+    pop = contact_population(
         gather([c.lik for c in lik], tracks.index, tracks.n),
         gather([c.found for c in lik], tracks.index, tracks.n),
         tracks.ball,
     )
     parts = [
-        _finish(tr, counts, ball, prior[idx], cameras, rig, opt, start_noise)
+        _finish(tr, counts, ball, pop.prior[idx], cameras, rig, opt, start_noise)
         for (tr, counts), ball, idx in zip(cleaned, balls, tracks.index, strict=True)
     ]
+    if population_shifts and CONTACT_POPULATION_SHIFTS:
+        for part, ball, idx in zip(parts, balls, tracks.index, strict=True):
+            part.contact_shift = contact_shifts(part, ball[-1], tuple(p[idx] for p in pop.shifted))
     if len(parts) == 1:
+        parts[0].contact_mean = (pop.mean, pop.mean_err)
         return parts[0]
     merged = _gathered(parts, tracks)
-    return replace(merged, tracks=tracks, cameras=cameras, rig=rig, times={}, phys={}, blocks=parts)
+    merged = replace(merged, tracks=tracks, cameras=cameras, rig=rig, times={}, phys={}, blocks=parts)
+    merged.contact_mean = (pop.mean, pop.mean_err)
+    return merged
+
+
+#: Solve the reduction again at +-1 standard error of each ball type's contact population mean
+#: (:func:`contact_shifts`). False: not (the studies' comparison, bench/intervals_study.py).
+CONTACT_POPULATION_SHIFTS = True
+#: The measured values (and uncertainties) the contact population moves (omega and v_ball_err do not depend on it).
+CONTACT_SHIFTED = ("v_bat", "v_ball", "theta", "v_bat_err", "theta_err")
+
+
+def contact_shifts(part: Reduction, lik: ContactLikelihood, shifted: tuple) -> dict[str, tuple]:
+    """Change of each impact's measured values with its ball type's contact population at +1 and -1 standard error.
+
+    Every impact's contact is solved again under the shifted distribution
+    (:func:`~ballbat.tracks.fit_contact.contact_posterior`), then its tip fit (whose alignment
+    prior is the contact's start) and its values; the flight and spin fits do not depend on the
+    contact and are kept. An impact whose distribution did not move (its ball type's likelihoods
+    flat, the uniform distribution kept) gets 0, as does one excluded for no impact found.
+
+    Parameters
+    ----------
+    part : Reduction
+        One block's nominal reduction (its ``phys`` holds the tip's track).
+    lik : ContactLikelihood
+        The block's contact likelihoods.
+    shifted : tuple
+        The block's rows of the distributions at +1 and at -1 standard error
+        (:attr:`~ballbat.tracks.fit_contact.ContactPopulation.shifted`).
+
+    Returns
+    -------
+    dict
+        Name of :data:`CONTACT_SHIFTED` -> (change at +1, change at -1), each (impact,), in the values' units.
+    """
+    out = {k: [] for k in CONTACT_SHIFTED}
+    for prior in shifted:
+        contact = contact_posterior(lik, prior)
+        moved = contact.duration != part.contact.duration
+        Xt, Yt = part.phys[("swing", "bat_tip")]
+        swing = fit_swing(
+            Xt,
+            Yt,
+            part.times["swing"],
+            part.onset["swing"],
+            part.cameras["swing"].fps,
+            part.rig.pivot_to_tip,
+            contact.t_start,
+            contact.t_start_err,
+        )
+        values = _measured_values(part.flight["swing"], swing, part.spin, contact, part.cameras, part.rig)
+        with np.errstate(invalid="ignore"):
+            for k in CONTACT_SHIFTED:
+                d = values[k] - part.values[k]
+                d = np.angle(np.exp(1j * d)) if k == "theta" else d
+                out[k].append(np.where(moved & np.isfinite(d), d, 0.0))
+    return {k: tuple(v) for k, v in out.items()}
 
 
 def _gathered(objs: list, tracks: TrackBlocks):
