@@ -313,8 +313,20 @@ UNCERTAINTY_NOTES = {
         "the measurement uncertainty of the largest tan(psi - theta), not a standard error of a sample "
         "maximum: it says how well the largest value of these impacts is measured (docs/studies.md)"
     ),
+    "e_x": (
+        "a sandwich (HC3) standard error of the fit with the bat's intrinsic-scatter term in its weights; "
+        "from camera tracks with the contact population's error in quadrature (docs/model.md)"
+    ),
+    "e_x_pooled": (
+        "a sandwich (HC3) standard error centred within bats, of the fit with the intrinsic scatter within "
+        "bats; from camera tracks with the contact population's error in quadrature (docs/model.md)"
+    ),
+    "tan_ratio_slope": (
+        "a standard error of the fit with the intrinsic scatter within bats (Paule-Mandel); from camera "
+        "tracks with the contact population's error in quadrature (docs/model.md)"
+    ),
     "e_y_implied": "a leverage-corrected (HC2) sandwich standard error (the impacts' influences through the Eq. "
-    "ratio slope and e_x per bat)",
+    "ratio slope and e_x per bat); from camera tracks with the contact population's error in quadrature",
     "spin_theta_slope": "a sandwich (HC3) standard error",
     "speed_theta_slope": "a sandwich (HC3) standard error",
     "eta2": (
