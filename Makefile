@@ -30,7 +30,8 @@ run: bytecode
 # tests/conftest.py (FIRST); the shared workflow runs are built once, by whichever process needs
 # them first. `make test` runs the package's tests and those of the default run; the tests of the
 # lab run (a lab's datasets, scenarios and studies in one folder, its outputs, faults and reruns:
-# marker `lab`, tests/conftest.py) are `make test-lab`; `make test-all` runs both in one session,
+# marker `lab`, tests/conftest.py) are `make test-lab`, and the report in a real browser (marker
+# `browser`) is `make test-report`'s; `make test-all` runs all of them in one session,
 # and `pytest` alone runs everything in one process. CI runs test, then test-lab, on the same
 # shared runs (BALLBAT_TEST_SHARED_RUNS, .ci/run).
 # Bytecode is written during the tests even where PYTHONDONTWRITEBYTECODE is set (as on this machine):
@@ -40,7 +41,7 @@ PYTEST_XDIST := -n $(CORES) --dist loadscope --no-loadscope-reorder
 PYTEST := PYTHONDONTWRITEBYTECODE= $(BIN)/python -m pytest
 
 test: bytecode
-	$(PYTEST) $(PYTEST_XDIST) -m "not lab"
+	$(PYTEST) $(PYTEST_XDIST) -m "not lab and not browser"
 
 test-lab: bytecode
 	$(PYTEST) $(PYTEST_XDIST) -m lab

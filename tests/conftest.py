@@ -267,6 +267,11 @@ def module_key(path: Path) -> str:
     return Path(path).resolve().relative_to(TESTS).as_posix()
 
 
+#: The report in a real browser (marker ``browser``): ``make test-report``'s, on the checkout's own
+#: run; ``make test`` leaves it out (CI runs it there), ``make test-all`` and ``pytest`` keep it.
+BROWSER = "workflow/test_report_browser.py"
+
+
 def pytest_collection_modifyitems(config, items):
     """Mark the lab run's tests ``lab``; order the modules: :data:`FIRST`, the rest as collected, :data:`LAST`.
 
@@ -277,6 +282,8 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if "lab_run" in getattr(item, "fixturenames", ()):
             item.add_marker(pytest.mark.lab)
+        if module_key(item.path) == BROWSER:
+            item.add_marker(pytest.mark.browser)
     rank = {name: i for i, name in enumerate(FIRST)}
     rank.update({name: len(FIRST) + 1 + i for i, name in enumerate(LAST)})
     items.sort(key=lambda item: rank.get(module_key(item.path), len(FIRST)))
