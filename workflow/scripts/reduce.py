@@ -2,8 +2,7 @@
 
 import yaml
 
-from ballbat.pipeline.ncio import write_dataset
-from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import log_exclusions, logged
 from ballbat.properties import InputError, load_balls, load_bats
 from ballbat.stages import reduce
@@ -34,11 +33,9 @@ with logged(snakemake.log[0], snakemake.rule) as log:
     for text in ds.attrs["reduce_warnings"].splitlines():
         log.warning(text)
     log_exclusions(log, reduce.excluded_listing(ds), ds.sizes["impact"])
-    write_dataset(
+    write_job_output(
         ds,
-        snakemake.output.impacts,
-        title=f"Impacts of dataset {snakemake.wildcards.dataset} reduced from raw camera tracks (Sec. II)",
-        rule=snakemake.rule,
-        inputs=data_inputs(inp),
-        config=dict(snakemake.params),
+        snakemake,
+        "impacts",
+        f"Impacts of dataset {snakemake.wildcards.dataset} reduced from raw camera tracks (Sec. II)",
     )

@@ -1,7 +1,6 @@
 """Rule render_tracks: adapter around ballbat.stages.render.run."""
 
-from ballbat.pipeline.ncio import read_dataset, write_dataset
-from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.ncio import read_dataset, write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls
 from ballbat.stages import render
@@ -10,11 +9,4 @@ with logged(snakemake.log[0], snakemake.rule) as log:
     settings = render.from_params(snakemake.params.settings)
     ds = render.run(settings, read_dataset(snakemake.input.truth), load_balls(snakemake.input.balls))
     log.info("%d impacts, %d tracked points", ds.sizes["impact"], ds.sizes["row"])
-    write_dataset(
-        ds,
-        snakemake.output.tracks,
-        title=f"Synthetic raw camera tracks of dataset {snakemake.wildcards.dataset}",
-        rule=snakemake.rule,
-        inputs=data_inputs(snakemake.input),
-        config=dict(snakemake.params),
-    )
+    write_job_output(ds, snakemake, "tracks", f"Synthetic raw camera tracks of dataset {snakemake.wildcards.dataset}")

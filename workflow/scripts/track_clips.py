@@ -1,7 +1,6 @@
 """Rule track_clips: adapter around ballbat.stages.clip_tracks (one batch of a dataset's clips tracked)."""
 
-from ballbat.pipeline.ncio import write_dataset
-from ballbat.pipeline.provenance import data_inputs
+from ballbat.pipeline.ncio import write_job_output
 from ballbat.pipeline.runlog import logged
 from ballbat.properties import load_balls
 from ballbat.stages import clip_tracks
@@ -10,11 +9,9 @@ with logged(snakemake.log[0], snakemake.rule) as log:
     inp = snakemake.input
     batch = clip_tracks.run(snakemake.params.tracker, load_balls(inp.balls))
     log.info("%d clips tracked: %d points found", batch.attrs["n_clips"], batch.attrs["n_found"])
-    write_dataset(
+    write_job_output(
         batch,
-        snakemake.output.batch,
-        title=f"Batch {snakemake.wildcards.batch} of dataset {snakemake.wildcards.dataset}'s clips, tracked",
-        rule=snakemake.rule,
-        inputs=data_inputs(inp),
-        config=dict(snakemake.params),
+        snakemake,
+        "batch",
+        f"Batch {snakemake.wildcards.batch} of dataset {snakemake.wildcards.dataset}'s clips, tracked",
     )
