@@ -37,7 +37,7 @@ References
 from __future__ import annotations
 
 import enum
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -602,8 +602,6 @@ def contact_population_error(ds: xr.Dataset, res: Sec4) -> dict[str, np.ndarray]
 
 def _widened(fit: LineFit, extra: float) -> LineFit:
     """``fit`` with ``extra`` added in quadrature to its standard error, its interval widened alike."""
-    from dataclasses import replace
-
     if not (np.isfinite(extra) and extra > 0 and np.isfinite(fit.slope_err) and fit.slope_err > 0):
         return fit
     tq = (fit.slope_ci_high - fit.slope) / fit.slope_err

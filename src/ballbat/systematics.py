@@ -150,7 +150,7 @@ def reduce_shifts(
         Zero for a source without uncertainty (not reduced again). theta's shift is wrapped to
         (-pi, pi].
     """
-    from .tracks.reduce import reduce_tracks
+    from .tracks.reduce import reduce_tracks, value_change
 
     rel = relative_sigmas(cameras, rig)
     n = tracks.n
@@ -163,8 +163,7 @@ def reduce_shifts(
             red = reduce_tracks(tracks, cams, rg, options, population_shifts=False)
             with np.errstate(invalid="ignore"):
                 for k in SHIFTED:
-                    d = red.values[k] - nominal.values[k]
-                    out[k][i, j] = np.angle(np.exp(1j * d)) if k == "theta" else d
+                    out[k][i, j] = value_change(k, red.values[k], nominal.values[k])
     return Shifts(rel, out)
 
 

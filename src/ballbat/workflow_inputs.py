@@ -295,7 +295,7 @@ class WorkflowInputs:
         d = self.dataset_config(wildcards)
         if films(d):
             cams = d["render"]["cameras"]
-            return batch_runtime_min(sum(cams[cam]["max_frames"] + 2 for _, cam, _ in self._batch(wildcards)))
+            return batch_runtime_min(sum(cams[cam]["max_frames"] for _, cam, _ in self._batch(wildcards)))
         return batch_runtime_min(file_frames(self.get_batch_clips(wildcards)["clips"]))
 
     def get_reduce_settings(self, wildcards: Namespace) -> dict:

@@ -18,7 +18,6 @@ from ballbat.stages.clip_tracks import GatheredClips, batch_clips, batch_dataset
 from ballbat.tracks.data import POINTS
 from ballbat.tracks.formats import FileTracks, FormatError
 from ballbat.video.plan import (
-    CLIPS_PER_JOB,
     TRACK_BASE_MB,
     batch_mem_mb,
     batch_runtime_min,
@@ -120,10 +119,11 @@ def test_each_batch_job_declares_one_thread_and_its_memory_and_time():
     cfg["datasets"]["video"] = example
     inputs = WorkflowInputs(cfg, ROOT)
     wc = Namespace(dataset="video", batch="0")
-    assert len(inputs.clip_batches("video")) == 40 // CLIPS_PER_JOB  # 20 impacts, 2 cameras
+    per_job = example["render"]["video"]["clips_per_job"]  # the schema's default (8)
+    assert len(inputs.clip_batches("video")) == 40 // per_job  # 20 impacts, 2 cameras
     assert inputs.clip_batch_mem_mb(wc) == TRACK_BASE_MB + 9  # 1024 x 512 8-bit
     # 8 clips: 4 swing (120 frames at most) and 4 spin (60)
-    assert inputs.clip_batch_runtime(wc) == batch_runtime_min(4 * 122 + 4 * 62)
+    assert inputs.clip_batch_runtime(wc) == batch_runtime_min(4 * 120 + 4 * 60)
     assert inputs.get_batch_clips(wc) == {"clips": "results/video/clips"}
     files = inputs.get_clip_batch_files(Namespace(dataset="video"))
     assert files == [f"results/video/clip_tracks/batch_{k}.nc" for k in range(5)]

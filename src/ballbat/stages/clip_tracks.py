@@ -92,10 +92,10 @@ def track_batch(clips: list[Clip], m_per_px: dict[str, float], video: dict, radi
 
 def batch_dataset(clips: list[Clip], tracks: list[FileTracks], quality: list[dict[str, np.ndarray]]) -> xr.Dataset:
     """Return a batch file's contents: the clips' quality tables, one after another, and each clip's settings."""
-    from ..video.track import Found, found_columns
+    from ..video.track import joined_quality
 
-    tables = quality or [found_columns(Found(), "", "")[1]]
-    values = {k: np.concatenate([t[k] for t in tables]) for k in QUALITY_TABLE}
+    joined = joined_quality(quality)
+    values = {k: joined[k] for k in QUALITY_TABLE}
     for k in ("impact_id", "camera", "point", "left_out"):
         values[k] = values[k].astype(str)
     values["frame"] = values["frame"].astype(np.int64)
@@ -164,10 +164,9 @@ class GatheredClips:
 
     def quality(self) -> dict[str, np.ndarray]:
         """Return the quality table of every clip read, clip after clip (as :meth:`ClipImport.quality`)."""
-        from ..video.track import Found, found_columns
+        from ..video.track import joined_quality
 
-        tables = self.tables or [found_columns(Found(), "", "")[1]]
-        return {k: np.concatenate([t[k] for t in tables]) for k in tables[0]}
+        return joined_quality(self.tables)
 
     def unread(self) -> list[str]:
         """Return the clips the batches hold that the import did not read (gone from the folder since)."""

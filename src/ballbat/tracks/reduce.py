@@ -264,6 +264,12 @@ CONTACT_POPULATION_SHIFTS = True
 CONTACT_SHIFTED = ("v_bat", "v_ball", "theta", "v_bat_err", "theta_err")
 
 
+def value_change(name: str, new: np.ndarray, old: np.ndarray) -> np.ndarray:
+    """Return ``new - old`` of a measured value (contact or calibration shift); theta's wrapped to (-pi, pi]."""
+    d = new - old
+    return np.angle(np.exp(1j * d)) if name == "theta" else d
+
+
 def contact_shifts(part: Reduction, lik: ContactLikelihood, shifted: tuple) -> dict[str, tuple]:
     """Change of each impact's measured values with its ball type's contact population at +1 and -1 standard error.
 
@@ -306,8 +312,7 @@ def contact_shifts(part: Reduction, lik: ContactLikelihood, shifted: tuple) -> d
         values = _measured_values(part.flight["swing"], swing, part.spin, contact, part.cameras, part.rig)
         with np.errstate(invalid="ignore"):
             for k in CONTACT_SHIFTED:
-                d = values[k] - part.values[k]
-                d = np.angle(np.exp(1j * d)) if k == "theta" else d
+                d = value_change(k, values[k], part.values[k])
                 out[k].append(np.where(moved & np.isfinite(d), d, 0.0))
     return {k: tuple(v) for k, v in out.items()}
 

@@ -28,7 +28,7 @@ from ..tracks.data import POINTS
 from ..tracks.formats import FileTracks, FormatError
 from .clip import VideoError
 from .io import open_clip
-from .track import Found, TrackOptions, found_columns, require_ball, track_clip
+from .track import Found, TrackOptions, found_columns, joined_quality, require_ball, track_clip
 
 #: Largest relative difference of the ball's measured radius from the one the config implies
 #: (Table I's radius / m_per_px). The fitted radius is within 1 % of the truth on rendered clips
@@ -152,5 +152,4 @@ class ClipImport:
 
     def quality(self) -> dict[str, np.ndarray]:
         """Return the quality table of every clip read (:func:`ballbat.video.track.found_columns`), clip after clip."""
-        tables = [t for r in self.readers for t in r.quality] or [found_columns(Found(), "", "")[1]]
-        return {k: np.concatenate([t[k] for t in tables]) for k in tables[0]}
+        return joined_quality([t for r in self.readers for t in r.quality])

@@ -27,8 +27,6 @@ if TYPE_CHECKING:
 
 #: The file each ``render.video.format`` writes (docs/video.md, "Files").
 EXTENSIONS = {"tif": ".tif", "mkv": ".mkv", "mp4": ".mp4"}
-#: Clips a batch job tracks when the config says nothing (the schema's default of ``video.clips_per_job``).
-CLIPS_PER_JOB = 8
 #: Memory of a batch job before its frames, MB: the interpreter with numpy, scipy, xarray, PyAV and
 #: tifffile loaded (measured peak RSS of a batch of 8 FFV1 clips, 1024 x 512 8-bit: see docs/video.md),
 #: with room to spare.

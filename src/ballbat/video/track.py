@@ -312,3 +312,9 @@ def found_columns(found: Found, impact_id: str, camera: str) -> tuple[dict, dict
         "left_out": np.array([""] * n + [why for _, _, why in lo], dtype=object),
     }
     return tracks, quality
+
+
+def joined_quality(tables: list[dict[str, np.ndarray]]) -> dict[str, np.ndarray]:
+    """Return clips' quality tables (:func:`found_columns`) one after another; an empty table where there are none."""
+    tables = tables or [found_columns(Found(), "", "")[1]]
+    return {k: np.concatenate([t[k] for t in tables]) for k in tables[0]}
