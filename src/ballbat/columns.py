@@ -45,6 +45,11 @@ class Columns(Mapping):
         """Return the number of variables."""
         return len(self._vars)
 
+    @property
+    def variables(self) -> Mapping:
+        """The variables by name, as :attr:`xarray.Dataset.variables` (readers that take either)."""
+        return self._vars
+
     def dropped(self, drop: Callable[[str], bool]) -> Columns:
         """Return the columns without those whose name ``drop`` is true of (the same arrays; ``attrs`` kept)."""
         out = Columns(self)

@@ -172,7 +172,7 @@ def has_shifts(ds: xr.Dataset) -> bool:
     return "systematic_rel_sigma" in ds and all(f"{k}_shift" in ds for k in SHIFTED)
 
 
-def shifted_impacts(rec: xr.Dataset, source: int, side: int) -> xr.Dataset:
+def shifted_impacts(rec: xr.Dataset, source: int, side: int) -> Columns:
     """Reconstructed impacts with the measured values of one calibration shift, normalised and reconstructed again.
 
     Parameters
@@ -184,20 +184,34 @@ def shifted_impacts(rec: xr.Dataset, source: int, side: int) -> xr.Dataset:
 
     Returns
     -------
-    xarray.Dataset
+    Columns
         The same impacts and flags, without the ``truth_*`` variables (the estimators' truth
-        is no systematic). The per-impact properties move too where the dataset has property
-        sources (:data:`PROPERTY_SHIFTED`).
+        is no systematic), read as :class:`~ballbat.columns.Columns` (plain arrays: no Dataset is
+        built, which cost a replicate study with the calibration drawn a third of its time). The
+        per-impact properties move too where the dataset has property sources
+        (:data:`PROPERTY_SHIFTED`).
     """
-    from .analysis import normalize_values, reconstruct_again_values
+    from .columns import Columns
 
-    out = rec.drop_vars([k for k in rec.data_vars if k.startswith("truth_")])
-    for k in (*SHIFTED, *PROPERTY_SHIFTED):
-        if f"{k}_shift" in rec:  # the properties: only where a property source is stated
-            out[k] = (rec[k].dims, rec[k].values + rec[f"{k}_shift"].values[source, side], rec[k].attrs)
-    # the normalize and reconstruct stages' steps, at the nominal reference speed and properties
-    out = out.assign({k: ("impact", v) for k, v in normalize_values(out, float(rec.attrs["v_ref"])).items()})
-    return out.assign({k: ("impact", v) for k, v in reconstruct_again_values(out).items()})
+    v = rec.variables
+    moved = {
+        k: xr.Variable(v[k].dims, v[k].values + v[f"{k}_shift"].values[source, side], v[k].attrs)
+        for k in (*SHIFTED, *PROPERTY_SHIFTED)
+        if f"{k}_shift" in v  # the properties: only where a property source is stated
+    }
+    return _renormalized(Columns(Columns(rec).dropped(lambda k: k.startswith("truth_")), moved), rec)
+
+
+def _renormalized(moved: Columns, rec: xr.Dataset) -> Columns:
+    """Return ``moved`` through the normalize and reconstruct stages' steps again, at ``rec``'s reference speed."""
+    from .analysis import normalize_values, reconstruct_again_values
+    from .columns import Columns
+
+    def variables(values: dict) -> dict:
+        return {k: xr.Variable(("impact",), v) for k, v in values.items()}
+
+    out = Columns(moved, variables(normalize_values(moved, float(rec.attrs["v_ref"]))))
+    return Columns(out, variables(reconstruct_again_values(out)))
 
 
 #: reduce.nc's variables of the contact population's shifts: ``contact_shift_<name>`` (shift, impact)
@@ -218,19 +232,15 @@ def contact_shifted_impacts(rec: xr.Dataset, side: int) -> Columns:
     moved by their ``contact_shift_<name>``, normalised and reconstructed again, without
     ``truth_*`` and the shifts themselves.
     """
-    from .analysis import normalize_values, reconstruct_again_values
     from .columns import Columns
-
-    def variables(values: dict) -> dict:
-        return {k: xr.Variable(("impact",), v) for k, v in values.items()}
 
     cols = Columns(rec).dropped(lambda k: k.startswith("truth_") or k.startswith(CONTACT_SHIFT))
     moved = {
-        k: cols[k].values + rec[f"{CONTACT_SHIFT}{k}"].values[side] for k in SHIFTED if f"{CONTACT_SHIFT}{k}" in rec
+        k: xr.Variable(("impact",), cols[k].values + rec[f"{CONTACT_SHIFT}{k}"].values[side])
+        for k in SHIFTED
+        if f"{CONTACT_SHIFT}{k}" in rec
     }
-    out = Columns(cols, variables(moved))
-    out = Columns(out, variables(normalize_values(out, float(rec.attrs["v_ref"]))))
-    return Columns(out, variables(reconstruct_again_values(out)))
+    return _renormalized(Columns(cols, moved), rec)
 
 
 @dataclass

@@ -192,6 +192,22 @@ def contact_error_vars() -> dict[str, Var]:
 
 def results_dataset(res: Sec4) -> xr.Dataset:
     """fit_ex.nc's contents: the :class:`Sec4` results on the declared table (dims ball, bat)."""
+    table = fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None, res.contact_error is not None)
+    coords = {
+        "ball": (Var(("ball",), None, "ball type"), np.array(res.balls, dtype=str)),
+        "bat": (Var(("bat",), None, "bat"), np.array(res.bats, dtype=str)),
+    }
+    ds = build_dataset(
+        table,
+        results_values(res),
+        coords,
+        {"mu_k_example": res.mu_k_example},
+    )
+    return add_fit_systematics(ds, res.systematics)
+
+
+def results_values(res: Sec4) -> dict[str, np.ndarray]:
+    """fit_ex.nc's variables of :func:`results_dataset` by name, as arrays (no Dataset: the refits read these)."""
     values: dict[str, np.ndarray] = {}
     for name in FIT_FAMILIES:
         grid: FitGrid = getattr(res, name)
@@ -214,20 +230,9 @@ def results_dataset(res: Sec4) -> xr.Dataset:
     values.update({k: v for k, v in res.per_ball.items() if res.has_truth or not k.startswith("truth_")})
     if res.systematic is not None:
         values.update(res.systematic)
-    table = fit_ex_table(res.has_truth, res.mu_k_example, res.systematic is not None, res.contact_error is not None)
     if res.contact_error is not None:
         values.update({f"{q}_err_contact": v for q, v in res.contact_error.items()})
-    coords = {
-        "ball": (Var(("ball",), None, "ball type"), np.array(res.balls, dtype=str)),
-        "bat": (Var(("bat",), None, "bat"), np.array(res.bats, dtype=str)),
-    }
-    ds = build_dataset(
-        table,
-        values,
-        coords,
-        {"mu_k_example": res.mu_k_example},
-    )
-    return add_fit_systematics(ds, res.systematics)
+    return values
 
 
 def run(settings: FitExSettings, impacts: xr.Dataset) -> xr.Dataset:
@@ -286,21 +291,21 @@ def fit_systematics(rec: xr.Dataset, res: Sec4) -> FitSystematics:
     -------
     FitSystematics
     """
-    nominal = results_dataset(res)
+    nominal = results_values(res)
     rel = rec["systematic_rel_sigma"].values
     names = source_names(rec)
-    out = {q: np.zeros((len(names), *nominal[q].shape)) for q in FIT_QUANTITIES}
+    out = {q: np.zeros((len(names), *np.shape(nominal[q]))) for q in FIT_QUANTITIES}
     for q in FIT_QUANTITIES:  # no value, no systematic
-        out[q][:, ~np.isfinite(nominal[q].values)] = np.nan
+        out[q][:, ~np.isfinite(nominal[q])] = np.nan
     for i in range(len(names)):
         if rel[i] == 0:
             continue
         fits = [
-            results_dataset(analyze_impacts(shifted_impacts(rec, i, j), res.mu_k_example, systematic=False))
+            results_values(analyze_impacts(shifted_impacts(rec, i, j), res.mu_k_example, systematic=False))
             for j in range(len(SIDES))
         ]
         for q in FIT_QUANTITIES:
-            out[q][i] = 0.5 * (fits[0][q].values - fits[1][q].values)
+            out[q][i] = 0.5 * (fits[0][q] - fits[1][q])
     return FitSystematics({q: np.abs(v) for q, v in out.items()}, rel, out, names, rec["systematic"].attrs["long_name"])
 
 

@@ -70,11 +70,11 @@ def add_shifts(ds: xr.Dataset, shifts: Shifts | None, what: dict[str, str] | Non
             {"units": "1", "long_name": "calibration shifted by this many standard uncertainties"},
         ),
     )
-    out["systematic_rel_sigma"] = _rel_sigma_var(shifts.rel_sigma)
+    new = {"systematic_rel_sigma": _rel_sigma_var(shifts.rel_sigma)}
     for k in SHIFTED:
         base = k.removesuffix("_err")
         what = f"the standard uncertainty of {base}" if k.endswith("_err") else base
-        out[f"{k}_shift"] = (
+        new[f"{k}_shift"] = (
             ("systematic", "shift", "impact"),
             shifts.shift[k],
             {
@@ -84,7 +84,7 @@ def add_shifts(ds: xr.Dataset, shifts: Shifts | None, what: dict[str, str] | Non
                 "ballbat_role": "systematic",
             },
         )
-    return out
+    return out.assign(new)  # one merge for all of them, in this order (one per variable cost a study's replicate more)
 
 
 def append_sources(
@@ -165,12 +165,12 @@ def systematic_vars(
         out = ds.assign_coords(**_coords())
     else:
         out = ds.assign_coords(**_coords(list(source.values.astype(str)), long_name=source.attrs.get("long_name")))
-    out["systematic_rel_sigma"] = _rel_sigma_var(rel)
+    new = {"systematic_rel_sigma": _rel_sigma_var(rel)}
     for q, per in by_source.items():
         dims, attrs = ds[q].dims, ds[q].attrs
         units = {"units": attrs["units"]} if "units" in attrs else {}
         syst = combine_sources(per)
-        out[f"{q}_syst_by_source"] = (
+        new[f"{q}_syst_by_source"] = (
             ("systematic", *dims),
             per,
             {
@@ -180,7 +180,7 @@ def systematic_vars(
                 "ballbat_role": "systematic",
             },
         )
-        out[f"{q}_syst"] = (
+        new[f"{q}_syst"] = (
             dims,
             syst,
             {
@@ -191,9 +191,9 @@ def systematic_vars(
             },
         )
         if f"{q}_err" in ds:
-            out[f"{q}_err_total"] = (
+            new[f"{q}_err_total"] = (
                 dims,
                 np.hypot(ds[f"{q}_err"].values, syst),
                 {**units, "long_name": f"standard error and systematic error of {q} in quadrature"},
             )
-    return out
+    return out.assign(new)  # one merge, in this order
