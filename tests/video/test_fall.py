@@ -6,7 +6,7 @@ import numpy as np
 import pytest
 from scipy import stats
 
-from ballbat.video.fall import fit_fall
+from ballbat.video.fall import fit_fall, mark_agreement
 
 G = 9.81
 M_PER_PX = 1 / 400.0  # a metre stick 400 px long
@@ -94,3 +94,15 @@ def test_bad_input_is_named(kwargs, message):
     kwargs = {"m_per_px": 0.001, **kwargs}
     with pytest.raises(ValueError, match=message.replace("(", r"\(").replace(")", r"\)")):
         fit_fall(**kwargs)
+
+
+def test_mark_agreement_matches_frames_and_splits_offset_from_scatter():
+    tracked = (np.array([3, 4, 5, 6, 9]), np.array([10.0, 20, 30, 40, 90]), np.array([5.0, 6, 7, 8, 11]))
+    marks = (np.array([2, 4, 5, 6, 9]), np.array([0.0, 20.5, 30.5, 40.5, 91.5]), np.array([0.0, 7.0, 8.0, 9.0, 12.0]))
+    ag = mark_agreement(tracked, marks, pixel_shift=0.5)
+    assert ag.frames.tolist() == [4, 5, 6, 9]
+    assert ag.dx.tolist() == [0.0, 0.0, 0.0, -1.0]
+    assert ag.offset == pytest.approx((-0.25, -0.5))
+    assert ag.rms == pytest.approx((np.std([0, 0, 0, -1.0]), 0.0))
+    with pytest.raises(ValueError, match="1 frames in common"):
+        mark_agreement((np.array([1, 2]), np.zeros(2), np.zeros(2)), (np.array([2, 3]), np.zeros(2), np.zeros(2)))

@@ -104,3 +104,38 @@ def _check_fall_input(t, y, s, m_per_px, m_per_px_err, dt_rel_err) -> None:
             f"fit_fall: m_per_px must be positive, its error and dt_rel_err not negative "
             f"(got {m_per_px}, {m_per_px_err}, {dt_rel_err})"
         )
+
+
+@dataclass(frozen=True)
+class MarkAgreement:
+    """Tracked centres against hand marks of the same clip, frame by frame (px): tracked minus marked."""
+
+    frames: np.ndarray
+    dx: np.ndarray
+    dy: np.ndarray
+
+    @property
+    def offset(self) -> tuple[float, float]:
+        """Return the mean difference (x, y): a constant one is where each method puts the centre, not noise."""
+        return float(self.dx.mean()), float(self.dy.mean())
+
+    @property
+    def rms(self) -> tuple[float, float]:
+        """Return the differences' root mean square about their mean (x, y)."""
+        return float(self.dx.std()), float(self.dy.std())
+
+
+def mark_agreement(tracked, marks, pixel_shift: float = 0.0) -> MarkAgreement:
+    """Return the differences of tracked centres and hand marks in the frames both have.
+
+    ``tracked`` and ``marks`` are (frames, x, y) arrays; ``pixel_shift`` is added to the tracked
+    coordinates first: a tool whose pixel i spans [i, i + 1) (Tracker, Java's images) puts a pixel's
+    centre at i + 0.5 where ballbat puts it at i, so 0.5 for Tracker's marks. Fewer than 2
+    frames in common is a ValueError.
+    """
+    ft, xt, yt = (np.asarray(v) for v in tracked)
+    fm, xm, ym = (np.asarray(v) for v in marks)
+    common, it, im = np.intersect1d(ft, fm, return_indices=True)
+    if common.size < 2:
+        raise ValueError(f"mark_agreement: {common.size} frames in common (tracked {ft.size}, marked {fm.size})")
+    return MarkAgreement(common, xt[it] + pixel_shift - xm[im], yt[it] + pixel_shift - ym[im])
