@@ -14,6 +14,7 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
+from numpy.typing import ArrayLike
 
 
 @dataclass(frozen=True)
@@ -46,13 +47,13 @@ class FallFit:
 
 
 def fit_fall(
-    t_s,
-    y_px,
+    t_s: ArrayLike,
+    y_px: ArrayLike,
     m_per_px: float,
     *,
     m_per_px_err: float = 0.0,
     dt_rel_err: float = 0.0,
-    sigma_px=None,
+    sigma_px: ArrayLike | None = None,
 ) -> FallFit:
     """Fit y(t) = y0 + v0 t + a t^2 / 2 to tracked positions (px) at times ``t_s`` (s); ``a`` in m/s^2.
 
@@ -125,7 +126,11 @@ class MarkAgreement:
         return float(self.dx.std()), float(self.dy.std())
 
 
-def mark_agreement(tracked, marks, pixel_shift: float = 0.0) -> MarkAgreement:
+def mark_agreement(
+    tracked: tuple[ArrayLike, ArrayLike, ArrayLike],
+    marks: tuple[ArrayLike, ArrayLike, ArrayLike],
+    pixel_shift: float = 0.0,
+) -> MarkAgreement:
     """Return the differences of tracked centres and hand marks in the frames both have.
 
     ``tracked`` and ``marks`` are (frames, x, y) arrays; ``pixel_shift`` is added to the tracked
