@@ -11,10 +11,12 @@ import numpy as np
 import pytest
 import yaml
 from video_clips import M_PER_PX, PLAIN, RADIUS_PX, spin_truth
+from video_toss import TOSS_R, toss_clip
 
 from ballbat.cli import main
 from ballbat.video.io import write_clip
 from ballbat.video.render import render_frames
+from ballbat.video.track import TrackOptions, track_clip
 
 DATA = Path(__file__).parents[1] / "data" / "video"
 
@@ -181,3 +183,16 @@ def test_the_balls_measured_radius_checks_the_scale_typed(tmp_path, capsys):
     assert check["given"] == pytest.approx(wrong) and check["frames"] == 3
     assert check["measured"] == pytest.approx(RADIUS_PX, rel=0.02)  # the clip's own radius, whatever was given
     assert -6.0 < float(check["off"].rstrip(" %")) < -2.0
+
+
+def test_track_video_takes_the_options(tmp_path, capsys):
+    """`ballbat track-video --background median --ball-fit centroid`: the same ball points as track_clip's."""
+    clip, _, _ = toss_clip(tmp_path, name="T1_spin.tif")
+    out = tmp_path / "tracks.csv"
+    argv = ["track-video", clip.info.path, "--ball-radius-px", f"{TOSS_R},{TOSS_R}", "-o", str(out)]
+    assert main([*argv, "--background", "median", "--ball-fit", "centroid", "--search-px", "30"]) == 0
+    report = yaml.safe_load(capsys.readouterr().out)
+    opt = TrackOptions(TOSS_R, background="median", ball_fit="centroid", search_px=30.0)
+    expected = sum(p == "ball" for p in track_clip(clip, opt).rows["point"])
+    assert report["clips"][0]["points_found"]["ball"] == expected >= 22
+    assert out.with_name("tracks.quality.csv").is_file()

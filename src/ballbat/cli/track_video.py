@@ -27,7 +27,8 @@ RADIUS_WARN = 0.02
 EXAMPLE = """examples:
   ballbat track-video W01_swing.mkv W01_spin.mkv --ball-radius-px 49.5,29.3 -o tracks.csv
   ballbat track-video clips/*.cihx --ball-radius-px 49.5,29.3 --dot-radius-px 3.2 -o tracks.csv
-  ballbat track-video clips/*.cine --ball-radius-px 49.5,29.3 -o tracks.csv"""
+  ballbat track-video clips/*.cine --ball-radius-px 49.5,29.3 -o tracks.csv
+  ballbat track-video T1_spin.mp4 --ball-radius-px 5,5 --background median --ball-fit centroid -o tracks.csv"""
 
 
 def add_parser(sub: argparse._SubParsersAction, formatter_class: type[argparse.HelpFormatter]) -> None:
@@ -49,6 +50,17 @@ def add_parser(sub: argparse._SubParsersAction, formatter_class: type[argparse.H
     )
     for key, what in (("dot_radius_px", "the spin dots' radius"), ("marker_radius_px", "the tip marker's radius")):
         p.add_argument(f"--{key.replace('_', '-')}", type=float, help=f"{what}, px (default: TrackOptions')")
+    p.add_argument(
+        "--background",
+        choices=("none", "median"),
+        help="median: subtract the clip's still background (the per-pixel median of 25 frames) first (default none)",
+    )
+    p.add_argument(
+        "--search-px", type=float, help="half-side of the region searched about the ball's prediction (default 4 radii)"
+    )
+    p.add_argument(
+        "--ball-fit", choices=("edge", "centroid"), help="centroid: for a ball a few pixels across (default edge)"
+    )
     p.set_defaults(func=cmd_track_video)
 
 
@@ -72,7 +84,8 @@ def _track_one(path: Path, radii: dict, args) -> tuple[dict, dict, dict]:
     cam = m["camera"]
     points = ("ball", "bat_tip") if cam == "swing" else ("ball", "dot_a", "dot_b")
     clip = open_clip(path)
-    sizes = {k: getattr(args, k) for k in ("dot_radius_px", "marker_radius_px") if getattr(args, k) is not None}
+    keys = ("dot_radius_px", "marker_radius_px", "background", "search_px", "ball_fit")
+    sizes = {k: getattr(args, k) for k in keys if getattr(args, k, None) is not None}
     found = track_clip(clip, TrackOptions(radii[cam], points, **sizes))
     require_ball(found, str(path))
     tracks, quality = found_columns(found, m["impact_id"], cam)

@@ -34,14 +34,24 @@ import numpy as np
 from .clip import VideoError
 from .edge import fit_ball
 from .io import Clip
-from .search import find_balls, find_dots, find_marker, find_marker_whole, roi
+from .search import ball_centroid, find_balls, find_dots, find_marker, find_marker_whole, roi
 
 
 @dataclass(frozen=True)
 class TrackOptions:
     """What the tracker expects (pixels): the ball's radius (e.g. Table I's diameter / 2 / m_per_px), dots and marker.
 
-    ``points``: which points to find (``ball`` always).
+    ``points``: which points to find (``ball`` always; ``("ball",)`` alone: the ball only).
+    ``background``: ``"none"`` (the frames as they are), or ``"median"``: the clip's still
+    background, the per-pixel median of up to :data:`BACKGROUND_FRAMES` frames spread evenly
+    over it (a first pass through the clip), is subtracted from every frame before the
+    searches, so that what stays put (a scale, a bright mark, clutter) is not taken for the
+    moving ball (docs/video.md, "A real clip"). ``search_px``: the half-side of the square
+    about the predicted position where the ball is looked for when its fit there fails (default
+    4 ball radii); a ball that moves further than that between frames (a slow camera) needs more.
+    ``ball_fit``: ``"edge"`` (the sub-pixel edge model, :func:`~ballbat.video.edge.fit_ball`),
+    or ``"centroid"`` for a ball a few pixels across, too small for it
+    (:func:`~ballbat.video.search.ball_centroid`; no edge residual: NaN).
     """
 
     ball_radius_px: float
@@ -49,6 +59,22 @@ class TrackOptions:
     dot_radius_px: float = 3.0
     marker_radius_px: float = 8.0
     radius_tolerance: float = 0.3
+    background: str = "none"
+    search_px: float | None = None
+    ball_fit: str = "edge"
+
+    def __post_init__(self) -> None:
+        """Refuse a background, a search region or a ball fit the tracker does not know."""
+        if self.background not in ("none", "median"):
+            raise ValueError(f"TrackOptions: background {self.background!r} is not 'none' or 'median'")
+        if self.ball_fit not in ("edge", "centroid"):
+            raise ValueError(f"TrackOptions: ball_fit {self.ball_fit!r} is not 'edge' or 'centroid'")
+        if self.search_px is not None and not self.search_px > 0:
+            raise ValueError(f"TrackOptions: search_px {self.search_px!r} must be positive")
+
+
+#: Frames whose per-pixel median is a clip's still background (``TrackOptions.background = "median"``).
+BACKGROUND_FRAMES = 25
 
 
 @dataclass
@@ -111,7 +137,7 @@ def _ball_candidates(img, guess, opt: TrackOptions) -> list:
     r = opt.ball_radius_px
     if guess is None:
         return find_balls(img, r, opt.radius_tolerance)
-    sub, x0, y0 = roi(img, guess[0], guess[1], 4 * r)
+    sub, x0, y0 = roi(img, guess[0], guess[1], opt.search_px or 4 * r)
     return [(x + x0, y + y0) for x, y in find_balls(sub, r, opt.radius_tolerance)]
 
 
@@ -120,22 +146,45 @@ def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found, 
     guess = trail.predict(k)
     v = trail.velocity()
     blur = (v[0] * exposure_frames, v[1] * exposure_frames)
-    fit, reason = fit_ball(img, *guess, r, sigma, blur) if guess is not None else ((), "")
+    if opt.ball_fit == "centroid":
+        fit_at = lambda x, y: _centroid_at(img, x, y, opt, sigma, trail)  # noqa: E731
+    else:
+        fit_at = lambda x, y: fit_ball(img, x, y, r, sigma, blur)  # noqa: E731
+    fit, reason = fit_at(*guess) if guess is not None else ((), "")
     if not fit:  # no prediction yet, or the fit failed there: look for the disc in the region
         cands = _ball_candidates(img, guess, opt)
         if len(cands) != 1:
             found.leave_out("ball", k, "no ball found" if not cands else f"{len(cands)} balls found")
             return None
-        fit, reason = fit_ball(img, *cands[0], r, sigma, blur)
+        fit, reason = fit_at(*cands[0])
     if reason is None and abs(fit[2] / r - 1) > opt.radius_tolerance:
         reason = f"fitted radius {fit[2]:.1f} px, expected {r:.1f} px"
     if reason:
         found.leave_out("ball", k, reason)
         return None
     trail.push(k, fit[0], fit[1])
+    trail.contrasts.append(fit[4])
     found.add("ball", k, fit[0], fit[1], fit[3], fit[4])
     found.ball_radii.append(fit[2])
     return fit
+
+
+def _centroid_at(img, x: float, y: float, opt: TrackOptions, sigma: float, trail: _Trail) -> tuple[tuple, str | None]:
+    """Return a small ball's centroid near (x, y) (``ball_fit`` "centroid"), refused where it is not the ball.
+
+    Refused: a radius off by more than the tolerance, or a peak under half the ball's usual one
+    (the median of those found in the clip so far): a part of the ball's edge, or noise, when
+    the prediction missed it. The ball is then looked for in the region about the prediction.
+    """
+    fit, reason = ball_centroid(img, x, y, opt.ball_radius_px, sigma)
+    if reason:
+        return fit, reason
+    if abs(fit[2] / opt.ball_radius_px - 1) > opt.radius_tolerance:
+        return (), f"fitted radius {fit[2]:.1f} px, expected {opt.ball_radius_px:.1f} px"
+    usual = float(np.median(trail.contrasts)) if trail.contrasts else 0.0
+    if fit[4] < 0.5 * usual:
+        return (), f"a spot at {fit[0]:.1f}, {fit[1]:.1f} too faint for the ball ({fit[4]:.0f} vs {usual:.0f})"
+    return fit, None
 
 
 @dataclass
@@ -236,8 +285,27 @@ def _check_time(clip: Clip, k: int, t: float | None, t0: list) -> None:
         )
 
 
+def still_background(clip: Clip, n: int = BACKGROUND_FRAMES) -> np.ndarray:
+    """Return the per-pixel median of up to ``n`` frames spread evenly over the clip (float32): what stays put.
+
+    Streamed: only the frames taken are kept. A moving ball is in few of them, so the median is
+    the ground behind it; something that stays where it is for most of the clip is background.
+    """
+    total = clip.info.n_frames if clip.info.n_frames is not None else sum(1 for _ in clip.frames())
+    take = set(np.unique(np.linspace(0, max(total - 1, 0), min(n, max(total, 1))).round().astype(int)).tolist())
+    kept = [img for k, _, img in clip.frames() if k in take]
+    if not kept:
+        raise VideoError(f"{clip.info.path}: no frames for the still background")
+    return np.median(np.stack(kept), axis=0).astype(np.float32)
+
+
 def track_clip(clip: Clip, opt: TrackOptions) -> Found:
-    """Track one clip, streamed; frames numbered by the file's frame numbers where it has them, else from 0."""
+    """Track one clip, streamed; frames numbered by the file's frame numbers where it has them, else from 0.
+
+    With ``opt.background == "median"`` the clip is read twice: first for its still background
+    (:func:`still_background`), then frame by frame with the background subtracted.
+    """
+    background = still_background(clip) if opt.background == "median" else None
     found = Found()
     trails = {"ball": _Trail(), "bat_tip": _Trail()}
     mem = _DotMemory()
@@ -248,6 +316,8 @@ def track_clip(clip: Clip, opt: TrackOptions) -> Found:
     exposure_frames = info.exposure_s * info.fps if info.exposure_s and info.fps else 0.0
     for k, t, img in clip.frames():
         _check_time(clip, k, t, t0)
+        if background is not None:
+            img = img.astype(np.float32) - background
         f = int(numbers[k]) if numbers is not None and k < numbers.size else k
         sigma = _noise_sigma(img) if sigma is None else sigma
         ball = _ball(img, f, opt, trails["ball"], sigma, found, exposure_frames)
