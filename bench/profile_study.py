@@ -9,8 +9,9 @@ replicate, and prints:
    Dataset), measured by timing the stage functions themselves;
 2. the top functions by their own time and by cumulative time (cProfile).
 
-Run: ``.venv/bin/python bench/profile_study.py [N] [study]`` (about N x 0.3 s). Read the
-stage table as shares when the machine is busy.
+Run: ``.venv/bin/python bench/profile_study.py [N] [study] [--plain]`` (about N x 0.3 s). Read the
+stage table as shares when the machine is busy. ``--plain``: without cProfile (the stage timers
+only, no function tables): the CPU time per replicate as a batch job spends it.
 """
 
 from __future__ import annotations
@@ -66,8 +67,8 @@ def instrument() -> None:
             setattr(module, name, _timed(getattr(module, name), label))
 
 
-def main(n: int = 10, study: str = "calibration") -> None:
-    """Profile ``n`` replicates of ``study``; print the stage table and the top functions."""
+def main(n: int = 10, study: str = "calibration", plain: bool = False) -> None:
+    """Profile ``n`` replicates of ``study``; print the stage table and the top functions (not with ``plain``)."""
     cfg = load_config()
     cfg["studies"][study]["batch_size"] = n
     s = StudySettings.from_config(cfg, study)
@@ -79,14 +80,15 @@ def main(n: int = 10, study: str = "calibration") -> None:
     instrument()
     prof = cProfile.Profile()
     t0, c0 = time.perf_counter(), time.process_time()
-    prof.enable()
+    if not plain:
+        prof.enable()
     ds = study_batch.run(s, 1, balls, bats)
     prof.disable()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     reps = ds.sizes["replicate"]
     print(
         f"{reps} replicates of study {study!r}: {cpu / reps * 1e3:.0f} ms CPU, "
-        f"{wall / reps * 1e3:.0f} ms wall per replicate (under cProfile)"
+        f"{wall / reps * 1e3:.0f} ms wall per replicate ({'no profiler' if plain else 'under cProfile'})"
     )
     print(f"\n{'stage':<36} {'ms / replicate':>15} {'share':>7}")
     for _, _, label in STAGES:
@@ -94,7 +96,7 @@ def main(n: int = 10, study: str = "calibration") -> None:
     top = [label for _, _, label in STAGES if not label.startswith(" ")]
     rest = cpu - sum(SPENT[label] for label in top)
     print(f"{'everything else (rows, Dataset)':<36} {rest / reps * 1e3:>15.1f} {rest / cpu:>7.1%}")
-    for key, title in (("tottime", "own time"), ("cumulative", "cumulative time")):
+    for key, title in () if plain else (("tottime", "own time"), ("cumulative", "cumulative time")):
         out = io.StringIO()
         pstats.Stats(prof, stream=out).sort_stats(key).print_stats(15)
         lines = out.getvalue().splitlines()
@@ -104,4 +106,5 @@ def main(n: int = 10, study: str = "calibration") -> None:
 
 
 if __name__ == "__main__":
-    main(int(sys.argv[1]) if len(sys.argv) > 1 else 10, sys.argv[2] if len(sys.argv) > 2 else "calibration")
+    args = [a for a in sys.argv[1:] if a != "--plain"]
+    main(int(args[0]) if args else 10, args[1] if len(args) > 1 else "calibration", "--plain" in sys.argv)
