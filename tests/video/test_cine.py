@@ -21,7 +21,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from cine_files import SETUP_605, SPECS, frames, spec, write_cine
+from cine_files import SETUP_605, SPECS, frames, image_ticks, spec, write_cine
 
 from ballbat.video.io import VideoError, open_clip
 
@@ -149,6 +149,21 @@ def test_what_pims_cannot_read_the_setup_and_blocks_an_old_file_may_lack(tmp_pat
     oldest = open_clip(write_cine(tmp_path / "oldest.cine", spec("grey8", setup_length=768, real_bpp=7)))
     assert (oldest.info.fps, oldest.info.exposure_s, oldest.info.bit_depth) == (2000.0, None, 8)
     assert oldest.info.source["fps"] == "oldest.cine FrameRate"
+
+
+def test_times_keep_their_precision_at_a_million_frames_per_second(tmp_path):
+    """TriggerTime is 1.7e9 s since 1970: each image's time is taken from it as integers first, so the
+    times keep TIME64's 2**-32 s (the tracker checks each to a quarter frame: 0.14 us at 1.75 Mfps).
+    Before, each time was a float of seconds since 1970 first (as pims' still are), 2**-22 s apart:
+    steps of 0.83-1.25 frames at 1.75 Mfps.
+    """
+    fast = spec("every10th", n_images=40, first_image_no=-20, frame_rate=1_750_000, every=1, shutter_ns=300)
+    times = np.array(_read(write_cine(tmp_path / "fast.cine", fast))[0])
+    exact = np.array(image_ticks(fast)) / 2.0**32
+    assert np.max(np.abs(times - exact)) < 1e-15
+    assert np.max(np.abs(np.diff(times) * 1_750_000 - 1)) < 1e-3
+    half = open_clip(write_cine(tmp_path / "half.cine", spec("every10th", frame_rate=1_000_000, every=2)))
+    assert half.info.fps == 500_000.0 and "every 2nd recorded frame" in half.info.source["fps"]
 
 
 def _edited(tmp_path: Path, name: str, edits: dict[int, bytes], cut: int | None = None, **changes) -> Path:
