@@ -20,8 +20,14 @@ Written from the public description of the format, Vision Research's "The Cine F
   ``ImageSize`` after the annotation), the annotation bytes, ``ImageSize`` (uint32), then the
   pixels.
 
-No program's code was copied. Deterministic: the same :class:`CineSpec` gives the same bytes
-(the SHA-256 sums in the tests hold).
+Where the offsets come from: the header's, the bitmap header's and the SETUP fields ballbat reads
+(``FrameRate16``, ``Length``, ``FrameRate``, ``Shutter``, ``CFA``, ``RealBPP``, ``ShutterNs``) are
+the description's, as ``ballbat.video.cine`` has them (checked there on two real PCC files
+before); ``ImWidth``, ``ImHeight``, ``SoftwareVersion`` and where an older program's setup ends
+(:data:`SETUP_649`, :data:`SETUP_605`, :data:`SETUP_FULL`) were counted from pims 0.7's list of
+the SETUP fields, which pims needs to read a file at all. No program's code was copied.
+Deterministic: the same :class:`CineSpec` gives the same bytes (the SHA-256 sums in the tests
+hold).
 """
 
 from __future__ import annotations
