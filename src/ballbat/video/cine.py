@@ -53,9 +53,13 @@ _TIME_ONLY, _RANGE_DATA = 1002, 1004
 _COMPRESSION = {1: "JPEG-compressed", 2: "raw colour (uninterpolated Bayer)"}
 
 
-def _time64(value: int) -> float:
-    """Seconds of a TIME64: the high 32 bits whole seconds, the low 32 bits a fraction of 2**32."""
-    return (value >> 32) + (value & 0xFFFFFFFF) / 2.0**32
+def _seconds_from(value: int, origin: int) -> float:
+    """Seconds from one TIME64 to another (each whole seconds in the high 32 bits, fractions of 2**-32 s in the low).
+
+    Subtracted as integers first: seconds since 1970 as a float keep only about 0.24 us (2**-22 s),
+    a quarter of a frame at 1 million frames per second.
+    """
+    return (value - origin) / 2.0**32
 
 
 @dataclass(frozen=True)
@@ -90,7 +94,7 @@ def _setup(raw: bytes, off: int, path: Path) -> dict[str, int]:
     return out
 
 
-def _tagged_times(raw: bytes, start: int, end: int, n: int, trigger: float, path: Path) -> np.ndarray | None:
+def _tagged_times(raw: bytes, start: int, end: int, n: int, trigger: int, path: Path) -> np.ndarray | None:
     """Each image's time from the trigger (tagged block 1002), or None where the file has no such block."""
     off = start
     while off + 8 <= end:
@@ -101,7 +105,7 @@ def _tagged_times(raw: bytes, start: int, end: int, n: int, trigger: float, path
             if size - 8 != 8 * n:
                 raise VideoError(f"{path}: the time block holds {(size - 8) // 8} times for {n} images")
             values = _unpack(f"{n}Q", raw, off + 8, path, "time block")
-            return np.array([_time64(v) for v in values]) - trigger
+            return np.array([_seconds_from(v, trigger) for v in values])
         if kind == _RANGE_DATA or not more:
             return None
         off += size
@@ -134,7 +138,7 @@ def _layout(path: Path) -> _Layout:
             " 8 and 16 bit are read (packed 10/12-bit is not: save the clip as 16-bit in PCC)"
         )
     pointers = _unpack(f"{n}Q", raw, off_ptr, path, "image offsets") if n else ()
-    times = _tagged_times(raw, off_setup + setup["Length"], off_ptr, n, _time64(trig), path)
+    times = _tagged_times(raw, off_setup + setup["Length"], off_ptr, n, trig, path)
     return _Layout(abs(width), abs(height), height > 0, bits, n, first_no, pointers, times, setup, size)
 
 
@@ -147,6 +151,12 @@ def _decimation(times: np.ndarray | None, fps: float) -> int:
     return k if k >= 2 and np.all(np.abs(steps - k) < 0.25) else 1
 
 
+def _ordinal(k: int) -> str:
+    """Return 2nd, 3rd, 10th, 21st, ..."""
+    suffix = "th" if 10 <= k % 100 <= 20 else {1: "st", 2: "nd", 3: "rd"}.get(k % 10, "th")
+    return f"{k}{suffix}"
+
+
 def cine_info(path: str | Path) -> ClipInfo:
     """Read a cine file's header and check it; a :class:`VideoError` naming what is wrong."""
     path = Path(path)
@@ -157,7 +167,7 @@ def cine_info(path: str | Path) -> ClipInfo:
     k = _decimation(lay.times, float(rate))
     info.fps = rate / k
     info.source["fps"] = f"{path.name} FrameRate" + (
-        f" {rate} / {k}: the clip holds every {k}th recorded frame (its timestamps)" if k > 1 else ""
+        f" {rate} / {k}: the clip holds every {_ordinal(k)} recorded frame (its timestamps)" if k > 1 else ""
     )
     if s.get("ShutterNs"):
         info.exposure_s, info.source["exposure_s"] = s["ShutterNs"] * 1e-9, "ShutterNs"
