@@ -509,8 +509,13 @@ def _same_reduction(a, b, what: str) -> None:
             # the workflow's tracks make a round trip through tracks.nc (dense columns that may start
             # elsewhere): the sums round differently in the last bit, and the contact prior's
             # Nelder-Mead optimum can carry that to about 1e-8 (relative); a setting honoured
-            # differently moves the values by far more
-            np.testing.assert_allclose(x, y, rtol=1e-7, atol=0, err_msg=f"{what}: {name}")
+            # differently moves the values by far more. A contact shift is a difference of two
+            # reductions, the second through a contact solved again: compared as the shifted value,
+            # to 1e-6 (2e-6 of a shift, 2.2e-7 of a shifted v_bat_err seen on an AMD EPYC)
+            shift = name.startswith("contact_shift_")
+            base = a[name.removeprefix("contact_shift_")].values if shift else 0.0
+            rtol = 1e-6 if shift else 1e-7
+            np.testing.assert_allclose(x + base, y + base, rtol=rtol, atol=0, err_msg=f"{what}: {name}")
         else:
             np.testing.assert_array_equal(x, y, err_msg=f"{what}: {name}")
 

@@ -36,7 +36,9 @@ def test_reduce_nc_from_blocks_is_that_of_one_block(tmp_path, monkeypatch):
     """reduce.nc of tracks held in blocks (30 impacts, one track 5x longer, budget lowered) is that of one block.
 
     The cross-checks' lines and warnings, flags, reasons and integers alike; floats to 1e-12 of the values
-    (the calibration-shifted values, through a second reduction each, to 1e-9: 1.2e-10 seen).
+    (the calibration-shifted values, through a second reduction each, to 1e-9: 1.2e-10 seen), and the
+    uncertainties and scatters to 1e-10 (a covariance's inverse amplifies the sums' round-off: v_bat_err
+    1.03e-12 on an AMD EPYC, within 1e-12 on the machines before).
     """
     from dataclasses import replace
 
@@ -48,7 +50,7 @@ def test_reduce_nc_from_blocks_is_that_of_one_block(tmp_path, monkeypatch):
 
     s = one_long_track(tmp_path / "tracks.nc", factor=5)
     cams = {"swing": replace(s.swing.camera, m_per_px_err=0.01), "spin": s.spin.camera}
-    settings = reduce.ReduceSettings(cams, s.rig, ReduceOptions.schema_defaults(), "tracks", True, True)
+    settings = reduce.ReduceSettings(cams, s.rig, ReduceOptions.schema_defaults(), "tracks", True, True, True)
     a = reduce.run(settings, load_tracks(tmp_path / "tracks.nc", balls=BALLS, bats=BATS), BALLS, BATS)
     monkeypatch.setattr(data, "BLOCK_BYTES", 100_000)
     blocks = load_tracks(tmp_path / "tracks.nc", balls=BALLS, bats=BATS)
@@ -62,6 +64,7 @@ def test_reduce_nc_from_blocks_is_that_of_one_block(tmp_path, monkeypatch):
             q = a[k.removeprefix("contact_shift_").removesuffix("_shift")].values
             np.testing.assert_allclose(q + y, q + x, rtol=1e-9, atol=0, err_msg=k)
         elif x.dtype.kind == "f":
-            np.testing.assert_allclose(y, x, rtol=1e-12, atol=0, err_msg=k)
+            spread = k.endswith(("_err", "_rms", "_sd"))
+            np.testing.assert_allclose(y, x, rtol=1e-10 if spread else 1e-12, atol=0, err_msg=k)
         else:
             np.testing.assert_array_equal(y, x, err_msg=k)

@@ -324,7 +324,8 @@ def _one_and_blocks(tmp_path, monkeypatch):
 
 def test_blocks_reduce_as_one_block(tmp_path, monkeypatch):
     """Every impact's numbers reduced block by block are those of one block: flags, reasons, counts and frames bit for
-    bit; fitted values to 1e-12 (sums over frame columns group their terms by the padded width: last bits).
+    bit; fitted values to 1e-12, their uncertainties to 1e-10 (sums over frame columns group their terms by the padded
+    width: last bits).
 
     The pooled steps (the glitch and misplaced-mark noise, the contact times' prior) run on all impacts: a
     block reduced by itself gets other contact times.
@@ -342,8 +343,9 @@ def test_blocks_reduce_as_one_block(tmp_path, monkeypatch):
         np.testing.assert_array_equal(b.flight[cam].n, a.flight[cam].n)
     np.testing.assert_array_equal(b.swing.n, a.swing.n)
     np.testing.assert_array_equal(b.spin.n, a.spin.n)
-    for k, v in a.values.items():
-        np.testing.assert_allclose(b.values[k], v, rtol=1e-12, atol=0, err_msg=k)
+    for k, v in a.values.items():  # uncertainties to 1e-10: a covariance's inverse amplifies the last bits
+        rtol = 1e-10 if k.endswith("_err") else 1e-12  # (v_bat_err 1.03e-12 seen on an AMD EPYC)
+        np.testing.assert_allclose(b.values[k], v, rtol=rtol, atol=0, err_msg=k)
     alone = reduce(blocks.blocks[0], s)  # the first block by itself: its own contact prior
     idx = blocks.index[0]
     assert np.nanmax(np.abs(alone.contact.duration - a.contact.duration[idx]) / a.contact.duration[idx]) > 1e-6

@@ -435,7 +435,13 @@ def test_one_long_track_among_many(tmp_path, monkeypatch):
     blocks = load_tracks(tmp_path / "tracks.nc", balls=BALLS, bats=BATS)
     assert nbytes(one) > 4 * tracked and nbytes(blocks) < 2 * tracked
     settings = reduce.ReduceSettings(
-        {"swing": s.swing.camera, "spin": s.spin.camera}, s.rig, ReduceOptions.schema_defaults(), "tracks", True, True
+        {"swing": s.swing.camera, "spin": s.spin.camera},
+        s.rig,
+        ReduceOptions.schema_defaults(),
+        "tracks",
+        True,
+        True,
+        True,
     )
     a, b = (reduce.run(settings, tr, BALLS, BATS) for tr in (one, blocks))
     assert b.sizes["impact"] == 30 and np.isfinite(b["v_bat"].values).sum() >= 25
