@@ -243,3 +243,36 @@ def test_a_batch_whose_data_are_refused_again_and_again_stops_with_the_first_rea
     with pytest.raises(TooManyRefused, match=r"refused 3 of its first 3 replicates.*replicate 0\)"):
         study_batch.run(s, 0, balls, bats)
     assert len(calls) == 3  # 5 % of 40: two may be false alarms, the third stops it
+
+
+def test_the_truth_jobs_replicate_skips_what_its_truth_does_not_read(config, balls, bats, monkeypatch):
+    """check=False (the truth job): no contact population shifts, eta^2's value not fitted; every truth as with them."""
+    from dataclasses import replace
+
+    dataset = copy.deepcopy(config["datasets"]["synthetic"])
+    dataset["synthetic"]["impacts"] = SMALL
+    settings = StudySettings.from_config(
+        {**config, "studies": {"s": {**config["studies"]["calibration"], "dataset": "synthetic"}}}, "s"
+    )
+    cs = replicates.chain_settings(settings, dataset, replicate_seeds(settings.seed, 2), check=False)
+    assert not (cs.reduce.cross_check or cs.reduce.systematics or cs.reduce.population_shifts)
+    lean = run_replicate(settings, dataset, 2, balls, bats, check=False)
+    real = replicates.chain_settings
+
+    def with_shifts(*args, **kw):
+        out = real(*args, **kw)
+        return replace(out, reduce=replace(out.reduce, population_shifts=True))
+
+    monkeypatch.setattr(replicates, "chain_settings", with_shifts)
+    full = run_replicate(settings, dataset, 2, balls, bats, check=False)
+    assert row_labels(lean) == row_labels(full)
+    truths = [(a["truth"], b["truth"]) for a, b in zip(lean, full, strict=True)]
+    assert all(a == b or (math.isnan(a) and math.isnan(b)) for a, b in truths), truths
+    eta2 = [r for r in lean if r["quantity"] == "eta2"]
+    assert eta2 and all(math.isnan(r["value"]) and math.isfinite(r["truth"]) for r in eta2)
+    assert all(
+        math.isfinite(r["value"]) for r in run_replicate(settings, dataset, 2, balls, bats) if r["quantity"] == "eta2"
+    )
+    # the uncertainties differ: the contact population's part is in the full one's only
+    e_x = [(a["uncertainty"], b["uncertainty"]) for a, b in zip(lean, full, strict=True) if a["quantity"] == "e_x"]
+    assert any(a < b for a, b in e_x), e_x

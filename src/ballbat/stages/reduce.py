@@ -51,6 +51,10 @@ class ReduceSettings:
         Cross-check the settings against the reduced tracks (:func:`ballbat.tracks.verdict.cross_check`).
         Always, but in a study's truth job: its truth needs no check, and the checks' tight errors
         over some 70000 impacts flag a small bias of the tip's arc at 5 px as a wrong rig.
+    population_shifts : bool
+        Solve the contact again at +-1 standard error of each ball type's population mean
+        (:func:`ballbat.tracks.reduce.contact_shifts`). Always, but in a study's truth job: its
+        truth is a value, and the shifts enter only the uncertainties.
     """
 
     cameras: dict[str, Camera]
@@ -59,6 +63,7 @@ class ReduceSettings:
     where: str
     systematics: bool
     cross_check: bool
+    population_shifts: bool
 
     @classmethod
     def from_config(cls, block: dict, where: str, *, systematics: bool) -> ReduceSettings:
@@ -75,6 +80,7 @@ class ReduceSettings:
             where=where,
             systematics=systematics,
             cross_check=True,
+            population_shifts=True,
         )
 
 
@@ -96,7 +102,7 @@ def reduce_and_check(
     Where ``settings.systematics`` asks, the tracks are reduced again at +-1 sigma of each stated
     calibration uncertainty (:func:`ballbat.systematics.reduce_shifts`, kept as ``Reduction.shifts``).
     """
-    red = reduce_tracks(tracks, settings.cameras, settings.rig, settings.options)
+    red = reduce_tracks(tracks, settings.cameras, settings.rig, settings.options, settings.population_shifts)
     verdict = cross_check(red, balls, bats, settings.where) if settings.cross_check else None
     if settings.systematics:
         from ..systematics import reduce_shifts

@@ -57,8 +57,9 @@ def chain_settings(
     come (no refusal of an unphysical e_x) and fits no systematic (:func:`run_replicate` asks
     for the calibration's where the replicate draws its calibration); the tracks are reduced
     again at +-1 sigma of each stated calibration uncertainty only where the calibration is drawn
-    (the workflow's reduce always does). ``check=False``: no cross-checks and no reruns (the truth
-    job's large experiment, whose truth needs neither; :attr:`ReduceSettings.cross_check`).
+    (the workflow's reduce always does). ``check=False``: the truth job's large experiment, whose
+    truth is a value: no cross-checks, no reruns and no contact population shifts
+    (:attr:`ReduceSettings.cross_check`, :attr:`ReduceSettings.population_shifts`).
     ``settings`` None: the reference bat speed and the example's friction are the schema's (they
     do not enter the source, :func:`replicate_source`).
     """
@@ -81,7 +82,7 @@ def chain_settings(
     ).with_seeds(*seeds)
     if check or base.reduce is None:
         return base
-    return replace(base, reduce=replace(base.reduce, cross_check=False, systematics=False))
+    return replace(base, reduce=replace(base.reduce, cross_check=False, systematics=False, population_shifts=False))
 
 
 def replicate_source(
@@ -112,8 +113,14 @@ def _truth_source(src: xr.Dataset) -> xr.Dataset:
     return xr.Dataset(variables, coords=src.coords, attrs=src.attrs)
 
 
-def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> tuple[float, float, float, float]:
-    """eta^2 of one ball (value, standard error, truth, degrees of freedom); NaN if not fitted."""
+def _eta2(
+    rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict, value: bool = True
+) -> tuple[float, float, float, float]:
+    """eta^2 of one ball (value, standard error, truth, degrees of freedom); NaN if not fitted.
+
+    ``value=False`` (the truth job, which reads only the truth): the truth alone, the value, its
+    error and dof NaN, NaN and 0.
+    """
     from ..linefit import MIN_FIT_IMPACTS
     from ..stronge.analysis import fit_ball, vtf_data
 
@@ -123,7 +130,8 @@ def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> t
     kw = {k: stronge[k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")}
     d = vtf_data(rec, sel)
     try:
-        fit = fit_ball(d, interval=False, **kw)  # the study keeps the value, error and dof, not the interval
+        # the study keeps the value, error and dof, not the interval
+        fit = fit_ball(d, interval=False, **kw) if value else None
         truth = fit_ball(
             vtf_data(rec_truth, sel),
             sigma=d.sigma,
@@ -135,6 +143,8 @@ def _eta2(rec: xr.Dataset, rec_truth: xr.Dataset, ball: str, stronge: dict) -> t
         ).eta2
     except (ValueError, RuntimeError):
         return math.nan, math.nan, math.nan, 0
+    if fit is None:
+        return math.nan, math.nan, truth, 0
     return fit.eta2, fit.eta2_err, truth, fit.dof
 
 
@@ -158,7 +168,9 @@ def run_replicate(
     balls, bats : dict
         Property tables.
     check : bool
-        Cross-check the reduced tracks' settings (:func:`chain_settings`; off for the truth job).
+        False: the truth job's large experiment, of which only each row's ``truth`` is read: no
+        cross-checks, no contact population shifts (:func:`chain_settings`), and eta^2's truth
+        alone (:func:`_eta2`).
 
     Returns
     -------
@@ -191,7 +203,7 @@ def run_replicate(
         nan = np.full(balls_fitted.size, np.nan)
         syst, effect = _eta2_systematic(rec, balls_fitted, settings.stronge, z) if drawn else (nan, nan)
         for ball, sy, ef in zip(balls_fitted, syst, effect, strict=True):
-            v, e, t, dof = _eta2(rec, rec_truth, ball, settings.stronge)
+            v, e, t, dof = _eta2(rec, rec_truth, ball, settings.stronge, value=check)
             rows.append(
                 {
                     "quantity": "eta2",
