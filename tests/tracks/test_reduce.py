@@ -403,7 +403,8 @@ def test_the_contact_shifts_move_each_ball_types_impacts_both_ways_and_reach_red
 @pytest.mark.parametrize("swing", [{}, {"fps": 1500, "pre_impact_frames": 12}])
 def test_the_swing_fit_on_its_own_columns_is_the_fit_on_all(swing, monkeypatch):
     """The tip's fit on the columns of its pre-contact frames only (fit_swing._fitted_columns) is bit for bit the fit
-    on every column, at 3000 and 1500 fps (columns cut in both)."""
+    on every column, at 3000 and 1500 fps (columns cut in both).
+    """
     from ballbat.tracks import fit_swing
 
     tr, s = render(experiment(4, per_bat=6), render_cfg(seed=4, swing=swing))
