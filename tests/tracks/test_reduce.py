@@ -402,25 +402,31 @@ def test_the_contact_shifts_move_each_ball_types_impacts_both_ways_and_reach_red
 
 @pytest.mark.parametrize("swing", [{}, {"fps": 1500, "pre_impact_frames": 12}])
 def test_the_swing_fit_on_its_own_columns_is_the_fit_on_all(swing, monkeypatch):
-    """The tip's fit on the columns of its pre-contact frames only (fit_swing._fitted_columns) is bit for bit the fit
-    on every column, at 3000 and 1500 fps (columns cut in both).
+    """The tip's fit and its arc's check on the columns of its pre-contact frames only (masked.fitted_columns) are bit
+    for bit those on every column, at 3000 and 1500 fps (columns cut in both).
     """
-    from ballbat.tracks import fit_swing
+    from ballbat.tracks import fit_swing, masked
+    from ballbat.tracks.verdict import _tip_arc
 
     tr, s = render(experiment(4, per_bat=6), render_cfg(seed=4, swing=swing))
     kept = []
-    real = fit_swing._fitted_columns
+    real = fit_swing.fitted_columns
 
     def spy(mask, *arrays):
         out = real(mask, *arrays)
         kept.append((mask.shape[1], out[-1].shape[1]))
         return out
 
-    monkeypatch.setattr(fit_swing, "_fitted_columns", spy)
+    monkeypatch.setattr(fit_swing, "fitted_columns", spy)
     cut = reduce(tr, s)
     assert kept and all(k < width for width, k in kept), kept
-    monkeypatch.setattr(fit_swing, "PAIRWISE_BLOCK", 0)  # every column kept
+    arc = _tip_arc(cut, None)
+    monkeypatch.setattr(masked, "PAIRWISE_BLOCK", 0)  # every column kept
     whole = reduce(tr, s)
+    whole_arc = _tip_arc(whole, None)
+    assert np.isfinite(arc[0]).sum() >= 0.8 * arc[0].size
+    for a, b in zip(arc, whole_arc, strict=True):
+        np.testing.assert_array_equal(a, b)
     for k in ("v_bat", "v_bat_err", "theta", "theta_err"):
         np.testing.assert_array_equal(cut.values[k], whole.values[k], err_msg=k)
     for f in ("omega", "omega_err", "beta", "beta_err", "tau", "a", "rms", "n", "mask"):

@@ -35,6 +35,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..batched import gram, nanmedian_rows, tdot
+from .masked import fitted_columns
 
 if TYPE_CHECKING:
     import os
@@ -421,7 +422,8 @@ def tip_arc(
     alignment time (the contact's start ``t_contact``, +- ``tau_prior_frames``), so that
     nothing of L_cfg enters the fit; kappa = w L_cfg^2 is 1 when the rig and pixel scale agree.
     """
-    mask = swing.mask
+    # the frames before the contact only (their columns: every sum keeps its bits, :func:`fitted_columns`)
+    X, Y, t, mask = fitted_columns(swing.mask, X, Y, t)
     along = np.where(mask, (X - swing.cx[:, None]) * swing.ux[:, None] + (Y - swing.cy[:, None]) * swing.uy[:, None], 0)
     n = mask.sum(axis=1)
     tau0 = np.asarray(t_contact, dtype=float).copy()

@@ -16,7 +16,7 @@ import numpy as np
 
 from ..batched import gram, tdot
 from .fit_flight import Onset
-from .masked import msum
+from .masked import fitted_columns, msum
 
 if TYPE_CHECKING:
     from numpy.typing import ArrayLike
@@ -115,7 +115,7 @@ def fit_swing(
     t_contact = np.asarray(t_contact, dtype=float)
     found = onset.found & np.isfinite(t_contact)
     full_mask = valid & found[:, None] & (t < np.where(found, t_contact, -np.inf)[:, None])
-    X, Y, t, mask = _fitted_columns(full_mask, np.asarray(X, dtype=float), np.asarray(Y, dtype=float), t)
+    X, Y, t, mask = fitted_columns(full_mask, np.asarray(X, dtype=float), np.asarray(Y, dtype=float), t)
     w = mask.astype(float)
     n = msum(np.ones_like(X), w)
     with np.errstate(all="ignore"):
@@ -166,30 +166,3 @@ def fit_swing(
         omega_err = np.sqrt(cov[:, 1, 1] * (n - 3) / np.maximum(n - 5, 1))  # Student-t, as for beta
         rms = np.sqrt(np.sum(rr**2, axis=1) / n)
     return Swing(om, omega_err, beta, beta_err, tau, a, ux, uy, cx, cy, rms, n.astype(int), full_mask)
-
-
-#: numpy sums a row of up to this many terms in eight interleaved partial sums (its pairwise sum's block).
-PAIRWISE_BLOCK = 128
-
-
-def _fitted_columns(mask: np.ndarray, *arrays: np.ndarray) -> tuple[np.ndarray, ...]:
-    """Return the columns of ``arrays`` and ``mask`` that hold the fitted frames, where that keeps every sum's bits.
-
-    The tip's track spans the clip, its fit only the frames before the contact (about a sixth
-    of them): every other column is masked, and the fit's sums add 0 for it. A row of up to
-    :data:`PAIRWISE_BLOCK` terms is summed by numpy in eight interleaved partial sums, term k in
-    partial sum k mod 8, and its last (width mod 8) terms are added one by one after them. So
-    the columns kept start and end at multiples of 8 and stop short of those last terms: each
-    term is added in the same place, and the dropped zeros change nothing (the batched matrix
-    products alike: checked on 20 000 random cases up to 256 columns). Otherwise every column
-    is kept. Arrays of one dimension (a time per column) are cut alike.
-    """
-    width = mask.shape[1]
-    cols = np.flatnonzero(mask.any(axis=0))
-    if cols.size == 0 or width > PAIRWISE_BLOCK:
-        return (*arrays, mask)
-    c0 = int(cols[0]) - int(cols[0]) % 8
-    c1 = c0 + -(-(int(cols[-1]) + 1 - c0) // 8) * 8
-    if c1 > width - width % 8:
-        return (*arrays, mask)
-    return (*(a[..., c0:c1] for a in arrays), mask[:, c0:c1])

@@ -25,3 +25,31 @@ def last_true(mask: np.ndarray) -> np.ndarray:
 def take_at(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
     """``a[i, idx[i]]`` for each row, ``idx`` clipped to the columns."""
     return np.take_along_axis(a, np.clip(idx, 0, a.shape[1] - 1)[:, None], axis=1)[:, 0]
+
+
+#: numpy sums a row of up to this many terms in eight interleaved partial sums (its pairwise sum's block)
+#: (:func:`fitted_columns`).
+PAIRWISE_BLOCK = 128
+
+
+def fitted_columns(mask: np.ndarray, *arrays: np.ndarray) -> tuple[np.ndarray, ...]:
+    """Return the columns of ``arrays`` and ``mask`` that hold the fitted frames, where that keeps every sum's bits.
+
+    A fit of some frames of a track (the tip's before the contact: about a sixth of its
+    columns) masks every other column, and its sums add 0 for each. A row of up to
+    :data:`PAIRWISE_BLOCK` terms is summed by numpy in eight interleaved partial sums, term k in
+    partial sum k mod 8, and its last (width mod 8) terms are added one by one after them. So
+    the columns kept start and end at multiples of 8 and stop short of those last terms: each
+    term is added in the same place, and the dropped zeros change nothing (the batched matrix
+    products alike: checked on 20 000 random cases up to 256 columns). Otherwise every column
+    is kept. Arrays of one dimension (a time per column) are cut alike.
+    """
+    width = mask.shape[1]
+    cols = np.flatnonzero(mask.any(axis=0))
+    if cols.size == 0 or width > PAIRWISE_BLOCK:
+        return (*arrays, mask)
+    c0 = int(cols[0]) - int(cols[0]) % 8
+    c1 = c0 + -(-(int(cols[-1]) + 1 - c0) // 8) * 8
+    if c1 > width - width % 8:
+        return (*arrays, mask)
+    return (*(a[..., c0:c1] for a in arrays), mask[:, c0:c1])
