@@ -421,7 +421,7 @@ def test_the_swing_fit_on_its_own_columns_is_the_fit_on_all(swing, monkeypatch):
     cut = reduce(tr, s)
     assert kept and all(k < width for width, k in kept), kept
     arc = _tip_arc(cut, None)
-    monkeypatch.setattr(masked, "PAIRWISE_BLOCK", 0)  # every column kept
+    monkeypatch.setattr(masked, "CUT_WIDTH", 0)  # every column kept
     whole = reduce(tr, s)
     whole_arc = _tip_arc(whole, None)
     assert np.isfinite(arc[0]).sum() >= 0.8 * arc[0].size
@@ -431,3 +431,31 @@ def test_the_swing_fit_on_its_own_columns_is_the_fit_on_all(swing, monkeypatch):
         np.testing.assert_array_equal(cut.values[k], whole.values[k], err_msg=k)
     for f in ("omega", "omega_err", "beta", "beta_err", "tau", "a", "rms", "n", "mask"):
         np.testing.assert_array_equal(getattr(cut.swing, f), getattr(whole.swing, f), err_msg=f)
+
+
+def test_fitted_columns_keep_the_bits_of_every_row_sum_and_product():
+    """Random rows of 8-256 columns, values in a random span: the sums and normal equations on the columns kept
+    (masked.fitted_columns) are bit for bit those on all; a span across numpy's blocks keeps every column."""
+    from ballbat.batched import gram, tdot
+    from ballbat.tracks.masked import _pairwise_leaves, fitted_columns
+
+    rng = np.random.default_rng(7)
+    cut = 0
+    for _ in range(400):
+        n = int(rng.integers(8, 257))
+        lo = int(rng.integers(0, n))
+        hi = int(rng.integers(lo + 1, min(n, lo + 40) + 1))
+        mask = np.zeros((20, n), dtype=bool)
+        mask[:, lo:hi] = rng.random((20, hi - lo)) < 0.9
+        x = np.where(mask, rng.normal(size=mask.shape) * 10 ** rng.uniform(-3, 3, mask.shape), 0.0)
+        J = np.where(mask[..., None], rng.normal(size=(*mask.shape, 3)), 0.0)
+        t = np.arange(n, dtype=float)
+        xc, Jc, tc, _ = fitted_columns(mask, x, J.transpose(0, 2, 1), t)  # (impact, parameter, column) cut
+        cut += xc.shape[1] < n
+        np.testing.assert_array_equal(np.sum(xc, axis=1), np.sum(x, axis=1))
+        Jc = Jc.transpose(0, 2, 1)
+        np.testing.assert_array_equal(gram(Jc), gram(J))
+        np.testing.assert_array_equal(tdot(Jc, xc), tdot(J, x))
+        assert tc.shape[0] == xc.shape[1]
+    assert cut > 200
+    assert _pairwise_leaves(133) == [(0, 64), (64, 133)]

@@ -31,25 +31,42 @@ def take_at(a: np.ndarray, idx: np.ndarray) -> np.ndarray:
 #: (:func:`fitted_columns`).
 PAIRWISE_BLOCK = 128
 
+#: The widest row :func:`fitted_columns` cuts: the batched matrix products (:func:`ballbat.batched.gram`)
+#: were checked to keep their bits up to here (BLAS blocks longer rows).
+CUT_WIDTH = 256
+
+
+def _pairwise_leaves(n: int, start: int = 0) -> list[tuple[int, int]]:
+    """Return the blocks numpy's pairwise sum splits a row of ``n`` terms into (start, end), in order.
+
+    A row longer than :data:`PAIRWISE_BLOCK` is split at half its length rounded down to a
+    multiple of 8, and each half again, down to blocks of at most that many terms.
+    """
+    if n <= PAIRWISE_BLOCK:
+        return [(start, start + n)]
+    half = n // 2 - (n // 2) % 8
+    return _pairwise_leaves(half, start) + _pairwise_leaves(n - half, start + half)
+
 
 def fitted_columns(mask: np.ndarray, *arrays: np.ndarray) -> tuple[np.ndarray, ...]:
     """Return the columns of ``arrays`` and ``mask`` that hold the fitted frames, where that keeps every sum's bits.
 
     A fit of some frames of a track (the tip's before the contact: about a sixth of its
-    columns) masks every other column, and its sums add 0 for each. A row of up to
-    :data:`PAIRWISE_BLOCK` terms is summed by numpy in eight interleaved partial sums, term k in
-    partial sum k mod 8, and its last (width mod 8) terms are added one by one after them. So
-    the columns kept start and end at multiples of 8 and stop short of those last terms: each
-    term is added in the same place, and the dropped zeros change nothing (the batched matrix
-    products alike: checked on 20 000 random cases up to 256 columns). Otherwise every column
-    is kept. Arrays of one dimension (a time per column) are cut alike.
+    columns) masks every other column, and its sums add 0 for each. numpy sums a row in
+    blocks of at most :data:`PAIRWISE_BLOCK` terms (:func:`_pairwise_leaves`), each in eight
+    interleaved partial sums, term k in partial sum k mod 8, the block's last (length mod 8)
+    terms added one by one after them. So the columns kept lie in one block, start and end at
+    multiples of 8 and stop short of its last terms: each term is added in the same place, and
+    the dropped zeros change nothing (the batched matrix products alike, up to
+    :data:`CUT_WIDTH` columns: both checked on 20 000 random cases). Otherwise every column is
+    kept. Arrays of one dimension (a time per column) are cut alike.
     """
     width = mask.shape[1]
     cols = np.flatnonzero(mask.any(axis=0))
-    if cols.size == 0 or width > PAIRWISE_BLOCK:
+    if cols.size == 0 or width > CUT_WIDTH:
         return (*arrays, mask)
     c0 = int(cols[0]) - int(cols[0]) % 8
     c1 = c0 + -(-(int(cols[-1]) + 1 - c0) // 8) * 8
-    if c1 > width - width % 8:
+    if not any(lo <= c0 and c1 <= hi - (hi - lo) % 8 for lo, hi in _pairwise_leaves(width)):
         return (*arrays, mask)
     return (*(a[..., c0:c1] for a in arrays), mask[:, c0:c1])
