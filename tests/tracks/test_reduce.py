@@ -435,7 +435,8 @@ def test_the_swing_fit_on_its_own_columns_is_the_fit_on_all(swing, monkeypatch):
 
 def test_fitted_columns_keep_the_bits_of_every_row_sum_and_product():
     """Random rows of 8-256 columns, values in a random span: the sums and normal equations on the columns kept
-    (masked.fitted_columns) are bit for bit those on all; a span across numpy's blocks keeps every column."""
+    (masked.fitted_columns) are bit for bit those on all; a span across numpy's blocks keeps every column.
+    """
     from ballbat.batched import gram, tdot
     from ballbat.tracks.masked import _pairwise_leaves, fitted_columns
 
