@@ -390,7 +390,7 @@ NORM = normalize.NormalizeSettings(v_ref_mph=77.0)
 REC = reconstruct.ReconstructSettings()
 
 
-FIT = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True)
+FIT = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True, mu_k_bound=True)
 
 
 def fit_chain(settings, balls, bats, **over):

@@ -62,7 +62,7 @@ def test_stage_settings_are_frozen_and_have_no_code_defaults(cls):
 
 def test_settings_from_the_validated_config(config):
     assert fit_ex.FitExSettings.from_config(config) == fit_ex.FitExSettings(
-        config["analysis"]["mu_k_example"], systematic=True, check_physical=True
+        config["analysis"]["mu_k_example"], systematic=True, check_physical=True, mu_k_bound=True
     )
     assert normalize.NormalizeSettings.from_config(config).v_ref_mph == config["normalize"]["v_ref_mph"]
     assert dataclasses.asdict(stronge.StrongeSettings.from_config(config)) == config["stronge"]

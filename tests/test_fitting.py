@@ -107,7 +107,7 @@ def test_the_contact_error_is_the_refits_half_difference_in_quadrature(config, b
     s = SyntheticSettings(**{**config["datasets"]["synthetic"]["synthetic"], "seed": 5})
     rec = reconstruct.run(REC, normalize.run(NORM, simulate.run(s, balls, bats)), balls, bats)
     rec = rec.drop_vars([k for k in rec.data_vars if k.startswith("truth_")])
-    settings = fit_ex.FitExSettings(mu_k_example=0.5, systematic=False, check_physical=True)
+    settings = fit_ex.FitExSettings(mu_k_example=0.5, systematic=False, check_physical=True, mu_k_bound=True)
     plain = fit_ex.run(settings, rec)
     got = fit_ex.run(settings, _with_contact_shift(rec, 2e-3, "softball"))
     sides = []
@@ -140,7 +140,7 @@ def test_the_switch_turns_the_contact_error_off(config, balls, bats, monkeypatch
 
     s = SyntheticSettings(**{**config["datasets"]["synthetic"]["synthetic"], "seed": 6})
     rec = reconstruct.run(REC, normalize.run(NORM, simulate.run(s, balls, bats)), balls, bats)
-    settings = fit_ex.FitExSettings(mu_k_example=0.5, systematic=False, check_physical=True)
+    settings = fit_ex.FitExSettings(mu_k_example=0.5, systematic=False, check_physical=True, mu_k_bound=True)
     monkeypatch.setattr(fitting, "CONTACT_POPULATION_ERROR", False)
     got = fit_ex.run(settings, _with_contact_shift(rec, 2e-3, "softball"))
     xr_equal = fit_ex.run(settings, rec)

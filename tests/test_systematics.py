@@ -36,7 +36,7 @@ STRONGE = {
     "n_time": 20,
 }
 SOURCE = list(systematics.SOURCES)
-FIT_SETTINGS = fit_ex.FitExSettings(0.5, systematic=True, check_physical=True)  # as the workflow's
+FIT_SETTINGS = fit_ex.FitExSettings(0.5, systematic=True, check_physical=True, mu_k_bound=True)  # as the workflow's
 
 
 @functools.cache
@@ -606,7 +606,9 @@ def test_pixel_scale_systematic_reaches_e_x():
             BALLS,
             BATS,
         )
-        return fit_ex.run(fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True), rec)
+        return fit_ex.run(
+            fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True, mu_k_bound=True), rec
+        )
 
     base, sys1, sys2 = fit(0.0), fit(0.01), fit(0.02)
     assert "e_x_err_scale" in sys1 and "e_x_pooled_err_scale" in sys1

@@ -483,7 +483,9 @@ def _mu_k_bound(pb: dict, i: int, y: np.ndarray, jy: np.ndarray, sig: np.ndarray
     pb["mu_k_lower_bound_impact"][i] = int(impact[k])
 
 
-def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True, core: bool = False) -> Sec4:
+def analyze_impacts(
+    ds: xr.Dataset, mu_k_example: float, systematic: bool = True, core: bool = False, mu_k_bound: bool = True
+) -> Sec4:
     """Sec. IV analysis of a normalised and reconstructed dataset (output of ``reconstruct``).
 
     Uses only impacts with ``flag == 0``. The Figs. 3-4 fits read the normalised spin and
@@ -495,7 +497,8 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
     where its replicates draw their calibration or their properties, the combined interval's
     coverage (:func:`ballbat.studies.replicates.run_replicate`). ``core``: only e_x (per bat and
     pooled), the Eq. ratio slope and implied e_y (:func:`contact_population_error`'s refits); the
-    other per-ball quantities stay NaN.
+    other per-ball quantities stay NaN. ``mu_k_bound=False``: the bound on mu_k is not estimated
+    (NaN; its truth is: a study's truth job, :class:`ballbat.stages.fit_ex.FitExSettings`).
     """
     ds = Columns(ds)  # plain arrays: the fits read some 200 of them
     usable = ds["flag"].values == 0
@@ -528,7 +531,8 @@ def analyze_impacts(ds: xr.Dataset, mu_k_example: float, systematic: bool = True
         pb["e_y_implied"][i], pb["e_y_implied_err"][i] = e_y, e_y_err
         if core:
             continue
-        _mu_k_bound(pb, i, y, jy, sig, ds["impact"].values[in_ball])
+        if mu_k_bound:
+            _mu_k_bound(pb, i, y, jy, sig, ds["impact"].values[in_ball])
         psi_g, theta_g, omega_g = gross_slip_onset(
             mu_k_example, rfit.slope, v_ref, exf.slope - 1.0, float(np.mean(r)), float(np.mean(r_x)), a
         )

@@ -109,7 +109,7 @@ def test_fit_ex_stage_gives_the_compute_functions_numbers(chain, config):
     assert fit.attrs["n_excluded"] == int((rec["flag"].values != 0).sum())
     assert fit.attrs["v_ref"] == rec.attrs["v_ref"] and fit.attrs["mu_k_example"] == 0.5
     # without the systematic (the studies): no *_err_scale, the same fits
-    quiet = fit_ex.run(fit_ex.FitExSettings(0.5, systematic=False, check_physical=True), rec)
+    quiet = fit_ex.run(fit_ex.FitExSettings(0.5, systematic=False, check_physical=True, mu_k_bound=True), rec)
     assert "e_x_err_scale" not in quiet
     np.testing.assert_array_equal(quiet["e_x"].values, fit["e_x"].values)
 
@@ -120,8 +120,8 @@ def test_fit_ex_stage_refuses_an_impossible_e_x_unless_told(chain):
     flipped["omega"] = -flipped["omega"]
     rec = reconstruct.run(reconstruct.ReconstructSettings(), flipped, *_tables())
     with pytest.raises(fitting.ImplausibleFit, match="outside the physical range"):
-        fit_ex.run(fit_ex.FitExSettings(0.5, systematic=False, check_physical=True), rec)
-    fit = fit_ex.run(fit_ex.FitExSettings(0.5, systematic=False, check_physical=False), rec)
+        fit_ex.run(fit_ex.FitExSettings(0.5, systematic=False, check_physical=True, mu_k_bound=True), rec)
+    fit = fit_ex.run(fit_ex.FitExSettings(0.5, systematic=False, check_physical=False, mu_k_bound=True), rec)
     assert np.nanmin(fit["e_x_pooled"].values) < -1
 
 

@@ -362,7 +362,9 @@ def fitted(path):
         load_balls(BALLS),
         load_bats(MAPLE_BATS),
     )
-    return ds, fit_ex.run(fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True), rec)
+    return ds, fit_ex.run(
+        fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True, mu_k_bound=True), rec
+    )
 
 
 def test_clean_file_flags_nothing():

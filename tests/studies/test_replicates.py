@@ -246,7 +246,9 @@ def test_a_batch_whose_data_are_refused_again_and_again_stops_with_the_first_rea
 
 
 def test_the_truth_jobs_replicate_skips_what_its_truth_does_not_read(config, balls, bats, monkeypatch):
-    """check=False (the truth job): no contact population shifts, eta^2's value not fitted; every truth as with them."""
+    """check=False (the truth job): no contact population shifts, eta^2's value not fitted, no bound on mu_k estimated;
+    every truth as with them.
+    """
     from dataclasses import replace
 
     dataset = copy.deepcopy(config["datasets"]["synthetic"])
@@ -268,6 +270,8 @@ def test_the_truth_jobs_replicate_skips_what_its_truth_does_not_read(config, bal
     assert row_labels(lean) == row_labels(full)
     truths = [(a["truth"], b["truth"]) for a, b in zip(lean, full, strict=True)]
     assert all(a == b or (math.isnan(a) and math.isnan(b)) for a, b in truths), truths
+    mu_k = [r for r in lean if r["quantity"] == "mu_k_lower_bound"]
+    assert mu_k and all(math.isnan(r["value"]) for r in mu_k)  # not estimated
     eta2 = [r for r in lean if r["quantity"] == "eta2"]
     assert eta2 and all(math.isnan(r["value"]) and math.isfinite(r["truth"]) for r in eta2)
     assert all(

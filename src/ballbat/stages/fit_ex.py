@@ -47,6 +47,10 @@ class FitExSettings(SectionSettings):
     check_physical : bool
         Refuse a fitted e_x outside [-1, 1] (:class:`ballbat.fitting.ImplausibleFit`); the
         replicate studies record every replicate's numbers as they come.
+    mu_k_bound : bool
+        Estimate the lower bound on mu_k (Eq. muk, corrected for picking the largest value:
+        :func:`ballbat.fitting.largest_value`, about 1.3 s a ball at 35 000 impacts). Always, but
+        in a study's truth job, which reads only its truth (the largest noise-free value).
     """
 
     SECTION = "analysis"
@@ -54,11 +58,12 @@ class FitExSettings(SectionSettings):
     mu_k_example: float
     systematic: bool
     check_physical: bool
+    mu_k_bound: bool
 
     @classmethod
     def from_params(cls, params: Mapping) -> FitExSettings:
         """Return the workflow's settings from the rule's params (``mu_k_example``, as config ``analysis``)."""
-        return cls(mu_k_example=float(params["mu_k_example"]), systematic=True, check_physical=True)
+        return cls(mu_k_example=float(params["mu_k_example"]), systematic=True, check_physical=True, mu_k_bound=True)
 
 
 # ---------------------------------------------------------------------------------------
@@ -247,7 +252,10 @@ def run(settings: FitExSettings, impacts: xr.Dataset) -> xr.Dataset:
 
 def fit(settings: FitExSettings, impacts: xr.Dataset) -> tuple[xr.Dataset, FitSystematics | None]:
     """:func:`run`'s dataset and the calibration systematics it holds, with their signs (None: none fitted)."""
-    res = with_contact_error(impacts, analyze_impacts(impacts, settings.mu_k_example, systematic=settings.systematic))
+    res = with_contact_error(
+        impacts,
+        analyze_impacts(impacts, settings.mu_k_example, systematic=settings.systematic, mu_k_bound=settings.mu_k_bound),
+    )
     if settings.systematic and has_shifts(impacts):  # every calibration source, the tracks reduced again
         res.systematics = fit_systematics(impacts, res)
         res.systematic = scale_entries(res.systematics)

@@ -58,8 +58,9 @@ def chain_settings(
     for the calibration's where the replicate draws its calibration); the tracks are reduced
     again at +-1 sigma of each stated calibration uncertainty only where the calibration is drawn
     (the workflow's reduce always does). ``check=False``: the truth job's large experiment, whose
-    truth is a value: no cross-checks, no reruns and no contact population shifts
-    (:attr:`ReduceSettings.cross_check`, :attr:`ReduceSettings.population_shifts`).
+    truth is a value: no cross-checks, no reruns, no contact population shifts
+    (:attr:`ReduceSettings.cross_check`, :attr:`ReduceSettings.population_shifts`) and no estimate
+    of the bound on mu_k (:attr:`FitExSettings.mu_k_bound`).
     ``settings`` None: the reference bat speed and the example's friction are the schema's (they
     do not enter the source, :func:`replicate_source`).
     """
@@ -76,7 +77,7 @@ def chain_settings(
         dataset,
         "study",
         norm,
-        fit_ex.FitExSettings(mu_k, systematic=False, check_physical=False),
+        fit_ex.FitExSettings(mu_k, systematic=False, check_physical=False, mu_k_bound=check),
         systematics=drawn,
         where=where,
     ).with_seeds(*seeds)
