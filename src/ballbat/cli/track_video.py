@@ -59,7 +59,9 @@ def add_parser(sub: argparse._SubParsersAction, formatter_class: type[argparse.H
         "--search-px", type=float, help="half-side of the region searched about the ball's prediction (default 4 radii)"
     )
     p.add_argument(
-        "--ball-fit", choices=("edge", "centroid"), help="centroid: for a ball a few pixels across (default edge)"
+        "--ball-fit",
+        choices=("edge", "centroid", "silhouette"),
+        help="centroid: for a ball a few pixels across; silhouette: a ball that is no bright disc (default edge)",
     )
     p.set_defaults(func=cmd_track_video)
 

@@ -230,3 +230,74 @@ def ball_centroid(img: np.ndarray, cx: float, cy: float, r: float, sigma: float)
         return (), f"ball centroid did not settle (last step {moved:.2f} px)"
     radius = float(np.sqrt(np.count_nonzero(above > 0.5 * peak) / np.pi))
     return (cx, cy, radius, float("nan"), peak), None
+
+
+def _robust_circle(edge: np.ndarray) -> tuple[float, float, float]:
+    """Return the circle (x, y, r) fitted to the True pixels of ``edge`` (algebraic least squares), outliers dropped."""
+    ys, xs = np.nonzero(edge)
+    xs, ys = xs.astype(np.float64), ys.astype(np.float64)
+    keep = np.ones(xs.size, bool)
+    cx, cy, rad = float(xs.mean()), float(ys.mean()), 0.0
+    for _ in range(5):
+        if np.count_nonzero(keep) < 3:
+            break
+        a = np.column_stack([xs[keep], ys[keep], np.ones(np.count_nonzero(keep))])
+        c = np.linalg.lstsq(a, xs[keep] ** 2 + ys[keep] ** 2, rcond=None)[0]
+        cx, cy = c[0] / 2, c[1] / 2
+        rad = float(np.sqrt(max(c[2] + cx * cx + cy * cy, 0.0)))
+        off = np.hypot(xs - cx, ys - cy) - rad
+        spread = 1.4826 * float(np.median(np.abs(off[keep])))
+        keep = np.abs(off) < max(3 * spread, 1.0)
+    return float(cx), float(cy), rad
+
+
+def ball_silhouette(
+    diff: np.ndarray, level: np.ndarray, r: float, tol: float, origin: tuple[int, int], frame_shape: tuple[int, int]
+) -> tuple[list, str | None]:
+    """Return the balls' silhouettes in a region of a background-subtracted frame: ([(x, y, r, nan, contrast)], None).
+
+    Or ([], the reason none is given). ``diff`` is the region of the frame minus the still
+    background, ``level`` the same region's threshold (grey levels, per pixel), ``origin`` the
+    region's (x0, y0) in the frame of ``frame_shape``. A pixel is the ball's where it differs
+    from the background by more than its level, either way (a ball darker than the ground, or
+    lit unevenly: a dark steel ball with a bright highlight is no bright disc); the mask is
+    opened by a 3 x 3 square (lone pixels: noise, compression), its holes filled (the ball's
+    face where it matches the ground), and each region of ``(1 +- tol)^2`` times the disc's area
+    ``pi r^2`` (blur lengthens it: its box at least half as wide as high) is a ball. Its centre
+    and radius are a circle's fitted by least squares to the region's boundary pixels, those
+    more than 3 robust standard deviations (at least 1 px) off dropped, five times: a part of
+    the limb that matches the ground (a mirror-like ball reflects it) is then not the edge.
+    Its contrast is the median absolute difference inside. A region that touches the frame's
+    border is refused (a part of the ball), as is one that touches the region's border (the
+    region cut it).
+    """
+    mask = ndimage.binary_fill_holes(ndimage.binary_opening(np.abs(diff) > level, np.ones((3, 3), bool)))
+    lab, n = ndimage.label(mask)
+    if n == 0:
+        return [], "no ball found"
+    area = np.bincount(lab.ravel(), minlength=n + 1)
+    expect = np.pi * r * r
+    ok = [j for j in range(1, n + 1) if (1 - tol) ** 2 * expect < area[j] < (1 + tol) ** 2 * expect]
+    out, why = [], "no ball found"
+    h, w = diff.shape
+    fh, fw = frame_shape
+    x0, y0 = origin
+    objs = ndimage.find_objects(lab)
+    for j in ok:
+        sl = objs[j - 1]
+        bh, bw = sl[0].stop - sl[0].start, sl[1].stop - sl[1].start
+        if min(bh, bw) < 0.5 * max(bh, bw):
+            why = f"a region of the ball's area {bw} x {bh} px: not round"
+            continue
+        at_frame = sl[0].start + y0 == 0 or sl[1].start + x0 == 0 or sl[0].stop + y0 == fh or sl[1].stop + x0 == fw
+        if at_frame:
+            why = "ball touches the frame's border"
+            continue
+        if sl[0].start == 0 or sl[1].start == 0 or sl[0].stop == h or sl[1].stop == w:
+            why = "the ball's silhouette cut by the search region's border"
+            continue
+        region = lab[sl] == j
+        contrast = float(np.median(np.abs(diff[sl][region])))
+        cx, cy, rad = _robust_circle(region & ~ndimage.binary_erosion(region))
+        out.append((cx + sl[1].start + x0, cy + sl[0].start + y0, rad, float("nan"), contrast))
+    return out, None if out else why

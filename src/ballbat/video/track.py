@@ -34,7 +34,7 @@ import numpy as np
 from .clip import VideoError
 from .edge import fit_ball
 from .io import Clip
-from .search import ball_centroid, find_balls, find_dots, find_marker, find_marker_whole, roi
+from .search import ball_centroid, ball_silhouette, find_balls, find_dots, find_marker, find_marker_whole, roi
 
 
 @dataclass(frozen=True)
@@ -51,7 +51,11 @@ class TrackOptions:
     4 ball radii); a ball that moves further than that between frames (a slow camera) needs more.
     ``ball_fit``: ``"edge"`` (the sub-pixel edge model, :func:`~ballbat.video.edge.fit_ball`),
     or ``"centroid"`` for a ball a few pixels across, too small for it
-    (:func:`~ballbat.video.search.ball_centroid`; no edge residual: NaN).
+    (:func:`~ballbat.video.search.ball_centroid`; no edge residual: NaN), or ``"silhouette"``
+    (needs the median background) for a ball that is no bright disc, darker than the ground or
+    lit unevenly: the region that differs from the still background by more than
+    :data:`SILHOUETTE_SIGMAS` times each pixel's own spread over the background frames
+    (:func:`~ballbat.video.search.ball_silhouette`; no edge residual: NaN).
     """
 
     ball_radius_px: float
@@ -67,14 +71,19 @@ class TrackOptions:
         """Refuse a background, a search region or a ball fit the tracker does not know."""
         if self.background not in ("none", "median"):
             raise ValueError(f"TrackOptions: background {self.background!r} is not 'none' or 'median'")
-        if self.ball_fit not in ("edge", "centroid"):
-            raise ValueError(f"TrackOptions: ball_fit {self.ball_fit!r} is not 'edge' or 'centroid'")
+        if self.ball_fit not in ("edge", "centroid", "silhouette"):
+            raise ValueError(f"TrackOptions: ball_fit {self.ball_fit!r} is not 'edge', 'centroid' or 'silhouette'")
+        if self.ball_fit == "silhouette" and self.background != "median":
+            raise ValueError("TrackOptions: ball_fit 'silhouette' needs background 'median' (the still background)")
         if self.search_px is not None and not self.search_px > 0:
             raise ValueError(f"TrackOptions: search_px {self.search_px!r} must be positive")
 
 
 #: Frames whose per-pixel median is a clip's still background (``TrackOptions.background = "median"``).
 BACKGROUND_FRAMES = 25
+#: A pixel is the ball's silhouette (``ball_fit="silhouette"``) where it differs from the still background by more
+#: than this many times its own spread over the background frames (at least the frame's noise sigma).
+SILHOUETTE_SIGMAS = 6.0
 
 
 @dataclass
@@ -146,6 +155,8 @@ def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found, 
     guess = trail.predict(k)
     v = trail.velocity()
     blur = (v[0] * exposure_frames, v[1] * exposure_frames)
+    if opt.ball_fit == "silhouette":
+        return _silhouette(img, k, opt, trail, found, guess)
     if opt.ball_fit == "centroid":
         fit_at = lambda x, y: _centroid_at(img, x, y, opt, sigma, trail)  # noqa: E731
     else:
@@ -157,6 +168,11 @@ def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found, 
             found.leave_out("ball", k, "no ball found" if not cands else f"{len(cands)} balls found")
             return None
         fit, reason = fit_at(*cands[0])
+    return _keep_ball(fit, reason, k, opt, trail, found)
+
+
+def _keep_ball(fit, reason, k, opt: TrackOptions, trail: _Trail, found: Found):
+    r = opt.ball_radius_px
     if reason is None and abs(fit[2] / r - 1) > opt.radius_tolerance:
         reason = f"fitted radius {fit[2]:.1f} px, expected {r:.1f} px"
     if reason:
@@ -167,6 +183,32 @@ def _ball(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found, 
     found.add("ball", k, fit[0], fit[1], fit[3], fit[4])
     found.ball_radii.append(fit[2])
     return fit
+
+
+def _silhouette(img, k: int, opt: TrackOptions, trail: _Trail, found: Found, guess):
+    """Find the ball's silhouette (``ball_fit`` "silhouette") about the prediction, or in the whole frame without one.
+
+    ``img`` is the frame minus the still background with the threshold map attached
+    (:class:`_Diff`).
+    """
+    if guess is None:
+        diff, level, x0, y0 = img.diff, img.level, 0, 0
+    else:
+        diff, x0, y0 = roi(img.diff, guess[0], guess[1], opt.search_px or 4 * opt.ball_radius_px)
+        level = img.level[y0 : y0 + diff.shape[0], x0 : x0 + diff.shape[1]]
+    balls, why = ball_silhouette(diff, level, opt.ball_radius_px, opt.radius_tolerance, (x0, y0), img.diff.shape)
+    if len(balls) != 1:
+        found.leave_out("ball", k, why if not balls else f"{len(balls)} balls found")
+        return None
+    return _keep_ball(balls[0], None, k, opt, trail, found)
+
+
+@dataclass
+class _Diff:
+    """A frame minus the still background (``diff``) and the silhouette's threshold for each pixel (``level``)."""
+
+    diff: np.ndarray
+    level: np.ndarray
 
 
 def _centroid_at(img, x: float, y: float, opt: TrackOptions, sigma: float, trail: _Trail) -> tuple[tuple, str | None]:
@@ -291,12 +333,23 @@ def still_background(clip: Clip, n: int = BACKGROUND_FRAMES) -> np.ndarray:
     Streamed: only the frames taken are kept. A moving ball is in few of them, so the median is
     the ground behind it; something that stays where it is for most of the clip is background.
     """
+    return _still(clip, n)[0]
+
+
+def _still(clip: Clip, n: int = BACKGROUND_FRAMES) -> tuple[np.ndarray, np.ndarray]:
+    """Return the still background (:func:`still_background`) and each pixel's spread about it over the same frames.
+
+    The spread is 1.4826 times the median absolute deviation (float32): a pixel's own noise, the
+    compression's, a flicker, robust to the ball passing in a few of the frames.
+    """
     total = clip.info.n_frames if clip.info.n_frames is not None else sum(1 for _ in clip.frames())
     take = set(np.unique(np.linspace(0, max(total - 1, 0), min(n, max(total, 1))).round().astype(int)).tolist())
     kept = [img for k, _, img in clip.frames() if k in take]
     if not kept:
         raise VideoError(f"{clip.info.path}: no frames for the still background")
-    return np.median(np.stack(kept), axis=0).astype(np.float32)
+    stack = np.stack(kept).astype(np.float32)
+    med = np.median(stack, axis=0)
+    return med, (1.4826 * np.median(np.abs(stack - med), axis=0)).astype(np.float32)
 
 
 def track_clip(clip: Clip, opt: TrackOptions) -> Found:
@@ -305,7 +358,8 @@ def track_clip(clip: Clip, opt: TrackOptions) -> Found:
     With ``opt.background == "median"`` the clip is read twice: first for its still background
     (:func:`still_background`), then frame by frame with the background subtracted.
     """
-    background = still_background(clip) if opt.background == "median" else None
+    background, spread = _still(clip) if opt.background == "median" else (None, None)
+    level = None
     found = Found()
     trails = {"ball": _Trail(), "bat_tip": _Trail()}
     mem = _DotMemory()
@@ -320,7 +374,11 @@ def track_clip(clip: Clip, opt: TrackOptions) -> Found:
             img = img.astype(np.float32) - background
         f = int(numbers[k]) if numbers is not None and k < numbers.size else k
         sigma = _noise_sigma(img) if sigma is None else sigma
-        ball = _ball(img, f, opt, trails["ball"], sigma, found, exposure_frames)
+        if opt.ball_fit == "silhouette":
+            level = SILHOUETTE_SIGMAS * np.maximum(spread, sigma) if level is None else level
+            ball = _ball(_Diff(img, level), f, opt, trails["ball"], sigma, found, exposure_frames)
+        else:
+            ball = _ball(img, f, opt, trails["ball"], sigma, found, exposure_frames)
         if ball is not None and "dot_a" in opt.points:
             _dots(img, f, ball, opt, sigma, mem, found)
         elif "dot_a" in opt.points:
