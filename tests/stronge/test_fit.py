@@ -257,3 +257,12 @@ def test_value_alone_without_errors(balls, bats):
     assert np.isfinite(full.eta2_err) and np.isnan(alone.eta2_err) and np.isnan(alone.dof)
     with pytest.raises(ValueError, match="the profile interval needs the standard errors"):
         fit_eta2(psi, x, y, r_x, r_y, errors=False)
+
+
+def test_the_start_snapped_to_zero_below_lmfits_own_tiny():
+    """fit.LMFIT_TINY is lmfit's ``lineshapes.tiny``, which lmfit's leastsq wrapper compares the start with."""
+    from lmfit.lineshapes import tiny
+
+    from ballbat.stronge import fit
+
+    assert fit.LMFIT_TINY == tiny

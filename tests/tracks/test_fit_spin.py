@@ -73,3 +73,21 @@ def test_the_spin_fit_tells_a_tilted_axis_from_noise():
     assert np.mean(tilted.offset_chi2 > limit) > 0.8  # 87 % (seed 4)
     off = np.hypot(*tilted.offset.T)
     assert 0.006 < np.median(off) < 0.014, np.median(off)  # height 19-27 mm x sin 30 deg
+
+
+def test_the_radius_limit_is_scipy_stats_f_isf_to_the_bit():
+    """radius_scatter_limit's F quantile (scipy.special.fdtri at 1 - q) is scipy.stats.f.isf's number, bit for bit."""
+    from scipy import stats
+
+    from ballbat.tracks.fit_spin import RADIUS_FALSE_ALARM, radius_scatter_limit
+
+    rng = np.random.default_rng(5)
+    n = rng.integers(0, 80, 500).astype(float)
+    dof = rng.integers(0, 300, 500).astype(float)
+    noise = rng.uniform(1e-4, 3e-3, 500)
+    got = radius_scatter_limit(noise, dof, n)
+    ok = (n >= 2) & (dof >= 1)
+    q = stats.f.isf(RADIUS_FALSE_ALARM, np.maximum(n - 1, 1), np.maximum(dof, 1))
+    want = np.where(ok, noise * np.sqrt((1 + 2 / np.maximum(n, 1)) * q), np.nan)
+    np.testing.assert_array_equal(got, want)
+    assert np.isfinite(got).sum() > 400

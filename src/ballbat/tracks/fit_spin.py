@@ -64,12 +64,12 @@ def radius_scatter_limit(noise: ArrayLike, noise_dof: ArrayLike, n: ArrayLike) -
     ndarray
         NaN where ``n`` < 2 or the noise has no degree of freedom.
     """
-    from scipy import stats
+    from scipy.special import fdtri  # scipy.stats.f.isf's own number (its ppf at 1 - q), without its checks
 
     n = np.asarray(n, dtype=float)
     dof2 = np.asarray(noise_dof, dtype=float)
     ok = (n >= 2) & (dof2 >= 1)
-    q = stats.f.isf(RADIUS_FALSE_ALARM, np.maximum(n - 1, 1), np.maximum(dof2, 1))
+    q = fdtri(np.maximum(n - 1, 1), np.maximum(dof2, 1), 1.0 - RADIUS_FALSE_ALARM)
     with np.errstate(all="ignore"):
         lim = np.asarray(noise, dtype=float) * np.sqrt((1 + 2 / np.maximum(n, 1)) * q)
     return np.where(ok, lim, np.nan)
