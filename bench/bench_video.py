@@ -5,7 +5,9 @@
 1. Speed: frames tracked per second of one core's CPU time on the swing clips (ball and tip
    marker) and the spin clips (ball and dots), 1024 x 512, 8 bit, read from TIFF with the
    exposure in the file (the fit's motion blur), the decoding alone timed apart; the first
-   clips also pay for the edge model's bases as they are first needed. Target >= 1000.
+   clips also pay for the edge model's bases as they are first needed. Target >= 1000. The
+   process's one start, importing numba and loading the compiled kernels (or compiling them,
+   where numba's cache has none), is timed apart, before.
 2. Memory: the peak of Python's allocations (tracemalloc) while tracking a clip and the same
    clip four times over (flat when frames are streamed).
 3. Accuracy: ``n_impacts`` impacts (default 4) rendered in both cameras (1024 x 512 px, 8 bit,
@@ -128,8 +130,16 @@ def accuracy(clips, s, tmp: Path) -> None:
 
 
 def speed(clips, s, tmp: Path) -> None:
-    """Print the frames decoded and tracked per second of CPU time, per camera."""
+    """Print the kernels' start, then the frames decoded and tracked per second of CPU time, per camera."""
     print("## 1. Speed, one core (CPU time), clips 1024 x 512 8 bit from TIFF")
+    t0 = time.process_time()
+    from ballbat.video import kernels
+
+    kernels.load(np.uint8)
+    print(
+        f"  start: numba imported and the tracker's compiled kernels loaded in {time.process_time() - t0:.2f} s "
+        "(once per process, not in the rates below)"
+    )
     for camera in ("swing", "spin"):
         n = dec = trk = 0.0
         for c in (c for c in clips if c.camera == camera):

@@ -6,10 +6,11 @@ wide window, until the circle moves by under a pixel; then a model of each ray's
 A circle is fitted to the edge points by least squares, points off it by more than 3 robust
 standard deviations dropped (twice).
 
-Speed (issue 38): every ray of a pass is one array operation (the 48 rays' profiles one
-bilinear gather from the frame, never the whole frame; the 61 tried edges of every ray one
-matrix product against the cached orthonormal bases of the model), and the circle's least
-squares are solved from their 3 x 3 normal equations.
+Speed (issue 38): the 48 rays' profiles are one bilinear gather from the frame, never the
+whole frame; the 61 tried edges of every ray one matrix product per blur against the cached
+orthonormal bases of the model; the circle's least squares are solved from their 3 x 3 normal
+equations. Each pass runs compiled (:mod:`ballbat.video.kernels`, one call); the numpy
+functions here are what the kernels do, and their reference (``fit_ball(compiled=False)``).
 """
 
 from __future__ import annotations
@@ -29,6 +30,8 @@ _SAMPLES = np.arange(-5.0, 5.01, 0.5)
 _CAND = np.arange(-3.0, 3.0001, 0.1)
 _WIDE = np.arange(-10.0, 10.01, 0.5)
 _TRIO = np.array([-1, 0, 1])
+#: Where each ray's row of tried edges starts in a (rays x 61) array, raveled.
+_ROW_STARTS = _CAND.size * np.arange(N_RAYS)
 #: The fine grid the model's terms are smoothed on (px), and where the samples fall on it.
 _FINE = np.arange(-9.0, 9.0, 0.05)
 _AT = np.round((_SAMPLES - _FINE[0]) / 0.05).astype(int)
@@ -50,14 +53,38 @@ def _sampled_convolution(kern: np.ndarray) -> np.ndarray:
     return np.where((lag >= 0) & (lag < kern.size), kern[np.clip(lag, 0, kern.size - 1)], 0.0)
 
 
-@functools.lru_cache(maxsize=32)
-def _terms(radius: float) -> np.ndarray:
-    """Return the ray model's four non-constant terms on the fine grid, for every tried edge: (4, 61, fine)."""
+def _fixed_terms() -> np.ndarray:
+    """Return the terms that do not depend on the radius: the slope outside, the constant inside: (2, 61, fine)."""
     e = _CAND[:, None]
     fine = _FINE[None, :]
     inside = (fine < e) * 1.0
+    return np.stack([(1 - inside) * (fine - e), inside])
+
+
+_TERMS_FIXED = _fixed_terms()
+
+
+@functools.lru_cache(maxsize=32)
+def _sphere(radius: float) -> np.ndarray:
+    """Return the sphere's two terms, of radius ``radius`` + e: sqrt(1 - rho^2) and rho inside: (2, 61, fine)."""
+    e = _CAND[:, None]
+    fine = _FINE[None, :]
     rho = (radius + fine) / (radius + e)
-    return np.stack([(1 - inside) * (fine - e), inside, np.sqrt(np.clip(1 - rho * rho, 0, None)), inside * rho])
+    return np.stack([np.sqrt(np.maximum(1 - rho * rho, 0)), _TERMS_FIXED[1] * rho])
+
+
+@functools.lru_cache(maxsize=64)
+def _smoothing(blur: float) -> tuple[np.ndarray, np.ndarray]:
+    """Return a blur's sampled smoothing K (:func:`_sampled_convolution`) and the three radius-free terms through it.
+
+    The constant, the slope outside, the constant inside: (61, samples, 3); a new radius then
+    smooths only the sphere's two terms.
+    """
+    k = _sampled_convolution(_kernel(blur))
+    fixed = np.empty((_CAND.size, _SAMPLES.size, 3))
+    fixed[:, :, 0] = k.sum(axis=0)
+    fixed[:, :, 1:] = np.moveaxis(_TERMS_FIXED @ k, 0, 2)
+    return k, fixed
 
 
 @functools.lru_cache(maxsize=256)
@@ -74,12 +101,13 @@ def edge_bases(radius: float, blur: float = 0.0) -> np.ndarray:
     A profile y's residual at e is |y|^2 - |y @ basis_e|^2. The basis is the QR factorisation's
     Q: the five terms are independent (their smallest singular value at least 2e-5 of the
     largest over radii of 5-80 px and blurs of 0-12 px), so it spans what a pseudo-inverse's
-    projector does.
+    projector does. The terms that do not depend on the radius are smoothed once per blur
+    (:func:`_smoothing`).
     """
-    k = _sampled_convolution(_kernel(blur))
+    k, fixed = _smoothing(blur)
     d = np.empty((_CAND.size, _SAMPLES.size, 5))  # each term smoothed and sampled
-    d[:, :, 0] = k.sum(axis=0)
-    d[:, :, 1:] = np.moveaxis(_terms(radius) @ k, 0, 2)
+    d[:, :, :3] = fixed
+    d[:, :, 3:] = np.moveaxis(_sphere(radius) @ k, 0, 2)
     q = np.linalg.qr(d)[0]  # (61, samples, 5)
     return np.ascontiguousarray(np.swapaxes(q, 0, 1).reshape(_SAMPLES.size, -1))
 
@@ -92,16 +120,19 @@ def profiles(
     In float32, as the tracker has always sampled them (float64 moved marginal frames of lossy clips).
     """
     rr = r + rad
-    xs, ys = cx + cos[:, None] * rr, cy + sin[:, None] * rr
-    return ndimage.map_coordinates(img, [ys.ravel(), xs.ravel()], output=np.float32, order=1, prefilter=False).reshape(
-        xs.shape
-    )
+    at = np.empty((2, cos.size, rad.size))
+    np.add(np.multiply.outer(sin, rr, out=at[0]), cy, out=at[0])
+    np.add(np.multiply.outer(cos, rr, out=at[1]), cx, out=at[1])
+    return ndimage.map_coordinates(img, at, output=np.float32, order=1, prefilter=False)
 
 
-def _edges_gradient(prof: np.ndarray, rad: np.ndarray) -> np.ndarray:
-    """Rough edge on each ray: the peak of the radial gradient, smoothed (offsets from the radius)."""
-    sign = np.sign(prof[:, :4].sum(axis=1) - prof[:, -4:].sum(axis=1))
-    d = np.diff(prof, axis=1) * -sign[:, None]  # the central gradient, smoothed by [1/4, 1/2, 1/4]
+def _edges_gradient(prof: np.ndarray, rad: np.ndarray, sign: np.ndarray) -> np.ndarray:
+    """Rough edge on each ray: the peak of the radial gradient, smoothed (offsets from the radius).
+
+    ``sign``: +1 where the ray's inner end is the brighter.
+    """
+    d = np.diff(prof, axis=1)
+    d *= -sign[:, None]  # the central gradient, smoothed by [1/4, 1/2, 1/4]
     g = np.concatenate([d[:, :1], d, d[:, -1:]], axis=1)
     g = g[:, :-1] + g[:, 1:]
     g = np.concatenate([g[:, :1], g, g[:, -1:]], axis=1)
@@ -112,20 +143,31 @@ def _edges_model(prof: np.ndarray, r: float, sigma, groups: list) -> tuple[np.nd
     """Return the edge on each ray by the ray model (:func:`edge_bases`): offsets and the fit's chi-square per sample.
 
     ``sigma`` is the scale of the residuals (per ray or one); ``groups`` the rays (a slice) of each motion blur (px).
+    One matrix product per blur into one array, the bases' columns ordered term by term (:func:`_term_bases`), so
+    that each tried edge's sum over its five terms adds five contiguous rows.
     """
+    n = prof.shape[0]
     y = prof.astype(np.float64)
-    y -= y.mean(axis=1, keepdims=True)  # the constant is in the model: its residual is unchanged
-    rss = np.empty((y.shape[0], _CAND.size))
-    yy = np.einsum("ij,ij->i", y, y)[:, None]
+    y -= np.add.reduce(y, axis=1, keepdims=True) / _SAMPLES.size  # the constant is in the model: residual unchanged
+    p = np.empty((n, 5 * _CAND.size))
+    radius = round(2 * r) / 2
     for sel, b in groups:
-        p = y[sel] @ edge_bases(round(2 * r) / 2, b)
-        p *= p
-        np.subtract(yy[sel], p.reshape(-1, _CAND.size, 5).sum(axis=2), out=rss[sel])
-    k = np.clip(np.argmin(rss, axis=1), 1, _CAND.size - 2)
-    r0, r1, r2 = np.take_along_axis(rss, k[:, None] + _TRIO, axis=1).T
+        np.matmul(y[sel], _term_bases(radius, b), out=p[sel])
+    p *= p
+    rss = np.einsum("ij,ij->i", y, y)[:, None] - np.add.reduce(p.reshape(n, 5, _CAND.size), axis=1)
+    k = np.argmin(rss, axis=1)
+    np.minimum(np.maximum(k, 1, out=k), _CAND.size - 2, out=k)  # np.clip's own overhead is several times these
+    r0, r1, r2 = rss.ravel()[(k + _ROW_STARTS[:n])[None, :] + _TRIO[:, None]]
     den = r0 - 2 * r1 + r2
-    off = np.clip(0.5 * (r0 - r2) / np.where(den > 0, den, np.inf), -0.5, 0.5)
+    off = np.minimum(np.maximum(0.5 * (r0 - r2) / np.where(den > 0, den, np.inf), -0.5), 0.5)
     return _CAND[k] + off * (_CAND[1] - _CAND[0]), r1 / (sigma**2 * (_SAMPLES.size - 5))
+
+
+@functools.lru_cache(maxsize=256)
+def _term_bases(radius: float, blur: float) -> np.ndarray:
+    """Return :func:`edge_bases` with its columns ordered term by term (5 x 61 tried edges), not edge by edge."""
+    q = edge_bases(radius, blur).reshape(_SAMPLES.size, _CAND.size, 5)
+    return np.ascontiguousarray(q.transpose(0, 2, 1).reshape(_SAMPLES.size, -1))
 
 
 def _circle_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
@@ -134,13 +176,21 @@ def _circle_fit(x: np.ndarray, y: np.ndarray) -> tuple[float, float, float]:
     About the points' mean the normal equations of x^2 + y^2 = a x + b y + c split: c is the
     mean of x^2 + y^2, and (a, b) solve a 2 x 2 system.
     """
-    mx, my = x.mean(), y.mean()
-    u, v = x - mx, y - my
-    z = u * u + v * v
-    suu, suv, svv, suz, svz = u @ u, u @ v, v @ v, u @ z, v @ z
+    return _circle_of(np.stack([x, y]))
+
+
+def _circle_of(pts: np.ndarray) -> tuple[float, float, float]:
+    """:func:`_circle_fit` of the points ``pts`` (2 x n), its sums one matrix product."""
+    n = pts.shape[1]
+    m = np.add.reduce(pts, axis=1) / n
+    uvz = np.empty((3, n))
+    np.subtract(pts, m[:, None], out=uvz[:2])
+    np.einsum("ij,ij->j", uvz[:2], uvz[:2], out=uvz[2])
+    (suu, suv, suz), (_, svv, svz) = (uvz[:2] @ uvz.T).tolist()
     det = suu * svv - suv * suv
     a, b = (suz * svv - svz * suv) / det, (svz * suu - suz * suv) / det
-    c = z.mean()
+    c = float(np.add.reduce(uvz[2])) / n
+    mx, my = m.tolist()
     return a / 2 + mx, b / 2 + my, float(np.sqrt(max(c + a * a / 4 + b * b / 4, 0)))
 
 
@@ -150,35 +200,50 @@ def _median(v: np.ndarray) -> float:
     return float(s[n // 2]) if n % 2 else float(0.5 * (s[n // 2 - 1] + s[n // 2]))
 
 
-def _fit_circle_robust(px, py, keep):
-    """Circle through the kept edge points, points off by more than 3 robust sigma dropped (twice)."""
+def _fit_circle_robust(pts: np.ndarray, keep: np.ndarray):
+    """Circle through the kept edge points (2 x rays), points off by more than 3 robust sigma dropped (twice)."""
     for _ in range(2):
-        if keep.sum() < N_RAYS // 2:
+        if np.count_nonzero(keep) < N_RAYS // 2:
             return None, keep
-        fx, fy, fr = _circle_fit(px[keep], py[keep])
-        res = np.hypot(px - fx, py - fy) - fr
+        fx, fy, fr = _circle_of(pts[:, keep])
+        res = np.hypot(pts[0] - fx, pts[1] - fy)
+        res -= fr
         kr = res[keep]
         mad = 1.4826 * _median(np.abs(kr - _median(kr))) + 0.05  # a clean edge: 0.15 px
         keep = keep & (np.abs(res) < 3 * mad)
     return (fx, fy, fr, res), keep
 
 
-def _rays(blur: tuple[float, float]) -> tuple[np.ndarray, np.ndarray, list]:
-    """Return the rays' directions (cos, sin), ordered by the motion blur along them, and each blur's rays (a slice).
+def _rays(blur: tuple[float, float]) -> tuple[np.ndarray, np.ndarray, list, np.ndarray]:
+    """Return the rays' directions (cos, sin) ordered by the blur along them, each blur's rays, and where they start.
 
-    The blur is taken to 0.5 px (the model's bases are cached per blur).
+    Each blur's rays as (a slice, the blur), and their starts as an array (with the end). The
+    blur is taken to 0.5 px (the model's bases are cached per blur); so is the order (per blur on
+    each ray).
     """
     buckets = np.round(2 * np.abs(_COS * blur[0] + _SIN * blur[1])) / 2
+    return _ray_order(buckets.tobytes())
+
+
+@functools.lru_cache(maxsize=1024)
+def _ray_order(key: bytes) -> tuple[np.ndarray, np.ndarray, list, np.ndarray]:
+    buckets = np.frombuffer(key)
     order = np.argsort(buckets, kind="stable")
     b = buckets[order]
     cut = np.flatnonzero(np.diff(b)) + 1
     edges = [0, *cut.tolist(), N_RAYS]
     groups = [(slice(i, j), float(b[i])) for i, j in itertools.pairwise(edges)]
-    return _COS[order], _SIN[order], groups
+    return _COS[order], _SIN[order], groups, np.array(edges)
 
 
 def fit_ball(
-    img: np.ndarray, cx: float, cy: float, r: float, sigma: float, blur: tuple[float, float] = (0.0, 0.0)
+    img: np.ndarray,
+    cx: float,
+    cy: float,
+    r: float,
+    sigma: float,
+    blur: tuple[float, float] = (0.0, 0.0),
+    compiled: bool = True,
 ) -> tuple[tuple, str | None]:
     """Return the ball's sub-pixel centre near (cx, cy): ((x, y, r, rms, contrast), None) or ((), reason left out).
 
@@ -186,24 +251,21 @@ def fit_ball(
     The rough edges (gradient peaks on a wide window) until the circle moves by under a pixel,
     then the ray model (:func:`_edges_model`) until it moves by under 0.01 px (at most 8 passes).
     ``blur`` is the ball's travel during the exposure (px, x and y), where known.
+    Each pass runs compiled (:mod:`ballbat.video.kernels`); ``compiled=False`` runs the numpy
+    functions they are checked against (the same fit, to rounding).
     """
-    cos, sin, groups = _rays(blur)
+    cos, sin, groups, starts = _rays(blur)
+    if compiled and not (img.flags.c_contiguous and img.dtype.isnative):  # one layout of the frame compiled
+        img = np.ascontiguousarray(img, img.dtype.newbyteorder("="))
     h, w = img.shape
     wide, moved, kept = True, np.inf, np.ones(N_RAYS, bool)
+    one_pass = _pass_compiled if compiled else _pass_numpy
     for _ in range(8):
         rad = _WIDE if wide else _SAMPLES
-        if min(cx - r, cy - r, w - 1 - cx - r, h - 1 - cy - r) < rad[-1] + 1:
+        # not min(...) < ...: a centre that is not a number is outside too
+        if not min(cx - r, cy - r, w - 1 - cx - r, h - 1 - cy - r) >= rad[-1] + 1 or not np.isfinite(cx + cy + r):
             return (), "ball touches the frame's border"
-        prof = profiles(img, cx, cy, r, rad, cos, sin)
-        step = np.abs(prof[:, :4].mean(axis=1) - prof[:, -4:].mean(axis=1))
-        keep = step > 6 * sigma
-        if wide:
-            edge = _edges_gradient(prof, rad)
-        else:
-            # the model's own mismatch grows with the edge's contrast: 2 % of the step counts as noise
-            edge, chi2 = _edges_model(prof, r, np.maximum(sigma, 0.02 * step), groups)
-            keep &= (chi2 < 2.0) & kept  # a ray once dropped stays dropped: the passes settle
-        fit, keep = _fit_circle_robust(cx + cos * (r + edge), cy + sin * (r + edge), keep)
+        fit, keep, step = one_pass(img, cx, cy, r, rad, cos, sin, (groups, starts), sigma, kept, wide)
         if fit is None:
             return (), f"ball edge seen on {int(keep.sum())} of {N_RAYS} rays (occluded, blurred or on clutter)"
         moved = max(abs(fit[0] - cx), abs(fit[1] - cy), abs(fit[2] - r))
@@ -218,3 +280,52 @@ def fit_ball(
     if rms > 0.5:  # edge points that no circle fits: the ball half hidden, or an edge of the clutter taken
         return (), f"ball edge not round (residual {rms:.2f} px; occluded or on clutter)"
     return (cx, cy, r, rms, _median(step[keep])), None
+
+
+def _pass_numpy(img, cx, cy, r, rad, cos, sin, groups, sigma, kept, wide):
+    """One pass of :func:`fit_ball` in numpy: ((x, y, r, residuals) or None, the rays kept, each ray's step)."""
+    groups = groups[0]
+    prof = profiles(img, cx, cy, r, rad, cos, sin)
+    ends = np.add.reduce(prof[:, :4], axis=1) - np.add.reduce(prof[:, -4:], axis=1)
+    step = np.abs(ends) / 4
+    keep = step > 6 * sigma
+    if wide:
+        edge = _edges_gradient(prof, rad, np.sign(ends))
+    else:
+        # the model's own mismatch grows with the edge's contrast: 2 % of the step counts as noise
+        edge, chi2 = _edges_model(prof, r, np.maximum(sigma, 0.02 * step), groups)
+        keep &= (chi2 < 2.0) & kept  # a ray once dropped stays dropped: the passes settle
+    at = r + edge
+    pts = np.stack([cx + cos * at, cy + sin * at])
+    fit, keep = _fit_circle_robust(pts, keep)
+    return fit, keep, step
+
+
+def _pass_compiled(img, cx, cy, r, rad, cos, sin, groups, sigma, kept, wide):
+    """:func:`_pass_numpy` by the kernels of :mod:`ballbat.video.kernels` (the model's products by BLAS, as numpy's)."""
+    kernels = _kernels()
+    if not kernels.inside(img, cx, cy, abs(r) + rad[-1]):  # what the border test keeps: never out of the frame
+        raise ValueError(f"fit_ball: rays about ({cx}, {cy}), radius {r}, leave the frame")
+    if wide:
+        fitted, fx, fy, fr, res, keep, step = kernels.gradient_pass(img, cx, cy, r, rad, cos, sin, sigma, N_RAYS // 2)
+    else:
+        groups, starts = groups
+        bases = _group_bases(round(2 * r) / 2, tuple(b for _, b in groups))
+        fitted, fx, fy, fr, res, keep, step = kernels.model_pass(
+            img, cx, cy, r, rad, cos, sin, bases, starts, _CAND, sigma, kept, N_RAYS // 2
+        )
+    return ((fx, fy, fr, res) if fitted else None), keep, step
+
+
+@functools.lru_cache(maxsize=1)
+def _kernels():
+    """Return :mod:`ballbat.video.kernels`, imported where a ball is first fitted (numba: about 0.3 s of CPU, once)."""
+    from . import kernels
+
+    return kernels
+
+
+@functools.lru_cache(maxsize=256)
+def _group_bases(radius: float, blurs: tuple[float, ...]) -> np.ndarray:
+    """Return the bases (:func:`_term_bases`) of each group of rays (by its blur), stacked."""
+    return np.stack([_term_bases(radius, b) for b in blurs])

@@ -2,8 +2,9 @@
 
 The searches of :mod:`ballbat.video.track`, each written for speed (issue 38): label statistics
 by ``np.bincount`` (one pass for every label), each spot's own work in a window about it (not
-the whole region), and the whole frame searched at quarter resolution (:func:`block_mean`),
-only where no prediction is at hand.
+the whole region), and the whole frame searched at quarter resolution (:func:`block_sum`),
+only where no prediction is at hand. The marker's and the dots' searches in their regions run
+compiled (:mod:`ballbat.video.kernels`); the numpy here is their reference (``compiled=False``).
 """
 
 from __future__ import annotations
@@ -48,6 +49,31 @@ def _median_top(v: np.ndarray, q: float) -> tuple[float, float]:
     return mid, top
 
 
+def median_of(v: np.ndarray) -> float:
+    """Return ``np.median`` of a 1-d float array without NaNs: the same partition and mean, minus its overhead."""
+    n = v.size
+    k = n // 2
+    if n % 2:
+        return float(np.partition(v, k)[k])
+    s = np.partition(v, (k - 1, k))
+    return float((s[k - 1] + s[k]) / 2)
+
+
+#: The offsets within 2 px in city-block distance: two binary dilations by the cross, as one.
+_DIAMOND2 = [(dy, dx) for dy in range(-2, 3) for dx in range(-2, 3) if abs(dy) + abs(dx) <= 2]
+
+
+def _grown2(mask: np.ndarray) -> np.ndarray:
+    """Return ``ndimage.binary_dilation(mask, iterations=2)`` (the cross twice; outside the array is False)."""
+    h, w = mask.shape
+    pad = np.zeros((h + 4, w + 4), bool)
+    pad[2:-2, 2:-2] = mask
+    out = np.zeros_like(mask)
+    for dy, dx in _DIAMOND2:
+        out |= pad[2 + dy : 2 + dy + h, 2 + dx : 2 + dx + w]
+    return out
+
+
 def _centroids(lab: np.ndarray, labels: np.ndarray, weights: np.ndarray) -> tuple[np.ndarray, np.ndarray, list]:
     """Return the ``weights``-weighted centroids (x, y) of ``labels`` in the labelled array, and their boxes.
 
@@ -86,17 +112,31 @@ def find_balls(img: np.ndarray, radius: float, tol: float) -> list[tuple[float, 
     return out
 
 
-def find_dots(img: np.ndarray, ball: tuple, dot_r: float, sigma: float) -> tuple[list, str | None]:
-    """Return the dark spots inside the ball: [(x, y, contrast, distance / radius)], or the reason they are left out."""
+def find_dots(
+    img: np.ndarray, ball: tuple, dot_r: float, sigma: float, compiled: bool = True
+) -> tuple[list, str | None]:
+    """Return the dark spots inside the ball: [(x, y, contrast, distance / radius)], or the reason they are left out.
+
+    Compiled (:func:`ballbat.video.kernels.dots_search`); ``compiled=False`` runs the numpy
+    reference it is checked against.
+    """
     cx, cy, r = ball[:3]
     sub, x0, y0 = roi(img, cx, cy, r + 2)
     sub = sub.astype(np.float32)  # the region only, not the whole frame
+    if compiled:
+        from . import kernels  # numba only where the dots are searched
+
+        spots, status = kernels.dots_search(sub, x0, y0, cx, cy, r, dot_r, sigma)
+        if status < 0:
+            return [], "no dot seen on the ball"
+        return [(float(x), float(y), float(c), float(d)) for x, y, c, d in spots.tolist()], None
     size = int(2 * np.ceil(2 * dot_r) + 1)
     dark = ndimage.grey_closing(sub, size=(size, size)) - sub
-    yy, xx = np.ogrid[0 : sub.shape[0], 0 : sub.shape[1]]
+    yy, xx = np.arange(sub.shape[0])[:, None], np.arange(sub.shape[1])[None, :]
     inside = np.hypot(xx + x0 - cx, yy + y0 - cy) < r - 2
     # a dot is dark: more than 5 noise sigma and a third of the ball's own level below the shading
-    level = max(5 * sigma, float(np.median(sub[inside])) / 3) if inside.any() else 5 * sigma
+    ball_px = sub[inside]
+    level = max(5 * sigma, median_of(ball_px) / 3) if ball_px.size else 5 * sigma
     lab, n = ndimage.label((dark > level) & inside)
     if n == 0:
         return [], "no dot seen on the ball"
@@ -106,8 +146,8 @@ def find_dots(img: np.ndarray, ball: tuple, dot_r: float, sigma: float) -> tuple
     for j in np.flatnonzero(area >= max(0.25 * np.pi * dot_r**2, 3)) + 1:
         win = tuple(slice(max(q.start - 2, 0), q.stop + 2) for q in objs[j - 1])  # the spot grown by 2 px
         spot = lab[win] == j
-        m = ndimage.binary_dilation(spot, iterations=2) & inside[win]
-        wgt = np.where(m, np.clip(dark[win], 0, None), 0)
+        m = _grown2(spot) & inside[win]
+        wgt = np.where(m, np.maximum(dark[win], 0), 0)
         tot = wgt.sum()
         x = (wgt * xx[:, win[1]]).sum() / tot + x0
         y = (wgt * yy[win[0], :]).sum() / tot + y0
@@ -120,11 +160,11 @@ def _marker_at(sub, mx, my, mr):
     ws = int(np.ceil(2.5 * mr)) + 1
     ya, xa = max(int(my) - ws, 0), max(int(mx) - ws, 0)
     win = sub[ya : int(my) + ws + 1, xa : int(mx) + ws + 1]
-    gy, gx = np.ogrid[ya : ya + win.shape[0], xa : xa + win.shape[1]]
+    gy, gx = np.arange(ya, ya + win.shape[0])[:, None], np.arange(xa, xa + win.shape[1])[None, :]
     d = np.hypot(gx - mx, gy - my)
-    level = float(np.median(win[(d > 1.5 * mr) & (d < 2.5 * mr)]))  # the end cap round the marker
+    level = median_of(win[(d > 1.5 * mr) & (d < 2.5 * mr)])  # the end cap round the marker
     core = d < 1.3 * mr
-    wgt = np.clip(win - level, 0, None) * core
+    wgt = np.maximum(win - level, 0) * core
     tot = wgt.sum()
     if tot <= 0:
         return level, None
@@ -132,17 +172,30 @@ def _marker_at(sub, mx, my, mr):
 
 
 def find_marker(
-    img: np.ndarray, cx: float, cy: float, half: float, mr: float, sigma: float, top: float | None = None
+    img: np.ndarray,
+    cx: float,
+    cy: float,
+    half: float,
+    mr: float,
+    sigma: float,
+    top: float | None = None,
+    compiled: bool = True,
 ) -> tuple | None:
     """Return the tip marker (a bright disc of radius ``mr`` in a dark surround) nearest (cx, cy): (x, y, contrast).
 
     A spot's contrast must be over 0.3 of the brightest value's above its surround (``top``:
-    the region's brightest, unless given).
+    the region's brightest, unless given). Compiled (:func:`ballbat.video.kernels.marker_search`);
+    ``compiled=False`` runs the numpy reference it is checked against.
     """
     sub, x0, y0 = roi(img, cx, cy, half)
     sub = sub.astype(np.float32)  # the region only, not the whole frame
     if min(sub.shape) < 2 * mr:
         return None
+    if compiled:
+        from . import kernels  # numba only where the marker is searched
+
+        found, x, y, contrast = kernels.marker_search(sub, cx - x0, cy - y0, mr, sigma, np.nan if top is None else top)
+        return (x + x0, y + y0, contrast) if found else None
     local = ndimage.uniform_filter(sub, size=int(4 * mr + 1))
     lab, n = ndimage.label(sub - local > 8 * sigma)
     if n == 0:
@@ -151,12 +204,19 @@ def find_marker(
     ok = np.flatnonzero((area > 0.3 * np.pi * mr**2) & (area < 2.0 * np.pi * mr**2)) + 1
     top = float(sub.max()) if top is None else top
     best = None
-    for j, mx, my, sl in zip(ok, *_centroids(lab, ok, sub), strict=True):
-        level, c = _marker_at(sub, mx, my, mr)
+    mx, my, boxes = _centroids(lab, ok, sub)
+    # the spots nearest first: a marker's centre is within 1.3 mr of its spot's, so a spot further than the best
+    # marker so far by more than that cannot give a nearer one (the same marker as trying every spot)
+    near = np.hypot(mx + x0 - cx, my + y0 - cy)
+    for i in np.argsort(near, kind="stable"):
+        if best is not None and near[i] - 1.3 * mr > best[3] + 1e-9:
+            break
+        level, c = _marker_at(sub, mx[i], my[i], mr)
         if c is None:
             continue
         x, y = c[0] + x0, c[1] + y0
-        contrast = float(sub[sl][lab[sl] == j].mean() - level)
+        sl = boxes[i]
+        contrast = float(sub[sl][lab[sl] == ok[i]].mean() - level)
         if contrast > 0.3 * (top - level) and (best is None or np.hypot(x - cx, y - cy) < best[3]):
             best = (float(x), float(y), contrast, float(np.hypot(x - cx, y - cy)))
     return best[:3] if best else None
@@ -182,7 +242,14 @@ def find_marker_whole(img: np.ndarray, mr: float, sigma: float) -> tuple | None:
     h, w = img.shape
     top = float(img.max())
     best = None
-    for x, y in zip((mx + 0.5) * s - 0.5, (my + 0.5) * s - 0.5, strict=True):
+    xs, ys = (mx + 0.5) * s - 0.5, (my + 0.5) * s - 0.5
+    # the spots nearest the centre first: a marker taken is within 2 mr of its spot, so a spot further than the
+    # best marker so far by more than that cannot give a nearer one (the same marker as trying every spot)
+    near = np.hypot(xs - w / 2, ys - h / 2)
+    for i in np.argsort(near, kind="stable"):
+        if best is not None and near[i] - 2 * mr > best[3] + 1e-9:
+            break
+        x, y = xs[i], ys[i]
         m = find_marker(img, x, y, 4 * mr + 20, mr, sigma, top)
         if m is None or np.hypot(m[0] - x, m[1] - y) > 2 * mr:  # another spot's, near the region's border
             continue

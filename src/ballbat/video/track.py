@@ -26,6 +26,7 @@ Nothing is guessed: a point that fails a test is left out, with the reason.
 
 from __future__ import annotations
 
+import bisect
 from collections import Counter
 from dataclasses import dataclass, field
 
@@ -107,9 +108,31 @@ class Found:
 
 
 def _noise_sigma(img: np.ndarray) -> float:
-    """Robust pixel noise from the differences of neighbouring pixels (MAD), at least the quantisation's (0.29)."""
-    d = np.diff(img[::4, :].astype(np.float32), axis=1)
-    return max(float(1.4826 * np.median(np.abs(d - np.median(d))) / np.sqrt(2)), 1 / np.sqrt(12))
+    """Robust pixel noise from the differences of neighbouring pixels (MAD), at least the quantisation's (0.29).
+
+    For integer frames both medians come from histograms of the differences (exact: the same
+    float32 values as numpy's medians, in a third of the time).
+    """
+    if img.dtype.kind in "ui":
+        d = np.diff(img[::4, :].astype(np.int32), axis=1).ravel()
+        twice = _twice_median(d)  # the median of the differences, doubled: an integer
+        mad = np.float32(_twice_median(np.abs(2 * d - twice))) / np.float32(4)
+    else:
+        d = np.diff(img[::4, :].astype(np.float32), axis=1)
+        mad = np.median(np.abs(d - np.median(d)))
+    return max(float(np.float32(1.4826) * mad / np.sqrt(2)), 1 / np.sqrt(12))
+
+
+def _twice_median(v: np.ndarray) -> int:
+    """Twice the median of integers (the sum of the middle two where there is an even number), by their histogram."""
+    lo = int(v.min())
+    cum = np.cumsum(np.bincount(v - lo))
+    n = int(cum[-1])
+
+    def at(k):  # the k-th smallest (from 0)
+        return int(np.searchsorted(cum, k + 1)) + lo
+
+    return 2 * at(n // 2) if n % 2 else at(n // 2 - 1) + at(n // 2)
 
 
 @dataclass
@@ -117,7 +140,7 @@ class _Trail:
     """Last two positions of a point (frame, x, y), for the prediction of the next, and the contrasts found."""
 
     last: list = field(default_factory=list)
-    contrasts: list = field(default_factory=list)
+    contrasts: list = field(default_factory=list)  # sorted, for their median (:meth:`usual`)
 
     def push(self, k: int, x: float, y: float) -> None:
         """Add a position."""
@@ -133,6 +156,17 @@ class _Trail:
         k0, x0, y0 = self.last[0]
         f = (k - k1) / (k1 - k0)
         return x1 + f * (x1 - x0), y1 + f * (y1 - y0)
+
+    def found(self, contrast: float) -> None:
+        """Add a contrast found."""
+        bisect.insort(self.contrasts, contrast)
+
+    def usual(self) -> float:
+        """Return the median of the contrasts found (np.median's value: the mean of the middle two), 0 before any."""
+        c, n = self.contrasts, len(self.contrasts)
+        if not n:
+            return 0.0
+        return c[n // 2] if n % 2 else (c[n // 2 - 1] + c[n // 2]) / 2
 
     def velocity(self) -> tuple[float, float]:
         """Return the last velocity (px per frame; 0 before two positions)."""
@@ -179,7 +213,7 @@ def _keep_ball(fit, reason, k, opt: TrackOptions, trail: _Trail, found: Found):
         found.leave_out("ball", k, reason)
         return None
     trail.push(k, fit[0], fit[1])
-    trail.contrasts.append(fit[4])
+    trail.found(fit[4])
     found.add("ball", k, fit[0], fit[1], fit[3], fit[4])
     found.ball_radii.append(fit[2])
     return fit
@@ -223,7 +257,7 @@ def _centroid_at(img, x: float, y: float, opt: TrackOptions, sigma: float, trail
         return fit, reason
     if abs(fit[2] / opt.ball_radius_px - 1) > opt.radius_tolerance:
         return (), f"fitted radius {fit[2]:.1f} px, expected {opt.ball_radius_px:.1f} px"
-    usual = float(np.median(trail.contrasts)) if trail.contrasts else 0.0
+    usual = trail.usual()
     if fit[4] < 0.5 * usual:
         return (), f"a spot at {fit[0]:.1f}, {fit[1]:.1f} too faint for the ball ({fit[4]:.0f} vs {usual:.0f})"
     return fit, None
@@ -301,14 +335,14 @@ def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -
     if m is None:
         found.leave_out("bat_tip", k, "no tip marker found")
         return
-    usual = float(np.median(trail.contrasts)) if trail.contrasts else 0.0
+    usual = trail.usual()
     if m[2] < 0.5 * usual:  # fainter than half the marker's usual contrast: some other bright spot
         found.leave_out(
             "bat_tip", k, f"a spot at {m[0]:.1f}, {m[1]:.1f} too faint for the marker ({m[2]:.0f} vs {usual:.0f})"
         )
         return
     trail.push(k, m[0], m[1])
-    trail.contrasts.append(m[2])
+    trail.found(m[2])
     found.add("bat_tip", k, m[0], m[1], np.nan, m[2])
 
 
