@@ -145,8 +145,27 @@ def add_variables(ds: xr.Dataset, table: Mapping[str, Var], values: Mapping[str,
         name: (var.dims, np.asarray(values[name]), var.attributes()) for name, var in table.items() if name in values
     }
     out = ds.copy()
-    out.update(new)  # one merge for all of them (one per variable is most of a replicate study's time)
-    return out
+    if not _plain_additions(ds, new):
+        out.update(new)  # one merge for all of them (one per variable is most of a replicate study's time)
+        return out
+    # variables of the dataset's own dimensions that are no coordinate: Dataset.update's result (the
+    # same variables in the same order, a test compares them) without its merge, 0.6 of 0.75 ms a call
+    variables = dict(out._variables)
+    variables.update({name: xr.Variable(*spec) for name, spec in new.items()})
+    return out._replace(variables=variables)
+
+
+def _plain_additions(ds: xr.Dataset, new: Mapping[str, tuple]) -> bool:
+    """Whether :func:`add_variables` may add ``new`` (name -> (dims, values, attributes)) without xarray's merge.
+
+    Each variable lies on ``ds``'s dimensions, at their sizes, and is none of its coordinates.
+    """
+    for name, (dims, values, _) in new.items():
+        if name in ds.coords or name in ds.dims or len(dims) != np.ndim(values):
+            return False
+        if any(ds.sizes.get(d) != n for d, n in zip(dims, np.shape(values), strict=True)):
+            return False
+    return True
 
 
 #: Attributes carried from a dataset's first files to every later file: a measured dataset's
