@@ -68,7 +68,7 @@ def test_anything_else_goes_through_xarrays_merge(table, values, monkeypatch):
 
 
 def test_a_replicates_stages_add_the_same_variables_either_way(monkeypatch):
-    """The normalize, reconstruct and fit_ex Datasets of a rendered replicate are the same with and without the merge."""
+    """The normalize, reconstruct and fit_ex Datasets of a rendered replicate: the same with and without the merge."""
     from helpers import BALLS, BATS, SMALL
 
     from ballbat import chain
