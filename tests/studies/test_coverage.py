@@ -281,3 +281,18 @@ def test_combined_interval_takes_welch_satterthwaite_degrees_of_freedom():
     held = np.mean(np.abs(d) <= _t(0.95, np.full(n, nu)) * total)
     assert abs(ws - 0.95) < 0.005, ws
     assert held > 0.97, held
+
+
+def test_the_interval_quantiles_are_scipy_stats_own_to_the_bit():
+    """coverage._t (scipy.special's ndtri and stdtrit) gives scipy.stats.norm.ppf's and t.ppf's numbers."""
+    from ballbat.studies.coverage import _t
+
+    dof = np.array([np.inf, np.nan, 0.0, -1.0, 1.0, 2.0, 2.5, 11.6, 17.457, 55.398, 1e4, 1e7])
+    for q in (0.6826894921370859, 0.95):
+        got = _t(q, dof)
+        safe = np.where(np.isfinite(dof) & (dof > 0), dof, 1.0)
+        want = np.where(
+            np.isfinite(dof), np.where(dof > 0, stats.t.ppf(0.5 + q / 2, safe), np.nan), stats.norm.ppf(0.5 + q / 2)
+        )
+        np.testing.assert_array_equal(got, want)
+    assert _t(0.95, np.array([np.inf]))[0] == pytest.approx(1.959964, abs=1e-6)

@@ -32,7 +32,9 @@ rule study_batch:
 rule study_truth_point:
     """The design's truth of every quantity at one sweep point: the estimators on a large noise-free experiment.
 
-    A job per point, beside the batches (a grid's points in parallel, not one after the other).
+    A job per point, beside the batches (a grid's points in parallel, not one after the other),
+    started before them: the longest jobs first, so that the study does not wait for a truth job
+    started last (the calibration study's truth takes as long as two or three batches).
     """
     input:
         balls=get_study_balls,
@@ -46,6 +48,7 @@ rule study_truth_point:
         f"{R}/studies/{{study}}/benchmarks/truth_point{{point}}.tsv"
     conda:
         ENV
+    priority: 1
     threads: 1
     resources:
         mem_mb=study_truth_mem_mb,

@@ -37,12 +37,17 @@ def combine(batches: Iterable[xr.Dataset]) -> xr.Dataset:
 
 
 def _t(q: float, dof: np.ndarray) -> np.ndarray:
-    from scipy import stats
+    """The two-sided ``q`` quantile of Student's t with ``dof`` (normal where it is infinite, NaN where not positive).
+
+    ``scipy.special``'s ``ndtri`` and ``stdtrit``: the numbers of ``scipy.stats.norm.ppf`` and
+    ``t.ppf``, without importing scipy.stats (0.35 s, at the end of every study).
+    """
+    from scipy.special import ndtri, stdtrit
 
     dof = np.asarray(dof, dtype=float)
-    z = stats.norm.ppf(0.5 + q / 2)
+    z = ndtri(0.5 + q / 2)
     with np.errstate(all="ignore"):
-        t = stats.t.ppf(0.5 + q / 2, np.where(np.isfinite(dof) & (dof > 0), dof, 1.0))
+        t = stdtrit(np.where(np.isfinite(dof) & (dof > 0), dof, 1.0), 0.5 + q / 2)
     return np.where(np.isfinite(dof), np.where(dof > 0, t, np.nan), z)
 
 
