@@ -37,7 +37,7 @@ def combine(batches: Iterable[xr.Dataset]) -> xr.Dataset:
 
 
 def _t(q: float, dof: np.ndarray) -> np.ndarray:
-    """The two-sided ``q`` quantile of Student's t with ``dof`` (normal where it is infinite, NaN where not positive).
+    """Return the two-sided ``q`` quantile of Student's t with ``dof`` (normal where infinite, NaN where not positive).
 
     ``scipy.special``'s ``ndtri`` and ``stdtrit``: the numbers of ``scipy.stats.norm.ppf`` and
     ``t.ppf``, without importing scipy.stats (0.35 s, at the end of every study).
