@@ -46,9 +46,9 @@ rule study_truth_point:
         f"{R}/studies/{{study}}/logs/truth_point{{point}}.log",
     benchmark:
         f"{R}/studies/{{study}}/benchmarks/truth_point{{point}}.tsv"
+    priority: 1
     conda:
         ENV
-    priority: 1
     threads: 1
     resources:
         mem_mb=study_truth_mem_mb,
