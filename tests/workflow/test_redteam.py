@@ -115,7 +115,7 @@ CONFIG_CASES = [
     (
         "replicates 10000000: the job graph",
         lambda c: c["studies"]["calibration"].update(replicates=10_000_000),
-        "make 100,000 batch jobs, more than the 10,000",
+        "make 80,000 batch jobs, more than the 10,000",  # batches of 125
     ),
     (
         "impacts_per_bat 1e6",
