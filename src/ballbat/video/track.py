@@ -370,11 +370,12 @@ def still_background(clip: Clip, n: int = BACKGROUND_FRAMES) -> np.ndarray:
     return _still(clip, n)[0]
 
 
-def _still(clip: Clip, n: int = BACKGROUND_FRAMES) -> tuple[np.ndarray, np.ndarray]:
-    """Return the still background (:func:`still_background`) and each pixel's spread about it over the same frames.
+def _still(clip: Clip, n: int = BACKGROUND_FRAMES, spread: bool = False) -> tuple[np.ndarray, np.ndarray | None]:
+    """Return the still background (:func:`still_background`) and, with ``spread``, each pixel's spread about it.
 
-    The spread is 1.4826 times the median absolute deviation (float32): a pixel's own noise, the
-    compression's, a flicker, robust to the ball passing in a few of the frames.
+    The spread over the same frames is 1.4826 times the median absolute deviation (the normal
+    distribution's standard deviation per MAD; float32): a pixel's own noise, the compression's,
+    a flicker, robust to the ball passing in a few of the frames. Only the silhouette reads it.
     """
     total = clip.info.n_frames if clip.info.n_frames is not None else sum(1 for _ in clip.frames())
     take = set(np.unique(np.linspace(0, max(total - 1, 0), min(n, max(total, 1))).round().astype(int)).tolist())
@@ -383,6 +384,8 @@ def _still(clip: Clip, n: int = BACKGROUND_FRAMES) -> tuple[np.ndarray, np.ndarr
         raise VideoError(f"{clip.info.path}: no frames for the still background")
     stack = np.stack(kept).astype(np.float32)
     med = np.median(stack, axis=0)
+    if not spread:
+        return med, None
     return med, (1.4826 * np.median(np.abs(stack - med), axis=0)).astype(np.float32)
 
 
@@ -392,7 +395,8 @@ def track_clip(clip: Clip, opt: TrackOptions) -> Found:
     With ``opt.background == "median"`` the clip is read twice: first for its still background
     (:func:`still_background`), then frame by frame with the background subtracted.
     """
-    background, spread = _still(clip) if opt.background == "median" else (None, None)
+    silhouette = opt.ball_fit == "silhouette"
+    background, spread = _still(clip, spread=silhouette) if opt.background == "median" else (None, None)
     level = None
     found = Found()
     trails = {"ball": _Trail(), "bat_tip": _Trail()}
@@ -408,7 +412,7 @@ def track_clip(clip: Clip, opt: TrackOptions) -> Found:
             img = img.astype(np.float32) - background
         f = int(numbers[k]) if numbers is not None and k < numbers.size else k
         sigma = _noise_sigma(img) if sigma is None else sigma
-        if opt.ball_fit == "silhouette":
+        if silhouette:
             level = SILHOUETTE_SIGMAS * np.maximum(spread, sigma) if level is None else level
             ball = _ball(_Diff(img, level), f, opt, trails["ball"], sigma, found, exposure_frames)
         else:
