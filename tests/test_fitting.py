@@ -175,3 +175,29 @@ def test_e_x_per_bat_error_is_the_sandwich_with_the_scatter_terms_weights(config
     want = eiv_line(x, y, jx, jy, measured_sigma(ds, sel), scatter=True, robust=True)
     got = res.e_x.fits[res.balls.index("softball"), res.bats.index("wood")]
     assert got.slope_err == pytest.approx(want.slope_err, rel=1e-12) and got.scatter == pytest.approx(want.scatter)
+
+
+@pytest.mark.parametrize("scatter", [0.0, 0.02])
+def test_the_values_alone_are_the_full_analysis_values_to_the_bit(config, balls, bats, scatter):
+    """analyze_impacts(errors=False), which the refits call (issue 39): every value of fit_ex.nc's refitted
+    quantities and every scatter tau equal the full analysis's bit for bit; the errors are NaN (not made).
+    """
+    from helpers import NORM, REC
+
+    from ballbat.stages import fit_ex, normalize, reconstruct, simulate
+    from ballbat.synthetic import SyntheticSettings
+    from ballbat.systematics import FIT_QUANTITIES
+
+    syn = {**config["datasets"]["synthetic"]["synthetic"], "seed": 8, "e_x_scatter": scatter}
+    rec = reconstruct.run(REC, normalize.run(NORM, simulate.run(SyntheticSettings(**syn), balls, bats)), balls, bats)
+    rec = rec.drop_vars([k for k in rec.data_vars if k.startswith("truth_")])
+    full = fit_ex.results_values(fitting.analyze_impacts(rec, 0.5, False))
+    alone = fit_ex.results_values(fitting.analyze_impacts(rec, 0.5, False, errors=False))
+    for q in (*FIT_QUANTITIES, *(f"{f}_scatter" for f in fit_ex.SCATTER_FITS)):
+        assert np.any(np.isfinite(full[q])), q
+        np.testing.assert_array_equal(alone[q], full[q], err_msg=q)
+    assert np.all(np.isnan(alone["e_x_err"])) and np.all(np.isnan(alone["e_y_implied_err"]))
+    assert np.sum(np.isfinite(full["e_x_err"])) >= 7  # a bat without softball impacts has none
+    np.testing.assert_array_equal(alone["e_x_status"], full["e_x_status"])
+    if scatter:
+        assert np.nanmax(full["e_x_scatter"]) > 0.005  # the scatter term was fitted

@@ -161,7 +161,9 @@ def _noise_moments(jx, jy, sigma) -> tuple[np.ndarray, np.ndarray]:
     return np.sum(jx**2 * sigma**2, axis=1), np.sum(jx * jy * sigma**2, axis=1)
 
 
-def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool) -> tuple[FitGrid, FitGrid]:
+def fit_e_x(
+    ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool, errors: bool = True
+) -> tuple[FitGrid, FitGrid]:
     """Fit Eq. omega per bat and ball and pooled per ball (usable impacts, ``flag == 0``).
 
     Parameters
@@ -172,6 +174,8 @@ def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool)
         The grid's labels.
     with_truth : bool
         Also apply the estimator to the noise-free ``truth_*`` (same weights).
+    errors : bool
+        False: the values alone (:func:`ballbat.linefit.eiv_line`'s ``errors``).
 
     Returns
     -------
@@ -201,6 +205,7 @@ def fit_e_x(ds: xr.Dataset, balls: list[str], bats: list[str], with_truth: bool)
             strata=strata,
             scatter=strata is None or WITHIN_BAT_SCATTER,
             robust=POOLED_SANDWICH if strata is not None else PER_BAT_SANDWICH and linefit.SCATTER_TERM,
+            errors=errors,
         )
         t = np.nan
         if with_truth and fit.success:
@@ -263,7 +268,7 @@ def scale_systematic(ds: xr.Dataset, res: Sec4) -> dict[str, np.ndarray] | None:
 
 
 def implied_e_y(
-    ds: xr.Dataset, sel: np.ndarray, res: Sec4, i: int, ratio_design: tuple, rfit: LineFit
+    ds: xr.Dataset, sel: np.ndarray, res: Sec4, i: int, ratio_design: tuple, rfit: LineFit, errors: bool = True
 ) -> tuple[float, float]:
     """Return e_y implied by the Eq. ratio slope of one ball, and its standard error.
 
@@ -297,6 +302,8 @@ def implied_e_y(
         ``(x, y, jx, jy, sigma)`` of the Eq. ratio fit.
     rfit : LineFit
         The Eq. ratio fit.
+    errors : bool
+        False: the value alone (the error NaN), the same number to the bit.
 
     Returns
     -------
@@ -310,11 +317,13 @@ def implied_e_y(
     w_r = _weights(jx, jy, sig, rfit.slope, rfit, x)  # the fit's weights, its scatter term included
     W = np.ones(n) if w_r is None else w_r**2
     # each impact's e_x (its bat's; the pooled one where the bat has no fit) and its influence
-    xs, ys, jxs, jys = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
+    if errors:
+        xs, ys, jxs, jys = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
     # the noise of each abscissa (and its covariance with the ordinate), removed from the sums
     # as the moment-corrected fits remove it (linefit.eiv_line); zero without uncertainties
     var_x, cov_xy = _noise_moments(jx, jy, sig)
-    var_xs, cov_s = _noise_moments(jxs, jys, sig)
+    if errors:
+        var_xs, cov_s = _noise_moments(jxs, jys, sig)
     one_plus = np.empty(n)
     influence_ex = np.empty(n)
     lev_ex = np.zeros(n)
@@ -324,6 +333,9 @@ def implied_e_y(
         fit, m_fit = res.e_x.fits[i, res.bats.index(bat)], m
         if not (fit.success and np.isfinite(fit.slope)):  # no fit of its own: the pooled one
             fit, m_fit = res.e_x_pooled.fits[i], np.ones(n, dtype=bool)
+        if not errors:
+            one_plus[m] = fit.slope
+            continue
         w = _weights(jxs[m_fit], jys[m_fit], None if sig is None else sig[m_fit], fit.slope, fit, xs[m_fit])
         ws = np.ones(int(m_fit.sum())) if w is None else w**2
         # the e_x fit's estimating function (moment-corrected for the bracket's noise, as the fit)
@@ -342,6 +354,8 @@ def implied_e_y(
     d = float(np.sum(W * x2 * k_i))
     t = float(np.sum(W * (x * y - cov_xy)))
     e_y = d / t - 1.0
+    if not errors:
+        return float(e_y), np.nan
     # influences on ln D (through each bat's e_x) and on ln T (each impact about its own
     # slope k_i / (1 + e_y): the bats' differences are structure, not scatter)
     share = np.zeros(n)
@@ -484,7 +498,12 @@ def _mu_k_bound(pb: dict, i: int, y: np.ndarray, jy: np.ndarray, sig: np.ndarray
 
 
 def analyze_impacts(
-    ds: xr.Dataset, mu_k_example: float, systematic: bool = True, core: bool = False, mu_k_bound: bool = True
+    ds: xr.Dataset,
+    mu_k_example: float,
+    systematic: bool = True,
+    core: bool = False,
+    mu_k_bound: bool = True,
+    errors: bool = True,
 ) -> Sec4:
     """Sec. IV analysis of a normalised and reconstructed dataset (output of ``reconstruct``).
 
@@ -499,6 +518,9 @@ def analyze_impacts(
     pooled), the Eq. ratio slope and implied e_y (:func:`contact_population_error`'s refits); the
     other per-ball quantities stay NaN. ``mu_k_bound=False``: the bound on mu_k is not estimated
     (NaN; its truth is: a study's truth job, :class:`ballbat.stages.fit_ex.FitExSettings`).
+    ``errors=False``: the values alone, the same numbers to the bit (every standard error and
+    interval NaN: :func:`ballbat.linefit.eiv_line`'s ``errors``), for the refits whose values
+    alone are read (:func:`contact_population_error`, the calibration systematics).
     """
     ds = Columns(ds)  # plain arrays: the fits read some 200 of them
     usable = ds["flag"].values == 0
@@ -509,7 +531,7 @@ def analyze_impacts(
     ball_list = sorted(set(balls))
     bat_list = sorted(set(bats))
     res = _empty_sec4(ball_list, bat_list, has_truth, mu_k_example)
-    res.e_x, res.e_x_pooled = fit_e_x(ds, ball_list, bat_list, with_truth=has_truth)
+    res.e_x, res.e_x_pooled = fit_e_x(ds, ball_list, bat_list, with_truth=has_truth, errors=errors)
     pb = res.per_ball
     for i, ball in enumerate(ball_list):
         in_ball = usable & (balls == ball)
@@ -523,11 +545,13 @@ def analyze_impacts(
         x, y, jx, jy = tan_ratio_design(Measured.from_dataset(ds, in_ball), r, alpha)
         sig = measured_sigma(ds, in_ball)
         bats_in_ball = ds["bat"].values[in_ball].astype(str)  # the strata of the scatter and the sandwiches
-        rfit = fit_line(x, y, jx, jy, sig, errors_in_variables=True, strata=bats_in_ball, scatter=WITHIN_BAT_SCATTER)
+        rfit = fit_line(
+            x, y, jx, jy, sig, errors_in_variables=True, strata=bats_in_ball, scatter=WITHIN_BAT_SCATTER, errors=errors
+        )
         res.tan_ratio_slope.fits[i] = rfit
         exf = res.e_x_pooled.fits[i]
         a = float(np.mean(alpha))
-        e_y, e_y_err = implied_e_y(ds, in_ball, res, i, (x, y, jx, jy, sig), rfit)
+        e_y, e_y_err = implied_e_y(ds, in_ball, res, i, (x, y, jx, jy, sig), rfit, errors)
         pb["e_y_implied"][i], pb["e_y_implied_err"][i] = e_y, e_y_err
         if core:
             continue
@@ -549,7 +573,16 @@ def analyze_impacts(
             y_norm = ds[f"{which}_norm"].values[in_ball].astype(float)
             x, y, jx, jy = normalized_theta_design(v_bat, y_norm, theta, which, v_ref)
             fit = fit_line(
-                x, y, jx, jy, sig, through_origin=False, robust=True, errors_in_variables=True, strata=bats_in_ball
+                x,
+                y,
+                jx,
+                jy,
+                sig,
+                through_origin=False,
+                robust=True,
+                errors_in_variables=True,
+                strata=bats_in_ball,
+                errors=errors,
             )
             grid.fits[i] = fit
             if has_truth:
@@ -599,7 +632,8 @@ def contact_population_error(ds: xr.Dataset, res: Sec4) -> dict[str, np.ndarray]
         Per name of :data:`CONTACT_QUANTITIES`, the error (>= 0; NaN where the quantity has no value).
     """
     fits = [
-        analyze_impacts(contact_shifted_impacts(ds, j), res.mu_k_example, False, core=True) for j in range(len(SIDES))
+        analyze_impacts(contact_shifted_impacts(ds, j), res.mu_k_example, False, core=True, errors=False)
+        for j in range(len(SIDES))
     ]
     return {q: 0.5 * np.abs(_quantity(fits[0], q) - _quantity(fits[1], q)) for q in CONTACT_QUANTITIES}
 

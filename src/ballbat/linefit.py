@@ -93,6 +93,7 @@ def fit_line(
     errors_in_variables: bool = False,
     strata: ArrayLike | None = None,
     scatter: bool = False,
+    errors: bool = True,
 ) -> LineFit:
     """Fit y = slope x (+ intercept) with lmfit, weighting by the effective variance.
 
@@ -117,10 +118,14 @@ def fit_line(
         misfit is not scatter, only the spread within a bat is.
     scatter : with ``errors_in_variables``, a fit through the origin whose slope varies from
         point to point (:func:`eiv_line`): a bat's e_x from impact to impact.
+    errors : False: the values alone, for the refits that read only them (:func:`eiv_line`'s
+        ``errors``; the lmfit fit of data without uncertainties makes its errors anyway).
     """
     weighted = sigma is not None and np.all(np.isfinite(sigma)) and np.any(np.asarray(sigma) > 0)
     if errors_in_variables and weighted:
-        return eiv_line(x, y, jx, jy, sigma, through_origin, iterations, robust, strata, scatter and through_origin)
+        return eiv_line(
+            x, y, jx, jy, sigma, through_origin, iterations, robust, strata, scatter and through_origin, errors
+        )
     import lmfit
 
     x = np.asarray(x, dtype=float)
@@ -190,6 +195,7 @@ def eiv_line(
     robust: bool = False,
     strata: ArrayLike | None = None,
     scatter: bool = False,
+    errors: bool = True,
 ) -> LineFit:
     """Straight line through data whose abscissa is measured: the moment-corrected weighted fit.
 
@@ -228,6 +234,11 @@ def eiv_line(
     (:func:`_scatter_residuals`); the bats' differences are the design's, not scatter.
     A corrected spread of x that is not positive (noise as large as the spread of the
     abscissa) gives a fit not made (NaN).
+
+    ``errors=False``: the values alone (slope, intercept, tau), the same numbers to the bit; the
+    errors, intervals, reduced chi-square and tau's interval NaN, and ``success`` whether the
+    slope is finite. For the refits whose values alone are read (the calibration systematics
+    and the contact population's error: :func:`ballbat.fitting.analyze_impacts`).
     """
     x = np.asarray(x, dtype=float)
     y = np.asarray(y, dtype=float)
@@ -260,6 +271,19 @@ def eiv_line(
         if np.linalg.det(A) <= 0 or A[0, 0] <= 0:
             return LineFit.not_fitted(n)
         beta = np.linalg.solve(A, rhs)
+    if not errors:
+        return LineFit(
+            slope=float(beta[0]),
+            slope_err=np.nan,
+            slope_ci_low=np.nan,
+            slope_ci_high=np.nan,
+            intercept=0.0 if through_origin else float(beta[1]),
+            intercept_err=np.nan,
+            n=n,
+            redchi=np.nan,
+            success=bool(np.isfinite(beta[0])),
+            scatter=float(np.sqrt(tau2)) if scatter else np.nan,
+        )
     r = y - X @ beta
     w = np.sqrt(W)
     redchi = float(np.sum(W * r**2) / (n - p))

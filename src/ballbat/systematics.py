@@ -160,7 +160,7 @@ def reduce_shifts(
             continue
         for j, side in enumerate(SIDES):
             cams, rg = shifted_settings(cameras, rig, source, 1.0 + side * rel[i])
-            red = reduce_tracks(tracks, cams, rg, options, population_shifts=False)
+            red = reduce_tracks(tracks, cams, rg, options, population_shifts=False, like=nominal)
             with np.errstate(invalid="ignore"):
                 for k in SHIFTED:
                     out[k][i, j] = value_change(k, red.values[k], nominal.values[k])

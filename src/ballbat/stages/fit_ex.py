@@ -309,7 +309,9 @@ def fit_systematics(rec: xr.Dataset, res: Sec4) -> FitSystematics:
         if rel[i] == 0:
             continue
         fits = [
-            results_values(analyze_impacts(shifted_impacts(rec, i, j), res.mu_k_example, systematic=False))
+            results_values(
+                analyze_impacts(shifted_impacts(rec, i, j), res.mu_k_example, systematic=False, errors=False)
+            )
             for j in range(len(SIDES))
         ]
         for q in FIT_QUANTITIES:

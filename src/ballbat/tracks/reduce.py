@@ -200,6 +200,7 @@ def reduce_tracks(
     rig: Rig,
     options: ReduceOptions | None = None,
     population_shifts: bool = True,
+    like: Reduction | None = None,
 ) -> Reduction:
     """Reduce every impact's tracks to v_bat, v_ball, theta, omega with fitted uncertainties.
 
@@ -222,6 +223,15 @@ def reduce_tracks(
         Solve the contact again at +-1 standard error of each ball type's population mean
         (:func:`contact_shifts`, where :data:`CONTACT_POPULATION_SHIFTS`); the calibration
         reruns (:func:`ballbat.systematics.reduce_shifts`) need only the values.
+    like : Reduction, optional
+        The nominal reduction of the same ``tracks`` (and ``options``), of which these settings
+        move one calibration: the calibration reruns (:func:`ballbat.systematics.reduce_shifts`),
+        which read the values alone. Every step whose inputs did not move is taken from it, not
+        made again: the glitches found (where both frame rates are the same), a camera's onset,
+        free flight and spin fit (where its settings are the same: :func:`_fit_ball`,
+        :func:`_fit_bat_and_spin`). The exclusions are not tested again: the flags, reasons and
+        agreement are ``like``'s. The values are those of the reduction from scratch, to the bit
+        (tests/tracks/test_reduce_like.py).
 
     Returns
     -------
@@ -231,10 +241,14 @@ def reduce_tracks(
     """
     opt = options or ReduceOptions.schema_defaults()
     blocks = tracks.blocks
-    glitch_noise = pooled_noises(blocks)
-    cleaned = [remove_glitches(b, cameras, glitch_noise) for b in blocks]
-    start_noise = pooled_noises([tr for tr, _ in cleaned])
-    balls = [_fit_ball(tr, cameras) for tr, _ in cleaned]
+    nominal = [None] * len(blocks) if like is None else [part for part, _ in like.parts()]
+    if like is not None and all(like.cameras[c].fps == cameras[c].fps for c in cameras):
+        cleaned = [(part.tracks, part.n_outliers) for part in nominal]  # the glitches depend on the frame rates alone
+    else:
+        glitch_noise = pooled_noises(blocks)
+        cleaned = [remove_glitches(b, cameras, glitch_noise) for b in blocks]
+    start_noise = pooled_noises([tr for tr, _ in cleaned]) if like is None else {}
+    balls = [_fit_ball(tr, cameras, part) for (tr, _), part in zip(cleaned, nominal, strict=True)]
     lik = [m[-1] for m in balls]
     pop = contact_population(
         gather([c.lik for c in lik], tracks.index, tracks.n),
@@ -242,8 +256,8 @@ def reduce_tracks(
         tracks.ball,
     )
     parts = [
-        _finish(tr, counts, ball, pop.prior[idx], cameras, rig, opt, start_noise)
-        for (tr, counts), ball, idx in zip(cleaned, balls, tracks.index, strict=True)
+        _finish(tr, counts, ball, pop.prior[idx], cameras, rig, opt, start_noise, part)
+        for (tr, counts), ball, idx, part in zip(cleaned, balls, tracks.index, nominal, strict=True)
     ]
     if population_shifts and CONTACT_POPULATION_SHIFTS:
         for part, ball, idx in zip(parts, balls, tracks.index, strict=True):
@@ -336,14 +350,28 @@ def _gathered(objs: list, tracks: TrackBlocks):
 
 
 def _finish(
-    tracks: Tracks, n_outliers: dict, ball: tuple, prior: np.ndarray, cameras, rig: Rig, opt, start_noise: dict
+    tracks: Tracks,
+    n_outliers: dict,
+    ball: tuple,
+    prior: np.ndarray,
+    cameras,
+    rig: Rig,
+    opt,
+    start_noise: dict,
+    like: Reduction | None = None,
 ) -> Reduction:
-    """Reduce one block from its ball fits (:func:`_fit_ball`) and its rows of the contact times' prior."""
+    """Reduce one block from its ball fits (:func:`_fit_ball`) and its rows of the contact times' prior.
+
+    ``like``: the block's nominal reduction (:func:`reduce_tracks`'s ``like``): its exclusions kept.
+    """
     onset, flight, times, phys, lik = ball
     contact = contact_posterior(lik, prior)
-    swing, spin = _fit_bat_and_spin(tracks, cameras, rig, onset, flight, times, phys, contact)
+    swing, spin = _fit_bat_and_spin(tracks, cameras, rig, onset, flight, times, phys, contact, like)
     values = _measured_values(flight["swing"], swing, spin, contact, cameras, rig)
-    flag, reason, agree = _exclusions(tracks, onset, flight, swing, spin, cameras, opt, start_noise)
+    if like is None:
+        flag, reason, agree = _exclusions(tracks, onset, flight, swing, spin, cameras, opt, start_noise)
+    else:
+        flag, reason, agree = like.flag, like.reason, like.agreement
     return Reduction(
         tracks,
         cameras,
@@ -363,15 +391,25 @@ def _finish(
     )
 
 
-def _fit_ball(tracks: Tracks, cameras: dict[str, Camera]) -> tuple:
+def _same_camera(like: Reduction | None, cameras: dict[str, Camera], name: str) -> bool:
+    """Whether ``like`` (a nominal reduction, or None) reduced camera ``name`` with these very settings."""
+    return like is not None and like.cameras[name] == cameras[name]
+
+
+def _fit_ball(tracks: Tracks, cameras: dict[str, Camera], like: Reduction | None = None) -> tuple:
     """Fit the ball of every impact: its onset and free flight in each camera, its contact's likelihood.
 
     Returns ``onset, flight, times, phys`` (:class:`Reduction`'s fields) and the
-    :class:`~ballbat.tracks.fit_contact.ContactLikelihood`.
+    :class:`~ballbat.tracks.fit_contact.ContactLikelihood`. ``like``: a reduction of the same
+    cleaned tracks, whose camera of unchanged settings is taken as it is.
     """
     n = tracks.n
     onset, flight, times, phys = {}, {}, {}, {}
     for name in ("swing", "spin"):
+        if _same_camera(like, cameras, name):
+            onset[name], flight[name], times[name] = like.onset[name], like.flight[name], like.times[name]
+            phys[(name, "ball")] = like.phys[(name, "ball")]
+            continue
         ct, cam = tracks.cameras[name], cameras[name]
         t = np.broadcast_to(np.arange(ct.n_columns)[None, :] / cam.fps, (n, ct.n_columns))
         times[name] = t
@@ -386,9 +424,20 @@ def _fit_ball(tracks: Tracks, cameras: dict[str, Camera]) -> tuple:
 
 
 def _fit_bat_and_spin(
-    tracks: Tracks, cameras: dict[str, Camera], rig: Rig, onset: dict, flight: dict, times: dict, phys: dict, contact
+    tracks: Tracks,
+    cameras: dict[str, Camera],
+    rig: Rig,
+    onset: dict,
+    flight: dict,
+    times: dict,
+    phys: dict,
+    contact,
+    like: Reduction | None = None,
 ) -> tuple[Swing, Spin]:
-    """Fit every impact's swing (before the contact's start) and spin; ``phys`` gets the tip's and dots' tracks."""
+    """Fit every impact's swing (before the contact's start) and spin; ``phys`` gets the tip's and dots' tracks.
+
+    ``like``: as :func:`_fit_ball`'s (the spin fit taken from it where the spin camera's settings are the same).
+    """
     Xt, Yt = physical(tracks.cameras["swing"], cameras["swing"], "bat_tip")
     phys[("swing", "bat_tip")] = (Xt, Yt)
     swing = fit_swing(
@@ -401,6 +450,10 @@ def _fit_bat_and_spin(
         contact.t_start,
         contact.t_start_err,
     )
+    if _same_camera(like, cameras, "spin"):
+        for p in ("dot_a", "dot_b"):
+            phys[("spin", p)] = like.phys[("spin", p)]
+        return swing, like.spin
     dots = {p: physical(tracks.cameras["spin"], cameras["spin"], p) for p in ("dot_a", "dot_b")}
     for p, v in dots.items():
         phys[("spin", p)] = v
