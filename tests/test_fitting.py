@@ -39,12 +39,13 @@ def test_largest_value_removes_most_of_the_bias_of_picking_the_largest():
 
 @pytest.mark.parametrize("by_impact", [True, False])
 def test_largest_value_is_the_full_grid_number_to_the_bit(monkeypatch, by_impact):
-    """The grid points where log Phi is -0.0 are left out of the evaluation, not out of the sum: same bits.
+    """The grid points where log Phi is negligible are left out of the evaluation, not out of the sum: same bits.
 
     The full (grid x impacts) evaluation, as :func:`ballbat.fitting.largest_value` made it
     before it skipped them, on values whose spreads differ by 10x, by each value's run of grid
     points and by blocks of grid points (:data:`ballbat.fitting.LARGEST_BY_IMPACT`), and
-    log Phi(z) is -0.0 everywhere past :data:`ballbat.fitting.LOG_NDTR_ZERO` (the skipped points).
+    log Phi(z) is below 7.7e-24 in magnitude everywhere past :data:`ballbat.fitting.LOG_NDTR_NEGLIGIBLE`
+    (the skipped points), and exactly -0.0 from 37.7 on.
     """
     if not by_impact:
         monkeypatch.setattr(fitting, "LARGEST_BY_IMPACT", 0)
@@ -57,13 +58,15 @@ def test_largest_value_is_the_full_grid_number_to_the_bit(monkeypatch, by_impact
         return 2 * top - float(m[0] + np.trapezoid(1.0 - cdf, m))
 
     rng = np.random.default_rng(7)
-    for n in (1, 5, 48, 130):
-        y = rng.normal(0.2, 0.05, n)
-        sigma = 0.01 * rng.uniform(0.2, 2.0, n)
-        assert fitting.largest_value(y, sigma) == full_grid(y, sigma)
-    z = np.concatenate([np.linspace(fitting.LOG_NDTR_ZERO - 2.3, 60.0, 200001), [1e3, 1e300, np.inf]])
-    assert np.all(log_ndtr(z) == 0.0)
-    assert log_ndtr(37.0) < 0.0  # the threshold is not far beyond where it has to be
+    for n in (1, 5, 48, 130, 400):
+        for spread in (0.05, 0.005):  # values spread over many of their errors, and within a few
+            y = rng.normal(0.2, spread, n)
+            sigma = 0.01 * rng.uniform(0.2, 2.0, n)
+            assert fitting.largest_value(y, sigma) == full_grid(y, sigma)
+    z = np.concatenate([np.linspace(fitting.LOG_NDTR_NEGLIGIBLE, 60.0, 200001), [1e3, 1e300, np.inf]])
+    assert np.all(-7.7e-24 <= log_ndtr(z)) and np.all(log_ndtr(z) <= 0.0)
+    assert np.all(log_ndtr(np.linspace(37.7, 60.0, 1001)) == 0.0)
+    assert log_ndtr(fitting.LOG_NDTR_NEGLIGIBLE) < 0.0  # the terms left out are not all zero
 
 
 def test_e_y_variance_forms():
