@@ -9,9 +9,11 @@ replicate, and prints:
    Dataset), measured by timing the stage functions themselves;
 2. the top functions by their own time and by cumulative time (cProfile).
 
-Run: ``.venv/bin/python bench/profile_study.py [N] [study] [--plain]`` (about N x 0.3 s). Read the
-stage table as shares when the machine is busy. ``--plain``: without cProfile (the stage timers
-only, no function tables): the CPU time per replicate as a batch job spends it.
+Run: ``.venv/bin/python bench/profile_study.py [N] [study] [point] [--plain]`` (about N x 0.1-0.3 s).
+Read the stage table as shares when the machine is busy. ``point``: the sweep point whose first
+replicates are run (default 0; the robustness grid's costliest are 24-26: 5 px, 60 impacts per bat).
+``--plain``: without cProfile (the stage timers only, no function tables): the CPU time per
+replicate as a batch job spends it.
 """
 
 from __future__ import annotations
@@ -67,8 +69,8 @@ def instrument() -> None:
             setattr(module, name, _timed(getattr(module, name), label))
 
 
-def main(n: int = 10, study: str = "calibration", plain: bool = False) -> None:
-    """Profile ``n`` replicates of ``study``; print the stage table and the top functions (not with ``plain``)."""
+def main(n: int = 10, study: str = "calibration", plain: bool = False, point: int = 0) -> None:
+    """Profile ``n`` replicates of ``study`` at ``point``; print the stage table and the top functions (not ``plain``)."""
     cfg = load_config()
     cfg["studies"][study]["batch_size"] = n
     s = StudySettings.from_config(cfg, study)
@@ -82,7 +84,8 @@ def main(n: int = 10, study: str = "calibration", plain: bool = False) -> None:
     t0, c0 = time.perf_counter(), time.process_time()
     if not plain:
         prof.enable()
-    ds = study_batch.run(s, 1, balls, bats)
+    # the batch that starts the point (batch 1 at point 0: batch 0 warmed up)
+    ds = study_batch.run(s, point * s.replicates // n + (1 if point == 0 else 0), balls, bats)
     prof.disable()
     wall, cpu = time.perf_counter() - t0, time.process_time() - c0
     reps = ds.sizes["replicate"]
@@ -107,4 +110,9 @@ def main(n: int = 10, study: str = "calibration", plain: bool = False) -> None:
 
 if __name__ == "__main__":
     args = [a for a in sys.argv[1:] if a != "--plain"]
-    main(int(args[0]) if args else 10, args[1] if len(args) > 1 else "calibration", "--plain" in sys.argv)
+    main(
+        int(args[0]) if args else 10,
+        args[1] if len(args) > 1 else "calibration",
+        "--plain" in sys.argv,
+        int(args[2]) if len(args) > 2 else 0,
+    )

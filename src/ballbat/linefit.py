@@ -268,9 +268,11 @@ def eiv_line(
         A[0, 0] -= (W * var_x).sum()
         rhs = X.T @ (W * y)
         rhs[0] -= (W * cov_xy).sum()
-        if np.linalg.det(A) <= 0 or A[0, 0] <= 0:
+        if A[0, 0] <= 0 or (p == 2 and np.linalg.det(A) <= 0):
             return LineFit.not_fitted(n)
-        beta = np.linalg.solve(A, rhs)
+        # a line through the origin: the 1 x 1 system divided out (LAPACK's solve of it is this
+        # division, and its determinant the element: the same numbers without their overhead)
+        beta = rhs / A[0, 0] if p == 1 else np.linalg.solve(A, rhs)
     if not errors:
         return LineFit(
             slope=float(beta[0]),
