@@ -425,3 +425,37 @@ def test_strata_of_one_point_each_leave_no_degree_of_freedom_for_the_scatter():
     fit = eiv_line(x, y, jx, jy, sigma, scatter=True, strata=np.arange(6).astype(str))
     plain = eiv_line(x, y, jx, jy, sigma)
     assert np.isnan(fit.scatter) and fit.slope == plain.slope  # fitted without the term, not a crash
+
+
+
+def test_the_iteration_ends_at_its_fixed_point_with_the_numbers_of_every_pass(monkeypatch):
+    """eiv_line stops where a pass returns the slope and tau^2 it started from (issue 39): with the stop switched off
+    (every pass made) every number of every fit is the same to the bit, and the stop saved passes.
+    """
+    rng = np.random.default_rng(11)
+    cases = []
+    for k in range(60):
+        n = int(rng.integers(8, 60))
+        x = rng.uniform(0.2, 2.0, n)
+        jx, jy = np.stack([np.ones(n), 0.3 * np.ones(n)], 1), np.stack([np.full(n, 1.3), np.ones(n)], 1)
+        sig = np.full((n, 2), 0.03)
+        y = (1.3 + [0.0, 0.05, 0.2][k % 3] * rng.standard_normal(n)) * x + 0.04 * rng.standard_normal(n)
+        strata = rng.integers(0, 3, n).astype(str) if k % 4 == 1 else None
+        cases.append(((x, y, jx, jy, sig), {"scatter": k % 2 == 0, "strata": strata, "through_origin": k % 5 != 3}))
+    calls = []
+    real = linefit._paule_mandel_within
+    monkeypatch.setattr(linefit, "_paule_mandel_within", lambda *a: calls.append(1) or real(*a))
+
+    def fits():
+        calls.clear()
+        out = [eiv_line(*a, robust=k % 3 == 0, **kw) for k, (a, kw) in enumerate(cases)]
+        return out, len(calls)
+
+    stopped, n_stopped = fits()
+    monkeypatch.setattr(linefit, "STOP_AT_FIXED_POINT", False)
+    every, n_every = fits()
+    for a, b in zip(stopped, every, strict=True):
+        for u, v in zip(vars(a).values(), vars(b).values(), strict=True):
+            assert u == v or (np.isnan(u) and np.isnan(v)), (a, b)
+    assert n_stopped < n_every, (n_stopped, n_every)
+    assert sum(f.scatter > 0 for f in stopped if np.isfinite(f.scatter)) >= 5

@@ -254,6 +254,11 @@ def eiv_line(
     scatter = scatter and SCATTER_TERM and through_origin
     g = scatter_gain(x, var_x)
     tau2 = 0.0
+    # an iteration whose slope and tau^2 are those it started from, to the bit, in the passes of
+    # one kind (after the first, or after the first with tau^2), is a fixed point: every later
+    # pass would repeat it exactly, so the loop ends there with the same numbers
+    settled = iterations if scatter else 1
+    state = None
     for it in range(iterations + (SCATTER_PASSES if scatter else 0)):
         var0 = ((jy - beta[0] * jx) ** 2 * sig2).sum(axis=1)
         if (var0 <= 0).any():
@@ -273,6 +278,9 @@ def eiv_line(
         # a line through the origin: the 1 x 1 system divided out (LAPACK's solve of it is this
         # division, and its determinant the element: the same numbers without their overhead)
         beta = rhs / A[0, 0] if p == 1 else np.linalg.solve(A, rhs)
+        state, before = (beta.tobytes(), tau2, scatter), state
+        if STOP_AT_FIXED_POINT and it >= settled and state == before:
+            break
     if not errors:
         return LineFit(
             slope=float(beta[0]),
@@ -362,6 +370,10 @@ def _scatter_residuals(
 
 #: Fit the intrinsic-scatter term where a fit asks for it (:func:`eiv_line`'s ``scatter``).
 SCATTER_TERM = True
+
+#: End :func:`eiv_line`'s passes at their fixed point (a pass that returns the slope and tau^2 it started
+#: from, to the bit: the rest would repeat it). False: every pass made (tests compare the two).
+STOP_AT_FIXED_POINT = True
 
 #: Passes of the slope and tau^2 after the fit without the term (both settle in three to four).
 SCATTER_PASSES = 5
