@@ -70,7 +70,7 @@ def instrument() -> None:
 
 
 def main(n: int = 10, study: str = "calibration", plain: bool = False, point: int = 0) -> None:
-    """Profile ``n`` replicates of ``study`` at ``point``; print the stage table and the top functions (not ``plain``)."""
+    """Profile ``n`` replicates of ``study`` at ``point``: the stage table and (not ``plain``) the top functions."""
     cfg = load_config()
     cfg["studies"][study]["batch_size"] = n
     s = StudySettings.from_config(cfg, study)
