@@ -427,7 +427,6 @@ def test_strata_of_one_point_each_leave_no_degree_of_freedom_for_the_scatter():
     assert np.isnan(fit.scatter) and fit.slope == plain.slope  # fitted without the term, not a crash
 
 
-
 def test_the_iteration_ends_at_its_fixed_point_with_the_numbers_of_every_pass(monkeypatch):
     """eiv_line stops where a pass returns the slope and tau^2 it started from (issue 39): with the stop switched off
     (every pass made) every number of every fit is the same to the bit, and the stop saved passes.
