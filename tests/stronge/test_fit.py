@@ -266,3 +266,27 @@ def test_the_start_snapped_to_zero_below_lmfits_own_tiny():
     from ballbat.stronge import fit
 
     assert fit.LMFIT_TINY == tiny
+
+
+@pytest.mark.parametrize("eta2", [2.5, 4.75, 12.0])
+def test_a_fit_started_next_to_its_minimum_is_the_scans_fit(balls, bats, eta2, monkeypatch):
+    """``start`` (the calibration refits start at the nominal fit, issue 39): from the scan's fit moved by 1 % the
+    least squares end within 1e-7 of the scan's fit (Levenberg-Marquardt's tolerance), and skip the scan; a start
+    outside the bounds or NaN is the scan's own, to the bit.
+    """
+    from ballbat.stronge import fit as fit_module
+
+    psi, x, y, r_x, r_y = _synthetic(balls, bats, np.random.default_rng(3), eta2=eta2, n=80)
+    scanned = fit_eta2(psi, x, y, r_x, r_y, interval=False)
+    calls = []
+    real = fit_module._scan_start
+    monkeypatch.setattr(fit_module, "_scan_start", lambda *a: calls.append(1) or real(*a))
+    for factor in (1.01, 0.99):
+        near = fit_eta2(psi, x, y, r_x, r_y, interval=False, start=scanned.eta2 * factor)
+        assert near.eta2 == pytest.approx(scanned.eta2, rel=1e-7)
+        assert near.eta2_err == pytest.approx(scanned.eta2_err, rel=1e-5)
+    assert calls == []
+    for bad in (np.nan, 0.5, 31.0):
+        again = fit_eta2(psi, x, y, r_x, r_y, interval=False, start=bad)
+        assert again.eta2 == scanned.eta2 and again.eta2_err == scanned.eta2_err
+    assert len(calls) == 3

@@ -299,9 +299,8 @@ def stronge_systematics(
     if not has_shifts(rec):
         return ds
     names = ["eta2"] + (["e_y"] if vary_e_y else []) + (["mu"] if vary_mu else [])
-    out = stronge_by_source(
-        rec, ds["ball"].values.astype(str), names, e_y=e_y, mu=mu, vary_e_y=vary_e_y, vary_mu=vary_mu
-    )
+    kw = {"e_y": e_y, "mu": mu, "vary_e_y": vary_e_y, "vary_mu": vary_mu}
+    out = stronge_by_source(rec, ds["ball"].values.astype(str), names, starts=ds["eta2"].values, **kw)
     for q in names:  # no value, no systematic
         out[q][:, ~np.isfinite(ds[q].values)] = np.nan
     rel = rec["systematic_rel_sigma"].values
@@ -312,24 +311,44 @@ def stronge_systematics(
 
 
 def stronge_by_source(
-    rec: xr.Dataset, balls: Sequence[str], names: Sequence[str], *, e_y: float, mu: float, vary_e_y: bool, vary_mu: bool
+    rec: xr.Dataset,
+    balls: Sequence[str],
+    names: Sequence[str],
+    *,
+    e_y: float,
+    mu: float,
+    vary_e_y: bool,
+    vary_mu: bool,
+    starts: Sequence[float] | None = None,
 ) -> dict[str, np.ndarray]:
     """Systematic of eta^2 (and e_y, mu when fitted: ``names``) of each ball, per source (source x ball).
 
     The size of :func:`stronge_shifts`' signed changes.
     """
     kw = {"e_y": e_y, "mu": mu, "vary_e_y": vary_e_y, "vary_mu": vary_mu}
-    return {q: np.abs(v) for q, v in stronge_shifts(rec, balls, names, **kw).items()}
+    return {q: np.abs(v) for q, v in stronge_shifts(rec, balls, names, starts=starts, **kw).items()}
 
 
 def stronge_shifts(
-    rec: xr.Dataset, balls: Sequence[str], names: Sequence[str], *, e_y: float, mu: float, vary_e_y: bool, vary_mu: bool
+    rec: xr.Dataset,
+    balls: Sequence[str],
+    names: Sequence[str],
+    *,
+    e_y: float,
+    mu: float,
+    vary_e_y: bool,
+    vary_mu: bool,
+    starts: Sequence[float] | None = None,
 ) -> dict[str, np.ndarray]:
     """Half of (the fit at +1 sigma) - (the fit at -1 sigma) of each source and ball (source x ball).
 
     Each ball is fitted again (:func:`ballbat.stronge.analysis.fit_ball`, no interval) on its
     usable impacts at +1 and at -1 sigma of each source (:func:`shifted_impacts`); 0 for a
-    source without uncertainty. ``rec`` carries the shifts (:func:`has_shifts`).
+    source without uncertainty. ``rec`` carries the shifts (:func:`has_shifts`). ``starts``: each
+    ball's nominal eta^2, where each refit's least squares starts (:func:`ballbat.stronge.fit.fit_eta2`'s
+    ``start``; None or NaN: the scan's start). A calibration moves the minimum a little: the refits
+    start next to it, without the scan (two thirds of a fit's cost), and stay in the nominal fit's
+    basin (issue 39).
     """
     rel = rec["systematic_rel_sigma"].values
     out = {q: np.zeros((rec.sizes["systematic"], len(balls))) for q in names}
@@ -342,7 +361,12 @@ def stronge_shifts(
         fits = []
         for j in range(len(SIDES)):
             sh = shifted_impacts(rec, i, j)
-            fits.append([fit_ball(vtf_data(sh, usable & (ball_of == b)), **kw) for b in balls])
+            fits.append(
+                [
+                    fit_ball(vtf_data(sh, usable & (ball_of == b)), start=None if starts is None else starts[k], **kw)
+                    for k, b in enumerate(balls)
+                ]
+            )
         for q in names:
             plus, minus = (np.array([getattr(f, q) for f in side]) for side in fits)
             out[q][i] = 0.5 * (plus - minus)

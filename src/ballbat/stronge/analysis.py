@@ -288,6 +288,7 @@ def fit_ball(
     errors: bool = True,
     errors_in_variables: bool = True,
     finite_sample: bool = True,
+    start: float | None = None,
 ) -> Eta2Fit:
     """Fit eta^2 to one ball's Eq. vtf data as the workflow does (the workflow and the replicate studies).
 
@@ -318,6 +319,8 @@ def fit_ball(
     finite_sample : remove the estimator's bias of order 1/n (:func:`finite_sample_bias`;
         with e_y or mu free as well it is not made). Off for a study's truth, the estimator's
         limit on the design's population.
+    start : the least-squares fit's starting eta^2 (:func:`ballbat.stronge.fit.fit_eta2`'s;
+        None: its scan).
 
     Returns
     -------
@@ -341,6 +344,7 @@ def fit_ball(
         strata=d.bat,
         interval=interval,
         errors=errors,
+        start=start,
     )
     names = ["eta2"] + (["e_y"] if vary_e_y else []) + (["mu"] if vary_mu else [])
     at = {"eta2": fit.eta2, "e_y": fit.e_y, "mu": fit.mu}

@@ -269,6 +269,7 @@ def fit_eta2(
     strata: ArrayLike | None = None,
     interval: bool = True,
     errors: bool = True,
+    start: float | None = None,
 ) -> Eta2Fit:
     """Fit eta^2 (and optionally e_y, mu) of Stronge's model to Eq. (vtf) data.
 
@@ -293,6 +294,11 @@ def fit_eta2(
         alone is wanted, such as a replicate study's noise-free truth).
     errors : compute the standard errors and their degrees of freedom (False: NaN; the value
         alone, e.g. a replicate study's noise-free truth; needs ``interval=False``).
+    start : the least-squares fit's starting eta^2 in place of the scan's (None: the scan). For a
+        fit whose minimum lies next to a known one: the calibration systematics' refits start at
+        the nominal fit (:func:`ballbat.stages.stronge.stronge_shifts`), which also keeps them in
+        its basin where e_x(eta^2) is not monotonic. A start outside ``eta2_bounds`` or not finite
+        is the scan's.
 
     Returns
     -------
@@ -320,7 +326,8 @@ def fit_eta2(
     geometry = ImpactGeometry(psi, r_x, r_y, alpha)
     residual = _Residual(geometry, x, y, sig)
     bounds = (float(eta2_bounds[0]), float(eta2_bounds[1]))
-    start = _scan_start(geometry, x, y, sig, e_y, mu, bounds)
+    if start is None or not (np.isfinite(start) and bounds[0] <= start <= bounds[1]):
+        start = _scan_start(geometry, x, y, sig, e_y, mu, bounds)
     res = _least_squares(residual, (start, e_y, mu), bounds, (vary_e_y, vary_mu), scale_covar, what)
     best = res.values["eta2"]
     if not res.success or not np.isfinite(best):

@@ -202,9 +202,10 @@ def run_replicate(
         rec_truth = chain.reconstructed(cs, _truth_source(src), true_balls, true_bats)
         balls_fitted = fit["ball"].values.astype(str)
         nan = np.full(balls_fitted.size, np.nan)
-        syst, effect = _eta2_systematic(rec, balls_fitted, settings.stronge, z) if drawn else (nan, nan)
-        for ball, sy, ef in zip(balls_fitted, syst, effect, strict=True):
-            v, e, t, dof = _eta2(rec, rec_truth, ball, settings.stronge, value=check)
+        fitted = [_eta2(rec, rec_truth, ball, settings.stronge, value=check) for ball in balls_fitted]
+        starts = [f[0] for f in fitted]  # the refits at each source's +-1 sigma start at the value
+        syst, effect = _eta2_systematic(rec, balls_fitted, settings.stronge, z, starts) if drawn else (nan, nan)
+        for ball, sy, ef, (v, e, t, dof) in zip(balls_fitted, syst, effect, fitted, strict=True):
             rows.append(
                 {
                     "quantity": "eta2",
@@ -289,17 +290,20 @@ def _calibration_effect(fit: xr.Dataset, signed: dict[str, np.ndarray], z: np.nd
     return xr.Dataset({q: (fit[q].dims, np.tensordot(z, v, axes=1)) for q, v in signed.items()}, coords=fit.coords)
 
 
-def _eta2_systematic(rec: xr.Dataset, balls: np.ndarray, stronge: dict, z: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _eta2_systematic(
+    rec: xr.Dataset, balls: np.ndarray, stronge: dict, z: np.ndarray, starts: list[float]
+) -> tuple[np.ndarray, np.ndarray]:
     """Return eta^2's calibration systematic of each ball and its change under the drawn calibration.
 
     The systematic: every source in quadrature (as stronge.nc's ``eta2_syst``); the change: first
-    order, under the drawn calibration ``z`` (:func:`_calibration_effect`).
+    order, under the drawn calibration ``z`` (:func:`_calibration_effect`). ``starts``: each ball's
+    fitted eta^2, where the refits start (:func:`ballbat.stages.stronge.stronge_shifts`).
     """
     from ..stages.stronge import stronge_shifts
     from ..stages.systematics import combine_sources
 
     kw = {k: stronge[k] for k in ("e_y", "mu", "vary_e_y", "vary_mu")}
-    signed = stronge_shifts(rec, list(balls), ["eta2"], **kw)["eta2"]
+    signed = stronge_shifts(rec, list(balls), ["eta2"], starts=starts, **kw)["eta2"]
     with np.errstate(invalid="ignore"):
         return combine_sources(signed), np.tensordot(z, signed, axes=1)
 
