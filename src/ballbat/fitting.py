@@ -572,32 +572,42 @@ def analyze_impacts(
             pb["truth_e_y_implied"][i] = float(np.mean(ds["truth_e_y"].values[in_ball]))
             pb["truth_mu_k_lower_bound"][i] = float(np.max(yt))
 
-        v_bat, _, theta, _ = Measured.from_dataset(ds, in_ball)
-        tv = Measured.from_dataset(ds, in_ball, "truth_") if has_truth else None
-        for grid, which in ((res.spin_theta_slope, "omega"), (res.speed_theta_slope, "v_ball")):
-            y_norm = ds[f"{which}_norm"].values[in_ball].astype(float)
-            x, y, jx, jy = normalized_theta_design(v_bat, y_norm, theta, which, v_ref)
-            fit = fit_line(
-                x,
-                y,
-                jx,
-                jy,
-                sig,
-                through_origin=False,
-                robust=True,
-                errors_in_variables=True,
-                strata=bats_in_ball,
-                errors=errors,
-            )
-            grid.fits[i] = fit
-            if has_truth:
-                yt_norm = normalize_to_bat_speed(tv[MEASURED.index(which)], tv[0], v_ref)
-                xt, yt, _, _ = normalized_theta_design(tv[0], yt_norm, tv[2], which, v_ref)
-                grid.truth[i] = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope), through_origin=False)[0]
+        _theta_slopes(ds, res, i, in_ball, (sig, bats_in_ball), v_ref, errors)
     # impacts that carry the calibration shifts get every source by the exact rerun instead
     # (the fit_ex stage: ballbat.stages.systematics)
     res.systematic = scale_systematic(ds, res) if systematic and not has_shifts(ds) else None
     return res
+
+
+def _theta_slopes(ds: Columns, res: Sec4, i: int, in_ball: np.ndarray, weights: tuple, v_ref: float, errors: bool):
+    """Fit ball ``i``'s Figs. 5-6 lines (spin and exit speed against theta, normalised) into ``res``.
+
+    ``weights``: the ball's measured uncertainties and bats (the sandwiches' strata); with the
+    noise-free ``truth_*`` where ``res.has_truth``. ``errors``: :func:`analyze_impacts`'.
+    """
+    sig, bats_in_ball = weights
+    v_bat, _, theta, _ = Measured.from_dataset(ds, in_ball)
+    tv = Measured.from_dataset(ds, in_ball, "truth_") if res.has_truth else None
+    for grid, which in ((res.spin_theta_slope, "omega"), (res.speed_theta_slope, "v_ball")):
+        y_norm = ds[f"{which}_norm"].values[in_ball].astype(float)
+        x, y, jx, jy = normalized_theta_design(v_bat, y_norm, theta, which, v_ref)
+        fit = fit_line(
+            x,
+            y,
+            jx,
+            jy,
+            sig,
+            through_origin=False,
+            robust=True,
+            errors_in_variables=True,
+            strata=bats_in_ball,
+            errors=errors,
+        )
+        grid.fits[i] = fit
+        if res.has_truth:
+            yt_norm = normalize_to_bat_speed(tv[MEASURED.index(which)], tv[0], v_ref)
+            xt, yt, _, _ = normalized_theta_design(tv[0], yt_norm, tv[2], which, v_ref)
+            grid.truth[i] = wls_slope(xt, yt, _weights(jx, jy, sig, fit.slope), through_origin=False)[0]
 
 
 #: Carry the contact population's estimation error into the statistical errors

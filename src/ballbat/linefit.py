@@ -253,34 +253,10 @@ def eiv_line(
     beta = np.linalg.lstsq(X, y, rcond=None)[0]
     scatter = scatter and SCATTER_TERM and through_origin
     g = scatter_gain(x, var_x)
-    tau2 = 0.0
-    # an iteration whose slope and tau^2 are those it started from, to the bit, in the passes of
-    # one kind (after the first, or after the first with tau^2), is a fixed point: every later
-    # pass would repeat it exactly, so the loop ends there with the same numbers
-    settled = iterations if scatter else 1
-    state = None
-    for it in range(iterations + (SCATTER_PASSES if scatter else 0)):
-        var0 = ((jy - beta[0] * jx) ** 2 * sig2).sum(axis=1)
-        if (var0 <= 0).any():
-            return LineFit.not_fitted(n)
-        if scatter and it >= iterations - 1:
-            tau2 = _paule_mandel_within(y - X @ beta, x, y, var_x, cov_xy, var0, tau2 * g, g, strata, n - p)
-            if not np.isfinite(tau2):  # the points at x ~ 0 (g = 0) alone exceed the residuals' dof,
-                scatter, tau2 = False, 0.0  # or no dof is left: fitted without the term (tau NaN)
-        W = 1.0 / (var0 + tau2 * g)
-        xwx = X.T @ (W[:, None] * X)
-        A = xwx.copy()
-        A[0, 0] -= (W * var_x).sum()
-        rhs = X.T @ (W * y)
-        rhs[0] -= (W * cov_xy).sum()
-        if A[0, 0] <= 0 or (p == 2 and np.linalg.det(A) <= 0):
-            return LineFit.not_fitted(n)
-        # a line through the origin: the 1 x 1 system divided out (LAPACK's solve of it is this
-        # division, and its determinant the element: the same numbers without their overhead)
-        beta = rhs / A[0, 0] if p == 1 else np.linalg.solve(A, rhs)
-        state, before = (beta.tobytes(), tau2, scatter), state
-        if STOP_AT_FIXED_POINT and it >= settled and state == before:
-            break
+    fit = _eiv_passes(X, y, (jx, jy, sig2, var_x, cov_xy, g), beta, iterations, scatter, strata)
+    if fit is None:
+        return LineFit.not_fitted(n)
+    beta, tau2, scatter, W, xwx, A, var0 = fit
     if not errors:
         return LineFit(
             slope=float(beta[0]),
@@ -323,6 +299,49 @@ def eiv_line(
         scatter_ci_low=float(tau[1]),
         scatter_ci_high=float(tau[2]),
     )
+
+
+def _eiv_passes(X, y, noise: tuple, beta, iterations: int, scatter: bool, strata) -> tuple | None:
+    """:func:`eiv_line`'s passes of the weights, tau^2 and the slope, from the start ``beta``.
+
+    ``noise``: ``(jx, jy, sig2, var_x, cov_xy, g)``. Returns ``(beta, tau2, scatter, W, xwx, A,
+    var0)`` at the last pass (``scatter`` False where tau^2 could not be estimated), or None for
+    a fit not made (an effective variance or a corrected spread of x that is not positive).
+
+    A pass whose slope and tau^2 are those it started from, to the bit, among the passes of one
+    kind (after the first, or after the first with tau^2) is a fixed point: every later pass
+    would repeat it exactly, so the loop ends there with the same numbers
+    (:data:`STOP_AT_FIXED_POINT`).
+    """
+    jx, jy, sig2, var_x, cov_xy, g = noise
+    x = X[:, 0]
+    n, p = X.shape
+    tau2 = 0.0
+    settled = iterations if scatter else 1
+    state = None
+    for it in range(iterations + (SCATTER_PASSES if scatter else 0)):
+        var0 = ((jy - beta[0] * jx) ** 2 * sig2).sum(axis=1)
+        if (var0 <= 0).any():
+            return None
+        if scatter and it >= iterations - 1:
+            tau2 = _paule_mandel_within(y - X @ beta, x, y, var_x, cov_xy, var0, tau2 * g, g, strata, n - p)
+            if not np.isfinite(tau2):  # the points at x ~ 0 (g = 0) alone exceed the residuals' dof,
+                scatter, tau2 = False, 0.0  # or no dof is left: fitted without the term (tau NaN)
+        W = 1.0 / (var0 + tau2 * g)
+        xwx = X.T @ (W[:, None] * X)
+        A = xwx.copy()
+        A[0, 0] -= (W * var_x).sum()
+        rhs = X.T @ (W * y)
+        rhs[0] -= (W * cov_xy).sum()
+        if A[0, 0] <= 0 or (p == 2 and np.linalg.det(A) <= 0):
+            return None
+        # a line through the origin: the 1 x 1 system divided out (LAPACK's solve of it is this
+        # division, and its determinant the element: the same numbers without their overhead)
+        beta = rhs / A[0, 0] if p == 1 else np.linalg.solve(A, rhs)
+        state, before = (beta.tobytes(), tau2, scatter), state
+        if STOP_AT_FIXED_POINT and it >= settled and state == before:
+            break
+    return beta, tau2, scatter, W, xwx, A, var0
 
 
 def _paule_mandel_within(r, x, y, var_x, cov_xy, var0, extra, g, strata, dof) -> float:

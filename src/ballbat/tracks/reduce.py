@@ -231,7 +231,7 @@ def reduce_tracks(
         free flight and spin fit (where its settings are the same: :func:`_fit_ball`,
         :func:`_fit_bat_and_spin`). The exclusions are not tested again: the flags, reasons and
         agreement are ``like``'s. The values are those of the reduction from scratch, to the bit
-        (tests/tracks/test_reduce_like.py).
+        (tests/tracks/test_reduce.py).
 
     Returns
     -------
