@@ -2,7 +2,9 @@
 
 1. Cold ``snakemake -c2`` of the default workflow in a fresh copy of the repository.
 2. A no-op rerun, against Snakemake's own no-op on a one-rule workflow (issue 39's target: within
-   1.2x), and on a one-rule workflow with a param (Snakemake imports pandas to store params).
+   1.2x; 1.22-1.31x on 2026-11-28, docs/studies.md "Where issue 39 stands"), and on a one-rule
+   workflow with a param (Snakemake imports pandas to store params, which our workflow spares it:
+   ballbat.pipeline.params_record). The three no-ops take turns (medians of 7).
 3. The fit stage alone (``ballbat.stages.fit_ex.run``) at 10^3 .. 10^5 impacts
    (targets: linear in the number of impacts, 10^5 impacts in under 5 s).
 
