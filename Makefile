@@ -103,7 +103,9 @@ test-report: report
 	command -v chromium >/dev/null || { apt-get update -qq && DEBIAN_FRONTEND=noninteractive apt-get install -y -qq chromium >/dev/null; }
 	BALLBAT_REPORT_ROOT=$(CURDIR) BALLBAT_REQUIRE_BROWSER=1 $(BIN)/python -m pytest tests/workflow/test_report_browser.py
 
-bench: install
+# With the package's bytecode, as `make run` has it: a no-op rerun would otherwise compile the
+# modules the Snakefile imports at every start (where PYTHONDONTWRITEBYTECODE is set).
+bench: bytecode
 	$(BIN)/python bench/bench_workflow.py
 	$(BIN)/python bench/bench_stronge.py
 	$(BIN)/python bench/bench_flight.py

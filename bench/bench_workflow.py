@@ -2,7 +2,9 @@
 
 1. Cold ``snakemake -c2`` of the default workflow in a fresh copy of the repository.
 2. A no-op rerun, against Snakemake's own no-op on a one-rule workflow (issue 39's target: within
-   1.2x), and on a one-rule workflow with a param (Snakemake imports pandas to store params).
+   1.2x; 1.22-1.31x on 2026-11-28, docs/studies.md "Where issue 39 stands"), and on a one-rule
+   workflow with a param (Snakemake imports pandas to store params, which our workflow spares it:
+   ballbat.pipeline.params_record). The three no-ops take turns (medians of 7).
 3. The fit stage alone (``ballbat.stages.fit_ex.run``) at 10^3 .. 10^5 impacts
    (targets: linear in the number of impacts, 10^5 impacts in under 5 s).
 
@@ -41,22 +43,35 @@ def fresh_copy(tmp: Path) -> Path:
     return wd
 
 
-def snakemake_times(repeats: int = 5) -> dict:
-    """Return the times of a cold run and of no-op reruns of the default workflow."""
+def snakemake_times(repeats: int = 7) -> dict:
+    """Return the times of a cold run and of no-op reruns of the default workflow and of the references.
+
+    Each workflow is run once before it is timed (the references' first runs, the default
+    workflow's first no-op), then the three no-ops take turns ``repeats`` times, so that a load
+    that comes and goes on a shared machine weighs on each alike; each time is their median.
+    """
     sm = [sys.executable, "-m", "snakemake", "-c2"]
     with tempfile.TemporaryDirectory() as tmp:
         wd = fresh_copy(Path(tmp))
         cold = timed(sm, wd)
-        noop = statistics.median(timed(sm, wd) for _ in range(repeats))
-        base = {}
+        dirs = {"noop": wd}
         for name, params in (("noop_one_rule", ""), ("noop_one_rule_params", "    params:\n        x=1,\n")):
             one = Path(tmp) / name
             one.mkdir()
             rule = f'rule a:\n    output:\n        "a.txt"\n{params}    shell:\n        "touch {{output}}"\n'
             (one / "Snakefile").write_text(rule)
-            timed(sm, one)
-            base[name] = statistics.median(timed(sm, one) for _ in range(repeats))
-    return {"cold": cold, "noop": noop, **base}
+            dirs[name] = one
+        for d in dirs.values():
+            timed(sm, d)
+        times = {name: [] for name in dirs}
+        for _ in range(repeats):
+            for name, d in dirs.items():
+                times[name].append(timed(sm, d))
+        # a regression guard: Snakemake imports pandas for the params' records unless the workflow
+        # spares it (ballbat.pipeline.params_record)
+        imports = subprocess.run([sys.executable, "-X", "importtime", *sm[1:]], cwd=wd, capture_output=True, text=True)
+        pandas = any(line.rstrip().endswith("| pandas") for line in imports.stderr.splitlines())
+    return {"cold": cold, **{name: statistics.median(t) for name, t in times.items()}, "pandas": pandas}
 
 
 def fit_times(sizes=(1_000, 10_000, 100_000)) -> list[tuple[int, float]]:
@@ -93,12 +108,13 @@ def main() -> None:
     sm = snakemake_times()
     print("workflow (default config, snakemake -c2)")
     print(f"  cold run                       {sm['cold']:7.2f} s")
-    print(f"  no-op rerun (median of 5)      {sm['noop']:7.2f} s")
+    print(f"  no-op rerun (median of 7)      {sm['noop']:7.2f} s")
     print(f"  one-rule workflow no-op        {sm['noop_one_rule']:7.2f} s")
     print(f"  ratio (target <= 1.2)          {sm['noop'] / sm['noop_one_rule']:7.2f}")
-    # Snakemake imports pandas (about 0.17 s) to store the params of any rule that has them
+    # Snakemake imports pandas (about 0.15 s, and more at exit) to store the params of a rule that has them
     print(f"  one rule with a param, no-op   {sm['noop_one_rule_params']:7.2f} s")
     print(f"  ratio to it                    {sm['noop'] / sm['noop_one_rule_params']:7.2f}")
+    print(f"  pandas imported by the no-op   {'yes' if sm['pandas'] else 'no':>7s}")
     print("fit stage alone (stages.fit_ex.run, all fits of Sec. IV)")
     fits = fit_times()
     for n, t in fits:

@@ -1,9 +1,10 @@
 """What the fork server of :mod:`forked` loads once, before it forks each run.
 
-Snakemake's own modules and the third-party libraries its start imports (pandas for the
-parameters' records, the report's libraries, smart_open, jsonschema), and its plugin
-registries, collected once by building the command line's parser: about 1.3 s of every
-run's start (profiled with ``python -X importtime`` and cProfile on ``snakemake -n``).
+Snakemake's own modules and the third-party libraries its start imports (the report's
+libraries, smart_open, jsonschema; pandas, which it imports for the parameters' records unless
+the workflow spares it, ballbat.pipeline.params_record), and its plugin registries, collected
+once by building the command line's parser: about 1.3 s of every run's start (profiled with
+``python -X importtime`` and cProfile on ``snakemake -n``).
 Then the libraries the ``ballbat`` command imports (xarray and netCDF4, scipy's optimize and
 stats, lmfit, openpyxl, yaml): 1-2.5 s of each command's start. And matplotlib's pyplot on
 its Agg backend (as :mod:`ballbat.plotting` sets it), about 0.8 s of each figure job's start.

@@ -406,3 +406,15 @@ def test_a_study_of_a_filmed_dataset_is_refused(raw, schema):
     raw["datasets"]["synthetic"]["render"]["video"] = {"format": "mkv"}
     with pytest.raises(ConfigError, match=r"studies\.calibration\.dataset: 'synthetic' films its impacts"):
         validate_config(raw, schema, available=10**12)
+
+
+def test_a_sweep_point_two_studies_share_is_named_in_each(raw, schema):
+    """A block checked once for two studies (and points that leave a block as it is) still names every study."""
+    raw["studies"]["robustness"]["sweep"]["grid"]["pixel_noise_px"] = [2.0, 150.0]
+    raw["studies"]["again"] = copy.deepcopy(raw["studies"]["robustness"])
+    text = problems(raw, schema)
+    for study in ("robustness", "again"):
+        for camera in ("swing", "spin"):
+            where = f"studies.{study}.sweep (pixel_noise_px = 150)"
+            assert f"{where}: render.cameras.{camera}.pixel_noise_px: 150.0 is greater" in text
+    assert text.count("(pixel_noise_px = 150)") == 4 and "(pixel_noise_px = 2)" not in text

@@ -102,6 +102,7 @@ def _studies(config: dict, schema: dict | None = None) -> list[str]:
 
     problems = []
     datasets = config.get("datasets") or {}
+    checked: dict[tuple[str, str], list[str]] = {}  # the studies' sweep points share their blocks' checks
     for name, study in (config.get("studies") or {}).items():
         where = f"studies.{name}"
         ds = datasets.get(study["dataset"])
@@ -121,7 +122,7 @@ def _studies(config: dict, schema: dict | None = None) -> list[str]:
             )
         else:
             found = check_study_sweep(ds, study, where)
-            problems += found or _sweep_point_problems(ds, study, where, schema)
+            problems += found or _sweep_point_problems(ds, study, where, schema, checked)
             problems += _draw_properties_problems(config, ds, study, where)
     return problems
 
@@ -146,10 +147,16 @@ def _draw_properties_problems(config: dict, dataset: dict, study: dict, where: s
     ]
 
 
-def _sweep_point_problems(dataset: dict, study: dict, where: str, schema: dict | None = None) -> list[str]:
+def _sweep_point_problems(
+    dataset: dict, study: dict, where: str, schema: dict | None = None, checked: dict | None = None
+) -> list[str]:
     """Return the schema's problems of the dataset at each swept value (the schema owns every setting's range).
 
     Each value of each swept setting is checked once (a grid's settings are independent keys).
+    A block a point leaves as it is (the render block of an ``impacts_per_bat`` point), or that
+    another point or study made the same, is checked once: ``checked`` holds the messages of each
+    block checked, by its kind and ``repr`` (which tells 1 from 1.0 and True, and keeps the keys'
+    order: the same text, the same errors in the same order).
     """
     import jsonschema
 
@@ -158,14 +165,19 @@ def _sweep_point_problems(dataset: dict, study: dict, where: str, schema: dict |
     names, points = sweep_points(study.get("sweep"))
     problems = []
     schema = packaged_schema() if schema is None else schema
+    checked = {} if checked is None else checked
     kinds = [k for k in ("synthetic", "render") if k in dataset]
-    validators = {k: jsonschema.Draft202012Validator(block_schema(k, schema)) for k in kinds}
+    validators = {}
     for i, name in enumerate(names):
         for value in sorted({p[i] for p in points}):
             point = point_dataset(dataset, name, value)
-            for kind, validator in validators.items():
-                for err in validator.iter_errors(point[kind]):
-                    problems.append(f"{where}.sweep ({name} = {value:g}): {kind}.{_message(err)}")
+            for kind in kinds:
+                key = (kind, repr(point[kind]))
+                if key not in checked:
+                    if kind not in validators:
+                        validators[kind] = jsonschema.Draft202012Validator(block_schema(kind, schema))
+                    checked[key] = [_message(err) for err in validators[kind].iter_errors(point[kind])]
+                problems += [f"{where}.sweep ({name} = {value:g}): {kind}.{message}" for message in checked[key]]
     return problems
 
 

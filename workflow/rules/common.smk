@@ -18,7 +18,12 @@ from ballbat.pipeline.guards import (
     users_files,
     warnings_summary,
 )
+from ballbat.pipeline.params_record import serialize_params_lazily
 from ballbat.workflow_inputs import WorkflowInputs
+
+# Snakemake records the rules' params without importing pandas (0.15 s of every start) while no
+# param is a pandas object: the same records, so a changed param reruns as before (ballbat.pipeline.params_record).
+serialize_params_lazily()
 
 # A results file given to --configfile (a target put after it): one line, before the config is checked.
 for _line in configfile_targets(workflow.configfiles, config.get("results") or "results"):

@@ -17,17 +17,20 @@ PACKAGE = "ballbat"
 PACKAGE_DIR = Path(__file__).resolve().parent.parent  # src/ballbat
 
 
+#: An import statement at the start of a line. The line's start is its newline (the text is read
+#: with one put before it), not ``^`` with re.MULTILINE: a pattern that starts with a character is
+#: searched for that character, not tried at every position (the package's 1.4 MB: 6.4 -> 2.7 ms,
+#: part of every start of the workflow). No match ends with a newline, so none hides the next.
 _IMPORT = re.compile(
-    r"^[ \t]*(?:from[ \t]+(?P<from>\.+[\w.]*|[\w.]+)[ \t]+import[ \t]+(?P<names>\([^)]*\)|[^\n#]+)"
+    r"\n[ \t]*(?:from[ \t]+(?P<from>\.+[\w.]*|[\w.]+)[ \t]+import[ \t]+(?P<names>\([^)]*\)|[^\n#]+)"
     r"|import[ \t]+(?P<mods>[^\n#]+))",
-    re.MULTILINE,
 )
 
 
 @cache
 def _imports_cached(path: str, mtime_ns: int, module: str | None) -> frozenset[str]:
     found: set[str] = set()
-    for m in _IMPORT.finditer(Path(path).read_text()):
+    for m in _IMPORT.finditer("\n" + Path(path).read_text()):
         if m.group("mods"):
             for part in m.group("mods").split(","):
                 name = part.split(" as ")[0].strip()
