@@ -129,7 +129,33 @@ def build_dataset(
         name: (c[0].dims, np.asarray(c[1]), c[0].attributes()) if isinstance(c[0], Var) else c
         for name, c in (coords or {}).items()
     }
-    return xr.Dataset(data_vars, coords=coord_vars, attrs=dict(attrs or {}))
+    base = xr.Dataset(coords=coord_vars, attrs=dict(attrs or {}))
+    if not _plain_data_vars(base, data_vars):
+        return xr.Dataset(data_vars, coords=coord_vars, attrs=dict(attrs or {}))
+    # the coordinates built (their indexes), the data variables put before them as xarray's merge
+    # puts them: the Dataset the constructor gives (a test compares them), without its merge
+    from xarray.core.variable import calculate_dimensions
+
+    variables = {name: xr.Variable(*spec) for name, spec in data_vars.items()}
+    variables.update(base._variables)
+    return base._replace(variables=variables, dims=calculate_dimensions(variables))
+
+
+def _plain_data_vars(base: xr.Dataset, data_vars: Mapping[str, tuple]) -> bool:
+    """Whether :func:`build_dataset` may put ``data_vars`` beside the coordinates of ``base`` without xarray's merge.
+
+    None is a coordinate or names a dimension (which would make it one), and every dimension
+    has one size across the coordinates and the variables.
+    """
+    sizes = dict(base.sizes)
+    for name, (dims, values, _) in data_vars.items():
+        if name in base.variables or len(dims) != np.ndim(values):
+            return False
+        for d, n in zip(dims, np.shape(values), strict=True):
+            if sizes.setdefault(d, n) != n:
+                return False
+    names = set(data_vars)
+    return not any(d in names for d in sizes)
 
 
 def add_variables(ds: xr.Dataset, table: Mapping[str, Var], values: Mapping[str, Any]) -> xr.Dataset:
