@@ -1,5 +1,4 @@
-"""Dataset assembly (ballbat.pipeline.products): add_variables and build_dataset without xarray's merge are
-Dataset.update's and the constructor's results."""
+"""Dataset assembly (ballbat.pipeline.products): add_variables and build_dataset skip xarray's merge, same result."""
 
 from __future__ import annotations
 
