@@ -401,7 +401,8 @@ def _fit_ball(tracks: Tracks, cameras: dict[str, Camera], like: Reduction | None
 
     Returns ``onset, flight, times, phys`` (:class:`Reduction`'s fields) and the
     :class:`~ballbat.tracks.fit_contact.ContactLikelihood`. ``like``: a reduction of the same
-    cleaned tracks, whose camera of unchanged settings is taken as it is.
+    cleaned tracks, whose camera of unchanged settings is taken as it is, and whose onsets (found
+    on the pixels alone) are taken for every camera where these are its very tracks.
     """
     n = tracks.n
     onset, flight, times, phys = {}, {}, {}, {}
@@ -413,7 +414,8 @@ def _fit_ball(tracks: Tracks, cameras: dict[str, Camera], like: Reduction | None
         ct, cam = tracks.cameras[name], cameras[name]
         t = np.broadcast_to(np.arange(ct.n_columns)[None, :] / cam.fps, (n, ct.n_columns))
         times[name] = t
-        onset[name] = find_onset(ct.x["ball"], ct.y["ball"])
+        same_pixels = like is not None and like.tracks is tracks
+        onset[name] = like.onset[name] if same_pixels else find_onset(ct.x["ball"], ct.y["ball"])
         X, Y = physical(ct, cam, "ball")
         phys[(name, "ball")] = (X, Y)
         flight[name] = fit_flight(X, Y, t, onset[name], cam.fps)
