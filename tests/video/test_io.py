@@ -112,3 +112,35 @@ def test_unknown_or_missing_files_are_named(tmp_path):
     (tmp_path / "lone.cihx").write_bytes((DATA / "beam.cihx").read_bytes())
     with pytest.raises(VideoError, match=r"lone\.cihx: its frames lone\.mraw are not beside it"):
         open_clip(tmp_path / "lone.cihx")
+
+
+def _stream_facts(frames, duration_us, rate, time_base):
+    """Return ``_av_facts`` of a container whose one stream says these (the numbers a phone's clip has)."""
+    from fractions import Fraction
+
+    from ballbat.video.io import _av_facts
+
+    s = types.SimpleNamespace(
+        format=types.SimpleNamespace(name="yuv420p"),
+        codec_context=types.SimpleNamespace(name="h264"),
+        average_rate=Fraction(rate),
+        guessed_rate=None,
+        frames=frames,
+        width=550,
+        height=310,
+        time_base=Fraction(time_base),
+    )
+    c = types.SimpleNamespace(streams=types.SimpleNamespace(video=[s]), duration=duration_us, metadata={})
+    return _av_facts(c, Path("clip.mp4"))
+
+
+def test_a_trimmed_clip_counts_the_frames_it_shows():
+    """A phone's trimmed clip stores 2057 frames, 212 of them before its edit list's start: 1843 shown, 30.73 s."""
+    f = _stream_facts(2057, 30_730_998, "718080/11971", "1/15360")
+    assert (f["n"], f["slack"]) == (1843, 1)
+    f = _stream_facts(1537, 25_618_718, "5930/99", "1/11860")  # two frames stored past the end
+    assert (f["n"], f["slack"]) == (1535, 1)
+    f = _stream_facts(1536, 25_618_718, "5930/99", "1/11860")  # a frame more than the duration: the count stands
+    assert (f["n"], f["slack"]) == (1536, 0)
+    f = _stream_facts(0, 2_000_000, "60", "1/1000")  # no count: the duration's, to its time base
+    assert (f["n"], f["slack"]) == (120, 1)

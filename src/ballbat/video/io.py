@@ -200,9 +200,11 @@ def _av_facts(c, path: Path) -> dict:
         raise VideoError(f"{path}: frame 0: no decoder for its video codec (unknown or unsupported)") from None
     rate = s.average_rate or s.guessed_rate
     n, slack = s.frames, 0
-    if not n and c.duration and rate:  # the duration, to its time base, in frames
-        n = round(c.duration / 1e6 * float(rate))
-        slack = int(np.ceil(float(s.time_base) * float(rate)))
+    shown = round(c.duration / 1e6 * float(rate)) if c.duration and rate else 0  # the duration, in frames
+    if shown and (not n or n > shown + 1):
+        # no count, or more frames stored than the clip lasts: an edit list shows part of them (a phone's trimmed
+        # clip keeps the frames cut off before its start), and only those are decoded
+        n, slack = shown, int(np.ceil(float(s.time_base) * float(rate)))
     return {
         "name": s.codec_context.name,
         "pix": pix,
