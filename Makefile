@@ -70,7 +70,7 @@ study: bytecode
 	$(BIN)/snakemake -c$(CORES) --report results/report.html all studies
 
 # The studies marked on_request (config `studies.robustness`: a grid over tracking noise, impacts
-# per bat and contact time with drawn calibration; 49 min on 2 shared cores, docs/studies.md), with
+# per bat and contact time with drawn calibration; 24 min on 2 free cores, docs/studies.md), with
 # those of `make study`, then the report with every study's figures.
 study-robustness: bytecode
 	$(BIN)/snakemake -c$(CORES) all studies studies_on_request
