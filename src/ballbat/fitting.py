@@ -316,14 +316,13 @@ def implied_e_y(
     n = x.size
     w_r = _weights(jx, jy, sig, rfit.slope, rfit, x)  # the fit's weights, its scatter term included
     W = np.ones(n) if w_r is None else w_r**2
-    # each impact's e_x (its bat's; the pooled one where the bat has no fit) and its influence
-    if errors:
-        xs, ys, jxs, jys = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
     # the noise of each abscissa (and its covariance with the ordinate), removed from the sums
     # as the moment-corrected fits remove it (linefit.eiv_line); zero without uncertainties
     var_x, cov_xy = _noise_moments(jx, jy, sig)
-    if errors:
+    if errors:  # each impact's e_x fit's design, for its influence
+        xs, ys, jxs, jys = spin_design(Measured.from_dataset(ds, sel), r, r_x, alpha)
         var_xs, cov_s = _noise_moments(jxs, jys, sig)
+    # each impact's e_x (its bat's; the pooled one where the bat has no fit) and its influence
     one_plus = np.empty(n)
     influence_ex = np.empty(n)
     lev_ex = np.zeros(n)
