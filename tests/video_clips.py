@@ -14,6 +14,15 @@ RADIUS_PX = 0.0366 / M_PER_PX
 #: A plain look (no clutter, even light, low noise) and the default one.
 PLAIN = Look(clutter=0, lighting=0.0, read_noise=0.004, shot_noise=0.0, exposure_s=0.0, seed=3)
 BUSY = Look(seed=4, dot_radius_m=0.008)
+#: A render block of the tracks renderer (the default rig) for clips drawn from a drawn motion.
+SCENE_RENDER = {
+    "cameras": {
+        "swing": {"fps": 3000, "m_per_px": 0.00074, "tee_px": [540, 480], "pixel_noise_px": 2.0},
+        "spin": {"fps": 1000, "m_per_px": 0.00125, "tee_px": [600, 480], "pre_impact_frames": 5},
+    },
+    "rig": {"pivot_to_tip_in": 34.0, "pivot_to_impact_in": 28.0},
+    "seed": 5,
+}
 
 
 def spin_truth(
@@ -116,3 +125,22 @@ def quality_table() -> dict:
         for cam in ("swing", "spin")
     ]
     return {k: np.concatenate([t[k] for t in tables]) for k in tables[0]}
+
+
+def two_impact_truths(seed: int = 5) -> list[ClipTruth]:
+    """Two impacts' clip truths (swing, spin, swing, spin) drawn by the renderer with :data:`SCENE_RENDER`."""
+    from ballbat.pipeline.config import checked_block
+    from ballbat.tracks.render import settings_from_config
+    from ballbat.units import DEGREE, MPH, RPM
+    from ballbat.video.scene import clip_truths
+
+    s = settings_from_config(checked_block(SCENE_RENDER | {"seed": seed}, "render"))
+    truth = {
+        "v_bat": np.array([75.0, 68.0]) * MPH,
+        "v_ball": np.array([85.0, 90.0]) * MPH,
+        "theta": np.array([10.0, -5.0]) * DEGREE,
+        "omega": np.array([2000.0, 3500.0]) * RPM,
+        "psi": np.array([15.0, -20.0]) * DEGREE,
+    }
+    ids = np.array(["W1", "W2"])
+    return clip_truths(s, truth, np.full(2, 0.0366), ids, np.full(2, "baseball"), np.full(2, "wood"))

@@ -220,14 +220,14 @@ def _ball_motion(t, v, launch, t_c):
 
 
 def _sample_times(n, cam: RenderCamera, t_end, rng):
-    """Frame times (impact at t = 0, random sub-frame phase) and integer frame origins."""
+    """Frame times (impact at t = 0, random sub-frame phase), integer frame origins, and each impact's phase."""
     fps = cam.camera.fps
     phase = rng.uniform(0.0, 1.0, n)
     ncol = int(min(cam.max_frames, cam.pre_impact_frames + np.ceil(np.max(t_end) * fps) + 2))
     k = np.arange(ncol)[None, :] - cam.pre_impact_frames
     t = (k + phase[:, None]) / fps
     frame0 = rng.integers(0, 5000, n)
-    return t, frame0
+    return t, frame0, phase
 
 
 def _to_pixels(X, Y, cam: RenderCamera, noise):
@@ -317,6 +317,109 @@ def _dot_geometry(rng: np.random.Generator, n: int, axis_offset: float) -> dict[
     return dots
 
 
+@dataclass(frozen=True)
+class Motion:
+    """Every impact's true motion as the renderer draws it: the points' positions at any time.
+
+    The draws of :func:`render_tracks` (swing-plane angle, contact time, the bat's slowdown,
+    the spin axis and dots) with the truth they move by; :meth:`points` gives each point's
+    position (m, physical frame, impact at t = 0) at any times, which the tracks sample at their
+    frames and :mod:`ballbat.video.render` within each frame's exposure (the motion blur).
+    """
+
+    settings: RenderSettings
+    v_bat: np.ndarray
+    v_ball: np.ndarray
+    omega: np.ndarray
+    psi: np.ndarray
+    r: np.ndarray
+    beta: np.ndarray
+    launch: np.ndarray
+    t_c: np.ndarray
+    slow: np.ndarray
+    chi: np.ndarray
+    dots: dict
+    frame: tuple
+
+    def take(self, i: int) -> Motion:
+        """Return the motion of impact ``i`` alone (every array of length one)."""
+        one = slice(i, i + 1)
+        fields = {k: getattr(self, k)[one] for k in ("v_bat", "v_ball", "omega", "psi", "r", "beta", "launch")}
+        fields |= {k: getattr(self, k)[one] for k in ("t_c", "slow", "chi")}
+        dots = {p: (rho[one], phi[one]) for p, (rho, phi) in self.dots.items()}
+        frame = tuple(v[:, one] for v in self.frame)
+        return Motion(self.settings, **fields, dots=dots, frame=frame)
+
+    def points(self, camera: str, t: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
+        """Each point ``camera`` records at times ``t`` (s, (impact, time)): (X, Y) in m, NaN for a hidden dot."""
+        X, Y, s = _ball_motion(t, self.v_ball, self.launch, self.t_c)
+        pts = {"ball": (X, Y)}
+        if camera == "swing":
+            omega_bat = self.v_bat / self.settings.rig.pivot_to_impact
+            ang = np.where(t < 0, omega_bat[:, None] * t, omega_bat[:, None] * (1 - self.slow[:, None]) * t)
+            u = self.settings.rig.pivot_to_tip * np.sin(ang)
+            n_dir = self.beta + self.psi
+            tx0 = -self.settings.bat_axis_to_ball * np.cos(n_dir)
+            ty0 = -self.settings.bat_axis_to_ball * np.sin(n_dir)
+            pts["bat_tip"] = (
+                tx0[:, None] + u * np.cos(self.beta)[:, None],
+                ty0[:, None] + u * np.sin(self.beta)[:, None],
+            )
+        else:
+            turn = self.omega[:, None] * s  # rotation angle (s is distance / speed: same clock)
+            for p, (rho, phi0) in self.dots.items():
+                pts[p] = _dot_track(X, Y, self.r, rho, phi0[:, None] + turn, self.frame)
+        return pts
+
+
+def _draw_motion(truth: dict, ball_radius: np.ndarray, settings: RenderSettings, rng: np.random.Generator) -> Motion:
+    """Draw every impact's motion (:class:`Motion`) from ``rng``, in the order the tracks always drew it."""
+    n = len(np.asarray(truth["v_bat"]))
+    theta, psi = (np.asarray(truth[k], float) for k in ("theta", "psi"))
+    beta = rng.uniform(*settings.swing_plane, n)
+    t_c = rng.uniform(*settings.contact_time, n)
+    slow = rng.uniform(*settings.bat_slowdown, n)
+    tilted = rng.uniform(size=n) < settings.tilted_fraction
+    chi = np.where(tilted, rng.uniform(*settings.tilt, n), 0.0)
+    zeta = rng.uniform(0, 2 * np.pi, n)
+    dots = _dot_geometry(rng, n, settings.axis_offset)
+    axis = np.stack([np.sin(chi) * np.cos(zeta), np.sin(chi) * np.sin(zeta), np.cos(chi)])
+    e1 = np.stack([np.cos(zeta) * np.cos(chi), np.sin(zeta) * np.cos(chi), -np.sin(chi)])
+    e2 = np.stack([-np.sin(zeta), np.cos(zeta), np.zeros(n)])
+    return Motion(
+        settings,
+        v_bat=np.asarray(truth["v_bat"], float),
+        v_ball=np.asarray(truth["v_ball"], float),
+        omega=np.asarray(truth["omega"], float),
+        psi=psi,
+        r=np.asarray(ball_radius, float),
+        beta=beta,
+        launch=beta + theta,
+        t_c=t_c,
+        slow=slow,
+        chi=chi,
+        dots=dots,
+        frame=(axis, e1, e2),
+    )
+
+
+@dataclass(frozen=True)
+class Clock:
+    """When a camera's columns are: column k of impact i at (k - ``pre_impact_frames`` + ``phase[i]``) / ``fps``."""
+
+    fps: float
+    pre_impact_frames: int
+    phase: np.ndarray
+
+    def take(self, i: int) -> Clock:
+        """Return the clock of impact ``i`` alone."""
+        return Clock(self.fps, self.pre_impact_frames, self.phase[i : i + 1])
+
+    def times(self, i: int, columns: np.ndarray) -> np.ndarray:
+        """Return the times (s, impact at 0) of impact ``i``'s (fractional) ``columns``."""
+        return (np.asarray(columns, float) - self.pre_impact_frames + self.phase[i]) / self.fps
+
+
 def render_tracks(
     truth: dict[str, np.ndarray],
     ball_radius: np.ndarray,
@@ -344,59 +447,43 @@ def render_tracks(
         Dense noisy tracks, and the truth (``truth_*``) including the rendering's own
         draws (swing-plane angle, launch angle, spin-axis tilt, dot radii, contact time).
     """
+    return render_motion(truth, ball_radius, settings, impact_id, ball, bat)[0]
+
+
+def render_motion(
+    truth: dict[str, np.ndarray],
+    ball_radius: np.ndarray,
+    settings: RenderSettings,
+    impact_id: np.ndarray,
+    ball: np.ndarray,
+    bat: np.ndarray,
+) -> tuple[Tracks, Motion, dict[str, Clock]]:
+    """:func:`render_tracks`, with the motion drawn and each camera's clock (the truth between frames)."""
     rng = np.random.default_rng(settings.seed)
-    n = len(impact_id)
-    v_bat, v_ball = np.asarray(truth["v_bat"], float), np.asarray(truth["v_ball"], float)
-    theta, omega, psi = (np.asarray(truth[k], float) for k in ("theta", "omega", "psi"))
-    r = np.asarray(ball_radius, float)
-
-    beta = rng.uniform(*settings.swing_plane, n)
-    launch = beta + theta
-    t_c = rng.uniform(*settings.contact_time, n)
-    slow = rng.uniform(*settings.bat_slowdown, n)
-    tilted = rng.uniform(size=n) < settings.tilted_fraction
-    chi = np.where(tilted, rng.uniform(*settings.tilt, n), 0.0)
-    zeta = rng.uniform(0, 2 * np.pi, n)
-    dots = _dot_geometry(rng, n, settings.axis_offset)
-    axis = np.stack([np.sin(chi) * np.cos(zeta), np.sin(chi) * np.sin(zeta), np.cos(chi)])
-    e1 = np.stack([np.cos(zeta) * np.cos(chi), np.sin(zeta) * np.cos(chi), -np.sin(chi)])
-    e2 = np.stack([-np.sin(zeta), np.cos(zeta), np.zeros(n)])
-
-    omega_bat = v_bat / settings.rig.pivot_to_impact
-    L = settings.rig.pivot_to_tip
-    cams = {}
+    motion = _draw_motion(truth, ball_radius, settings, rng)
+    cams, clocks = {}, {}
     for name, cam in (("swing", settings.swing), ("spin", settings.spin)):
-        t, frame0 = _sample_times(n, cam, _exit_time(v_ball, launch, t_c, cam), rng)
-        X, Y, s = _ball_motion(t, v_ball, launch, t_c)
-        pts = {"ball": (X, Y)}
-        if name == "swing":
-            ang = np.where(t < 0, omega_bat[:, None] * t, omega_bat[:, None] * (1 - slow[:, None]) * t)
-            u = L * np.sin(ang)
-            nx, ny = np.cos(beta + psi), np.sin(beta + psi)
-            tx0 = -settings.bat_axis_to_ball * nx
-            ty0 = -settings.bat_axis_to_ball * ny
-            pts["bat_tip"] = (tx0[:, None] + u * np.cos(beta)[:, None], ty0[:, None] + u * np.sin(beta)[:, None])
-        else:
-            turn = omega[:, None] * s  # rotation angle (s is distance / speed: same clock)
-            for p, (rho, phi0) in dots.items():
-                pts[p] = _dot_track(X, Y, r, rho, phi0[:, None] + turn, (axis, e1, e2))
-        xs, ys = _observed(pts, POINTS[name], cam, t, rng)
+        t_end = _exit_time(motion.v_ball, motion.launch, motion.t_c, cam)
+        t, frame0, phase = _sample_times(len(impact_id), cam, t_end, rng)
+        clocks[name] = Clock(cam.camera.fps, cam.pre_impact_frames, phase)
+        xs, ys = _observed(motion.points(name, t), POINTS[name], cam, t, rng)
         cams[name] = CameraTracks(frame0.astype(np.int64), xs, ys)
 
     keep = {f"truth_{k}": np.asarray(v) for k, v in truth.items()}
     keep.update(
-        truth_swing_plane=beta,
-        truth_launch_angle=launch,
-        truth_contact_time=t_c,
-        truth_bat_slowdown=slow,
-        truth_spin_axis_tilt=chi,
-        truth_dot_a_radius=dots["dot_a"][0],
-        truth_dot_b_radius=dots["dot_b"][0],
+        truth_swing_plane=motion.beta,
+        truth_launch_angle=motion.launch,
+        truth_contact_time=motion.t_c,
+        truth_bat_slowdown=motion.slow,
+        truth_spin_axis_tilt=motion.chi,
+        truth_dot_a_radius=motion.dots["dot_a"][0],
+        truth_dot_b_radius=motion.dots["dot_b"][0],
     )
-    return Tracks(
+    tracks = Tracks(
         impact_id=np.asarray(impact_id).astype(str),
         ball=np.asarray(ball).astype(str),
         bat=np.asarray(bat).astype(str),
         cameras=cams,
         truth=keep,
     )
+    return tracks, motion, clocks

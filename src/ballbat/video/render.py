@@ -1,8 +1,9 @@
 """Frames of a synthetic high-speed clip, drawn from its truth (:class:`~ballbat.video.scene.ClipTruth`).
 
 Each frame is the average of sub-exposures spread over the exposure time (motion blur), the
-points moving linearly between the frames' true positions. Drawn in the region the moving
-objects cover, over a fixed background:
+points where the clip's motion puts them at each (:class:`~ballbat.video.scene.ClipMotion`;
+linear between the frames' true positions for a clip made by hand). Drawn in the region the
+moving objects cover, over a fixed background:
 
 * background: a dark wall with clutter (grey boxes and bars, slightly soft), times the lighting;
 * lighting: a linear gradient and a vignette across the view (``lighting``: their strength);
@@ -88,11 +89,17 @@ def _coverage(dist: np.ndarray) -> np.ndarray:
 
 
 def _sample_positions(truth: ClipTruth, k: int, offsets: np.ndarray) -> dict[str, np.ndarray]:
-    """Each point's (x, y) at frame ``k`` + each offset (frames), linear between frames.
+    """Each point's (x, y) at frame ``k`` + each offset (frames): the clip's motion, else linear between frames.
 
-    Where a neighbouring frame has no position (the point appears or disappears), the nearest
-    frame's position is used (NaN if it has none).
+    With the clip's motion (:class:`~ballbat.video.scene.ClipMotion`) every sub-exposure is
+    where the point truly is then (NaN for a dot behind the ball), for the points in view at
+    frame ``k`` (one out of view there is not drawn). Without it (a clip made by hand), linear
+    between frames, and where a neighbouring frame has no position (the point appears or
+    disappears) the nearest frame's position is used (NaN if it has none).
     """
+    if truth.motion is not None:
+        at = truth.motion(k + offsets)
+        return {p: v if np.isfinite(truth.x[p][k]) else np.full_like(v, np.nan) for p, v in at.items()}
     n = truth.n_frames
     t = k + offsets
     lo = np.clip(np.floor(t).astype(int), 0, max(n - 2, 0))
