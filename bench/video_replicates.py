@@ -1,6 +1,6 @@
 """e_x per bat from filmed replicates (issue 38): the filmed example drawn again and again, tracked, e_x judged.
 
-    .venv/bin/python bench/video_replicates.py [N] [FORMAT[:CRF]]   (default 50 replicates, mkv)
+    .venv/bin/python bench/video_replicates.py [N] [FORMAT[:CRF]] [--keep DIR]   (default 50 replicates, mkv)
 
 ``config/examples/video.yaml``'s dataset (two bats, 10 impacts each, both cameras filmed at
 1024 x 512, 50 us exposure, noise, uneven light and clutter) is repeated ``N`` times as datasets
@@ -17,7 +17,8 @@ standard error (SE), bias / SE, the pulls' spread (SD of (e_x - truth) / SE), th
 the 95 % interval fit_ex.nc gives (``e_x_ci_low``, ``e_x_ci_high``) and of the 68 % one (the
 same Student t, at 68 %), with their binomial errors, each measured value's pulls against its
 truth (reduce.nc against simulate.nc: where a bias comes from), and the impacts left out.
-About 45 s of CPU a replicate (drawing 40 clips 18 s, tracking them 17 s).
+About 45 s of CPU a replicate (drawing 40 clips 18 s, tracking them 17 s). ``--keep DIR`` runs
+in ``DIR`` (a new folder) and keeps it, results and clips, to look into; else a temporary one.
 """
 
 from __future__ import annotations
@@ -139,10 +140,17 @@ def report(results: Path, n: int, seconds: float) -> list[str]:
 
 def main() -> None:
     """Run the replicates named on the command line and print the table."""
-    n = int(sys.argv[1]) if len(sys.argv) > 1 else 50
-    fmt, _, crf = (sys.argv[2] if len(sys.argv) > 2 else "mkv").partition(":")
+    args = sys.argv[1:]
+    keep = None
+    if "--keep" in args:
+        i = args.index("--keep")
+        keep = Path(args[i + 1])
+        del args[i : i + 2]
+        keep.mkdir(parents=True)  # a new folder: never one with a lab's files in it
+    n = int(args[0]) if args else 50
+    fmt, _, crf = (args[1] if len(args) > 1 else "mkv").partition(":")
     with tempfile.TemporaryDirectory() as tmp:
-        results, seconds = run(n, fmt, int(crf) if crf else None, Path(tmp))
+        results, seconds = run(n, fmt, int(crf) if crf else None, keep or Path(tmp))
         print("\n".join(report(results, n, seconds)), flush=True)
 
 
