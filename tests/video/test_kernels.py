@@ -7,10 +7,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 from scipy import ndimage
-from video_clips import BUSY, M_PER_PX, RADIUS_PX, spin_truth, swing_truth
+from video_clips import BUSY, M_PER_PX, RADIUS_PX, spin_truth, swing_truth, two_impact_truths
 
 from ballbat.video import edge, kernels, search, track
-from ballbat.video.render import render_frames
+from ballbat.video.render import Look, render_frames
 
 
 def _noisy_disc(rng, dtype, size=(120, 160)):
@@ -188,3 +188,21 @@ def test_the_numpy_shortcuts_are_numpys():
         trail.found(float(c))
         seen.append(float(c))
         assert trail.usual() == float(np.median(seen))
+
+
+def test_the_dots_refinement_compiled_is_the_numpy_one():
+    """A dot's centroid against the fitted shading, from the search's spots on rendered frames, to 1e-9 px."""
+    done = 0
+    for c in two_impact_truths(7):
+        if c.camera != "spin":
+            continue
+        for k, img in enumerate(render_frames(c, Look(), 0.00125)):
+            if not np.isfinite(c.x["ball"][k]) or k % 3:
+                continue
+            ball = (c.x["ball"][k], c.y["ball"][k], c.ball_radius_px)
+            for x, y, *_ in search.find_dots(img, ball, 3.2, 0.004)[0]:
+                fast = search.refine_dot(img, x, y, ball, 3.2)
+                ref = search.refine_dot(img, x, y, ball, 3.2, compiled=False)
+                np.testing.assert_allclose(fast, ref, rtol=0, atol=1e-9)
+                done += 1
+    assert done > 20

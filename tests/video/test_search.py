@@ -10,12 +10,20 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from video_clips import BUSY, M_PER_PX, PLAIN, RADIUS_PX, spin_truth, swing_truth
+from video_clips import BUSY, M_PER_PX, PLAIN, RADIUS_PX, spin_truth, swing_truth, two_impact_truths
 
 from ballbat.video.edge import fit_ball
 from ballbat.video.io import open_clip, write_clip
-from ballbat.video.render import render_frames
-from ballbat.video.search import _median_top, block_sum, find_balls, find_marker, find_marker_whole
+from ballbat.video.render import Look, render_frames
+from ballbat.video.search import (
+    _median_top,
+    block_sum,
+    find_balls,
+    find_dots,
+    find_marker,
+    find_marker_whole,
+    refine_dot,
+)
 from ballbat.video.track import TrackOptions, track_clip
 
 
@@ -91,3 +99,32 @@ def test_ball_centroid_of_a_small_shaded_disc_and_its_reasons():
     assert ball_centroid(img, 5.0, 80.0, TOSS_R, 1.0) == ((), "ball touches the frame's border")
     faint = ball_centroid(18.0 + 0.02 * _ball_image(100.3, 80.6), 100.0, 80.0, TOSS_R, 1.0)
     assert faint[0] == () and "under 6 noise sigma" in faint[1]
+
+
+def test_a_dots_centroid_refined_against_the_balls_shading():
+    """Weighted by the light it takes from the fitted shading, a dot's centroid is half as far off as the search's.
+
+    On noise-free rendered frames (29-px ball, 3.2-px dots, lit from the upper left): the
+    search's darkness-weighted centroid leans with the shading (0.07-0.09 px RMS), the refined
+    one is within 0.05 px.
+    """
+    look = Look(read_noise=0.0, shot_noise=0.0)
+    found, refined = [], []
+    for c in two_impact_truths(5):
+        if c.camera != "spin":
+            continue
+        for k, img in enumerate(render_frames(c, look, 0.00125)):
+            if not np.isfinite(c.x["ball"][k]):
+                continue
+            ball = (c.x["ball"][k], c.y["ball"][k], c.ball_radius_px)
+            for x, y, *_ in find_dots(img, ball, 3.2, 0.004)[0]:
+                d = {p: np.hypot(x - c.x[p][k], y - c.y[p][k]) for p in ("dot_a", "dot_b") if np.isfinite(c.x[p][k])}
+                p = min(d, key=d.get)
+                rx, ry = refine_dot(img, x, y, ball, 3.2)
+                found.append(d[p])
+                refined.append(np.hypot(rx - c.x[p][k], ry - c.y[p][k]))
+    rms = lambda v: float(np.sqrt(np.mean(np.square(v))))  # noqa: E731
+    assert len(found) > 60
+    assert rms(found) > 0.06  # what the search alone gives
+    assert rms(refined) < 0.05 and rms(refined) < 0.6 * rms(found)
+    assert max(refined) < 0.15

@@ -57,7 +57,15 @@ from .checks import IMPACT_Z, START_MARKS, camera_agreement, glitch_mask, mispla
 from .data import POINTS, Camera, CameraTracks, Rig, TrackBlocks, Tracks, gather
 from .fit_contact import Contact, ContactLikelihood, contact_likelihood, contact_population, contact_posterior
 from .fit_flight import CONTACT_MAX, Flight, find_onset, fit_flight
-from .fit_spin import OFFSET_FALSE_ALARM, RADIUS_TOLERANCE, UNWRAP_LIMIT, Spin, fit_spin, radius_scatter_limit
+from .fit_spin import (
+    OFFSET_FALSE_ALARM,
+    OFFSET_TOLERANCE,
+    RADIUS_TOLERANCE,
+    UNWRAP_LIMIT,
+    Spin,
+    fit_spin,
+    radius_scatter_limit,
+)
 from .fit_swing import Swing, fit_swing
 
 if TYPE_CHECKING:
@@ -652,9 +660,9 @@ def _spin_exclusions(mark: _Marks, flight: dict, spin: Spin, fps_spin: float, op
             spin.offset_chi2 > limit,
             ReduceFlag.DOT_NOT_ROTATING_ABOUT_CENTRE,
             lambda i: (
-                f"the dots turn about a point {1e3 * np.hypot(*spin.offset[i]):.1f} mm off the ball's centre "
-                f"(score test chi^2 {spin.offset_chi2[i]:.1f}, limit {limit:.1f}): a spin axis tilted from "
-                "the line of sight"
+                f"the dots turn about a point {1e3 * np.hypot(*spin.offset[i]):.1f} mm off the ball's centre, "
+                f"more than the {1e3 * OFFSET_TOLERANCE:.1f} mm tolerated (chi^2 {spin.offset_chi2[i]:.1f}, "
+                f"limit {limit:.1f}): a spin axis tilted from the line of sight"
             ),
         )
     mark(

@@ -5,7 +5,8 @@ Each kernel does what numpy and scipy functions of :mod:`ballbat.video.edge` and
 (``compiled=False``), and ``tests/video/test_kernels.py`` checks each kernel against them on
 random inputs and rendered frames. A pass of the ball's edge fit is one call
 (:func:`gradient_pass`, :func:`model_pass`), and so are the marker's and the dots' searches in
-their regions (:func:`marker_search`, :func:`dots_search`).
+their regions (:func:`marker_search`, :func:`dots_search`) and a dot's refinement
+(:func:`dot_refine`).
 
 Why compiled: a pass of the edge fit is about 25 numpy calls on arrays of 48 x 21, so numpy's
 per-call overhead, not the arithmetic, set its cost (about 130 us a pass; here 14 us a
@@ -641,6 +642,69 @@ def _spot(lab, k, box, dark, inside):
     return sx / tot, sy / tot, deepest
 
 
+@_jit
+def _shading(sub, x0, y0, x, y, cx, cy, r, dot_r, core_k, ring_k):
+    """Return the quadratic shading fitted on the ring round a dot at (x, y), and whether there was one.
+
+    As :func:`.search._shading_fit`: least squares on the ring, then again without the pixels
+    darker than it by 4 robust sd. The shading on the window, (h, w), float64.
+    """
+    h, w = sub.shape
+    rows = np.empty((h * w, 6))
+    vals = np.empty(h * w)
+    at = np.empty(h * w, np.int64)
+    n = 0
+    for i in range(h):
+        for j in range(w):
+            gx, gy = j + x0, i + y0
+            d = np.hypot(gx - x, gy - y)
+            if np.hypot(gx - cx, gy - cy) < r - 2.0 and core_k * dot_r + 1.0 < d < ring_k * dot_r + 1.0:
+                u, v = (gx - x) / dot_r, (gy - y) / dot_r
+                rows[n, 0], rows[n, 1], rows[n, 2], rows[n, 3], rows[n, 4], rows[n, 5] = 1.0, u, v, u * u, u * v, v * v
+                vals[n] = sub[i, j]
+                at[n] = i * w + j
+                n += 1
+    coef = np.zeros(6)
+    if n < 12:
+        return coef, False
+    keep = np.ones(n, np.bool_)
+    for _ in range(2):
+        A = rows[:n][keep[:n]]
+        coef = np.linalg.solve(A.T @ A, A.T @ vals[:n][keep[:n]])
+        res = vals[:n] - rows[:n] @ coef
+        s = 1.4826 * np.median(np.abs(res[keep[:n]]))
+        keep[:n] = res > -4 * max(s, 1e-9)
+    return coef, True
+
+
+@_jit
+def dot_refine(sub, x0, y0, x, y, cx, cy, r, dot_r, core_k, ring_k, passes):
+    """Return a dot's centroid weighted by the light it takes from the shading (:func:`.search.refine_dot`).
+
+    ``sub`` (float64) is the frame's region at (x0, y0) holding the dot's window for every pass.
+    """
+    h, w = sub.shape
+    for _ in range(passes):
+        coef, ok = _shading(sub, x0, y0, x, y, cx, cy, r, dot_r, core_k, ring_k)
+        if not ok:
+            return x, y
+        tot = sx = sy = 0.0
+        for i in range(h):
+            for j in range(w):
+                gx, gy = j + x0, i + y0
+                if np.hypot(gx - x, gy - y) < core_k * dot_r and np.hypot(gx - cx, gy - cy) < r - 2.0:
+                    u, v = (gx - x) / dot_r, (gy - y) / dot_r
+                    shade = coef[0] + coef[1] * u + coef[2] * v + coef[3] * u * u + coef[4] * u * v + coef[5] * v * v
+                    wt = max(1.0 - sub[i, j] / max(shade, 1e-9), 0.0)
+                    tot += wt
+                    sx += wt * gx
+                    sy += wt * gy
+        if not tot > 0:
+            return x, y
+        x, y = sx / tot, sy / tot
+    return x, y
+
+
 def load(dtype: type = np.uint8) -> None:
     """Load every kernel the tracker calls on frames of ``dtype`` (compiling any not in the cache).
 
@@ -658,3 +722,4 @@ def load(dtype: type = np.uint8) -> None:
     model_pass(img, 40.0, 40.0, 5.0, samples, cos, sin, bases, starts, cand, 1.0, kept, 24)
     marker_search(np.zeros((40, 40), np.float32), 20.0, 20.0, 4.0, 1.0, np.nan)
     dots_search(np.zeros((40, 40), np.float32), 0, 0, 20.0, 20.0, 15.0, 2.0, 1.0)
+    dot_refine(np.ones((40, 40)), 0, 0, 20.0, 20.0, 20.0, 20.0, 15.0, 2.0, 1.4, 2.6, 2)

@@ -35,7 +35,16 @@ import numpy as np
 from .clip import VideoError
 from .edge import fit_ball
 from .io import Clip
-from .search import ball_centroid, ball_silhouette, find_balls, find_dots, find_marker, find_marker_whole, roi
+from .search import (
+    ball_centroid,
+    ball_silhouette,
+    find_balls,
+    find_dots,
+    find_marker,
+    find_marker_whole,
+    refine_dot,
+    roi,
+)
 
 
 @dataclass(frozen=True)
@@ -323,7 +332,8 @@ def _dots(img, k, ball, opt: TrackOptions, sigma, mem: _DotMemory, found: Found)
             continue
         s = spots[labels[p]]
         mem.remember(p, k, float(np.arctan2(rel[labels[p]][1], rel[labels[p]][0])))
-        found.add(p, k, s[0], s[1], np.nan, s[2])
+        x, y = refine_dot(img, s[0], s[1], ball, opt.dot_radius_px)
+        found.add(p, k, x, y, np.nan, s[2])
 
 
 def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -> None:
