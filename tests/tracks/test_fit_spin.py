@@ -61,7 +61,7 @@ def test_the_spin_fitted_with_the_centre_is_unbiased_at_large_noise():
 def test_the_spin_fit_tells_a_tilted_axis_from_noise(monkeypatch):
     """At 5 px a dot's radius scatter cannot tell a spin axis tilted 30 degrees, but its circle sits
     about 10 mm off the ball's centre: the joint fit's score test flags most such impacts, and
-    about OFFSET_FALSE_ALARM of the untilted ones (fewer: offsets within OFFSET_TOLERANCE pass).
+    about OFFSET_FALSE_ALARM of the untilted ones (fewer: offsets within OFFSET_TOLERANCE are not flagged).
     """
     from ballbat.tracks import fit_spin as module
 
@@ -74,11 +74,10 @@ def test_the_spin_fit_tells_a_tilted_axis_from_noise(monkeypatch):
         plain = fit_spin(dx, dy, t, flight, cam, ball)
     assert 1.8 < np.mean(plain.offset_chi2) < 2.4
     np.testing.assert_array_equal(plain.offset, straight.offset)
-    # the tolerance takes the offset's excess over it: never more, nothing within it
-    assert np.all(straight.offset_chi2 <= plain.offset_chi2 * (1 + 1e-12))
+    # within the tolerance an offset is not flagged, however significant; beyond it the test is the plain one
     within = np.hypot(*straight.offset.T) <= module.OFFSET_TOLERANCE
     assert within.sum() > 50 and np.all(straight.offset_chi2[within] == 0)
-    assert np.mean(straight.offset_chi2) < 0.9 * np.mean(plain.offset_chi2)
+    np.testing.assert_array_equal(straight.offset_chi2[~within], plain.offset_chi2[~within])
     (dx, dy, t, flight, cam, ball), _ = _spinning_ball(300, 22, 0.00625, (0.022, 0.030), seed=4, tilt=np.radians(30))
     tilted = fit_spin(dx, dy, t, flight, cam, ball)
     assert np.mean(tilted.offset_chi2 > limit) > 0.8  # 87 % (seed 4)

@@ -370,12 +370,11 @@ def _spin_dot_rows(p, j, ct_x, ct_y, m, wd, ud, J, r) -> None:
 
 
 def _offset_score(J, r, cov, ok, wd, chi2) -> tuple[np.ndarray, np.ndarray]:
-    """Test of a common offset of the dots' circles beyond :data:`OFFSET_TOLERANCE` (:func:`_spin_block`'s last fit).
+    """Score test of a common offset of the dots' circles (:func:`_spin_block`'s last residuals and design).
 
-    Returns the statistic (chi^2, 2 degrees of freedom: the offset's excess over the tolerance,
-    along it, in the offset's own covariance; 0 within the tolerance, so that an offset of up to
-    the tolerance is flagged at most as often as the false alarm) and the offset (one
-    Gauss-Newton step from the fit without it).
+    Returns the statistic (chi^2, 2 degrees of freedom; 0 where the offset is within
+    :data:`OFFSET_TOLERANCE`: an impact is flagged where its offset is both significant and
+    larger than that) and the offset (one Gauss-Newton step).
     """
     nf = wd["dot_a"].shape[1]
     Jo = np.zeros((*r.shape, 2))
@@ -389,11 +388,8 @@ def _offset_score(J, r, cov, ok, wd, chi2) -> tuple[np.ndarray, np.ndarray]:
     g = tdot(Jo, r)
     V[~ok] = np.eye(2)
     step = -np.linalg.solve(V, g[..., None])[..., 0]
-    size = np.hypot(step[:, 0], step[:, 1])
-    with np.errstate(all="ignore"):
-        excess = step * np.clip(1.0 - OFFSET_TOLERANCE / size, 0.0, None)[:, None]
-    excess = np.where(size[:, None] > OFFSET_TOLERANCE, excess, 0.0)
-    return np.einsum("ni,nij,nj->n", excess, V, excess) / chi2, step
+    score = np.sum(g * -step, axis=1) / chi2
+    return np.where(np.hypot(step[:, 0], step[:, 1]) > OFFSET_TOLERANCE, score, 0.0), step
 
 
 def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept, radius, masks, s_dot):

@@ -14,7 +14,9 @@ prediction is at hand (not found yet, or lost for more than 3 frames). The searc
   rays kept (occluded), the disc touching the frame's border, no such disc, or two.
 * **dot_a, dot_b** -- dark spots inside the disc: the ball's own shading (a grey closing,
   which removes spots smaller than it) minus the frame, thresholded at 5 noise sigma; each
-  spot's centroid weighted by its darkness. Left out: a spot beyond 0.9 of the radius (on
+  spot then located by its centroid weighted by the light it takes from the ball's shading,
+  a quadratic fitted on a ring round it (:func:`~ballbat.video.search.refine_dot`). Left out:
+  a spot beyond 0.9 of the radius (on
   the limb: foreshortened, partly hidden), and both dots when there are none or more than two
   spots. The names a and b are the tracker's own, kept from frame to frame (by the turn from a
   to b when both are seen, by the angle carried on at the last spin when one is).
