@@ -16,10 +16,10 @@ prediction is at hand (not found yet, or lost for more than 3 frames). The searc
   which removes spots smaller than it) minus the frame, thresholded at 5 noise sigma; each
   spot then located by its centroid weighted by the light it takes from the ball's shading,
   a quadratic fitted on a ring round it (:func:`~ballbat.video.search.refine_dot`). Left out:
-  a spot beyond 0.9 of the radius (on
-  the limb: foreshortened, partly hidden), and both dots when there are none or more than two
-  spots. The names a and b are the tracker's own, kept from frame to frame (by the turn from a
-  to b when both are seen, by the angle carried on at the last spin when one is).
+  a spot beyond 0.9 of the radius (on the limb: foreshortened, partly hidden), and both dots
+  when there are none or more than two spots. The names a and b are the tracker's own, kept
+  from frame to frame (by the turn from a to b when both are seen, by the angle carried on at
+  the last spin when one is).
 * **bat_tip** -- a small bright disc (the marker) inside a dark surround (the end cap):
   its centroid weighted by brightness above the surround.
 
