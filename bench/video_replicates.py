@@ -100,7 +100,7 @@ def report(results: Path, n: int, seconds: float) -> list[str]:
         for q in QUANTITIES:
             d = red[q].values - sim[f"truth_{q}"].sel(impact=red["impact"]).values
             pulls_of[q].extend((d / red[f"{q}_err"].values)[ok])
-        left.update(r.split(":")[1].strip()[:60] for r in reasons if r != "ok")
+        left.update((r.partition(":")[2] or r).strip()[:60] for r in reasons if r != "ok")
         for bat in fit["bat"].values.astype(str):
             f = fit.sel(ball="baseball", bat=bat)
             rows[bat].append(
