@@ -24,7 +24,7 @@ track ends when the ball leaves its view. Vectorised over impacts and frames.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -344,11 +344,10 @@ class Motion:
     def take(self, i: int) -> Motion:
         """Return the motion of impact ``i`` alone (every array of length one)."""
         one = slice(i, i + 1)
-        fields = {k: getattr(self, k)[one] for k in ("v_bat", "v_ball", "omega", "psi", "r", "beta", "launch")}
-        fields |= {k: getattr(self, k)[one] for k in ("t_c", "slow", "chi")}
+        per_impact = {f.name: getattr(self, f.name) for f in fields(self)}
+        per_impact = {k: v[one] for k, v in per_impact.items() if isinstance(v, np.ndarray)}
         dots = {p: (rho[one], phi[one]) for p, (rho, phi) in self.dots.items()}
-        frame = tuple(v[:, one] for v in self.frame)
-        return Motion(self.settings, **fields, dots=dots, frame=frame)
+        return replace(self, **per_impact, dots=dots, frame=tuple(v[:, one] for v in self.frame))
 
     def points(self, camera: str, t: np.ndarray) -> dict[str, tuple[np.ndarray, np.ndarray]]:
         """Each point ``camera`` records at times ``t`` (s, (impact, time)): (X, Y) in m, NaN for a hidden dot."""
