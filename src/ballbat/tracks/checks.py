@@ -538,9 +538,9 @@ def camera_agreement(flight: dict, cameras: dict) -> Agreement:
         for c in ("swing", "spin"):
             f = flight[c]
             v[c] = np.hypot(f.vx, f.vy)
-            ve[c] = np.hypot(np.sqrt(f.vx_var), v[c] * cameras[c].m_per_px_err)
+            ve[c] = np.hypot(np.sqrt(f.var_along), v[c] * cameras[c].m_per_px_err)
             la[c] = np.arctan2(f.vy, f.vx)
-            le[c] = np.sqrt(f.vx_var) / v[c]
+            le[c] = np.sqrt(f.var_across) / v[c]
         z_speed = (v["swing"] - v["spin"]) / np.hypot(ve["swing"], ve["spin"])
         z_angle = np.angle(np.exp(1j * (la["swing"] - la["spin"]))) / np.hypot(le["swing"], le["spin"])
         ratio = v["swing"] / v["spin"]
