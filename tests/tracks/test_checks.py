@@ -261,3 +261,29 @@ def test_a_singular_system_leaves_its_impact_out_not_the_others():
     np.testing.assert_array_equal(x[2], [1.0, 0.5, 0.25, 0.125])
     inv = _solve_each(A, np.broadcast_to(np.eye(4), A.shape).copy())
     np.testing.assert_array_equal(inv[2], np.linalg.inv(A[2]))
+
+
+def test_cameras_launch_angles_a_hair_apart_agree_a_degree_apart_do_not():
+    """Two cameras' launch angles 0.05 deg apart at 0.005 deg errors (z = 7, a filmed ball's precision and a
+    hand-levelled camera) agree; 1 deg apart at the same errors (rows of another impact) and a mirrored
+    camera's angle do not (z beyond IMPACT_Z and beyond ANGLE_TOLERANCE).
+    """
+    from types import SimpleNamespace
+
+    from ballbat.tracks.checks import ANGLE_TOLERANCE, IMPACT_Z, camera_agreement
+
+    up = np.radians([20.0, 20.0, 20.0])
+    spin_up = up + np.radians([0.05, 1.0, -40.0])
+    err = np.radians(0.005) * 30.0  # the velocity's error across the motion, m/s at 30 m/s
+    flight = {
+        c: SimpleNamespace(
+            vx=30 * np.cos(a), vy=30 * np.sin(a), var_along=np.full(3, 0.01**2), var_across=np.full(3, err**2)
+        )
+        for c, a in (("swing", up), ("spin", spin_up))
+    }
+    cams = {c: SimpleNamespace(m_per_px_err=0.0) for c in flight}
+    agree = camera_agreement(flight, cams)
+    assert np.all(np.abs(agree.z_angle) > IMPACT_Z)
+    assert np.radians(0.05) < ANGLE_TOLERANCE < np.radians(1.0)
+    assert agree.angle_apart[0] == 0 and np.all(agree.angle_apart[1:] > 0)
+    assert np.all(np.abs(agree.z_speed) < 1e-9)

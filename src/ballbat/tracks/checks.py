@@ -50,6 +50,11 @@ if TYPE_CHECKING:
 GLITCH_FALSE_ALARM = 1e-9
 #: z beyond which one impact's two cameras disagree (two-sided normal, 1e-6 per test).
 IMPACT_Z = 4.89
+#: Launch angles of one impact's two cameras closer than this (rad) are not a disagreement, however
+#: significant: the check is for gross mistakes (rows of another camera or impact, a mirror or a
+#: flipped y, which differ by degrees); at 0.05 px a filmed ball's direction is known to 0.01 deg,
+#: and two cameras set up by hand differ by more than that (levelling, lens distortion).
+ANGLE_TOLERANCE = 0.5 * np.pi / 180
 #: z beyond which a dataset's pooled check fails (two-sided normal, 6e-7).
 DATASET_Z = 5.0
 #: z of the one-sided test of g's sign: a camera whose y points up sees g negative. A y-down
@@ -515,7 +520,10 @@ def _solve_each(A: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 @dataclass
 class Agreement:
-    """Per impact: the ball's speed and launch angle in each camera and the z of their difference."""
+    """Per impact: the ball's speed and launch angle in each camera and the z of their difference.
+
+    ``angle_apart``: the launch angles' difference beyond :data:`ANGLE_TOLERANCE` (rad, 0 within it).
+    """
 
     v: dict
     v_err: dict
@@ -523,6 +531,7 @@ class Agreement:
     launch_err: dict
     z_speed: np.ndarray
     z_angle: np.ndarray
+    angle_apart: np.ndarray
     ratio: np.ndarray
     ratio_err: np.ndarray
 
@@ -538,14 +547,16 @@ def camera_agreement(flight: dict, cameras: dict) -> Agreement:
         for c in ("swing", "spin"):
             f = flight[c]
             v[c] = np.hypot(f.vx, f.vy)
-            ve[c] = np.hypot(np.sqrt(f.vx_var), v[c] * cameras[c].m_per_px_err)
+            ve[c] = np.hypot(np.sqrt(f.var_along), v[c] * cameras[c].m_per_px_err)
             la[c] = np.arctan2(f.vy, f.vx)
-            le[c] = np.sqrt(f.vx_var) / v[c]
+            le[c] = np.sqrt(f.var_across) / v[c]
         z_speed = (v["swing"] - v["spin"]) / np.hypot(ve["swing"], ve["spin"])
-        z_angle = np.angle(np.exp(1j * (la["swing"] - la["spin"]))) / np.hypot(le["swing"], le["spin"])
+        diff = np.angle(np.exp(1j * (la["swing"] - la["spin"])))
+        z_angle = diff / np.hypot(le["swing"], le["spin"])
+        apart = np.maximum(np.abs(diff) - ANGLE_TOLERANCE, 0.0)
         ratio = v["swing"] / v["spin"]
         ratio_err = ratio * np.hypot(ve["swing"] / v["swing"], ve["spin"] / v["spin"])
-    return Agreement(v, ve, la, le, z_speed, z_angle, ratio, ratio_err)
+    return Agreement(v, ve, la, le, z_speed, z_angle, apart, ratio, ratio_err)
 
 
 def weighted_mean(x: ArrayLike, err: ArrayLike) -> tuple[float, float, int]:

@@ -307,8 +307,8 @@ def contact_likelihood(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, f
             t_mid = flight.t_ref + u
             early = at_rest & (t < t_mid[:, None] - 0.5 * hi)
             w = np.where(early.sum(axis=1)[:, None] >= 2, early, at_rest).astype(float)
-        # error of t_mid: the extrapolated line's position error at u, over the speed
-        var_pos = flight.sigma**2 * (1 / flight.n + (u - flight.u_mean) ** 2 / flight.sxx)
+        # error of t_mid: the extrapolated line's position error along the motion at u, over the speed
+        var_pos = flight.var_along * (flight.sxx / flight.n + (u - flight.u_mean) ** 2)
         t_mid_err = np.sqrt(var_pos + flight.sigma**2 / n_rest) / v
         s = ((X - xr[:, None]) * flight.vx[:, None] + (Y - yr[:, None]) * flight.vy[:, None]) / v[:, None]
         dt = t - t_mid[:, None]

@@ -5,7 +5,10 @@
    (``max(THRESHOLD_FLOOR_PX, THRESHOLD_SIGMA x`` the rest scatter)) is the impact frame; the
    last frame before it at rest is ``rest_frame`` (:func:`find_onset`).
 2. **Free flight**: from ``ceil(CONTACT_MAX fps)`` frames after impact, x = a + v_x u and
-   y + g u^2/2 = b + v_y u, a linear least-squares fit with the residual scatter as noise.
+   y + g u^2/2 = b + v_y u, a linear least-squares fit with the residual scatter as noise,
+   stated along and across the motion apart (a blurred ball scatters more along its motion;
+   the fit itself is the same: both coordinates share one design, so weighting by a 2 x 2
+   scatter leaves it unchanged).
    Earlier frames that agree with the flight (within :data:`SEPARATION_SIGMA` sigma) are
    added; the first one is the separation frame; u is the time from separation (half a frame
    before it) (:func:`fit_flight`).
@@ -119,11 +122,19 @@ def find_onset(x: np.ndarray, y: np.ndarray) -> Onset:
 
 @dataclass
 class Flight:
-    """Free-flight fit of one camera's ball track (physical frame, m and s)."""
+    """Free-flight fit of one camera's ball track (physical frame, m and s).
+
+    ``vx_var`` is each velocity component's variance from the pooled scatter (both coordinates);
+    ``var_along`` and ``var_across`` the variance of the velocity's component along the motion
+    (the speed) and across it (the speed times the direction), each from the residuals' scatter
+    in that direction.
+    """
 
     vx: np.ndarray
     vy: np.ndarray
     vx_var: np.ndarray
+    var_along: np.ndarray
+    var_across: np.ndarray
     x0: np.ndarray
     y0: np.ndarray
     t_ref: np.ndarray
@@ -141,7 +152,7 @@ class Flight:
 
 
 def _line_fit(u, X, Y, w):
-    """X = a + b u and Y + g u^2/2 = c + d u on the same frames; pooled residual scatter."""
+    """X = a + b u and Y + g u^2/2 = c + d u on the same frames; pooled residual scatter, and along and across."""
     n = msum(np.ones_like(u), w)
     with np.errstate(all="ignore"):
         um = msum(u, w) / n
@@ -156,7 +167,11 @@ def _line_fit(u, X, Y, w):
         ry = Yc - ay[:, None] - by[:, None] * u
         ss = msum(rx**2 + ry**2, w)
         sigma = np.sqrt(ss / (2 * n - 4))
-        return ax, bx, ay, by, sigma, sigma**2 / sxx, n, np.hypot(rx, ry), um, sxx
+        # the residuals along the fitted motion and across it, each n - 2 degrees of freedom
+        cos, sin = (bx / np.hypot(bx, by))[:, None], (by / np.hypot(bx, by))[:, None]
+        ss_along = msum((rx * cos + ry * sin) ** 2, w)
+        along = (ss_along / (n - 2), (ss - ss_along) / (n - 2))
+        return ax, bx, ay, by, sigma, sigma**2 / sxx, along, n, np.hypot(rx, ry), um, sxx
 
 
 def fit_flight(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: float) -> Flight:
@@ -184,7 +199,7 @@ def fit_flight(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: floa
     first = valid & onset.found[:, None] & (cols >= on + n_c)
     t_ref = take_at(t, first_true(first))
     u = t - t_ref[:, None]
-    ax, bx, ay, by, sigma, var, n, res, um, sxx = _line_fit(u, X, Y, first.astype(float))
+    ax, bx, ay, by, sigma, var, _, n, res, um, sxx = _line_fit(u, X, Y, first.astype(float))
     # separation: the first frame from which every frame agrees with the flight (earlier
     # frames of the contact window lag behind it); the fit itself keeps to the safe frames
     cand = valid & onset.found[:, None] & (cols >= on) & (cols < on + n_c)
@@ -195,5 +210,7 @@ def fit_flight(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: floa
     mask = first
     t_ref = take_at(t, sep_col) - 0.5 / fps
     u = t - t_ref[:, None]
-    ax, bx, ay, by, sigma, var, n, res, um, sxx = _line_fit(u, X, Y, mask.astype(float))
-    return Flight(bx, by, var, ax, ay, t_ref, sigma, n.astype(int), sep_col, mask, um, sxx)
+    ax, bx, ay, by, sigma, var, (s2_along, s2_across), n, res, um, sxx = _line_fit(u, X, Y, mask.astype(float))
+    with np.errstate(all="ignore"):
+        var_along, var_across = s2_along / sxx, s2_across / sxx
+    return Flight(bx, by, var, var_along, var_across, ax, ay, t_ref, sigma, n.astype(int), sep_col, mask, um, sxx)

@@ -494,11 +494,11 @@ def _measured_values(
         known = np.isfinite(t_end)
         vy = np.where(known, fs.vy - G * t_end, fs.vy)
         v_ball = np.hypot(fs.vx, vy)
-        v_ball_err = np.sqrt(fs.vx_var)  # same design for both components: isotropic
+        v_ball_err = np.sqrt(fs.var_along)  # the scatter along the motion
         launch = np.arctan2(vy, fs.vx)
         # the contact end's error turns the velocity by g cos(launch) / v per second
         end_err = np.where(known, contact.t_start_err, 0.0)  # t_mid + t_c / 2: the start's error
-        launch_err = np.hypot(np.sqrt(fs.vx_var) / v_ball, G * np.cos(launch) * end_err / v_ball)
+        launch_err = np.hypot(np.sqrt(fs.var_across) / v_ball, G * np.cos(launch) * end_err / v_ball)
         theta = launch - swing.beta
         theta = np.angle(np.exp(1j * theta))
         theta_err = np.hypot(launch_err, swing.beta_err)
@@ -610,7 +610,7 @@ def _motion_exclusions(
         ),
     )
     mark(
-        np.abs(agree.z_angle) > IMPACT_Z,
+        (np.abs(agree.z_angle) > IMPACT_Z) & (agree.angle_apart > 0),
         ReduceFlag.CAMERAS_DISAGREE,
         lambda i: (
             f"the ball's launch angle differs between the cameras: {np.degrees(agree.launch['swing'][i]):.1f} "
