@@ -55,10 +55,13 @@ def test_the_ray_pieces_are_the_numpy_ones():
         p = np.empty((y.shape[0], bases.shape[2]))
         for g, (sel, _) in enumerate(groups):
             p[sel] = y[sel] @ bases[g]
-        e1, c1 = kernels.edges_model(p, y, yy, past, starts, edge._CAND, step, sigma, edge._SAMPLES.size)
-        e2, c2 = edge._edges_model(prof, r, np.maximum(sigma, 0.02 * step), groups)
-        np.testing.assert_allclose(e1, e2, rtol=0, atol=1e-9)
-        np.testing.assert_allclose(c1, c2, rtol=1e-9)
+        m1, m2 = np.full(48, -1), np.full(48, -1)
+        for models in (m1, m1):  # each ray's model chosen, then held
+            e1, c1 = kernels.edges_model(p, y, yy, past, starts, edge._CAND, step, sigma, edge._SAMPLES.size, models)
+            e2, c2 = edge._edges_model(prof, r, np.maximum(sigma, 0.02 * step), groups, m2)
+            np.testing.assert_allclose(e1, e2, rtol=0, atol=1e-9)
+            np.testing.assert_allclose(c1, c2, rtol=1e-9)
+            np.testing.assert_array_equal(m1, m2)
     a = np.linspace(0, 2 * np.pi, 48, endpoint=False)
     for _ in range(20):
         px, py = 300.2 + 25.1 * np.cos(a) + rng.normal(0, 0.1, 48), 99.7 + 25.1 * np.sin(a) + rng.normal(0, 0.1, 48)

@@ -176,7 +176,7 @@ def _edges_gradient(prof: np.ndarray, rad: np.ndarray, sign: np.ndarray) -> np.n
     return rad[np.argmax(g[:, :-2] + 2 * g[:, 1:-1] + g[:, 2:], axis=1)]
 
 
-def _edges_model(prof: np.ndarray, r: float, sigma, groups: list) -> tuple[np.ndarray, np.ndarray]:
+def _edges_model(prof: np.ndarray, r: float, sigma, groups: list, models=None) -> tuple[np.ndarray, np.ndarray]:
     """Return the edge on each ray by the ray models (:func:`edge_bases`): offsets and the fit's chi-square per sample.
 
     ``sigma`` is the scale of the residuals (per ray or one); ``groups`` the rays (a slice) of each motion blur (px).
@@ -184,7 +184,8 @@ def _edges_model(prof: np.ndarray, r: float, sigma, groups: list) -> tuple[np.nd
     that each tried edge's sum over a model's terms adds contiguous rows. Each model's least residual over the tried
     edges (kept off the ends); where the lit fit there needs a light from behind (:func:`edge_bases`), the ray's edge
     is that of the model with the least (the lit model's on a tie), else the lit model's; parabolic between its
-    neighbours.
+    neighbours. ``models`` (rays; 0 lit, j terminator j, -1 not yet chosen), where given, holds each ray's model
+    once chosen: a later pass fits it alone (a ray that switched models from pass to pass kept its fit from settling).
     """
     n = prof.shape[0]
     y = prof.astype(np.float64)
@@ -204,6 +205,8 @@ def _edges_model(prof: np.ndarray, r: float, sigma, groups: list) -> tuple[np.nd
     rows = np.arange(n)
     behind = coef[rows, k[:, 0]] < 0  # the lit fit's light from behind: past a terminator
     m = np.where(behind, np.argmin(np.take_along_axis(rss, k[:, :, None], axis=2)[:, :, 0], axis=1), 0)
+    if models is not None:
+        m = models[:] = np.where(models >= 0, models, m)
     k = k[rows, m]
     r0, r1, r2 = rss[rows, m][rows[None, :], k[None, :] + _TRIO[:, None]]
     den = r0 - 2 * r1 + r2
@@ -307,13 +310,14 @@ def fit_ball(
         img = np.ascontiguousarray(img, img.dtype.newbyteorder("="))
     h, w = img.shape
     wide, moved, kept = True, np.inf, np.ones(N_RAYS, bool)
+    models = np.full(N_RAYS, -1)  # each ray's model, chosen in the first model pass (:func:`_edges_model`)
     one_pass = _pass_compiled if compiled else _pass_numpy
     for _ in range(8):
         rad = _WIDE if wide else _SAMPLES
         # not min(...) < ...: a centre that is not a number is outside too
         if not min(cx - r, cy - r, w - 1 - cx - r, h - 1 - cy - r) >= rad[-1] + 1 or not np.isfinite(cx + cy + r):
             return (), "ball touches the frame's border"
-        fit, keep, step = one_pass(img, cx, cy, r, rad, cos, sin, (groups, starts), sigma, kept, wide)
+        fit, keep, step = one_pass(img, cx, cy, r, rad, cos, sin, (groups, starts), sigma, (kept, models), wide)
         if fit is None:
             return (), f"ball edge seen on {int(keep.sum())} of {N_RAYS} rays (occluded, blurred or on clutter)"
         moved = max(abs(fit[0] - cx), abs(fit[1] - cy), abs(fit[2] - r))
@@ -331,7 +335,11 @@ def fit_ball(
 
 
 def _pass_numpy(img, cx, cy, r, rad, cos, sin, groups, sigma, kept, wide):
-    """One pass of :func:`fit_ball` in numpy: ((x, y, r, residuals) or None, the rays kept, each ray's step)."""
+    """One pass of :func:`fit_ball` in numpy: ((x, y, r, residuals) or None, the rays kept, each ray's step).
+
+    ``kept``: the rays kept by the last pass, and each ray's model (:func:`_edges_model`; updated in place).
+    """
+    kept, models = kept
     groups = groups[0]
     prof = profiles(img, cx, cy, r, rad, cos, sin)
     ends = np.add.reduce(prof[:, :4], axis=1) - np.add.reduce(prof[:, -4:], axis=1)
@@ -341,7 +349,7 @@ def _pass_numpy(img, cx, cy, r, rad, cos, sin, groups, sigma, kept, wide):
         edge = _edges_gradient(prof, rad, np.sign(ends))
     else:
         # the model's own mismatch grows with the edge's contrast: 2 % of the step counts as noise
-        edge, chi2 = _edges_model(prof, r, np.maximum(sigma, 0.02 * step), groups)
+        edge, chi2 = _edges_model(prof, r, np.maximum(sigma, 0.02 * step), groups, models)
         keep &= (chi2 < 2.0) & kept  # a ray once dropped stays dropped: the passes settle
     at = r + edge
     pts = np.stack([cx + cos * at, cy + sin * at])
@@ -352,6 +360,7 @@ def _pass_numpy(img, cx, cy, r, rad, cos, sin, groups, sigma, kept, wide):
 def _pass_compiled(img, cx, cy, r, rad, cos, sin, groups, sigma, kept, wide):
     """:func:`_pass_numpy` by the kernels of :mod:`ballbat.video.kernels` (the model's products by BLAS, as numpy's)."""
     kernels = _kernels()
+    kept, models = kept
     if not kernels.inside(img, cx, cy, abs(r) + rad[-1]):  # what the border test keeps: never out of the frame
         raise ValueError(f"fit_ball: rays about ({cx}, {cy}), radius {r}, leave the frame")
     if wide:
@@ -360,7 +369,7 @@ def _pass_compiled(img, cx, cy, r, rad, cos, sin, groups, sigma, kept, wide):
         groups, starts = groups
         bases, past = _group_bases(round(2 * r) / 2, tuple(b for _, b in groups))
         fitted, fx, fy, fr, res, keep, step = kernels.model_pass(
-            img, cx, cy, r, rad, cos, sin, bases, past, starts, _CAND, sigma, kept, N_RAYS // 2
+            img, cx, cy, r, rad, cos, sin, bases, past, starts, _CAND, sigma, kept, models, N_RAYS // 2
         )
     return ((fx, fy, fr, res) if fitted else None), keep, step
 

@@ -169,6 +169,7 @@ def edges_model(
     step: np.ndarray,
     sigma: float,
     n_samples: int,
+    models: np.ndarray,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Return the edges and chi-squares per sample of :func:`.edge._edges_model`, after the lit model's product.
 
@@ -180,7 +181,8 @@ def edges_model(
     behind), each terminator's too (their products taken for those rays alone), and the edge is
     that of the model with the least (the lit model's on a tie), parabolic between its
     neighbours. The residuals' scale is the noise ``sigma`` or 2 % of the ray's ``step``,
-    whichever is more, in float32 as numpy takes them.
+    whichever is more, in float32 as numpy takes them. ``models`` (0 lit, j terminator j, -1 not
+    yet chosen) holds each ray's model once chosen, a later pass fitting it alone (in place).
     """
     n, nc = p.shape[0], cand.size
     rss, none = np.empty(nc), np.empty(0)
@@ -191,13 +193,18 @@ def edges_model(
     for i in range(n):
         k = _least(rss, shared[i], yy[i], p[i, 3 * nc : 4 * nc], p[i, 4 * nc : 5 * nc])
         kb[i], trio[i, 0], trio[i, 1], trio[i, 2] = k, rss[k - 1], rss[k], rss[k + 1]
-        behind[i] = p[i, 5 * nc + k] < 0
+        behind[i] = models[i] > 0 if models[i] >= 0 else p[i, 5 * nc + k] < 0
     own = _past_products(y, past, starts, behind)
     for i in np.flatnonzero(behind):
+        best = 0
         for m in range(past.shape[2] // nc):
             k = _least(rss, shared[i], yy[i], own[i, m * nc : (m + 1) * nc], none)
-            if rss[k] < trio[i, 1]:
+            if (rss[k] < trio[i, 1] and models[i] < 0) or models[i] == m + 1:
                 kb[i], terms[i], trio[i, 0], trio[i, 1], trio[i, 2] = k, 4, rss[k - 1], rss[k], rss[k + 1]
+                best = m + 1
+        models[i] = best
+    for i in range(n):
+        models[i] = max(models[i], 0)
     edge, chi2 = np.empty(n), np.empty(n)
     for i in range(n):
         r0, r1, r2 = trio[i, 0], trio[i, 1], trio[i, 2]
@@ -328,6 +335,7 @@ def model_pass(
     cand: np.ndarray,
     sigma: float,
     kept: np.ndarray,
+    models: np.ndarray,
     min_kept: int,
 ) -> tuple:
     """Return a pass of :func:`.edge.fit_ball` by the ray model: (fitted, x, y, r, residuals, keep, step).
@@ -335,7 +343,7 @@ def model_pass(
     ``bases`` (groups x samples x 6 * tried edges) are the lit model's bases and coefficient of each
     group of rays (by their blur; rays ``starts[g]`` to ``starts[g + 1]``), their columns term by
     term, ``past`` the terminators' (:func:`edges_model`); the products with ``bases`` are BLAS's
-    (numpy's ``dot``).
+    (numpy's ``dot``). ``models``: each ray's model, -1 until chosen (updated in place).
     """
     prof = profiles(img, cx, cy, r, rad, cos, sin)
     y, yy = centred(prof)
@@ -343,7 +351,7 @@ def model_pass(
     p = np.empty((y.shape[0], bases.shape[2]))
     for g in range(bases.shape[0]):
         p[starts[g] : starts[g + 1]] = np.dot(y[starts[g] : starts[g + 1]], bases[g])
-    edge, chi2 = edges_model(p, y, yy, past, starts, cand, step, sigma, rad.size)
+    edge, chi2 = edges_model(p, y, yy, past, starts, cand, step, sigma, rad.size, models)
     keep = (step > np.float32(6 * sigma)) & (chi2 < 2.0) & kept
     px, py = cx + cos * (r + edge), cy + sin * (r + edge)
     fitted, fx, fy, fr, res, keep = circle_robust(px, py, keep, min_kept)
@@ -777,7 +785,8 @@ def load(dtype: type = np.uint8) -> None:
     gradient_pass(img, 40.0, 40.0, 5.0, wide, cos, sin, 1.0, 24)
     bases, past = np.zeros((1, samples.size, 6 * cand.size)), np.zeros((1, samples.size, 4 * cand.size))
     starts, kept = np.array([0, 48]), np.ones(48, np.bool_)
-    model_pass(img, 40.0, 40.0, 5.0, samples, cos, sin, bases, past, starts, cand, 1.0, kept, 24)
+    models = np.full(48, -1)
+    model_pass(img, 40.0, 40.0, 5.0, samples, cos, sin, bases, past, starts, cand, 1.0, kept, models, 24)
     marker_search(np.zeros((40, 40), np.float32), 20.0, 20.0, 4.0, 1.0, np.nan)
     dots_search(np.zeros((40, 40), np.float32), 0, 0, 20.0, 20.0, 15.0, 2.0, 1.0)
     dot_refine(np.ones((40, 40)), 0, 0, 20.0, 20.0, 20.0, 20.0, 15.0, 2.0, 1.4, 2.6, 2)
