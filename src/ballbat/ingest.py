@@ -394,14 +394,17 @@ def implausible_rows(
       judged against its ``coarse`` group (the ball's impacts on every bat) when that has enough:
       bats differ in e_x by a tenth, a row in km/h or rad/s by a factor of 1.6 or 10.
 
-    Impacts psi cannot reconstruct are left to :func:`exclusions` ("" here).
+    Impacts psi cannot reconstruct are left to :func:`exclusions` ("" here), but for an exit
+    speed above 2/(1 + r_y) of the bat's, which needs no psi: a ball that leaves faster than any
+    collision sends it (a bat tip tracked on a still spot measures a bat at rest) is named so,
+    not as a psi beyond 90 deg.
     """
     v_bat, v_ball, omega = (np.asarray(a, dtype=float) for a in (m.v_bat, m.v_ball, m.omega))
     c = _collision_checks(m)
     off = _group_outliers(m, c, np.asarray(groups), sigma, None if coarse is None else np.asarray(coarse))
     robust = np.any(list(off.values()), axis=0) if off else np.zeros(v_bat.shape, dtype=bool)
     out = np.full(v_bat.shape, "", dtype=object)
-    for i in np.flatnonzero(c.ok):
+    for i in np.flatnonzero(c.ok | c.ratio_high):
         words = []
         for k, top in SPEED_MAX_MPH.items():
             speed = (v_bat if k == "v_bat" else v_ball)[i] / MPH

@@ -617,3 +617,25 @@ def test_ingest_stage_keeps_warnings_and_exclusions():
     assert ds.attrs["n_excluded"] == 1 and ds.sizes["impact"] == 31
     assert ingest_stages.excluded_listing(ds)[0].startswith("impact MP31 (row 32):")
     assert ds.attrs["source_file"] == str(MAPLE)
+
+
+def test_a_ball_faster_than_any_collision_sends_it_is_named_even_where_psi_fails():
+    """A bat at rest (a tip tracked on a still spot of the background: 4 mm/s, its swing plane garbage, so theta
+    -97 deg) and a ball leaving at 34 m/s: psi cannot be reconstructed, and the reason is the exit speed, not a
+    psi beyond 90 deg (before: "", left to the reconstruction's "the bat cannot reach the ball"). A plausible
+    impact beside it gives no reason.
+    """
+    m = ingest.Measured(
+        np.array([0.004, 30.0]),
+        np.array([34.0, 35.0]),
+        np.radians([-97.0, 20.0]),
+        np.array([17.0, 170.0]),
+        0.0366,
+        0.4,
+        1.2,
+        0.02,
+    )
+    assert not ingest._collision_checks(m).ok[0]
+    why = ingest.implausible_rows(m, np.array([0, 1]))
+    assert "exceeds 2/(1 + r_y), the most any collision gives" in why[0], why
+    assert why[1] == "", why

@@ -294,3 +294,27 @@ def test_a_dark_ball_with_a_highlight_is_found_by_its_silhouette_and_gives_g(tmp
 def test_the_silhouette_needs_the_still_background():
     with pytest.raises(ValueError, match="ball_fit 'silhouette' needs background 'median'"):
         TrackOptions(5.0, ball_fit="silhouette")
+
+
+def test_a_still_spot_like_the_marker_is_not_taken_for_it(tmp_path):
+    """A copy of the marker (with its end cap) still in the background, nearer the frame's centre than the
+    swinging marker: the whole-frame search takes it first, but a marker that does not move is the
+    background's. Its two marks are taken back and left out with the reason, and the marker is tracked from
+    the next frame on, to its truth (before: the still copy, in all 8 frames).
+    """
+    truth = swing_truth(n=8)
+    frames = list(render_frames(truth, PLAIN, M_PER_PX))
+    x0, y0 = round(truth.x["bat_tip"][0]), round(truth.y["bat_tip"][0])
+    patch = frames[0][y0 - 9 : y0 + 10, x0 - 9 : x0 + 10].copy()
+    for f in frames:
+        f[21:40, 111:130] = patch  # centred on (120, 30), up to 0.4 px off the marker's own sub-pixel place
+    found = track_clip(open_clip(write_clip(tmp_path / "c.tif", iter(frames), 3000.0)), SWING)
+    rows = [
+        (k, x)
+        for p, k, x in zip(found.rows["point"], found.rows["frame"], found.rows["x_px"], strict=True)
+        if p == "bat_tip"
+    ]
+    assert [k for k, _ in rows] == [2, 3, 4, 5, 6, 7]
+    assert max(abs(x - truth.x["bat_tip"][k]) for k, x in rows) < 0.15
+    why = {k: w for p, k, w in found.left_out if p == "bat_tip"}
+    assert sorted(why) == [0, 1] and all("does not move" in w for w in why.values()), why

@@ -283,8 +283,10 @@ def find_marker(
     return best[:3] if best else None
 
 
-def find_marker_whole(img: np.ndarray, mr: float, sigma: float) -> tuple | None:
+def find_marker_whole(img: np.ndarray, mr: float, sigma: float, avoid: list | tuple = ()) -> tuple | None:
     """Return the tip marker nearest the frame's centre, searched in the whole frame: (x, y, contrast).
+
+    ``avoid``: positions (x, y) of still spots of the background; a marker within 2 ``mr`` of one is not taken.
 
     Bright spots of about the marker's size are looked for at quarter resolution (block means:
     2 sigma above their surround, 0.1 to 4 times the marker's area), and each is then searched
@@ -313,6 +315,8 @@ def find_marker_whole(img: np.ndarray, mr: float, sigma: float) -> tuple | None:
         x, y = xs[i], ys[i]
         m = find_marker(img, x, y, 4 * mr + 20, mr, sigma, top)
         if m is None or np.hypot(m[0] - x, m[1] - y) > 2 * mr:  # another spot's, near the region's border
+            continue
+        if any(np.hypot(m[0] - ax, m[1] - ay) < 2 * mr for ax, ay in avoid):
             continue
         if best is None or np.hypot(m[0] - w / 2, m[1] - h / 2) < best[3]:
             best = (*m, float(np.hypot(m[0] - w / 2, m[1] - h / 2)))

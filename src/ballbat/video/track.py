@@ -21,7 +21,9 @@ prediction is at hand (not found yet, or lost for more than 3 frames). The searc
   from frame to frame (by the turn from a to b when both are seen, by the angle carried on at
   the last spin when one is).
 * **bat_tip** -- a small bright disc (the marker) inside a dark surround (the end cap):
-  its centroid weighted by brightness above the surround.
+  its centroid weighted by brightness above the surround. A bright spot that stays put for
+  :data:`STILL_FRAMES` frames is the background's, not the swinging bat's: its marks are
+  taken back and left out with the reason, and the search skips it from then on.
 
 Nothing is guessed: a point that fails a test is left out, with the reason.
 """
@@ -113,6 +115,18 @@ class Found:
         for k, v in zip(self.rows, (point, frame, x, y, residual, contrast), strict=True):
             self.rows[k].append(v)
 
+    def take_back(self, point: str, frames: set, reason: str) -> None:
+        """Remove the point's rows of these frames, each left out with the reason."""
+        keep = [
+            i
+            for i, (p, k) in enumerate(zip(self.rows["point"], self.rows["frame"], strict=True))
+            if p != point or k not in frames
+        ]
+        for name, v in self.rows.items():
+            self.rows[name] = [v[i] for i in keep]
+        for k in sorted(frames):
+            self.leave_out(point, k, reason)
+
     def leave_out(self, point: str, frame: int, reason: str) -> None:
         """Note a point not given, and why."""
         self.left_out.append((point, frame, reason))
@@ -146,16 +160,33 @@ def _twice_median(v: np.ndarray) -> int:
     return 2 * at(n // 2) if n % 2 else at(n // 2 - 1) + at(n // 2)
 
 
+#: A tip marker found within STILL_PX of where it was, frame after frame, for STILL_FRAMES frames is a
+#: still spot of the background (clutter): the bat's marker crosses the swing camera's view at 10-20 px
+#: a frame, and a bat filmed at rest gives no bat speed.
+STILL_FRAMES = 2
+STILL_PX = 0.5
+
+
 @dataclass
 class _Trail:
     """Last two positions of a point (frame, x, y), for the prediction of the next, and the contrasts found."""
 
     last: list = field(default_factory=list)
     contrasts: list = field(default_factory=list)  # sorted, for their median (:meth:`usual`)
+    still: list = field(default_factory=list)  # the latest positions within STILL_PX of each other's frame
+    spots: list = field(default_factory=list)  # still spots found: (x, y), skipped by the search
 
     def push(self, k: int, x: float, y: float) -> None:
         """Add a position."""
+        if self.still and np.hypot(x - self.still[-1][1], y - self.still[-1][2]) < STILL_PX * (k - self.still[-1][0]):
+            self.still.append((k, x, y))
+        else:
+            self.still = [(k, x, y)]
         self.last = [*self.last[-1:], (k, x, y)]
+
+    def forget(self) -> None:
+        """Start again (a still spot taken for the marker): no positions, no contrasts."""
+        self.last, self.contrasts, self.still = [], [], []
 
     def predict(self, k: int) -> tuple[float, float] | None:
         """Return the position expected at frame ``k`` (constant velocity), None when lost for over 3 frames."""
@@ -340,12 +371,16 @@ def _dots(img, k, ball, opt: TrackOptions, sigma, mem: _DotMemory, found: Found)
 
 def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -> None:
     guess = trail.predict(k)
+    mr = opt.marker_radius_px
     if guess is None:  # lost, or not found yet: the whole frame
-        m = find_marker_whole(img, opt.marker_radius_px, sigma)
+        m = find_marker_whole(img, mr, sigma, avoid=trail.spots)
     else:
-        m = find_marker(img, guess[0], guess[1], 4 * opt.marker_radius_px + 20, opt.marker_radius_px, sigma)
+        m = find_marker(img, guess[0], guess[1], 4 * mr + 20, mr, sigma)
     if m is None:
         found.leave_out("bat_tip", k, "no tip marker found")
+        return
+    if any(np.hypot(m[0] - x, m[1] - y) < 2 * mr for x, y in trail.spots):  # the marker passing a still spot
+        found.leave_out("bat_tip", k, f"a spot at {m[0]:.1f}, {m[1]:.1f}, beside a still spot of the background")
         return
     usual = trail.usual()
     if m[2] < 0.5 * usual:  # fainter than half the marker's usual contrast: some other bright spot
@@ -356,6 +391,12 @@ def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -
     trail.push(k, m[0], m[1])
     trail.found(m[2])
     found.add("bat_tip", k, m[0], m[1], np.nan, m[2])
+    if len(trail.still) >= STILL_FRAMES:  # a spot of the background: its marks taken back, the search skips it
+        x, y = np.mean([q[1] for q in trail.still]), np.mean([q[2] for q in trail.still])
+        frames = {q[0] for q in trail.still}
+        found.take_back("bat_tip", frames, f"a bright spot at {x:.1f}, {y:.1f} that does not move: the background's")
+        trail.spots.append((float(x), float(y)))
+        trail.forget()
 
 
 def _check_time(clip: Clip, k: int, t: float | None, t0: list) -> None:
