@@ -46,8 +46,8 @@ from .search import (
     find_dots,
     find_marker,
     find_marker_whole,
-    refine_marker,
     refine_dot,
+    refine_marker,
     roi,
 )
 
