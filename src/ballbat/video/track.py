@@ -47,6 +47,7 @@ from .search import (
     find_marker,
     find_marker_whole,
     refine_dot,
+    refine_marker,
     roi,
 )
 
@@ -388,9 +389,10 @@ def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -
             "bat_tip", k, f"a spot at {m[0]:.1f}, {m[1]:.1f} too faint for the marker ({m[2]:.0f} vs {usual:.0f})"
         )
         return
-    trail.push(k, m[0], m[1])
+    x, y = refine_marker(img, m[0], m[1], mr)
+    trail.push(k, x, y)
     trail.found(m[2])
-    found.add("bat_tip", k, m[0], m[1], np.nan, m[2])
+    found.add("bat_tip", k, x, y, np.nan, m[2])
     if len(trail.still) >= STILL_FRAMES:  # a spot of the background: its marks taken back, the search skips it
         x, y = np.mean([q[1] for q in trail.still]), np.mean([q[2] for q in trail.still])
         frames = {q[0] for q in trail.still}
