@@ -232,24 +232,24 @@ def refine_marker(img: np.ndarray, x: float, y: float, mr: float) -> tuple[float
     plateau (within :data:`MARKER_CORE` radii, inside the blur) gives the relative gradient;
     the centroid of the frame divided by it, above the end cap's level, within 1.3 radii, twice.
     """
+    sub, x0, y0 = roi(img, x, y, int(np.ceil(2.5 * mr)) + 3)  # every pass's window: a pass moves it under a pixel
+    sub = sub.astype(np.float64)
+    gx = np.arange(x0, x0 + sub.shape[1], dtype=np.float64)[None, :]
+    gy = np.arange(y0, y0 + sub.shape[0], dtype=np.float64)[:, None]
     for _ in range(MARKER_PASSES):
-        ws = int(np.ceil(2.5 * mr)) + 1
-        sub, x0, y0 = roi(img, x, y, ws)
-        sub = sub.astype(np.float64)
-        gy, gx = np.mgrid[y0 : y0 + sub.shape[0], x0 : x0 + sub.shape[1]]
         u, v = gx - x, gy - y
-        d = np.hypot(u, v)
-        ring = (d > 1.5 * mr) & (d < 2.5 * mr)
-        core = d < MARKER_CORE * mr
+        d2 = u * u + v * v
+        ring = (d2 > (1.5 * mr) ** 2) & (d2 < (2.5 * mr) ** 2)
+        core = d2 < (MARKER_CORE * mr) ** 2
         if ring.sum() < 12 or core.sum() < 6:
             return x, y
         level = float(np.median(sub[ring]))
-        A = np.stack([np.ones(int(core.sum())), u[core], v[core]], axis=1)
-        a, bx, by = np.linalg.lstsq(A, sub[core], rcond=None)[0]
+        uc, vc = np.broadcast_to(u, sub.shape)[core], np.broadcast_to(v, sub.shape)[core]
+        A = np.stack([np.ones_like(uc), uc, vc], axis=1)
+        a, bx, by = np.linalg.solve(A.T @ A, A.T @ sub[core])  # the plane's least squares
         if not a > level:
             return x, y
-        light = 1.0 + (bx * u + by * v) / a
-        w = np.where(d < 1.3 * mr, np.maximum(sub / light - level, 0.0), 0.0)
+        w = np.where(d2 < (1.3 * mr) ** 2, np.maximum(sub / (1.0 + (bx * u + by * v) / a) - level, 0.0), 0.0)
         tot = w.sum()
         if not tot > 0:
             return x, y
