@@ -39,7 +39,8 @@ def test_the_speed_and_direction_errors_follow_the_scatter_along_and_across_the_
     assert np.all(fl.n == 20)
     assert np.var(speed) / np.mean(fl.var_along) == pytest.approx(1.0, rel=0.08)
     assert np.var(direction * v) / np.mean(fl.var_across) == pytest.approx(1.0, rel=0.08)
-    assert np.var(speed) / np.mean(fl.vx_var) > 1.4
-    assert np.var(direction * v) / np.mean(fl.vx_var) < 0.7
+    pooled = (fl.var_along + fl.var_across) / 2  # one scatter for both: the pooled residuals' 2n - 4 dof
+    assert np.var(speed) / np.mean(pooled) > 1.4
+    assert np.var(direction * v) / np.mean(pooled) < 0.7
     assert abs(np.mean(speed) - v) < 3 * np.std(speed) / np.sqrt(speed.size)
     assert abs(np.mean(direction) - ang) < 3 * np.std(direction) / np.sqrt(speed.size)

@@ -28,9 +28,8 @@ def _spinning_ball(n, frames, noise, radii, seed, tilt=0.0, ball_radius=0.0366):
     y = yc + noise * rng.standard_normal((n, frames))
     mask = np.ones((n, frames), bool)
     t_ref = np.full(n, -0.5 / FPS)
-    ax, bx, ay, by, sigma, var, (s2a, s2c), k, _, um, sxx = _line_fit(t - t_ref[:, None], x, y, mask.astype(float))
-    along, across = s2a / sxx, s2c / sxx
-    flight = Flight(bx, by, var, along, across, ax, ay, t_ref, sigma, k.astype(int), np.zeros(n, int), mask, um, sxx)
+    ax, bx, ay, by, sigma, (along, across), k, _, um, sxx = _line_fit(t - t_ref[:, None], x, y, mask.astype(float))
+    flight = Flight(bx, by, along, across, ax, ay, t_ref, sigma, k.astype(int), np.zeros(n, int), mask, um, sxx)
     dx, dy = {}, {}
     for j, p in enumerate(("dot_a", "dot_b")):
         rho = rng.uniform(*radii, n)[:, None]

@@ -520,10 +520,7 @@ def _solve_each(A: np.ndarray, b: np.ndarray) -> np.ndarray:
 
 @dataclass
 class Agreement:
-    """Per impact: the ball's speed and launch angle in each camera and the z of their difference.
-
-    ``angle_apart``: the launch angles' difference beyond :data:`ANGLE_TOLERANCE` (rad, 0 within it).
-    """
+    """Per impact: the ball's speed and launch angle in each camera and the z of their difference."""
 
     v: dict
     v_err: dict
@@ -531,9 +528,14 @@ class Agreement:
     launch_err: dict
     z_speed: np.ndarray
     z_angle: np.ndarray
-    angle_apart: np.ndarray
     ratio: np.ndarray
     ratio_err: np.ndarray
+
+    def angles_disagree(self) -> np.ndarray:
+        """Return the impacts whose launch angles differ beyond IMPACT_Z of their errors and beyond ANGLE_TOLERANCE."""
+        diff = np.angle(np.exp(1j * (self.launch["swing"] - self.launch["spin"])))
+        with np.errstate(invalid="ignore"):
+            return (np.abs(self.z_angle) > IMPACT_Z) & (np.abs(diff) > ANGLE_TOLERANCE)
 
 
 def camera_agreement(flight: dict, cameras: dict) -> Agreement:
@@ -551,12 +553,10 @@ def camera_agreement(flight: dict, cameras: dict) -> Agreement:
             la[c] = np.arctan2(f.vy, f.vx)
             le[c] = np.sqrt(f.var_across) / v[c]
         z_speed = (v["swing"] - v["spin"]) / np.hypot(ve["swing"], ve["spin"])
-        diff = np.angle(np.exp(1j * (la["swing"] - la["spin"])))
-        z_angle = diff / np.hypot(le["swing"], le["spin"])
-        apart = np.maximum(np.abs(diff) - ANGLE_TOLERANCE, 0.0)
+        z_angle = np.angle(np.exp(1j * (la["swing"] - la["spin"]))) / np.hypot(le["swing"], le["spin"])
         ratio = v["swing"] / v["spin"]
         ratio_err = ratio * np.hypot(ve["swing"] / v["swing"], ve["spin"] / v["spin"])
-    return Agreement(v, ve, la, le, z_speed, z_angle, apart, ratio, ratio_err)
+    return Agreement(v, ve, la, le, z_speed, z_angle, ratio, ratio_err)
 
 
 def weighted_mean(x: ArrayLike, err: ArrayLike) -> tuple[float, float, int]:

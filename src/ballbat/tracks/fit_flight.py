@@ -124,15 +124,13 @@ def find_onset(x: np.ndarray, y: np.ndarray) -> Onset:
 class Flight:
     """Free-flight fit of one camera's ball track (physical frame, m and s).
 
-    ``vx_var`` is each velocity component's variance from the pooled scatter (both coordinates);
-    ``var_along`` and ``var_across`` the variance of the velocity's component along the motion
+    ``var_along`` and ``var_across``: the variance of the velocity's component along the motion
     (the speed) and across it (the speed times the direction), each from the residuals' scatter
     in that direction.
     """
 
     vx: np.ndarray
     vy: np.ndarray
-    vx_var: np.ndarray
     var_along: np.ndarray
     var_across: np.ndarray
     x0: np.ndarray
@@ -152,7 +150,11 @@ class Flight:
 
 
 def _line_fit(u, X, Y, w):
-    """X = a + b u and Y + g u^2/2 = c + d u on the same frames; pooled residual scatter, and along and across."""
+    """X = a + b u and Y + g u^2/2 = c + d u on the same frames; the pooled scatter, and the slopes' variances.
+
+    The variances are those of the velocity along the motion and across it, each from the residuals'
+    scatter in that direction (n - 2 degrees of freedom).
+    """
     n = msum(np.ones_like(u), w)
     with np.errstate(all="ignore"):
         um = msum(u, w) / n
@@ -167,11 +169,10 @@ def _line_fit(u, X, Y, w):
         ry = Yc - ay[:, None] - by[:, None] * u
         ss = msum(rx**2 + ry**2, w)
         sigma = np.sqrt(ss / (2 * n - 4))
-        # the residuals along the fitted motion and across it, each n - 2 degrees of freedom
         cos, sin = (bx / np.hypot(bx, by))[:, None], (by / np.hypot(bx, by))[:, None]
         ss_along = msum((rx * cos + ry * sin) ** 2, w)
-        along = (ss_along / (n - 2), (ss - ss_along) / (n - 2))
-        return ax, bx, ay, by, sigma, sigma**2 / sxx, along, n, np.hypot(rx, ry), um, sxx
+        var = (ss_along / (n - 2) / sxx, (ss - ss_along) / (n - 2) / sxx)
+        return ax, bx, ay, by, sigma, var, n, np.hypot(rx, ry), um, sxx
 
 
 def fit_flight(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: float) -> Flight:
@@ -199,7 +200,7 @@ def fit_flight(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: floa
     first = valid & onset.found[:, None] & (cols >= on + n_c)
     t_ref = take_at(t, first_true(first))
     u = t - t_ref[:, None]
-    ax, bx, ay, by, sigma, var, _, n, res, um, sxx = _line_fit(u, X, Y, first.astype(float))
+    ax, bx, ay, by, sigma, _, n, res, um, sxx = _line_fit(u, X, Y, first.astype(float))
     # separation: the first frame from which every frame agrees with the flight (earlier
     # frames of the contact window lag behind it); the fit itself keeps to the safe frames
     cand = valid & onset.found[:, None] & (cols >= on) & (cols < on + n_c)
@@ -210,7 +211,5 @@ def fit_flight(X: ArrayLike, Y: ArrayLike, t: ArrayLike, onset: Onset, fps: floa
     mask = first
     t_ref = take_at(t, sep_col) - 0.5 / fps
     u = t - t_ref[:, None]
-    ax, bx, ay, by, sigma, var, (s2_along, s2_across), n, res, um, sxx = _line_fit(u, X, Y, mask.astype(float))
-    with np.errstate(all="ignore"):
-        var_along, var_across = s2_along / sxx, s2_across / sxx
-    return Flight(bx, by, var, var_along, var_across, ax, ay, t_ref, sigma, n.astype(int), sep_col, mask, um, sxx)
+    ax, bx, ay, by, sigma, (var_along, var_across), n, res, um, sxx = _line_fit(u, X, Y, mask.astype(float))
+    return Flight(bx, by, var_along, var_across, ax, ay, t_ref, sigma, n.astype(int), sep_col, mask, um, sxx)

@@ -610,7 +610,7 @@ def _motion_exclusions(
         ),
     )
     mark(
-        (np.abs(agree.z_angle) > IMPACT_Z) & (agree.angle_apart > 0),
+        agree.angles_disagree(),
         ReduceFlag.CAMERAS_DISAGREE,
         lambda i: (
             f"the ball's launch angle differs between the cameras: {np.degrees(agree.launch['swing'][i]):.1f} "

@@ -394,10 +394,10 @@ def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -
     trail.found(m[2])
     found.add("bat_tip", k, x, y, np.nan, m[2])
     if len(trail.still) >= STILL_FRAMES:  # a spot of the background: its marks taken back, the search skips it
-        x, y = np.mean([q[1] for q in trail.still]), np.mean([q[2] for q in trail.still])
+        sx, sy = np.mean([q[1] for q in trail.still]), np.mean([q[2] for q in trail.still])
         frames = {q[0] for q in trail.still}
-        found.take_back("bat_tip", frames, f"a bright spot at {x:.1f}, {y:.1f} that does not move: the background's")
-        trail.spots.append((float(x), float(y)))
+        found.take_back("bat_tip", frames, f"a bright spot at {sx:.1f}, {sy:.1f} that does not move: the background's")
+        trail.spots.append((float(sx), float(sy)))
         trail.forget()
 
 
