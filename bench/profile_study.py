@@ -101,11 +101,11 @@ def main(n: int = 10, study: str = "calibration", plain: bool = False, point: in
     print(f"{'everything else (rows, Dataset)':<36} {rest / reps * 1e3:>15.1f} {rest / cpu:>7.1%}")
     for key, title in () if plain else (("tottime", "own time"), ("cumulative", "cumulative time")):
         out = io.StringIO()
-        pstats.Stats(prof, stream=out).sort_stats(key).print_stats(15)
+        pstats.Stats(prof, stream=out).sort_stats(key).print_stats(int(__import__("os").environ.get("TOPN", 15)))
         lines = out.getvalue().splitlines()
         start = next(i for i, line in enumerate(lines) if line.strip().startswith("ncalls"))
         print(f"\nTop 15 functions by {title} (seconds over {reps} replicates):")
-        print("\n".join(lines[start : start + 16]))
+        print("\n".join(lines[start : start + 1 + int(__import__("os").environ.get("TOPN", 15))]))
 
 
 if __name__ == "__main__":

@@ -308,50 +308,43 @@ def _eiv_passes(X, y, noise: tuple, beta, iterations: int, scatter: bool, strata
     var0)`` at the last pass (``scatter`` False where tau^2 could not be estimated), or None for
     a fit not made (an effective variance or a corrected spread of x that is not positive).
 
-    A pass whose slope and tau^2 are those it started from, to the bit, among the passes of one
-    kind (after the first, or after the first with tau^2) is a fixed point: every later pass
-    would repeat it exactly, so the loop ends there with the same numbers
-    (:data:`STOP_AT_FIXED_POINT`).
+    Each pass: the effective variances var0 at the slope so far; with ``scatter``, from the
+    last of the ``iterations`` on, Paule and Mandel's tau^2 from the residuals (within
+    ``strata``: :func:`_scatter_residuals`; not finite where the points at x ~ 0 alone exceed
+    the residuals' degrees of freedom, or none is left: the fit goes on without the term);
+    the weights 1 / (var0 + tau^2 g) and the moment-corrected slope. A pass whose slope and
+    tau^2 are those it started from, to the bit, among the passes of one kind (after the
+    first, or after the first with tau^2) is a fixed point: every later pass would repeat it
+    exactly, so the loop ends there with the same numbers (:data:`STOP_AT_FIXED_POINT`).
+    The passes run compiled, as one call (:func:`ballbat.linefit_kernels.passes`).
     """
-    jx, jy, sig2, var_x, cov_xy, g = noise
-    x = X[:, 0]
-    n, p = X.shape
-    tau2 = 0.0
-    settled = iterations if scatter else 1
-    state = None
-    for it in range(iterations + (SCATTER_PASSES if scatter else 0)):
-        var0 = ((jy - beta[0] * jx) ** 2 * sig2).sum(axis=1)
-        if (var0 <= 0).any():
-            return None
-        if scatter and it >= iterations - 1:
-            tau2 = _paule_mandel_within(y - X @ beta, x, y, var_x, cov_xy, var0, tau2 * g, g, strata, n - p)
-            if not np.isfinite(tau2):  # the points at x ~ 0 (g = 0) alone exceed the residuals' dof,
-                scatter, tau2 = False, 0.0  # or no dof is left: fitted without the term (tau NaN)
-        W = 1.0 / (var0 + tau2 * g)
-        xwx = X.T @ (W[:, None] * X)
-        A = xwx.copy()
-        A[0, 0] -= (W * var_x).sum()
-        rhs = X.T @ (W * y)
-        rhs[0] -= (W * cov_xy).sum()
-        if A[0, 0] <= 0 or (p == 2 and np.linalg.det(A) <= 0):
-            return None
-        # a line through the origin: the 1 x 1 system divided out (LAPACK's solve of it is this
-        # division, and its determinant the element: the same numbers without their overhead)
-        beta = rhs / A[0, 0] if p == 1 else np.linalg.solve(A, rhs)
-        state, before = (beta.tobytes(), tau2, scatter), state
-        if STOP_AT_FIXED_POINT and it >= settled and state == before:
-            break
+    from . import linefit_kernels as kern
+
+    jx, jy, sig2, var_x, cov_xy, g = (np.ascontiguousarray(a, dtype=float) for a in noise)
+    idx, nstrata = np.zeros(y.size, dtype=np.int64), 1
+    if strata is not None:
+        _, inv = np.unique(np.asarray(strata), return_inverse=True)
+        idx, nstrata = inv.reshape(-1).astype(np.int64), int(inv.max()) + 1
+    status, beta, tau2, scatter, W, xwx, A, var0, _ = kern.passes(
+        np.ascontiguousarray(X, dtype=float),
+        np.ascontiguousarray(y, dtype=float),
+        jx,
+        jy,
+        sig2,
+        var_x,
+        cov_xy,
+        g,
+        np.asarray(beta, dtype=float),
+        iterations,
+        SCATTER_PASSES,
+        bool(scatter),
+        idx,
+        nstrata,
+        STOP_AT_FIXED_POINT,
+    )
+    if status != kern.FITTED:
+        return None
     return beta, tau2, scatter, W, xwx, A, var0
-
-
-def _paule_mandel_within(r, x, y, var_x, cov_xy, var0, extra, g, strata, dof) -> float:
-    """Return Paule-Mandel's tau^2 from the residuals within ``strata`` (inf where no degree of freedom is left).
-
-    ``extra``: each point's intrinsic variance so far (the weights of the strata's own slopes
-    are 1 / (``var0`` + ``extra``)); the other arguments as :func:`_scatter_residuals`'.
-    """
-    r_s, dof_s = _scatter_residuals(r, x, y, var_x, cov_xy, var0 + extra, strata, dof)
-    return paule_mandel(r_s, var0, g, dof_s) if dof_s >= 1 else np.inf
 
 
 def _scatter_residuals(
@@ -429,20 +422,14 @@ def scatter_gain(x: ArrayLike, var_x: ArrayLike) -> np.ndarray:
 
 
 def _q_root(r2: np.ndarray, v0: np.ndarray, g: np.ndarray, target: float) -> float:
-    """tau^2 >= 0 where sum r^2 / (v0 + tau^2 g) equals ``target`` (0 where it is below at tau^2 = 0)."""
-    from scipy.optimize import brentq
+    """tau^2 >= 0 where sum r^2 / (v0 + tau^2 g) equals ``target`` (0 where it is below at tau^2 = 0).
 
-    def q(t):
-        return float((r2 / (v0 + t * g)).sum()) - target  # ndarray.sum: np.sum's reduction, without its wrapper
+    inf where no tau brings it down to the target (the points with g = 0 alone exceed it).
+    Newton's method on the reciprocal, compiled (:func:`ballbat.linefit_kernels.q_root`).
+    """
+    from .linefit_kernels import q_root
 
-    if q(0.0) <= 0 or not np.any(g > 0):
-        return 0.0
-    if float(np.sum(r2[g <= 0] / v0[g <= 0])) >= target:  # no tau brings it down to the target
-        return np.inf
-    hi = float(np.sum(r2) / np.sum(g))
-    while q(hi) > 0:
-        hi *= 4.0
-    return float(brentq(q, 0.0, hi, xtol=1e-14, rtol=1e-10))
+    return float(q_root(*(np.ascontiguousarray(a, dtype=float) for a in (r2, v0, g)), float(target)))
 
 
 def paule_mandel(r: ArrayLike, v0: ArrayLike, g: ArrayLike, dof: int) -> float:

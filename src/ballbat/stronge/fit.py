@@ -437,9 +437,13 @@ class _Residual:
         return r
 
 
+#: The values of eta^2 whose chi^2 is scanned for the fit's start (:func:`_scan_start`).
+SCAN_POINTS = 48
+
+
 def _scan_start(geometry: ImpactGeometry, x, y, sig, e_y, mu, bounds: tuple[float, float]) -> float:
-    """Return the starting eta^2: the lowest chi^2 of a logarithmic scan of ``bounds`` (48 values)."""
-    scan = np.geomspace(bounds[0], bounds[1], 48)
+    """Return the starting eta^2: the lowest chi^2 of a logarithmic scan of ``bounds`` (:data:`SCAN_POINTS` values)."""
+    scan = np.geomspace(bounds[0], bounds[1], SCAN_POINTS)
     # one call of the closed-form model for the whole scan (elementwise: the same numbers as one call per value)
     ex_scan = geometry.e_x(scan[:, None], e_y, mu)
     res_scan = (y - (1.0 + ex_scan) * x) / sig
