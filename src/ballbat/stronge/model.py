@@ -756,6 +756,19 @@ def stronge_ex(psi: ArrayLike, contact: ContactParams) -> NDArray[np.float64]:
     return _solve_ex(_prepare(psi, contact))
 
 
+#: e_x's fast path (rho <= 1) compiled (:mod:`.soft_kernel`); False: the numpy reference (:func:`_uf_soft`).
+COMPILED_SOFT = True
+
+
+def _soft(rho, Lam, e, thf):
+    """Final U on the fast path: compiled (:func:`.soft_kernel.uf_soft`) or numpy's (:data:`COMPILED_SOFT`)."""
+    if not COMPILED_SOFT:
+        return _uf_soft(rho, Lam, e, thf)
+    from .soft_kernel import uf_soft
+
+    return uf_soft(*(np.ascontiguousarray(a, dtype=float) for a in (rho, Lam, e, thf)))
+
+
 def _solve_ex(p: _Params) -> NDArray[np.float64] | float:
     """e_x of the prepared impacts ``p`` (:func:`stronge_ex`): the fast path where rho <= 1, else the engine."""
     uf = np.empty(p.rho.size)
@@ -765,11 +778,11 @@ def _solve_ex(p: _Params) -> NDArray[np.float64] | float:
         sl = slice(a, b)
         m = soft[sl]
         if m.all():
-            uf[sl] = _uf_soft(p.rho[sl], p.Lam[sl], p.e[sl], p.thf[sl])
+            uf[sl] = _soft(p.rho[sl], p.Lam[sl], p.e[sl], p.thf[sl])
         else:
             i = np.flatnonzero(m) + a
             if i.size:
-                uf[i] = _uf_soft(p.rho[i], p.Lam[i], p.e[i], p.thf[i])
+                uf[i] = _soft(p.rho[i], p.Lam[i], p.e[i], p.thf[i])
             j = np.flatnonzero(~m) + a
             uf[j] = _engine(p, j, record=False).uf
     ex = -uf
