@@ -38,7 +38,7 @@ FITTED, NOT_FITTED = 0, 1
 
 @_jit
 def q_root(r2: np.ndarray, v0: np.ndarray, g: np.ndarray, target: float) -> float:
-    """tau^2 >= 0 where sum r2 / (v0 + tau^2 g) equals ``target``: 0 where it is below at 0, inf where no tau reaches it."""
+    """Return tau^2 >= 0 where sum r2 / (v0 + tau^2 g) equals ``target`` (0: below it at 0; inf: no tau reaches it)."""
     n = r2.size
     q0 = 0.0
     fixed = 0.0  # the points with g = 0: their part of Q whatever tau
@@ -132,7 +132,7 @@ def _normal_equations(X, y, W, var_x, cov_xy, xwx, A, rhs):
 
 @_jit
 def _solve(A, rhs, beta):
-    """beta = A^-1 rhs for p = 1 or 2 (2 x 2: elimination with the larger pivot); False where A is not positive."""
+    """Solve A beta = rhs for p = 1 or 2 (2 x 2: elimination with the larger pivot); False where A is not positive."""
     if A[0, 0] <= 0:
         return False
     if A.shape[0] == 1:

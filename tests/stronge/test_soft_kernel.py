@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+
 from ballbat.stronge import model
 from ballbat.stronge.model import ContactParams, ImpactGeometry, stronge_ex
 from ballbat.stronge.soft_kernel import uf_soft

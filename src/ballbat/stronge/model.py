@@ -761,7 +761,7 @@ COMPILED_SOFT = True
 
 
 def _soft(rho, Lam, e, thf):
-    """Final U on the fast path: compiled (:func:`.soft_kernel.uf_soft`) or numpy's (:data:`COMPILED_SOFT`)."""
+    """Return the final U on the fast path, compiled (:func:`.soft_kernel.uf_soft`) or not (:data:`COMPILED_SOFT`)."""
     if not COMPILED_SOFT:
         return _uf_soft(rho, Lam, e, thf)
     from .soft_kernel import uf_soft

@@ -95,7 +95,7 @@ def _root_unloading(rho: float, Lam: float, e: float, thf: float, x0: float) -> 
 
 @_jit
 def _uf_one(rho: float, Lam: float, e: float, thf: float) -> float:
-    """Final U of one impact with rho <= 1 (``model._uf_soft``'s cases)."""
+    """Return the final U of one impact with rho <= 1 (``model._uf_soft``'s cases)."""
     r2 = rho * rho
     if not Lam > 1.0:  # gross slip
         return 1.0 - r2 * Lam * (1.0 + e)
@@ -116,7 +116,7 @@ def _uf_one(rho: float, Lam: float, e: float, thf: float) -> float:
 
 @_jit
 def uf_soft(rho: np.ndarray, Lam: np.ndarray, e: np.ndarray, thf: np.ndarray) -> np.ndarray:
-    """Final U = u_f/u_0 of impacts with rho <= 1 (1-D arrays; ``model._uf_soft``)."""
+    """Return the final U = u_f/u_0 of impacts with rho <= 1 (1-D arrays; ``model._uf_soft``)."""
     out = np.empty(rho.size)
     for i in range(rho.size):
         out[i] = _uf_one(rho[i], Lam[i], e[i], thf[i])
