@@ -2,7 +2,11 @@
 # A table of contents: config, validation, one file of rules per stage, and the targets.
 from snakemake.utils import min_version
 
+from ballbat.pipeline.parsed import keep_parsed, save_parsed
+
 min_version("9.0")
+# The rule files' translation into Python, kept by their content (ballbat.pipeline.parsed; saved below).
+keep_parsed(".snakemake/ballbat/parsed.json")
 
 
 configfile: "config/config.yaml"
@@ -25,6 +29,11 @@ include: "workflow/rules/plots.smk"
 include: "workflow/rules/workbook.smk"
 include: "workflow/rules/studies.smk"
 include: "workflow/rules/report.smk"
+
+
+# The rules' code inputs and the rule files' translations as read this time, kept for the next start.
+save_code_record()
+save_parsed()
 
 
 # Cheap jobs (drawing, tabulating) run where Snakemake runs, never as cluster jobs.

@@ -74,9 +74,17 @@ def study_impacts(dataset: dict, parameter: str | tuple | None, values: list, tr
     """
     from .studies.sweeps import point_dataset, truth_counts
 
-    one = truth = 0
+    # the counts are the synthetic block's impacts alone (truth_counts reads nothing else): each point's
+    # impacts_per_bat is set on a copy of them, not of the whole block (a grid's 27 points, 10 ms a start)
+    light = {"synthetic": {"impacts": dataset["synthetic"]["impacts"]}}
+    names = (parameter,) if isinstance(parameter, str) else tuple(parameter or ())
+    sizes = set()
     for value in values if parameter else [None]:
-        ds = point_dataset(dataset, parameter or None, value)
+        point = dict(zip(names, (value,) if isinstance(parameter, str) else value, strict=True)) if parameter else {}
+        sizes.add(point.get("impacts_per_bat"))
+    one = truth = 0
+    for size in sorted(sizes, key=lambda s: (s is None, s)):
+        ds = light if size is None else point_dataset(light, "impacts_per_bat", size)
         counts = [int(n) for v in ds["synthetic"]["impacts"].values() for n in (v or {}).values()]
         if sum(counts) == 0:
             continue
@@ -96,8 +104,12 @@ def _render_without_synthetic(config: dict) -> list[str]:
     ]
 
 
-def _studies(config: dict, schema: dict | None = None) -> list[str]:
-    """Check that each study names a synthetic dataset and that its sweep suits that dataset."""
+def _studies(config: dict, schema: dict | None = None, sweep_schema: bool = True) -> list[str]:
+    """Check that each study names a synthetic dataset and that its sweep suits that dataset.
+
+    ``sweep_schema=False``: the sweep points' blocks are not checked against the schema again
+    (a config remembered as passed: :mod:`ballbat.pipeline.validated`).
+    """
     from .studies.sweeps import check_study_sweep
 
     problems = []
@@ -122,7 +134,7 @@ def _studies(config: dict, schema: dict | None = None) -> list[str]:
             )
         else:
             found = check_study_sweep(ds, study, where)
-            problems += found or _sweep_point_problems(ds, study, where, schema, checked)
+            problems += found or (_sweep_point_problems(ds, study, where, schema, checked) if sweep_schema else [])
             problems += _draw_properties_problems(config, ds, study, where)
     return problems
 
@@ -305,21 +317,40 @@ def _sizes(config: dict, available: int) -> list[str]:
     return problems
 
 
-def validate_config(config: dict, schema: dict, source: str = "config", available: int | None = None) -> dict:
+def validate_config(
+    config: dict,
+    schema: dict,
+    source: str = "config",
+    available: int | None = None,
+    record: os.PathLike[str] | str | None = None,
+) -> dict:
     """Check ``config`` against ``schema``; fill defaults; raise :class:`ConfigError` listing all problems.
 
     Beyond the schema (:func:`ballbat.pipeline.config.schema_problems`: names of datasets and
     scenarios, the whole name, reserved names): the rules of the domain below, and counts the
     machine cannot hold (``available`` bytes of memory; default: what it has now).
+
+    ``record``: a folder of the configs that passed (:mod:`ballbat.pipeline.validated`; the
+    workflow's ``.snakemake/ballbat/validated``). A config remembered there, with this schema and
+    this code, skips the schema's checks (its own and its sweep points'); the rest run.
     """
-    lines = schema_problems(config, schema, source) + _render_without_synthetic(config)
+    from pathlib import Path
+
+    from .pipeline import validated
+
+    key = validated.config_key(config, schema) if record is not None else None
+    passed = key is not None and validated.seen(key, Path(record))
+    lines = ([] if passed else schema_problems(config, schema, source)) + _render_without_synthetic(config)
     if not lines:
         lines = _synthetic_keys(config) + _offsets(config)
     if not lines:
         fill_defaults(config, schema)
-        lines = _studies(config, schema) + _sizes(config, _available_memory() if available is None else available)
+        memory = _available_memory() if available is None else available
+        lines = _studies(config, schema, sweep_schema=not passed) + _sizes(config, memory)
     if lines:
         raise ConfigError(f"{source} is not valid:\n  " + "\n  ".join(lines))
+    if key is not None and not passed:
+        validated.remember(key, Path(record))
     return config
 
 

@@ -80,6 +80,7 @@ class WorkflowInputs:
         self.all_studies = sorted(config.get("studies") or {})
         self.studies = [s for s in self.all_studies if not config["studies"][s]["on_request"]]
         self._batches: dict[str, list[list[Clip]]] = {}
+        self._study_settings: dict[str, StudySettings] = {}
 
     # -- code and datasets ----------------------------------------------------------------
 
@@ -421,10 +422,12 @@ class WorkflowInputs:
     # -- replicate studies ----------------------------------------------------------------
 
     def study_settings(self, name: str) -> StudySettings:
-        """Return study ``name``'s settings."""
+        """Return study ``name``'s settings (built once: the rules' functions ask for them some 20 times a start)."""
         from .studies.settings import StudySettings
 
-        return StudySettings.from_config(self.config, name)
+        if name not in self._study_settings:
+            self._study_settings[name] = StudySettings.from_config(self.config, name)
+        return self._study_settings[name]
 
     def get_study_config(self, wildcards: Namespace) -> dict:
         """Return everything a study's results depend on (its, its dataset's and the chain's settings)."""

@@ -4,10 +4,11 @@ import sys
 import time
 from pathlib import Path
 
-import yaml
 from snakemake.exceptions import WorkflowError
 
 from ballbat.config_checks import scenario_problems, validate_config
+from ballbat.pipeline.codedeps import save_record as save_code_record
+from ballbat.pipeline.codedeps import use_record as use_code_record
 from ballbat.pipeline.config import ConfigError, drop_nulls
 from ballbat.pipeline.guards import (
     configfile_targets,
@@ -19,6 +20,7 @@ from ballbat.pipeline.guards import (
     warnings_summary,
 )
 from ballbat.pipeline.params_record import serialize_params_lazily
+from ballbat.pipeline.validated import load_schema
 from ballbat.workflow_inputs import WorkflowInputs
 
 # Snakemake records the rules' params without importing pandas (0.15 s of every start) while no
@@ -32,15 +34,21 @@ for _line in configfile_targets(workflow.configfiles, config.get("results") or "
 SCHEMA = Path(workflow.basedir) / "workflow" / "schemas" / "config.schema.yaml"
 # A dataset or scenario set to null (e.g. `datasets: {synthetic: null}` in a --configfile) is dropped.
 drop_nulls(config)
-with open(SCHEMA) as _fh:
-    # the C loader (libyaml, shipped in the PyYAML wheel) parses the schema ~10x faster
-    _schema = yaml.load(_fh, Loader=getattr(yaml, "CSafeLoader", yaml.SafeLoader))
-    validate_config(config, _schema, source="config (config/config.yaml and --configfile/--config overrides)")
+# The schema, from its JSON copy where one of the same bytes is kept (ballbat.pipeline.validated).
+_schema = load_schema(SCHEMA)
+validate_config(
+    config,
+    _schema,
+    source="config (config/config.yaml and --configfile/--config overrides)",
+    record=Path(".snakemake") / "ballbat" / "validated",  # a config that passed: its schema checks not run again
+)
 # A scenario's ball and bat, and the dataset of its e_x, checked before the DAG is built (one line each).
 _problems = scenario_problems(config)
 if _problems:
     raise ConfigError("config is not valid:\n  " + "\n  ".join(_problems))
 
+# The package modules' imports read at earlier starts (the rules' code inputs; saved at the Snakefile's end).
+use_code_record(Path(".snakemake") / "ballbat" / "codedeps.json")
 INPUTS = WorkflowInputs(config, workflow.basedir)
 #: The run's results folder (config `results`, default `results`): every rule's paths start with it, so a
 #: test session written to its own folder (`--config results=results/2026-11-h01`) touches no other.

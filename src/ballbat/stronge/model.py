@@ -766,7 +766,7 @@ def _soft(rho, Lam, e, thf):
         return _uf_soft(rho, Lam, e, thf)
     from .soft_kernel import uf_soft
 
-    return uf_soft(*(np.ascontiguousarray(a, dtype=float) for a in (rho, Lam, e, thf)))
+    return uf_soft(*(np.ascontiguousarray(a, dtype=float) for a in (rho, Lam, e, thf)), NEWTON_TOL)
 
 
 def _solve_ex(p: _Params) -> NDArray[np.float64] | float:

@@ -8,7 +8,7 @@ numpy that is some 30 calls of a few microseconds each on short arrays for every
 step, so the calls' overhead, not the arithmetic, set the cost (about 4 ms of a calibration
 replicate's 63). Here each impact is one pass of plain loops (:func:`uf_soft`): the same
 formulas, the same safeguarded Newton iterations with the same tolerance, except that each
-impact stops where its own step is below :data:`~ballbat.stronge.model.NEWTON_TOL` (numpy
+impact stops where its own step is below the model's ``NEWTON_TOL`` (``tol``; numpy
 stepped every impact until the largest step was): the roots agree to that tolerance's square,
 e_x to round-off (``tests/stronge/test_soft_kernel.py`` compares the two).
 
@@ -24,9 +24,9 @@ import math
 import numpy as np
 from numba import njit
 
-from .model import HALF_PI, NEWTON_TOL
-
 _jit = njit(cache=True, nogil=True, error_model="numpy")
+
+HALF_PI = 0.5 * math.pi  # the model's (0.5 * np.pi: the same double)
 
 #: Newton's iterations at most (as :func:`ballbat.stronge.model._root_loading`'s and ``_root_unloading``'s).
 ITERATIONS = 60
@@ -42,7 +42,7 @@ def _sincos(x: float) -> tuple[float, float]:
 
 
 @_jit
-def _root_loading(rho: float, Lam: float) -> float:
+def _root_loading(rho: float, Lam: float, tol: float) -> float:
     """Root theta in (0, pi/2) of sin(rho theta) / (rho sin theta) = Lam (``model._root_loading``, one impact)."""
     lo, hi = 0.0, HALF_PI
     g = math.sqrt(6.0 * (Lam - 1.0) / max(1.0 - rho * rho, 1e-300))
@@ -62,13 +62,13 @@ def _root_loading(rho: float, Lam: float) -> float:
             new = 0.5 * (lo + hi)
         step = abs(new - th)
         th = new
-        if step < NEWTON_TOL:
+        if step < tol:
             break
     return th
 
 
 @_jit
-def _root_unloading(rho: float, Lam: float, e: float, thf: float, x0: float) -> float:
+def _root_unloading(rho: float, Lam: float, e: float, thf: float, x0: float, tol: float) -> float:
     """Root x in (0, pi/2] of sin(rho (thf - e x)) = rho Lam sin(x) (``model._root_unloading``, one impact)."""
     lo, hi = 0.0, HALF_PI
     x = min(max(math.asin(min(x0, 1.0)), 1e-300), HALF_PI)
@@ -88,13 +88,13 @@ def _root_unloading(rho: float, Lam: float, e: float, thf: float, x0: float) -> 
             new = math.sqrt(lo * hi) if lo > 0 else 0.5 * hi
         step = abs(new - x) / new
         x = new
-        if step < NEWTON_TOL:
+        if step < tol:
             break
     return x
 
 
 @_jit
-def _uf_one(rho: float, Lam: float, e: float, thf: float) -> float:
+def _uf_one(rho: float, Lam: float, e: float, thf: float, tol: float) -> float:
     """Return the final U of one impact with rho <= 1 (``model._uf_soft``'s cases)."""
     r2 = rho * rho
     if not Lam > 1.0:  # gross slip
@@ -102,22 +102,22 @@ def _uf_one(rho: float, Lam: float, e: float, thf: float) -> float:
     s_half = _sincos(rho * HALF_PI)[0]
     s_f, c_f = _sincos(rho * thf)
     if s_half / rho > Lam:  # stick ends while loading
-        th = _root_loading(rho, Lam)
+        th = _root_loading(rho, Lam, tol)
         cr = _sincos(rho * th)[1]
         return cr - r2 * Lam * (e + np.cos(th))
     x0 = s_f / (rho * Lam)
     if not x0 > 1e-280:  # stick to separation (psi = 0, the superball)
         return c_f
-    x = _root_unloading(rho, Lam, e, thf, x0)
+    x = _root_unloading(rho, Lam, e, thf, x0, tol)
     cr = _sincos(rho * (thf - e * x))[1]
     sh = np.sin(0.5 * x)
     return cr - r2 * Lam * 2.0 * e * sh * sh
 
 
 @_jit
-def uf_soft(rho: np.ndarray, Lam: np.ndarray, e: np.ndarray, thf: np.ndarray) -> np.ndarray:
-    """Return the final U = u_f/u_0 of impacts with rho <= 1 (1-D arrays; ``model._uf_soft``)."""
+def uf_soft(rho: np.ndarray, Lam: np.ndarray, e: np.ndarray, thf: np.ndarray, tol: float) -> np.ndarray:
+    """Return the final U = u_f/u_0 of impacts with rho <= 1 (1-D arrays; ``model._uf_soft``; ``tol``: NEWTON_TOL)."""
     out = np.empty(rho.size)
     for i in range(rho.size):
-        out[i] = _uf_one(rho[i], Lam[i], e[i], thf[i])
+        out[i] = _uf_one(rho[i], Lam[i], e[i], thf[i], tol)
     return out
