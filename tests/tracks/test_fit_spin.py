@@ -5,6 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from ballbat.tracks import fit_spin as module
 from ballbat.tracks.fit_flight import Flight, _line_fit
 from ballbat.tracks.fit_spin import OFFSET_FALSE_ALARM, fit_spin
 from ballbat.units import G
@@ -101,3 +102,43 @@ def test_the_radius_limit_is_scipy_stats_f_isf_to_the_bit():
     want = np.where(ok, noise * np.sqrt((1 + 2 / np.maximum(n, 1)) * q), np.nan)
     np.testing.assert_array_equal(got, want)
     assert np.isfinite(got).sum() > 400
+
+
+# The compiled normal equations of the joint fit (ballbat.tracks.spin_kernel) against numpy's products.
+def _both(monkeypatch, args):
+    with monkeypatch.context() as m:
+        m.setattr(module, "SPIN_COMPILED", False)
+        want = fit_spin(*args)
+    return want, fit_spin(*args)
+
+
+def test_the_compiled_fit_is_numpy_s_to_round_off(monkeypatch):
+    """600 impacts at 5 px, some with frames or a whole dot untracked: spin, error, phases and offset agree."""
+    (dx, dy, t, flight, cam, ball), _ = _spinning_ball(600, 22, 0.00625, (0.022, 0.030), seed=5)
+    rng = np.random.default_rng(1)
+    for d in ("dot_a", "dot_b"):
+        gone = rng.random(dx[d].shape) < 0.15  # frames where a dot is hidden
+        dx[d][gone], dy[d][gone] = np.nan, np.nan
+    dx["dot_b"][:20] = np.nan  # impacts whose second dot is never tracked
+    want, got = _both(monkeypatch, (dx, dy, t, flight, cam, ball))
+    for name in ("omega", "omega_err", "offset"):
+        w, g = getattr(want, name), getattr(got, name)
+        assert np.array_equal(np.isnan(w), np.isnan(g)), name
+        np.testing.assert_allclose(g, w, rtol=1e-12, atol=1e-15, err_msg=name)
+    np.testing.assert_allclose(got.offset_chi2, want.offset_chi2, rtol=1e-8, atol=1e-12)  # a score of small differences
+    for d in ("dot_a", "dot_b"):
+        np.testing.assert_allclose(got.intercept[d], want.intercept[d], rtol=1e-12, atol=1e-12)
+    assert np.isfinite(got.omega).sum() > 550
+
+
+def test_an_impact_whose_fit_cannot_be_made_keeps_the_angle_fit(monkeypatch):
+    """Non-finite positions in an impact's tracked frames: compiled and numpy alike keep the angles' spin and error."""
+    (dx, dy, t, flight, cam, ball), _ = _spinning_ball(50, 22, 0.001, (0.022, 0.030), seed=6)
+    x, y = ball
+    x = x.copy()
+    x[3, 5] = np.inf  # a tracked frame of the ball at infinity
+    angles = fit_spin(dx, dy, t, flight, cam)
+    want, got = _both(monkeypatch, (dx, dy, t, flight, cam, (x, y)))
+    assert got.omega[3] == want.omega[3] == angles.omega[3]
+    assert got.omega_err[3] == want.omega_err[3] == angles.omega_err[3]
+    np.testing.assert_allclose(got.omega, want.omega, rtol=1e-12)

@@ -369,12 +369,10 @@ def _spin_dot_rows(p, j, ct_x, ct_y, m, wd, ud, J, r) -> None:
     np.multiply(rc, wd, out=J[:, by, :, k + 1])
 
 
-def _offset_score(J, r, cov, ok, wd, chi2) -> tuple[np.ndarray, np.ndarray]:
-    """Score test of a common offset of the dots' circles (:func:`_spin_block`'s last residuals and design).
+def _offset_terms(J, r, wd) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Return J'J_o, J_o'J_o and J_o'r of the offset's columns J_o (:func:`_numpy_steps`' last Jacobian and residuals).
 
-    Returns the statistic (chi^2, 2 degrees of freedom; 0 where the offset is within
-    :data:`OFFSET_TOLERANCE`: an impact is flagged where its offset is both significant and
-    larger than that) and the offset (one Gauss-Newton step).
+    J_o: minus each dot row's weight on its coordinate (x rows in column 0, y rows in column 1).
     """
     nf = wd["dot_a"].shape[1]
     Jo = np.zeros((*r.shape, 2))
@@ -383,9 +381,18 @@ def _offset_score(J, r, cov, ok, wd, chi2) -> tuple[np.ndarray, np.ndarray]:
         k = nb + 2 * j * nf
         Jo[:, k : k + nf, 0] = -wd[d]
         Jo[:, k + nf : k + 2 * nf, 1] = -wd[d]
-    B = gram(J, Jo)
-    V = gram(Jo) - gram(B, cov @ B)
-    g = tdot(Jo, r)
+    return gram(J, Jo), gram(Jo), tdot(Jo, r)
+
+
+def _offset_score(B, Vo, g, cov, ok, chi2) -> tuple[np.ndarray, np.ndarray]:
+    """Score test of a common offset of the dots' circles (:func:`_spin_block`'s last step).
+
+    ``B``, ``Vo``, ``g``: J'J_o, J_o'J_o and J_o'r of the offset's columns J_o at the last step.
+    Returns the statistic (chi^2, 2 degrees of freedom; 0 where the offset is within
+    :data:`OFFSET_TOLERANCE`: an impact is flagged where its offset is both significant and
+    larger than that) and the offset (one Gauss-Newton step).
+    """
+    V = Vo - gram(B, cov @ B)
     V[~ok] = np.eye(2)
     step = -np.linalg.solve(V, g[..., None])[..., 0]
     score = np.sum(g * -step, axis=1) / chi2
@@ -412,6 +419,10 @@ def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept
     The score test of a common offset of both dots' circles (chi^2, 2 degrees of freedom)
     tells such an axis where the scatter of the dots' radii cannot (large noise).
 
+    Each step's normal equations are summed impact by impact in compiled code
+    (:func:`ballbat.tracks.spin_kernel.normal_equations`, :data:`SPIN_COMPILED`), or as numpy's
+    products of the whole Jacobian (:func:`_numpy_steps`, the reference).
+
     Returns
     -------
     omega, omega_err, intercept, offset_chi2, offset
@@ -429,30 +440,17 @@ def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept
     wb = np.where(flight.mask, 1.0 / flight.sigma[:, None], 0.0)
     dots = ("dot_a", "dot_b")
     with np.errstate(all="ignore"):
-        # what does not change between iterations: the dots' weights and times, most of the Jacobian
+        # what does not change between iterations: the dots' weights and times
         wd = {d: np.where(masks[d], 1.0 / s_dot[:, None], 0.0) for d in dots}
         ud = {d: np.where(masks[d], u, 0.0) for d in dots}
-        J6, r6 = _spin_design(wd, ud, ub, wb)
-        J, r = J6.reshape(u.shape[0], -1, 9), r6.reshape(u.shape[0], -1)  # views: rows (ball x, y, dots' x, y)
-        for _ in range(SPIN_GN_ITERATIONS):
-            cx, cy = p[:, [0]] + p[:, [1]] * ub, p[:, [2]] + p[:, [3]] * ub - 0.5 * G * ub**2
-            r6[:, 0] = np.where(wb > 0, (X - cx) * wb, 0.0)
-            r6[:, 1] = np.where(wb > 0, (Y - cy) * wb, 0.0)
-            for j, d in enumerate(dots):
-                _spin_dot_rows(p, j, ct_x[d], ct_y[d], masks[d], wd[d], ud[d], J6, r6)
-            A = gram(J)
-            b = tdot(J, r)
-            ok = np.all(np.isfinite(A), axis=(1, 2)) & np.all(np.isfinite(b), axis=1)
-            ok &= full_rank(np.where(ok[:, None, None], A, np.eye(9)))
-            A[~ok] = np.eye(9)
-            b[~ok] = 0.0
-            p = p - np.linalg.solve(A, b[..., None])[..., 0]
+        steps = _compiled_steps if SPIN_COMPILED else _numpy_steps
+        p, A, ss, ok, offset_terms = steps(p, (X, Y, ub, wb), ct_x, ct_y, masks, wd, ud)
         cov = np.linalg.inv(A)
         # the weights' scale from the residuals (the ball's and the dots' scatter are estimates)
         n_rows = 2 * (flight.mask.sum(axis=1) + masks["dot_a"].sum(axis=1) + masks["dot_b"].sum(axis=1))
-        chi2 = np.sum(r**2, axis=1) / np.maximum(n_rows - 9, 1)
+        chi2 = ss / np.maximum(n_rows - 9, 1)
         err = np.sqrt(cov[:, 4, 4] * chi2)
-        offset_chi2, step = _offset_score(J, r, cov, ok, wd, chi2)
+        offset_chi2, step = _offset_score(*offset_terms, cov, ok, chi2)
     good = ok & np.isfinite(p[:, 4]) & np.isfinite(err)
     new_omega = np.where(good, p[:, 4], omega)
     new_err = np.where(good, err, omega_err)
@@ -462,3 +460,56 @@ def _spin_block(ball, ct_x, ct_y, t, flight: Flight, omega, omega_err, intercept
     }
     offset_chi2 = np.where(good, offset_chi2, np.nan)
     return new_omega, new_err, new_intercept, offset_chi2, np.where(good[:, None], step, np.nan)
+
+
+#: The joint spin fit's normal equations compiled (:mod:`ballbat.tracks.spin_kernel`); False: numpy's (the reference).
+SPIN_COMPILED = True
+
+
+def _step(p, A, b):
+    """Return the Gauss-Newton step's new parameters, and which impacts' normal equations were usable.
+
+    Usable: finite and of full rank; an impact whose are not keeps its parameters (the identity, a zero right side).
+    """
+    ok = np.all(np.isfinite(A), axis=(1, 2)) & np.all(np.isfinite(b), axis=1)
+    ok &= full_rank(np.where(ok[:, None, None], A, np.eye(9)))
+    A[~ok] = np.eye(9)
+    b[~ok] = 0.0
+    return p - np.linalg.solve(A, b[..., None])[..., 0], ok
+
+
+def _compiled_steps(p, ball, ct_x, ct_y, masks, wd, ud):
+    """:data:`SPIN_GN_ITERATIONS` steps, each impact's normal equations summed in compiled code.
+
+    Returns the parameters, the last step's normal matrix, sum of squared residuals and usable
+    impacts, and the offset test's terms (J'J_o, J_o'J_o, J_o'r) at the last step.
+    """
+    from .spin_kernel import normal_equations
+
+    dots = ("dot_a", "dot_b")
+    stacked = [np.ascontiguousarray(np.stack([a[d] for d in dots]), dtype=float) for a in (ct_x, ct_y)]
+    DM = np.ascontiguousarray(np.stack([masks[d] for d in dots]), dtype=np.bool_)
+    DW, DU = (np.ascontiguousarray(np.stack([a[d] for d in dots]), dtype=float) for a in (wd, ud))
+    ball = [np.ascontiguousarray(a, dtype=float) for a in ball]
+    for k in range(SPIN_GN_ITERATIONS):
+        last = k == SPIN_GN_ITERATIONS - 1
+        A, b, ss, Bo, go, Go = normal_equations(np.ascontiguousarray(p), *ball, *stacked, DM, DW, DU, G, last)
+        p, ok = _step(p, A, b)
+    Vo = Go[:, None, None] * np.eye(2)
+    return p, A, ss, ok, (Bo, Vo, go)
+
+
+def _numpy_steps(p, ball, ct_x, ct_y, masks, wd, ud):
+    """:func:`_compiled_steps` with numpy's products of the whole Jacobian (the reference)."""
+    X, Y, ub, wb = ball
+    J6, r6 = _spin_design(wd, ud, ub, wb)
+    J, r = J6.reshape(ub.shape[0], -1, 9), r6.reshape(ub.shape[0], -1)  # views: rows (ball x, y, dots' x, y)
+    for _ in range(SPIN_GN_ITERATIONS):
+        cx, cy = p[:, [0]] + p[:, [1]] * ub, p[:, [2]] + p[:, [3]] * ub - 0.5 * G * ub**2
+        r6[:, 0] = np.where(wb > 0, (X - cx) * wb, 0.0)
+        r6[:, 1] = np.where(wb > 0, (Y - cy) * wb, 0.0)
+        for j, d in enumerate(("dot_a", "dot_b")):
+            _spin_dot_rows(p, j, ct_x[d], ct_y[d], masks[d], wd[d], ud[d], J6, r6)
+        A = gram(J)
+        p, ok = _step(p, A, tdot(J, r))
+    return p, A, np.sum(r**2, axis=1), ok, _offset_terms(J, r, wd)
