@@ -64,8 +64,6 @@ def test_the_spin_fit_tells_a_tilted_axis_from_noise(monkeypatch):
     about 10 mm off the ball's centre: the joint fit's score test flags most such impacts, and
     about OFFSET_FALSE_ALARM of the untilted ones (fewer: offsets within OFFSET_TOLERANCE are not flagged).
     """
-    from ballbat.tracks import fit_spin as module
-
     limit = -2 * np.log(OFFSET_FALSE_ALARM)
     (dx, dy, t, flight, cam, ball), _ = _spinning_ball(3000, 22, 0.00625, (0.022, 0.030), seed=3)
     straight = fit_spin(dx, dy, t, flight, cam, ball)
