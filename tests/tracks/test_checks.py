@@ -287,3 +287,33 @@ def test_cameras_launch_angles_a_hair_apart_agree_a_degree_apart_do_not():
     assert np.radians(0.05) < ANGLE_TOLERANCE < np.radians(1.0)
     assert agree.angles_disagree().tolist() == [False, True, True]
     assert np.all(np.abs(agree.z_speed) < 1e-9)
+
+
+def test_the_compiled_glitch_test_flags_what_numpy_flags(monkeypatch):
+    """60 random blocks of tracks (glitches, untracked frames, skipped frames, pooled or own noise): the same flags,
+    and the misplaced-start test's noise the same to the bit (tracks.glitch_kernel against the numpy reference).
+    """
+    from ballbat.tracks import checks
+
+    rng = np.random.default_rng(2)
+    flagged = 0
+    for trial in range(60):
+        n, m = int(rng.integers(1, 80)), int(rng.integers(3, 130))
+        t = np.arange(m)
+        x = 100 + 3 * t[None, :] + rng.normal(0, rng.uniform(0.1, 2), (n, m))
+        y = 50 + 0.01 * t[None, :] ** 2 + rng.normal(0, 0.5, (n, m))
+        g = rng.random((n, m)) < 0.02
+        x[g] += rng.choice([-1, 1], g.sum()) * rng.uniform(5, 40, g.sum())
+        x[rng.random((n, m)) < 0.05] = np.nan
+        y[np.isnan(x)] = np.nan
+        skip = rng.random((n, m)) < 0.1 if trial % 2 else None
+        pooled = None if trial % 3 else float(rng.uniform(0.1, 1))
+        with monkeypatch.context() as mp:
+            mp.setattr(checks, "GLITCH_COMPILED", False)
+            want, want_start = checks.glitch_mask(x, y, skip, pooled), checks.misplaced_starts(x, y, pooled)
+        got, got_start = checks.glitch_mask(x, y, skip, pooled), checks.misplaced_starts(x, y, pooled)
+        np.testing.assert_array_equal(got, want)
+        np.testing.assert_array_equal(got_start.noise, want_start.noise)
+        np.testing.assert_array_equal(got_start.found, want_start.found)
+        flagged += want.sum()
+    assert flagged > 1000  # the trials do have glitches to find

@@ -178,11 +178,13 @@ def glitch_mask(
     noisy point can turn into a spike). ``pooled``: the noise of all impacts
     (:func:`pooled_noise`) when ``x``, ``y`` hold a block of them; default: of the impacts given.
     """
-    ok = np.isfinite(x) & np.isfinite(y)
     n, m = x.shape
-    out = np.zeros((n, m), dtype=bool)
     if m < 3:
-        return out
+        return np.zeros((n, m), dtype=bool)
+    if GLITCH_COMPILED:
+        return _glitch_mask_compiled(x, y, skip, pooled)
+    ok = np.isfinite(x) & np.isfinite(y)
+    out = np.zeros((n, m), dtype=bool)
     sh = _shifter(m)
     rx, ry, sd = _midpoint_noise(x, y, pooled)
     with np.errstate(invalid="ignore"):
@@ -204,6 +206,35 @@ def glitch_mask(
         peak = (rn >= np.nan_to_num(sh(rn, -1))) & (rn >= np.nan_to_num(sh(rn, 1)))
     out = big & same & peak & ok
     return out if skip is None else out & ~skip
+
+
+#: The glitch test in compiled loops (:mod:`ballbat.tracks.glitch_kernel`); False: the numpy reference.
+GLITCH_COMPILED = True
+
+
+def _glitch_mask_compiled(x, y, skip, pooled) -> np.ndarray:
+    """:func:`glitch_mask` in compiled loops: the same flags."""
+    from . import glitch_kernel as kern
+
+    x, y = np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float)
+    rx, ry, sd = _midpoint_noise_compiled(x, y, pooled)
+    if sd is None:
+        return np.zeros(x.shape, dtype=bool)
+    z = math.sqrt(2 * math.log(1 / GLITCH_FALSE_ALARM))
+    has_skip = skip is not None
+    mask = np.ascontiguousarray(skip, dtype=np.bool_) if has_skip else np.zeros((1, 1), dtype=np.bool_)
+    return kern.glitches(x, y, rx, ry, sd, z, mask, has_skip)
+
+
+def _midpoint_noise_compiled(x, y, pooled):
+    """:func:`_midpoint_noise` in compiled loops (``x``, ``y`` contiguous floats): the same numbers."""
+    from . import glitch_kernel as kern
+
+    rx, ry = kern.midpoint_offsets(x, y)
+    pooled = kern.pooled_mad(rx, ry) if pooled is None else float(pooled)
+    if not np.isfinite(pooled):
+        return rx, ry, None
+    return rx, ry, kern.track_noise(rx, ry, pooled)
 
 
 def _shifter(m: int):
@@ -290,7 +321,12 @@ def misplaced_starts(x: np.ndarray, y: np.ndarray, pooled: float | None = None) 
     found = np.zeros(n, dtype=bool)
     column = np.zeros(n, dtype=np.int64)
     distance = np.zeros(n)
-    _, _, sd = _midpoint_noise(x, y, pooled)
+    if GLITCH_COMPILED:
+        _, _, sd = _midpoint_noise_compiled(
+            np.ascontiguousarray(x, dtype=float), np.ascontiguousarray(y, dtype=float), pooled
+        )
+    else:
+        _, _, sd = _midpoint_noise(x, y, pooled)
     if sd is None or m < START_MARKS + 2:
         return MisplacedStart(found, column, distance, np.full(n, np.nan))
     ok = np.isfinite(x) & np.isfinite(y)
