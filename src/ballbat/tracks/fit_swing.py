@@ -29,6 +29,9 @@ TAU_PRIOR_FRAMES = 0.6
 #: Gauss-Newton iterations of the tip fit.
 GN_ITERATIONS = 6
 
+#: The tip fit's iterations in compiled loops (:mod:`ballbat.tracks.swing_kernel`); False: numpy's (the reference).
+SWING_COMPILED = True
+
 
 @dataclass
 class Swing:
@@ -133,6 +136,17 @@ def fit_swing(
         tau = tau0.copy()
         prior = np.full_like(om, 1e12)  # first iterations: tau held at its prior
         sigma_tau = np.hypot(TAU_PRIOR_FRAMES / fps, np.nan_to_num(np.asarray(t_contact_err, dtype=float)))
+        if SWING_COMPILED:
+            from .swing_kernel import gauss_newton
+
+            a, om, tau, omega_err, rms = gauss_newton(
+                *(np.ascontiguousarray(v, dtype=float) for v in (along, np.broadcast_to(t, mask.shape))),
+                np.ascontiguousarray(mask),
+                float(L),
+                *(np.ascontiguousarray(np.broadcast_to(v, om.shape), dtype=float) for v in (a, om, tau0, sigma_tau, n)),
+                GN_ITERATIONS,
+            )
+            return Swing(om, omega_err, beta, beta_err, tau, a, ux, uy, cx, cy, rms, n.astype(int), full_mask)
         J = np.empty((*mask.shape, 3))
         J[..., 0] = np.where(mask, 1.0, 0.0)
         for it in range(GN_ITERATIONS):
