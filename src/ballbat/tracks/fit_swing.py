@@ -133,20 +133,32 @@ def fit_swing(
         slope = msum((t - tm[:, None]) * along, w) / msum((t - tm[:, None]) ** 2, w)
         om = slope / L
         a = -L * np.sin(om * st)  # start: u = a + L sin(om (t - tau0)) through the centroid
+        sigma_tau = np.hypot(TAU_PRIOR_FRAMES / fps, np.nan_to_num(np.asarray(t_contact_err, dtype=float)))
+        iterations = _compiled_iterations if SWING_COMPILED else _numpy_iterations
+        a, om, tau, omega_err, rms = iterations(along, t, mask, L, a, om, tau0, sigma_tau, n)
+    return Swing(om, omega_err, beta, beta_err, tau, a, ux, uy, cx, cy, rms, n.astype(int), full_mask)
+
+
+def _compiled_iterations(along, t, mask, L, a, om, tau0, sigma_tau, n) -> tuple:
+    """Return :func:`fit_swing`'s a, omega, tau, omega's error and rms from its steps in compiled loops."""
+    from .swing_kernel import gauss_newton
+
+    vec = (np.ascontiguousarray(np.broadcast_to(v, om.shape), dtype=float) for v in (a, om, tau0, sigma_tau, n))
+    return gauss_newton(
+        np.ascontiguousarray(along, dtype=float),
+        np.ascontiguousarray(np.broadcast_to(t, mask.shape), dtype=float),
+        np.ascontiguousarray(mask),
+        float(L),
+        *vec,
+        GN_ITERATIONS,
+    )
+
+
+def _numpy_iterations(along, t, mask, L, a, om, tau0, sigma_tau, n) -> tuple:
+    """:func:`_compiled_iterations` with numpy's batched products and solves (the reference)."""
+    with np.errstate(all="ignore"):
         tau = tau0.copy()
         prior = np.full_like(om, 1e12)  # first iterations: tau held at its prior
-        sigma_tau = np.hypot(TAU_PRIOR_FRAMES / fps, np.nan_to_num(np.asarray(t_contact_err, dtype=float)))
-        if SWING_COMPILED:
-            from .swing_kernel import gauss_newton
-
-            a, om, tau, omega_err, rms = gauss_newton(
-                *(np.ascontiguousarray(v, dtype=float) for v in (along, np.broadcast_to(t, mask.shape))),
-                np.ascontiguousarray(mask),
-                float(L),
-                *(np.ascontiguousarray(np.broadcast_to(v, om.shape), dtype=float) for v in (a, om, tau0, sigma_tau, n)),
-                GN_ITERATIONS,
-            )
-            return Swing(om, omega_err, beta, beta_err, tau, a, ux, uy, cx, cy, rms, n.astype(int), full_mask)
         J = np.empty((*mask.shape, 3))
         J[..., 0] = np.where(mask, 1.0, 0.0)
         for it in range(GN_ITERATIONS):
@@ -179,4 +191,4 @@ def fit_swing(
         cov = np.linalg.inv(A) * s2[:, None, None]
         omega_err = np.sqrt(cov[:, 1, 1] * (n - 3) / np.maximum(n - 5, 1))  # Student-t, as for beta
         rms = np.sqrt(np.sum(rr**2, axis=1) / n)
-    return Swing(om, omega_err, beta, beta_err, tau, a, ux, uy, cx, cy, rms, n.astype(int), full_mask)
+    return a, om, tau, omega_err, rms
