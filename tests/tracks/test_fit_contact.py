@@ -102,7 +102,11 @@ def test_contact_likelihood_on_the_whole_grid_is_the_pointwise_number(monkeypatc
         x = np.clip(dtw + 0.5 * tc, 0.0, tc)
         model = v[:, None] * (contact_distance(x, tc) + np.maximum(dtw - 0.5 * tc, 0.0))
         expected[:, j] = -0.5 * msum((sw - model) ** 2, ww.astype(float)) / sigma**2
-    assert np.array_equal(fc._contact_loglik(dtw, sw, ww, v, sigma, grid), expected)
+    with monkeypatch.context() as m:  # numpy's arrays: the same bits
+        m.setattr(fc, "CONTACT_COMPILED", False)
+        assert np.array_equal(fc._contact_loglik(dtw, sw, ww, v, sigma, grid), expected)
+    # the compiled loops (tracks.contact_kernel): the same sums in frame order, to round-off
+    np.testing.assert_allclose(fc._contact_loglik(dtw, sw, ww, v, sigma, grid), expected, rtol=1e-12, atol=1e-12)
 
 
 def _likelihoods(rng, n: int, width: float, grid: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

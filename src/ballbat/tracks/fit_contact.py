@@ -101,6 +101,12 @@ class _PopulationFit:
     estimated: bool  # False: the likelihoods are flat and the uniform distribution was kept
 
 
+#: The contact times' likelihood (:func:`_contact_loglik`) in compiled loops (:mod:`ballbat.tracks.contact_kernel`);
+#: False: numpy's. The population's likelihood stays numpy's: Nelder-Mead's path (to 1e-3 in its parameters) turns
+#: on its last bits, which numpy's sums keep the same wherever the impacts are held (blocks, a study, the workflow).
+CONTACT_COMPILED = True
+
+
 def _population_nll(p, L: np.ndarray, grid: np.ndarray) -> float:
     """Minus the group's marginal log-likelihood at beta parameters ``p``."""
     # elementwise and summed along rows, not a BLAS product: the same bits wherever L lies in memory
@@ -215,7 +221,15 @@ def _contact_loglik(dtw, sw, ww, v, sigma, grid) -> np.ndarray:
     flight from rest, ``ww`` the frames in the window (impact, frame). All grid points at
     once, in blocks of :data:`CONTACT_BLOCK` impacts; each impact's sum over its frames runs
     along the last (contiguous) axis, as one grid point at a time summed it: the same bits.
+    Compiled (:func:`ballbat.tracks.contact_kernel.loglik`, :data:`CONTACT_COMPILED`): one loop.
     """
+    if CONTACT_COMPILED:
+        from .contact_kernel import loglik
+
+        arrays = (np.ascontiguousarray(a, dtype=float) for a in (dtw, sw))
+        return loglik(
+            *arrays, np.ascontiguousarray(ww, dtype=np.bool_), *(np.asarray(a, dtype=float) for a in (v, sigma, grid))
+        )
     logl = np.empty((dtw.shape[0], grid.size))
     tc = grid[None, :, None]
     for lo in range(0, dtw.shape[0], CONTACT_BLOCK):
