@@ -769,6 +769,29 @@ def _soft(rho, Lam, e, thf):
     return uf_soft(*(np.ascontiguousarray(a, dtype=float) for a in (rho, Lam, e, thf)), NEWTON_TOL)
 
 
+#: e_x's general phase machine (rho > 1) compiled (:mod:`.engine_kernel`); False: the numpy engine (:func:`_engine`).
+COMPILED_ENGINE = True
+
+
+def _general(p: _Params, idx: NDArray) -> NDArray:
+    """Return the final U of the impacts ``idx`` through the general phase machine, compiled or not."""
+    if not COMPILED_ENGINE:
+        return _engine(p, idx, record=False).uf
+    from .engine_kernel import final_u
+
+    args = (np.ascontiguousarray(a[idx], dtype=float) for a in (p.rho, p.Lam, p.e, p.thf))
+    consts = (float(STICK_GRID), STICK_DPHASE, ROUND_TOL, NEWTON_TOL, SEPARATION_TOL)
+    uf, bad, count = final_u(*args, MAX_PIECES, consts)
+    if bad >= 0:
+        k = idx[bad]
+        raise RuntimeError(
+            f"stronge: no separation after {MAX_PIECES} stick/slip pieces for {count} impact(s),"
+            f" e.g. tan(psi)={p.tan_psi[k]:g}, eta2={p.eta2[k]:g}, e_y={p.e[k]:g},"
+            f" mu*eta2={p.lam[k]:g}, Omega_t/Omega_n={p.rho[k]:g}"
+        )
+    return uf
+
+
 def _solve_ex(p: _Params) -> NDArray[np.float64] | float:
     """e_x of the prepared impacts ``p`` (:func:`stronge_ex`): the fast path where rho <= 1, else the engine."""
     uf = np.empty(p.rho.size)
@@ -784,7 +807,7 @@ def _solve_ex(p: _Params) -> NDArray[np.float64] | float:
             if i.size:
                 uf[i] = _soft(p.rho[i], p.Lam[i], p.e[i], p.thf[i])
             j = np.flatnonzero(~m) + a
-            uf[j] = _engine(p, j, record=False).uf
+            uf[j] = _general(p, j)
     ex = -uf
     return ex.reshape(p.shape) if p.shape else float(ex[0])
 
