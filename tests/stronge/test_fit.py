@@ -290,3 +290,28 @@ def test_a_fit_started_next_to_its_minimum_is_the_scans_fit(balls, bats, eta2, m
         again = fit_eta2(psi, x, y, r_x, r_y, interval=False, start=bad)
         assert again.eta2 == scanned.eta2 and again.eta2_err == scanned.eta2_err
     assert len(calls) == 3
+
+
+def test_the_two_pass_scan_starts_where_the_whole_scan_does(balls, bats, monkeypatch):
+    """150 fits (eta^2 1.5-25, 20-200 impacts, noise 0.003-0.03), some with two minima of chi^2 over the scan: the
+    scan in two passes (every third value, then around each of its local minima) starts every fit at the whole
+    scan's lowest chi^2, so the fit is the same to the bit (refined around the lowest coarse value alone, one of
+    them stopped in the other minimum).
+    """
+    from ballbat.stronge import fit as fit_module
+    from ballbat.stronge.model import ImpactGeometry
+
+    rng = np.random.default_rng(12)
+    two_minima = 0
+    for k in range(150):
+        eta2, n = float(np.exp(rng.uniform(np.log(1.5), np.log(25)))), int(rng.integers(20, 200))
+        noise = float(rng.choice([0.003, 0.01, 0.03]))
+        psi, x, y, r_x, r_y = _synthetic(balls, bats, rng, eta2=eta2, n=n, noise=noise)
+        with monkeypatch.context() as m:
+            m.setattr(fit_module, "SCAN_STRIDE", 1)
+            whole = fit_eta2(psi, x, y, r_x, r_y, interval=False)
+        two = fit_eta2(psi, x, y, r_x, r_y, interval=False)
+        assert two.eta2 == whole.eta2 and two.eta2_err == whole.eta2_err, (k, eta2, n)
+        c = fit_module._chi2_at(ImpactGeometry(psi, r_x, r_y), x, y, np.ones(n), 0.5, 0.5, np.geomspace(1, 30, 48))
+        two_minima += np.sum((c[1:-1] < c[:-2]) & (c[1:-1] < c[2:])) >= 2
+    assert two_minima >= 3, two_minima
