@@ -317,3 +317,28 @@ def test_the_compiled_glitch_test_flags_what_numpy_flags(monkeypatch):
         np.testing.assert_array_equal(got_start.found, want_start.found)
         flagged += want.sum()
     assert flagged > 1000  # the trials do have glitches to find
+
+
+def test_the_compiled_tip_arc_is_numpy_s(rendered, monkeypatch):
+    """The tip-arc check's fit (tracks.arc_kernel) against numpy's: kappa to 1e-10, its error to 1e-12, the
+    same impacts fitted; and the cross-check's lines identical (the tip at a rig 10 % off: the same refusal).
+    """
+    from ballbat.tracks import checks, verdict
+
+    tr, s = rendered
+    seen = []
+    real = checks.tip_arc
+    monkeypatch.setattr(verdict, "tip_arc", lambda *a: seen.append(a) or real(*a))
+    v = run(tr, s)[1]
+    with monkeypatch.context() as m:
+        m.setattr(checks, "ARC_COMPILED", False)
+        want = real(*seen[0])
+        assert run(tr, s)[1].lines == v.lines
+    got = real(*seen[0])
+    assert np.array_equal(np.isnan(got[0]), np.isnan(want[0])) and np.isfinite(want[0]).sum() >= 20
+    np.testing.assert_allclose(got[0], want[0], rtol=1e-10)
+    np.testing.assert_allclose(got[1], want[1], rtol=1e-10)
+    off = replace(s.rig, pivot_to_tip=s.rig.pivot_to_tip * 1.5)
+    compiled = stopped(tr, s, rig=off)
+    monkeypatch.setattr(checks, "ARC_COMPILED", False)
+    assert stopped(tr, s, rig=off) == compiled and "pivot_to_tip" in compiled

@@ -477,8 +477,45 @@ def tip_arc(
         )
         a = um - V * sm
     tau = tau0.copy()
-    w = np.zeros(a.shape)
     sigma_tau = tau_prior_frames / fps
+    ok = (n >= 6) & np.isfinite(V) & np.isfinite(tau) & np.isfinite(a)
+    with np.errstate(all="ignore"):
+        a, V, tau = np.where(ok, a, 0.0), np.where(ok, V, 1.0), np.where(ok, tau, 0.0)
+        tau0 = np.where(ok, tau0, 0.0)
+    steps = _tip_arc_compiled if ARC_COMPILED else _tip_arc_numpy
+    return steps(along, t, mask, n, (a, V, tau, tau0, ok), sigma_tau, L_cfg)
+
+
+#: The tip-arc fit in compiled loops (:mod:`ballbat.tracks.arc_kernel`); False: numpy's (the reference).
+ARC_COMPILED = True
+
+
+def _tip_arc_compiled(along, t, mask, n, start, sigma_tau, L_cfg) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`tip_arc`'s Gauss-Newton steps and covariance in compiled loops: kappa and its error (NaN: not made)."""
+    from .arc_kernel import fit
+
+    a, V, tau, tau0, ok = start
+    shape = a.shape
+    w, var_w, ok = fit(
+        np.ascontiguousarray(along, dtype=float),
+        np.ascontiguousarray(np.broadcast_to(t, mask.shape), dtype=float),
+        np.ascontiguousarray(mask),
+        np.asarray(n, dtype=float),
+        *(np.ascontiguousarray(np.broadcast_to(v, shape), dtype=float) for v in (a, V, tau, tau0)),
+        np.ascontiguousarray(ok),
+        np.ascontiguousarray(np.broadcast_to(sigma_tau, shape), dtype=float),
+        10,
+    )
+    with np.errstate(all="ignore"):
+        kappa, kappa_err = w * L_cfg**2, np.sqrt(var_w) * L_cfg**2
+    good = ok & np.isfinite(kappa) & np.isfinite(kappa_err) & (kappa_err > 0)
+    return np.where(good, kappa, np.nan), np.where(good, kappa_err, np.nan)
+
+
+def _tip_arc_numpy(along, t, mask, n, start, sigma_tau, L_cfg) -> tuple[np.ndarray, np.ndarray]:
+    """:func:`_tip_arc_compiled` with numpy's batched products and solves (the reference)."""
+    a, V, tau, tau0, ok = start
+    w = np.zeros(a.shape)
     fact = [math.factorial(2 * k + 1) for k in range(5)]
 
     def model(a, V, tau, w):
@@ -499,10 +536,7 @@ def tip_arc(
             x2k *= x2
         return a[:, None] + f, _masked_columns(mask, (np.ones_like(s), s * dx, -V[:, None] * dx, dw))
 
-    ok = (n >= 6) & np.isfinite(V) & np.isfinite(tau) & np.isfinite(a)
     with np.errstate(all="ignore"):
-        a, V, tau = np.where(ok, a, 0.0), np.where(ok, V, 1.0), np.where(ok, tau, 0.0)
-        tau0 = np.where(ok, tau0, 0.0)
         for _ in range(10):
             f, J = model(a, V, tau, w)
             r = np.where(mask, along - f, 0.0)
