@@ -155,7 +155,7 @@ class Reduction:
 
 
 def remove_glitches(
-    tracks: Tracks, cameras: dict[str, Camera], noise: dict | None = None
+    tracks: Tracks, cameras: dict[str, Camera], noise: dict | None = None, onsets: dict | None = None
 ) -> tuple[Tracks, dict[str, np.ndarray]]:
     """Return the tracks without their single-frame glitches (:func:`.checks.glitch_mask`), and the count per impact.
 
@@ -163,7 +163,9 @@ def remove_glitches(
     (:data:`CONTACT_MAX`) after the impact frame (:func:`find_onset` on the raw track) are
     not tested. The input is not changed. Counts are per camera (all its points), shape (impact,).
     ``noise``: each (camera, point)'s noise over all impacts when ``tracks`` is a block of them
-    (:func:`pooled_noises`); default: of the impacts given.
+    (:func:`pooled_noises`); default: of the impacts given. ``onsets`` (a dict, filled): each
+    camera's onset of the raw ball track where none of its frames was a glitch (the cleaned
+    track's onset is then that very one: :func:`_fit_ball` need not find it again).
     """
     noise = noise or {}
     cams, counts = {}, {}
@@ -178,6 +180,8 @@ def remove_glitches(
             bad = glitch_mask(ct.x[p], ct.y[p], None if p == "bat_tip" else kink, noise.get((name, p)))
             xs[p], ys[p] = np.where(bad, np.nan, ct.x[p]), np.where(bad, np.nan, ct.y[p])
             count += bad.sum(axis=1)
+            if p == "ball" and onsets is not None and not bad.any():
+                onsets[name] = on
         cams[name] = CameraTracks(ct.frame0, xs, ys)
         counts[name] = count
     return replace(tracks, cameras=cams), counts
@@ -249,14 +253,15 @@ def reduce_tracks(
     """
     opt = options or ReduceOptions.schema_defaults()
     blocks = tracks.blocks
+    onsets: list[dict] = [{} for _ in blocks]  # the raw ball tracks' onsets that glitches left alone
     nominal = [None] * len(blocks) if like is None else [part for part, _ in like.parts()]
     if like is not None and all(like.cameras[c].fps == cameras[c].fps for c in cameras):
         cleaned = [(part.tracks, part.n_outliers) for part in nominal]  # the glitches depend on the frame rates alone
     else:
         glitch_noise = pooled_noises(blocks)
-        cleaned = [remove_glitches(b, cameras, glitch_noise) for b in blocks]
+        cleaned = [remove_glitches(b, cameras, glitch_noise, o) for b, o in zip(blocks, onsets, strict=True)]
     start_noise = pooled_noises([tr for tr, _ in cleaned]) if like is None else {}
-    balls = [_fit_ball(tr, cameras, part) for (tr, _), part in zip(cleaned, nominal, strict=True)]
+    balls = [_fit_ball(tr, cameras, part, o) for (tr, _), part, o in zip(cleaned, nominal, onsets, strict=True)]
     lik = [m[-1] for m in balls]
     pop = contact_population(
         gather([c.lik for c in lik], tracks.index, tracks.n),
@@ -404,13 +409,14 @@ def _same_camera(like: Reduction | None, cameras: dict[str, Camera], name: str) 
     return like is not None and like.cameras[name] == cameras[name]
 
 
-def _fit_ball(tracks: Tracks, cameras: dict[str, Camera], like: Reduction | None = None) -> tuple:
+def _fit_ball(tracks: Tracks, cameras: dict[str, Camera], like: Reduction | None = None, known=None) -> tuple:
     """Fit the ball of every impact: its onset and free flight in each camera, its contact's likelihood.
 
     Returns ``onset, flight, times, phys`` (:class:`Reduction`'s fields) and the
     :class:`~ballbat.tracks.fit_contact.ContactLikelihood`. ``like``: a reduction of the same
     cleaned tracks, whose camera of unchanged settings is taken as it is, and whose onsets (found
-    on the pixels alone) are taken for every camera where these are its very tracks.
+    on the pixels alone) are taken for every camera where these are its very tracks. ``known``:
+    onsets found on these very pixels already, by camera (:func:`remove_glitches`'s).
     """
     n = tracks.n
     onset, flight, times, phys = {}, {}, {}, {}
@@ -423,7 +429,11 @@ def _fit_ball(tracks: Tracks, cameras: dict[str, Camera], like: Reduction | None
         t = np.broadcast_to(np.arange(ct.n_columns)[None, :] / cam.fps, (n, ct.n_columns))
         times[name] = t
         same_pixels = like is not None and like.tracks is tracks
-        onset[name] = like.onset[name] if same_pixels else find_onset(ct.x["ball"], ct.y["ball"])
+        if same_pixels:
+            onset[name] = like.onset[name]
+        else:
+            found = (known or {}).get(name)
+            onset[name] = find_onset(ct.x["ball"], ct.y["ball"]) if found is None else found
         X, Y = physical(ct, cam, "ball")
         phys[(name, "ball")] = (X, Y)
         flight[name] = fit_flight(X, Y, t, onset[name], cam.fps)
