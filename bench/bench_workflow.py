@@ -81,7 +81,7 @@ def fit_times(sizes=(1_000, 10_000, 100_000)) -> list[tuple[int, float]]:
     from ballbat.synthetic import SyntheticSettings
 
     norm, rec = normalize.NormalizeSettings(v_ref_mph=77.0), reconstruct.ReconstructSettings()
-    fit = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True)
+    fit = fit_ex.FitExSettings(mu_k_example=0.5, systematic=True, check_physical=True, mu_k_bound=True)
 
     balls = load_balls(ROOT / "config" / "balls.csv")
     bats = load_bats(ROOT / "config" / "bats.csv")
