@@ -109,6 +109,8 @@ bench: bytecode
 	$(BIN)/python bench/bench_workflow.py
 	$(BIN)/python bench/bench_stronge.py
 	$(BIN)/python bench/bench_flight.py
+	$(BIN)/python bench/profile_study.py 40 --plain
+	$(BIN)/python bench/bench_study.py
 
 # Habits enforced (CI runs this): ruff (pycodestyle, pyflakes, docstrings, RUF), the format
 # of Python and rule files, and Snakemake's own linter. Type hints: tests/test_lint.py.
