@@ -102,16 +102,29 @@ class _PopulationFit:
 
 
 #: The contact times' likelihood (:func:`_contact_loglik`) in compiled loops (:mod:`ballbat.tracks.contact_kernel`);
-#: False: numpy's. The population's likelihood stays numpy's: Nelder-Mead's path (to 1e-3 in its parameters) turns
-#: on its last bits, which numpy's sums keep the same wherever the impacts are held (blocks, a study, the workflow).
+#: False: numpy's.
 CONTACT_COMPILED = True
+
+#: The population likelihood's sums over the grid (:func:`_population_nll`) in a compiled loop
+#: (:func:`ballbat.tracks.contact_kernel.weighted_row_sums`), numpy's bits; False: numpy's. Only the sums: Nelder-Mead's
+#: path (to 1e-3 in its parameters) turns on the objective's last bits, which numpy's weights and logarithm and its
+#: pairwise sums keep the same wherever the impacts are held (blocks, a study, the workflow). Compiled, a group's
+#: likelihoods are held in Fortran order (:func:`_population_fits`), where the kernel's loops run along memory.
+POPULATION_COMPILED = True
 
 
 def _population_nll(p, L: np.ndarray, grid: np.ndarray) -> float:
     """Minus the group's marginal log-likelihood at beta parameters ``p``."""
     # elementwise and summed along rows, not a BLAS product: the same bits wherever L lies in memory
-    # (ndarray.sum: np.sum's reduction without its wrapper; this runs a hundred times a replicate)
-    return -float(np.log((L * _beta_weights(grid, p)[None, :]).sum(axis=1) + 1e-300).sum())
+    # (ndarray.sum: np.sum's reduction without its wrapper; this runs hundreds of times a replicate)
+    w = _beta_weights(grid, p)
+    if POPULATION_COMPILED:
+        from .contact_kernel import weighted_row_sums
+
+        rows = weighted_row_sums(L, w)  # the product and numpy's pairwise sums in one pass, the same bits
+    else:
+        rows = (L * w[None, :]).sum(axis=1)
+    return -float(np.log(rows + 1e-300).sum())
 
 
 def _population_fits(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -> list[tuple[np.ndarray, _PopulationFit]]:
@@ -126,7 +139,9 @@ def _population_fits(lik: np.ndarray, groups: np.ndarray, grid: np.ndarray) -> l
         rows = (groups == g) & np.all(np.isfinite(lik), axis=1)
         if g < 0 or not rows.any():
             continue
-        L = np.ascontiguousarray(lik[rows] / lik[rows].max(axis=1, keepdims=True))
+        L = lik[rows] / lik[rows].max(axis=1, keepdims=True)
+        # numpy sums C order's rows; the compiled sums (the same bits in any layout) run fastest down its columns
+        L = np.asfortranarray(L) if POPULATION_COMPILED else np.ascontiguousarray(L)
         uniform = np.array([0.0, np.log(2.0)])  # beta(1, 1)
         simplex = uniform + np.array([[0.0, 0.0], [1.0, 0.0], [0.0, 1.0]])
         best = minimize(
