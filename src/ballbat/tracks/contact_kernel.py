@@ -8,7 +8,7 @@ temporaries of each, 34 ms of a 242 ms replicate at the robustness grid's costli
 frame, so it agrees with numpy to round-off (``tests/tracks/test_fit_contact.py``): 16 ms there;
 13.6 -> 9.0 ms (CPU a replicate there, ``profile_study.py``'s timers) since its cosine is skipped for
 the frames before and after the contact, where it is 1 to the bit (the same bits as with it, checked
-against the formula in Python's floats: ``tests/tracks/test_kernels.py``).
+against the formula in Python's floats: ``tests/tracks/test_contact_kernel.py``).
 numpy's stays the reference (``fit_contact.CONTACT_COMPILED = False``).
 
 The population's likelihood (Nelder-Mead's objective, ``fit_contact._population_nll``, some 850
@@ -19,7 +19,7 @@ turns on the objective's last bits, and numpy's keep these the same wherever the
 moved a ball type's contact durations by 2.5e-9 between blocks and one block. So only its costliest
 step is compiled, the likelihood of each impact under the weights, ``(L * w).sum(axis=1)``
 (:func:`weighted_row_sums`): each product rounded as numpy's and each row summed in numpy's pairwise
-order, without the product's temporary, the same bits (``tests/tracks/test_kernels.py`` checks them
+order, without the product's temporary, the same bits (``tests/tracks/test_contact_kernel.py`` checks them
 against numpy's on random rows of 1-1000 terms, and the fitted population with and without); the
 beta weights and the logarithm stay numpy's (its SIMD exp and log are not libm's, which numba calls:
 5 % and 0.1 % of random arguments differ in the last bit). 21 -> 4.7 us a call on 240 impacts held
