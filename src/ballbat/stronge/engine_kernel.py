@@ -62,35 +62,21 @@ def _stick_state(th0, u0, s0, rho, th) -> tuple[float, float]:
 
 
 @_jit
-def _newton_crossing(th0, u0, s0, rho, Lam, e, thf, sign_s, x, lo, hi, tol) -> float:
-    """Root of sign_s S - Lam N in [lo, hi] by safeguarded Newton from ``x`` (``model._newton_bracketed``)."""
+def _newton(th0, u0, s0, rho, Lam, e, thf, sgn, x, lo, hi, tol, maximum) -> float:
+    """Safeguarded Newton from ``x`` in [lo, hi] (``model._newton_bracketed``) on g = sgn S - Lam N.
+
+    ``maximum`` False: g's root (the crossing); True: the root of minus g' (where g has its
+    maximum, ``model._crossings_at_maxima``).
+    """
     for _ in range(100):
         U1, S1 = _stick_state(th0, u0, s0, rho, x)
         N1, dN1 = _normal(x, e, thf)
-        F, dF = sign_s * S1 - Lam * N1, sign_s * U1 - Lam * dN1
-        if F > 0:
-            hi = x
+        if maximum:
+            d2N = -N1 / e**2 if x > HALF_PI else -N1
+            F = -(sgn * U1 - Lam * dN1)
+            dF = -(-sgn * rho * rho * S1 - Lam * d2N)
         else:
-            lo = x
-        new = x - F / dF
-        if not (new >= lo and new <= hi):
-            new = 0.5 * (lo + hi)
-        step = abs(new - x)
-        x = new
-        if step < tol:
-            break
-    return x
-
-
-@_jit
-def _newton_maximum(th0, u0, s0, rho, Lam, e, thf, sgc, x, lo, hi, tol) -> float:
-    """Where g = sgc S - Lam N has its maximum in [lo, hi]: Newton on minus g' (``model._crossings_at_maxima``)."""
-    for _ in range(100):
-        U1, S1 = _stick_state(th0, u0, s0, rho, x)
-        N1, dN1 = _normal(x, e, thf)
-        d2N = -N1 / e**2 if x > HALF_PI else -N1
-        F = -(sgc * U1 - Lam * dN1)
-        dF = -(-sgc * rho * rho * S1 - Lam * d2N)
+            F, dF = sgn * S1 - Lam * N1, sgn * U1 - Lam * dN1
         if F > 0:
             hi = x
         else:
@@ -147,8 +133,8 @@ def _stick_event(th0, u0, s0, rho, Lam, e, thf, end, consts):
             if not (gp[j] > 0 and gp[j + 1] < 0 and j + 1 < first):
                 continue
             sgc = _sign(S[j] if abs(S[j]) > abs(S[j + 1]) else S[j + 1])
-            xm = _newton_maximum(
-                th0, u0, s0, rho, Lam, e, thf, sgc, 0.5 * (grid[j] + grid[j + 1]), grid[j], grid[j + 1], tol
+            xm = _newton(
+                th0, u0, s0, rho, Lam, e, thf, sgc, 0.5 * (grid[j] + grid[j + 1]), grid[j], grid[j + 1], tol, True
             )
             S1 = _stick_state(th0, u0, s0, rho, xm)[1]
             N1 = _normal(xm, e, thf)[0]
@@ -157,7 +143,7 @@ def _stick_event(th0, u0, s0, rho, Lam, e, thf, end, consts):
                 break
     if not has:
         return np.nan, 0.0
-    return _newton_crossing(th0, u0, s0, rho, Lam, e, thf, sg, hi, lo, hi, tol), sg
+    return _newton(th0, u0, s0, rho, Lam, e, thf, sg, hi, lo, hi, tol, False), sg
 
 
 @_jit
