@@ -1,6 +1,7 @@
 """e_x per bat from filmed replicates (issue 38): the filmed example drawn again and again, tracked, e_x judged.
 
-    .venv/bin/python bench/video_replicates.py [N] [FORMAT[:CRF]] [--keep DIR]   (default 50 replicates, mkv)
+    .venv/bin/python bench/video_replicates.py [N] [FORMAT[:CRF]] [--first K] [--keep DIR]  (50 replicates, mkv)
+    .venv/bin/python bench/video_replicates.py --pool DIR...   (the table of kept runs together)
 
 ``config/examples/video.yaml``'s dataset (two bats, 10 impacts each, both cameras filmed at
 1024 x 512, 50 us exposure, noise, uneven light and clutter) is repeated ``N`` times as datasets
@@ -19,6 +20,14 @@ same Student t, at 68 %), with their binomial errors, each measured value's pull
 truth (reduce.nc against simulate.nc: where a bias comes from), and the impacts left out.
 About 45 s of CPU a replicate (drawing 40 clips 18 s, tracking them 17 s). ``--keep DIR`` runs
 in ``DIR`` (a new folder) and keeps it, results and clips, to look into; else a temporary one.
+``--first K`` starts at replicate K (seeds of their own, apart from those of replicates 0 to
+K - 1: a second, independent run). ``--pool DIR...`` prints the table of runs kept with
+``--keep`` together (their replicates must differ).
+
+Last, what the fits alone do: each replicate's reduce.nc with every measured value replaced by
+its truth plus a normal error of its stated size (``IDEAL_DRAWS`` draws), through the same
+fits (:func:`ballbat.chain.run`). Their bias is the fits' own (weights, errors-in-variables);
+what the filmed replicates have beyond it comes from the tracked values.
 """
 
 from __future__ import annotations
@@ -41,14 +50,15 @@ from scipy.special import stdtrit
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "config" / "examples" / "video.yaml"
 QUANTITIES = ("v_bat", "v_ball", "theta", "omega")  # the measured values reduce.nc holds with their errors
+IDEAL_DRAWS = 4  # draws of truth + stated errors per replicate (the fits' own bias)
 SEED_STEP = 7919  # replicate k's seeds: the example's + k * SEED_STEP (apart from every other replicate's)
 
 
-def replicate_config(n: int, fmt: str, crf: int | None) -> dict:
-    """The example's config with its dataset repeated ``n`` times, each with seeds of its own."""
+def replicate_config(ks: range, fmt: str, crf: int | None) -> dict:
+    """The example's config with its dataset repeated as replicates ``ks``, each with seeds of its own."""
     example = yaml.safe_load(EXAMPLE.read_text())
     base = example["datasets"].pop("video")
-    for k in range(n):
+    for k in ks:
         ds = yaml.safe_load(yaml.safe_dump(base))
         ds["synthetic"]["seed"] = int(base["synthetic"]["seed"]) + k * SEED_STEP
         ds["render"]["seed"] = int(base["render"]["seed"]) + k * SEED_STEP
@@ -57,15 +67,15 @@ def replicate_config(n: int, fmt: str, crf: int | None) -> dict:
     return example
 
 
-def run(n: int, fmt: str, crf: int | None, tmp: Path) -> tuple[Path, float]:
-    """Run the ``n`` replicates in a fresh copy under ``tmp``; return its results folder and the wall time."""
+def run(ks: range, fmt: str, crf: int | None, tmp: Path) -> tuple[Path, float]:
+    """Run the replicates ``ks`` in a fresh copy under ``tmp``; return its results folder and the wall time."""
     wd = tmp / "wf"
     wd.mkdir()
     for name in ("Snakefile", "workflow", "config", "src"):
         src = ROOT / name
         (shutil.copytree if src.is_dir() else shutil.copy)(src, wd / name)
-    (wd / "replicates.yaml").write_text(yaml.safe_dump(replicate_config(n, fmt, crf), sort_keys=False))
-    targets = [f"results/video_r{k}/fit_ex.nc" for k in range(n)]
+    (wd / "replicates.yaml").write_text(yaml.safe_dump(replicate_config(ks, fmt, crf), sort_keys=False))
+    targets = [f"results/video_r{k}/fit_ex.nc" for k in ks]
     cmd = [sys.executable, "-m", "snakemake", "-c2", "--configfile", "replicates.yaml", "-q", "--", *targets]
     env = {**os.environ, "PYTHONPATH": str(wd / "src")}
     t0 = time.perf_counter()
@@ -75,18 +85,19 @@ def run(n: int, fmt: str, crf: int | None, tmp: Path) -> tuple[Path, float]:
     return wd / "results", time.perf_counter() - t0
 
 
-def report(results: Path, n: int, seconds: float) -> list[str]:
-    """The table of the ``n`` replicates' e_x per bat against the truth."""
+def report(folders: list[Path], seconds: float | None) -> list[str]:
+    """The table of the replicates in the results ``folders`` (``video_rK``): e_x per bat against the truth."""
     truth = yaml.safe_load(EXAMPLE.read_text())["datasets"]["video"]["synthetic"]["e_x"]["baseball"]
     rows = collections.defaultdict(list)
     left = collections.Counter()
     usable = []
     pulls_of = collections.defaultdict(list)  # measured quantity -> each usable impact's (measured - truth) / error
-    for k in range(n):
-        fit = xr.open_dataset(results / f"video_r{k}" / "fit_ex.nc")
-        red = xr.open_dataset(results / f"video_r{k}" / "reduce.nc")
-        sim = xr.open_dataset(results / f"video_r{k}" / "simulate.nc")
-        rec = xr.open_dataset(results / f"video_r{k}" / "reconstruct.nc")
+    reps = sorted((d for f in folders for d in f.glob("video_r*")), key=lambda d: int(d.name[7:]))
+    if len({d.name for d in reps}) < len(reps):
+        sys.exit("the runs pooled share replicates (the same seeds): pool runs with different --first")
+    n = len(reps)
+    for rep in reps:
+        fit, red, sim, rec = (xr.open_dataset(rep / f"{s}.nc") for s in ("fit_ex", "reduce", "simulate", "reconstruct"))
         reasons = [str(r) for r in red["ingest_flag_reason"].values]
         ok = rec["flag"].values == 0  # the impacts the fits use (reconstruct also leaves out those psi cannot take)
         usable.append(int(ok.sum()))
@@ -106,9 +117,10 @@ def report(results: Path, n: int, seconds: float) -> list[str]:
             rows[bat].append(
                 (float(f["e_x"]), float(f["e_x_err"]), float(f["e_x_ci_low"]), float(f["e_x_ci_high"]), int(f["e_x_n"]))
             )
+    when = f", {seconds / 60:.1f} min on 2 cores" if seconds is not None else ""
     lines = [
-        f"{n} filmed replicates of config/examples/video.yaml, {seconds / 60:.1f} min on 2 cores; usable impacts per "
-        f"replicate {min(usable)}-{max(usable)} of 20"
+        f"{n} filmed replicates of config/examples/video.yaml ({reps[0].name}-{reps[-1].name}){when}; usable "
+        f"impacts per replicate {min(usable)}-{max(usable)} of 20"
     ]
     for bat, r in rows.items():
         e, se, lo, hi, nn = (np.array(c) for c in zip(*r, strict=True))
@@ -119,9 +131,11 @@ def report(results: Path, n: int, seconds: float) -> list[str]:
         half68 = (hi - e) / stdtrit(nn - 1, 0.975) * stdtrit(nn - 1, 0.84)
         cover68 = np.mean(np.abs(d) <= half68)
         m = len(e)
+        bias_err = d.std(ddof=1) / math.sqrt(m) / se.mean()
         lines.append(
             f"  {bat:12s} truth {t:.3f}  mean e_x - truth {d.mean():+.6f} +- {d.std(ddof=1) / math.sqrt(m):.6f}  "
-            f"mean SE {se.mean():.6f}  bias/SE {d.mean() / se.mean():+.3f}  pulls' SD {pulls.std(ddof=1):.3f}  "
+            f"mean SE {se.mean():.6f}  bias/SE {d.mean() / se.mean():+.3f} +- {bias_err:.3f}  "
+            f"pulls' SD {pulls.std(ddof=1):.3f}  "
             f"95 %: {100 * cover95:.1f} +- {100 * math.sqrt(0.95 * 0.05 / m):.1f}  "
             f"68 %: {100 * cover68:.1f} +- {100 * math.sqrt(0.68 * 0.32 / m):.1f}  (n {m} replicates)"
         )
@@ -135,6 +149,39 @@ def report(results: Path, n: int, seconds: float) -> list[str]:
             f"beyond 5: {int(np.sum(np.abs(p) > 5))}  (n {p.size})"
         )
     lines += [f"  left out {c} impacts: {k}" for k, c in left.most_common()]
+    return lines + ideal_lines(reps, truth)
+
+
+def ideal_lines(reps: list[Path], truth: dict[str, float]) -> list[str]:
+    """e_x per bat from each replicate's truth plus normal errors of the stated sizes, through the same fits."""
+    sys.path.insert(0, str(ROOT / "src"))
+    from ballbat import chain
+    from ballbat.config_checks import load_config
+    from ballbat.properties import load_balls, load_bats
+
+    settings = chain.DatasetSettings.from_config(load_config(EXAMPLE), "video")
+    balls, bats = load_balls(ROOT / "config" / "balls.csv"), load_bats(ROOT / "config" / "bats.csv")
+    rng = np.random.default_rng(20261128)
+    out = collections.defaultdict(list)
+    for rep in reps:
+        red = xr.load_dataset(rep / "reduce.nc")
+        sim = xr.load_dataset(rep / "simulate.nc").sel(impact=red["impact"])
+        for _ in range(IDEAL_DRAWS):
+            ds = red.copy()
+            for q in QUANTITIES:
+                noise = rng.standard_normal(red.sizes["impact"]) * red[f"{q}_err"].values
+                ds[q] = ds[q].copy(data=sim[f"truth_{q}"].values + noise)
+            fit = chain.run(settings, ds, balls, bats).fit_ex.sel(ball="baseball")
+            for bat in truth:
+                f = fit.sel(bat=bat)
+                out[bat].append((float(f["e_x"]) - truth[bat], float(f["e_x_err"])))
+    lines = [f"  the same fits from each replicate's truth + its stated errors ({IDEAL_DRAWS} draws a replicate):"]
+    for bat, v in out.items():
+        d, se = (np.array(c) for c in zip(*v, strict=True))
+        lines.append(
+            f"    {bat:12s} bias/SE {d.mean() / se.mean():+.3f} +- {d.std(ddof=1) / math.sqrt(d.size) / se.mean():.3f}"
+            f"  pulls' SD {np.std(d / se, ddof=1):.3f}  (n {d.size})"
+        )
     return lines
 
 
@@ -147,11 +194,19 @@ def main() -> None:
         keep = Path(args[i + 1])
         del args[i : i + 2]
         keep.mkdir(parents=True)  # a new folder: never one with a lab's files in it
+    if args and args[0] == "--pool":
+        print("\n".join(report([Path(a) / "wf" / "results" for a in args[1:]], None)), flush=True)
+        return
+    first = 0
+    if "--first" in args:
+        i = args.index("--first")
+        first = int(args[i + 1])
+        del args[i : i + 2]
     n = int(args[0]) if args else 50
     fmt, _, crf = (args[1] if len(args) > 1 else "mkv").partition(":")
     with tempfile.TemporaryDirectory() as tmp:
-        results, seconds = run(n, fmt, int(crf) if crf else None, keep or Path(tmp))
-        print("\n".join(report(results, n, seconds)), flush=True)
+        results, seconds = run(range(first, first + n), fmt, int(crf) if crf else None, keep or Path(tmp))
+        print("\n".join(report([results], seconds)), flush=True)
 
 
 if __name__ == "__main__":
