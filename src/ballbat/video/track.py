@@ -23,7 +23,9 @@ prediction is at hand (not found yet, or lost for more than 3 frames). The searc
 * **bat_tip** -- a small bright disc (the marker) inside a dark surround (the end cap):
   its centroid weighted by brightness above the surround. A bright spot that stays put for
   :data:`STILL_FRAMES` frames is the background's, not the swinging bat's: its marks are
-  taken back and left out with the reason, and the search skips it from then on.
+  taken back (with the trail's latest marks within two marker radii of it) and left out with
+  the reason, and the search skips it from then on. A marker whose surround reaches the
+  frame's border (:data:`MARKER_SURROUND`) is cut by it: left out.
 
 Nothing is guessed: a point that fails a test is left out, with the reason.
 """
@@ -166,6 +168,12 @@ def _twice_median(v: np.ndarray) -> int:
 #: a frame, and a bat filmed at rest gives no bat speed.
 STILL_FRAMES = 2
 STILL_PX = 0.5
+#: How many of a trail's latest marks are kept to be taken back with a still spot: those within 2 marker radii of
+#: it are the same spot, measured a pixel or two off before it stayed put (a clutter spot the bat passed).
+RECENT = 5
+#: A tip marker is left out where its surround (to this many marker radii, whose median is the end cap's level under
+#: the centroid) is cut by the frame's border: a marker half out of the view is placed 0.2-1.9 px inside it.
+MARKER_SURROUND = 2.5
 
 
 @dataclass
@@ -173,6 +181,7 @@ class _Trail:
     """Last two positions of a point (frame, x, y), for the prediction of the next, and the contrasts found."""
 
     last: list = field(default_factory=list)
+    recent: list = field(default_factory=list)  # the last RECENT positions (a still spot's earlier marks)
     contrasts: list = field(default_factory=list)  # sorted, for their median (:meth:`usual`)
     still: list = field(default_factory=list)  # the latest positions within STILL_PX of each other's frame
     spots: list = field(default_factory=list)  # still spots found: (x, y), skipped by the search
@@ -184,10 +193,11 @@ class _Trail:
         else:
             self.still = [(k, x, y)]
         self.last = [*self.last[-1:], (k, x, y)]
+        self.recent = [*self.recent[-(RECENT - 1) :], (k, x, y)]
 
     def forget(self) -> None:
         """Start again (a still spot taken for the marker): no positions, no contrasts."""
-        self.last, self.contrasts, self.still = [], [], []
+        self.last, self.recent, self.contrasts, self.still = [], [], [], []
 
     def predict(self, k: int) -> tuple[float, float] | None:
         """Return the position expected at frame ``k`` (constant velocity), None when lost for over 3 frames."""
@@ -390,12 +400,16 @@ def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -
         )
         return
     x, y = refine_marker(img, m[0], m[1], mr)
+    edge = min(x, y, img.shape[1] - 1 - x, img.shape[0] - 1 - y)
+    if not edge >= MARKER_SURROUND * mr:  # not a number is cut off too
+        found.leave_out("bat_tip", k, f"marker at {x:.1f}, {y:.1f}, {max(edge, 0):.1f} px from the frame's border: cut")
+        return
     trail.push(k, x, y)
     trail.found(m[2])
     found.add("bat_tip", k, x, y, np.nan, m[2])
     if len(trail.still) >= STILL_FRAMES:  # a spot of the background: its marks taken back, the search skips it
         sx, sy = np.mean([q[1] for q in trail.still]), np.mean([q[2] for q in trail.still])
-        frames = {q[0] for q in trail.still}
+        frames = {q[0] for q in trail.still} | {q[0] for q in trail.recent if np.hypot(q[1] - sx, q[2] - sy) < 2 * mr}
         found.take_back("bat_tip", frames, f"a bright spot at {sx:.1f}, {sy:.1f} that does not move: the background's")
         trail.spots.append((float(sx), float(sy)))
         trail.forget()
