@@ -301,10 +301,13 @@ def _example_reduction(edit=None):
     return reduce_and_check(settings, tracks, balls, bats)[0]
 
 
+@pytest.mark.parametrize("gap", [0, 2])
 @pytest.mark.parametrize("point", ["bat_tip", "ball"])
-def test_a_misplaced_first_click_is_flagged_with_its_reason(point):
+def test_a_misplaced_first_click_is_flagged_with_its_reason(point, gap):
     """The first tip (or ball) click 300 px off moved v_bat 27 % with no flag; now the impact is excluded
-    (flag misplaced_mark), its reason naming the point, the frame and the distance, its values kept.
+    (flag misplaced_mark), its reason naming the point, the frame and the distance, its values kept. Followed
+    by ``gap`` frames not clicked, it was not tested at all (neither by the glitch test, which needs both
+    neighbours; the video tracker kept such a mark once in 2000 filmed impacts, docs/video.md).
     """
     from ballbat.tracks.reduce import ReduceFlag
 
@@ -317,6 +320,8 @@ def test_a_misplaced_first_click_is_flagged_with_its_reason(point):
         ct = tracks.cameras[cam]
         first = int(np.argmax(np.isfinite(ct.x[point][0])))
         ct.x[point][0, first] += 300.0
+        ct.x[point][0, first + 1 : first + 1 + gap] = np.nan
+        ct.y[point][0, first + 1 : first + 1 + gap] = np.nan
         frame.append(int(ct.frame0[0]) + first)
 
     red = _example_reduction(move)

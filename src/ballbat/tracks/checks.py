@@ -292,6 +292,9 @@ def _midpoint_noise(
 #: Marks at the start of a track that :func:`misplaced_starts` tests (the glitch test needs two tracked
 #: frames on each side, so it never tests a track's first two).
 START_MARKS = 2
+#: Untracked frames :func:`misplaced_starts` allows among a track's first START_MARKS + 2 marks (a first mark
+#: followed by frames not clicked, or not found, is tested too; over longer gaps a straight line is no prediction).
+START_GAPS = 2
 
 
 @dataclass
@@ -314,7 +317,11 @@ def misplaced_starts(x: np.ndarray, y: np.ndarray, pooled: float | None = None) 
     third and fourth marks already straddle the impact agrees with its neighbour). s comes from
     the offsets of each mark from its neighbours' midpoint (sd 1.5^0.5 s: :func:`glitch_mask`'s
     robust noise); the threshold is the glitch test's z. A misplaced first click (hundreds of
-    pixels off) is found; a track with fewer than four marks from its start is not tested.
+    pixels off) is found; a track with fewer than four marks is not tested. Up to
+    :data:`START_GAPS` untracked frames among the four are allowed: the marks are then
+    predicted at their frames (p = p2 + lam (p3 - p2), lam = (f_k - f2) / (f3 - f2); offset sd
+    s sqrt(1 + (1 - lam)^2 + lam^2)). Before, a first mark followed by an untracked frame was
+    not tested, and neither is it by the glitch test.
     ``pooled``: as for :func:`glitch_mask`.
     """
     n, m = x.shape
@@ -330,24 +337,27 @@ def misplaced_starts(x: np.ndarray, y: np.ndarray, pooled: float | None = None) 
     if sd is None or m < START_MARKS + 2:
         return MisplacedStart(found, column, distance, np.full(n, np.nan))
     ok = np.isfinite(x) & np.isfinite(y)
-    first = np.argmax(ok, axis=1)
-    cols = np.minimum(first[:, None] + np.arange(START_MARKS + 2)[None, :], m - 1)
+    rank = np.cumsum(ok, axis=1)  # the marks up to each column
+    cols = np.stack([np.argmax(ok & (rank == j + 1), axis=1) for j in range(START_MARKS + 2)], axis=1)
     px, py = np.take_along_axis(x, cols, axis=1), np.take_along_axis(y, cols, axis=1)
-    tested = ok.any(axis=1) & (first + START_MARKS + 1 < m) & np.all(np.take_along_axis(ok, cols, axis=1), axis=1)
+    first = cols[:, 0]
+    tested = (rank[:, -1] >= START_MARKS + 2) & (cols[:, -1] - first <= START_MARKS + 1 + START_GAPS)
     z = math.sqrt(2 * math.log(1 / GLITCH_FALSE_ALARM))
     point_sd = sd / math.sqrt(1.5)
+    t = cols.astype(float)
     for k in range(START_MARKS - 1, -1, -1):  # the earliest far mark is named
-        ex = px[:, k] - (px[:, 2] + (2 - k) * (px[:, 2] - px[:, 3]))
-        ey = py[:, k] - (py[:, 2] + (2 - k) * (py[:, 2] - py[:, 3]))
+        lam = (t[:, k] - t[:, 2]) / np.where(tested, t[:, 3] - t[:, 2], 1.0)  # -2 and -1 without gaps
+        ex = px[:, k] - (px[:, 2] + lam * (px[:, 3] - px[:, 2]))
+        ey = py[:, k] - (py[:, 2] + lam * (py[:, 3] - py[:, 2]))
         d = np.hypot(ex, ey)
         # a mark that sits on one of its neighbours is not misplaced (a ball at rest whose next marks
         # already straddle the impact is not on one line with them)
         others = [j for j in range(3) if j != k]
         near = np.min([np.hypot(px[:, k] - px[:, j], py[:, k] - py[:, j]) for j in others], axis=0)
         alone = near > z * point_sd * math.sqrt(2)
-        far = tested & alone & (d > z * point_sd * math.sqrt(1 + (3 - k) ** 2 + (2 - k) ** 2))
+        far = tested & alone & (d > z * point_sd * np.sqrt(1 + (1 - lam) ** 2 + lam**2))
         found |= far
-        column = np.where(far, first + k, column)
+        column = np.where(far, cols[:, k], column)
         distance = np.where(far, d, distance)
     return MisplacedStart(found, column, distance, point_sd)
 
