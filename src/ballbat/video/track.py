@@ -24,8 +24,8 @@ prediction is at hand (not found yet, or lost for more than 3 frames). The searc
   its centroid weighted by brightness above the surround. A bright spot that stays put for
   :data:`STILL_FRAMES` frames is the background's, not the swinging bat's: its marks are
   taken back (with the trail's latest marks within two marker radii of it) and left out with
-  the reason, and the search skips it from then on. A marker whose surround reaches the
-  frame's border (:data:`MARKER_SURROUND`) is cut by it: left out.
+  the reason, and the search skips it from then on. A marker whose window reaches the
+  frame's border (:data:`MARKER_MARGIN`) is cut by it: left out.
 
 Nothing is guessed: a point that fails a test is left out, with the reason.
 """
@@ -171,9 +171,10 @@ STILL_PX = 0.5
 #: How many of a trail's latest marks are kept to be taken back with a still spot: those within 2 marker radii of
 #: it are the same spot, measured a pixel or two off before it stayed put (a clutter spot the bat passed).
 RECENT = 5
-#: A tip marker is left out where its surround (to this many marker radii, whose median is the end cap's level under
-#: the centroid) is cut by the frame's border: a marker half out of the view is placed 0.2-1.9 px inside it.
-MARKER_SURROUND = 2.5
+#: A tip marker is left out where the frame's border is nearer than this many marker radii (its centroid's window of
+#: 1.3 radii and the blur): a marker partly out of the view is placed 0.2-1.9 px inside it; 9 px (1.9 radii) off
+#: the border the filmed replicates' marks were within 0.02 px of their truth.
+MARKER_MARGIN = 1.5
 
 
 @dataclass
@@ -401,7 +402,7 @@ def _tip(img, k, opt: TrackOptions, trail: _Trail, sigma: float, found: Found) -
         return
     x, y = refine_marker(img, m[0], m[1], mr)
     edge = min(x, y, img.shape[1] - 1 - x, img.shape[0] - 1 - y)
-    if not edge >= MARKER_SURROUND * mr:  # not a number is cut off too
+    if not edge >= MARKER_MARGIN * mr:  # not a number is cut off too
         found.leave_out("bat_tip", k, f"marker at {x:.1f}, {y:.1f}, {max(edge, 0):.1f} px from the frame's border: cut")
         return
     trail.push(k, x, y)
