@@ -26,7 +26,7 @@ import math
 import numpy as np
 from numba import njit
 
-from .soft_kernel import HALF_PI, _sincos
+from .soft_kernel import HALF_PI, _sincos, bracketed_step
 
 _jit = njit(cache=True, nogil=True, error_model="numpy")
 
@@ -77,13 +77,7 @@ def _newton(th0, u0, s0, rho, Lam, e, thf, sgn, x, lo, hi, tol, maximum) -> floa
             dF = -(-sgn * rho * rho * S1 - Lam * d2N)
         else:
             F, dF = sgn * S1 - Lam * N1, sgn * U1 - Lam * dN1
-        if F > 0:
-            hi = x
-        else:
-            lo = x
-        new = x - F / dF
-        if not (new >= lo and new <= hi):
-            new = 0.5 * (lo + hi)
+        new, lo, hi = bracketed_step(x, F, dF, lo, hi)
         step = abs(new - x)
         x = new
         if step < tol:

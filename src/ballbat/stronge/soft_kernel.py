@@ -42,6 +42,22 @@ def _sincos(x: float) -> tuple[float, float]:
 
 
 @_jit
+def bracketed_step(x: float, f: float, df: float, lo: float, hi: float) -> tuple[float, float, float]:
+    """Return one safeguarded Newton step on an increasing f (``model._newton_bracketed``): (new x, lo, hi).
+
+    The bracket is narrowed at ``x``, then Newton's step taken, bisection where it leaves the bracket.
+    """
+    if f > 0:
+        hi = x
+    else:
+        lo = x
+    new = x - f / df
+    if not (new >= lo and new <= hi):
+        new = 0.5 * (lo + hi)
+    return new, lo, hi
+
+
+@_jit
 def _root_loading(rho: float, Lam: float, tol: float) -> float:
     """Root theta in (0, pi/2) of sin(rho theta) / (rho sin theta) = Lam (``model._root_loading``, one impact)."""
     lo, hi = 0.0, HALF_PI
@@ -53,13 +69,7 @@ def _root_loading(rho: float, Lam: float, tol: float) -> float:
         s, c = _sincos(th)
         P = math.log(sr / s) - lr
         dP = rho * cr / sr - c / s
-        if P > 0:
-            hi = th
-        else:
-            lo = th
-        new = th - P / dP
-        if not (new >= lo and new <= hi):
-            new = 0.5 * (lo + hi)
+        new, lo, hi = bracketed_step(th, P, dP, lo, hi)
         step = abs(new - th)
         th = new
         if step < tol:
