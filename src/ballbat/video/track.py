@@ -179,9 +179,8 @@ MARKER_MARGIN = 1.5
 
 @dataclass
 class _Trail:
-    """Last two positions of a point (frame, x, y), for the prediction of the next, and the contrasts found."""
+    """Latest positions of a point (frame, x, y), the last two for predicting the next, and the contrasts found."""
 
-    last: list = field(default_factory=list)
     recent: list = field(default_factory=list)  # the last RECENT positions (a still spot's earlier marks)
     contrasts: list = field(default_factory=list)  # sorted, for their median (:meth:`usual`)
     still: list = field(default_factory=list)  # the latest positions within STILL_PX of each other's frame
@@ -193,12 +192,16 @@ class _Trail:
             self.still.append((k, x, y))
         else:
             self.still = [(k, x, y)]
-        self.last = [*self.last[-1:], (k, x, y)]
         self.recent = [*self.recent[-(RECENT - 1) :], (k, x, y)]
+
+    @property
+    def last(self) -> list:
+        """The last two positions (fewer before two)."""
+        return self.recent[-2:]
 
     def forget(self) -> None:
         """Start again (a still spot taken for the marker): no positions, no contrasts."""
-        self.last, self.recent, self.contrasts, self.still = [], [], [], []
+        self.recent, self.contrasts, self.still = [], [], []
 
     def predict(self, k: int) -> tuple[float, float] | None:
         """Return the position expected at frame ``k`` (constant velocity), None when lost for over 3 frames."""
