@@ -47,6 +47,10 @@ import xarray as xr
 import yaml
 from scipy.special import stdtrit
 
+from ballbat import chain
+from ballbat.config_checks import load_config
+from ballbat.properties import load_balls, load_bats
+
 ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "config" / "examples" / "video.yaml"
 QUANTITIES = ("v_bat", "v_ball", "theta", "omega")  # the measured values reduce.nc holds with their errors
@@ -154,11 +158,6 @@ def report(folders: list[Path], seconds: float | None) -> list[str]:
 
 def ideal_lines(reps: list[Path], truth: dict[str, float]) -> list[str]:
     """e_x per bat from each replicate's truth plus normal errors of the stated sizes, through the same fits."""
-    sys.path.insert(0, str(ROOT / "src"))
-    from ballbat import chain
-    from ballbat.config_checks import load_config
-    from ballbat.properties import load_balls, load_bats
-
     settings = chain.DatasetSettings.from_config(load_config(EXAMPLE), "video")
     balls, bats = load_balls(ROOT / "config" / "balls.csv"), load_bats(ROOT / "config" / "bats.csv")
     rng = np.random.default_rng(20261128)
