@@ -107,7 +107,9 @@ def render_clip_folder(folder, seed: int = 3, n: int | None = None) -> list[Clip
     look = Look(dot_radius_m=0.004, marker_radius_m=0.006)
     for c in true:
         frames = render_frames(c, look, LAB_CAMERAS[c.camera]["m_per_px"])
-        write_clip(folder / f"{c.impact_id}_{c.camera}.tif", frames, c.fps, frame_numbers=c.frames)
+        write_clip(
+            folder / f"{c.impact_id}_{c.camera}.tif", frames, c.fps, exposure_s=look.exposure_s, frame_numbers=c.frames
+        )
     rows = "".join(f"{i},wood,baseball\n" for i in ids)
     (folder / "impacts.csv").write_text("impact_id,bat,ball\n" + rows)
     return true

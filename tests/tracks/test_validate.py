@@ -178,6 +178,21 @@ def test_calibration_uncertainties():
     assert len(ps) == 3
 
 
+def test_exposure_time():
+    """exposure_us: microseconds into the Camera's seconds (0 by default: not known); one longer than the time
+    between frames (1/2000 s typed as 500 us at 3000 fps), or negative, is named.
+    """
+    cams, _ = cameras_from_config(checked_block(tracks_block(swing={"exposure_us": 50}), "tracks"))
+    assert cams["swing"].exposure_s == pytest.approx(50e-6) and cams["spin"].exposure_s == 0.0
+    bad = tracks_block(swing={"exposure_us": 500}, spin={"exposure_us": -1})
+    ps = camera_problems_named(
+        bad,
+        "cameras.swing.exposure_us: 500 us is longer than the 333.3 us between frames at 3000 fps",
+        "cameras.spin.exposure_us: -1 must be a number >= 0",
+    )
+    assert len(ps) == 2
+
+
 def test_camera_settings_good():
     block = tracks_block(swing={"mirror": True, "m_per_px_err": 0.005})
     cams, rig = cameras_from_config(checked_block(block, "tracks"))  # the schema's defaults filled

@@ -59,6 +59,9 @@ def test_clips_are_tracked_into_the_tracks_the_reduction_reads(lab_clips, lab_im
     assert list(tracks.impact_id) == ["W1", "W2", "W3"] and imported.settings_yaml()["files"] == 6
     # the frame rates from the clips (the config gives none)
     assert imported.cameras["swing"]["fps"] == 3000.0 and "file(s)" in imported.cameras["swing"]["fps_from"]
+    # and the exposure (the tip's fit keeps clear of the contact by it)
+    assert imported.cameras["swing"]["exposure_us"] == pytest.approx(50.0)
+    assert "file(s)" in imported.cameras["swing"]["exposure_us_from"]
     for c in true:
         i = list(tracks.impact_id).index(c.impact_id)
         for p in c.x:
@@ -140,6 +143,19 @@ def test_a_frame_rate_the_clips_contradict_is_named(one_impact):
     wrong = _block(folder, swing={"fps": 2000})
     with pytest.raises(InputError, match=r"cameras\.swing\.fps: the config says 2000 but .*W1_swing\.tif says 3000"):
         import_block(wrong, "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
+
+
+@pytest.mark.slow
+def test_an_exposure_the_clips_contradict_is_named(one_impact):
+    """The config's exposure against the clip's (its 0, the default, is "not known": the clip's is taken)."""
+    folder, _ = one_impact
+    wrong = _block(folder, swing={"exposure_us": 500})  # 1/2000 s typed for 1/20000 s
+    with pytest.raises(
+        InputError, match=r"cameras\.swing\.exposure_us: the config says 500 us but .*W1_swing\.tif says 50 us"
+    ):
+        import_block(wrong, "datasets.vid.tracks", *_tables(), clip_reader=clip_reader)
+    _, imported = import_block(_block(folder, swing={"exposure_us": 0.0}), "x", *_tables(), clip_reader=clip_reader)
+    assert imported.cameras["swing"]["exposure_us"] == pytest.approx(50.0)
 
 
 @pytest.mark.slow

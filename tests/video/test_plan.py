@@ -152,8 +152,9 @@ def _tracked(iid: str, cam: str, seed: int) -> tuple[FileTracks, dict]:
     found = q["left_out"] == ""
     tracks = {p: (q["frame"][found & (q["point"] == p)], q["x_px"][found & (q["point"] == p)],
                   q["y_px"][found & (q["point"] == p)]) for p in POINTS[cam]}  # fmt: skip
-    fps = None if cam == "spin" else 3000.0
-    return FileTracks(f"lab/{iid}_{cam}.tif", tracks, fps=fps, source={"fps": "the clip" if fps else ""}), q
+    fps, exposure = (None, None) if cam == "spin" else (3000.0, 50e-6)
+    source = {"fps": "the clip" if fps else "", "exposure_s": "the clip" if exposure else ""}
+    return FileTracks(f"lab/{iid}_{cam}.tif", tracks, fps=fps, source=source, exposure_s=exposure), q
 
 
 def test_a_batch_file_gives_back_what_tracking_gave(tmp_path):
@@ -168,7 +169,7 @@ def test_a_batch_file_gives_back_what_tracking_gave(tmp_path):
     back = batch_clips(read_dataset(path))
     assert list(back) == [c[2] for c in clips]
     for (ft, q), (ft0, q0) in zip(back.values(), made, strict=True):
-        assert ft.path == ft0.path and ft.fps == ft0.fps and ft.source == ft0.source
+        assert ft.path == ft0.path and ft.fps == ft0.fps and ft.source == ft0.source and ft.exposure_s == ft0.exposure_s
         for p in POINTS[ft.path.split("_")[1].removesuffix(".tif")]:
             for a, b in zip(ft.tracks[p], ft0.tracks[p], strict=True):
                 assert a.dtype == b.dtype and np.array_equal(a, b)

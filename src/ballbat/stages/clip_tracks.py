@@ -42,6 +42,8 @@ BATCH_TABLE = {
     "clip_path": Var(("clip",), None, "the clip's file, as the import finds it in the dataset's folder"),
     "clip_fps": Var(("clip",), "Hz", "frame rate the clip's file holds (NaN: none, the config must give it)"),
     "clip_fps_source": Var(("clip",), None, "where in the clip's file its frame rate was read"),
+    "clip_exposure": Var(("clip",), "s", "exposure time of a frame the clip's file holds (NaN: none)"),
+    "clip_exposure_source": Var(("clip",), None, "where in the clip's file its exposure time was read"),
 }
 
 
@@ -104,6 +106,8 @@ def batch_dataset(clips: list[Clip], tracks: list[FileTracks], quality: list[dic
     values["clip_path"] = np.array([ft.path for ft in tracks], dtype=str)
     values["clip_fps"] = np.array([np.nan if ft.fps is None else ft.fps for ft in tracks], dtype=float)
     values["clip_fps_source"] = np.array([ft.source.get("fps", "") for ft in tracks], dtype=str)
+    values["clip_exposure"] = np.array([np.nan if ft.exposure_s is None else ft.exposure_s for ft in tracks], float)
+    values["clip_exposure_source"] = np.array([ft.source.get("exposure_s", "") for ft in tracks], dtype=str)
     attrs = {"n_clips": len(clips), "n_found": int((values["left_out"] == "").sum())}
     return build_dataset(BATCH_TABLE, values, attrs=attrs)
 
@@ -122,7 +126,11 @@ def batch_clips(ds: xr.Dataset) -> dict[str, tuple[FileTracks, dict[str, np.ndar
             sel = mine & found & (q["point"] == p)
             tracks[p] = (q["frame"][sel].astype(np.int64), q["x_px"][sel].astype(float), q["y_px"][sel].astype(float))
         source = {"fps": str(ds["clip_fps_source"].values[k])}
-        ft = FileTracks(path, tracks, fps=None if np.isnan(fps) else fps, source=source)
+        source["exposure_s"] = str(ds["clip_exposure_source"].values[k])
+        exposure = float(ds["clip_exposure"].values[k])
+        ft = FileTracks(
+            path, tracks, None if np.isnan(fps) else fps, None, source, None if np.isnan(exposure) else exposure
+        )
         out[path] = (ft, {c: v[mine] for c, v in q.items()})
     return out
 

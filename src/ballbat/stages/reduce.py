@@ -296,6 +296,7 @@ def reduction_dataset(red: Reduction) -> xr.Dataset:
         attrs[f"{cam}_m_per_px"] = float(c.m_per_px)
         attrs[f"{cam}_mirror"] = int(bool(c.mirror))
         attrs[f"{cam}_m_per_px_rel_err"] = float(c.m_per_px_err)
+        attrs[f"{cam}_exposure_s"] = float(c.exposure_s)
     attrs["pivot_to_tip_m"] = float(red.rig.pivot_to_tip)
     attrs["pivot_to_impact_m"] = float(red.rig.pivot_to_impact)
     _contact_values(red, values, coords)

@@ -47,6 +47,9 @@ class Camera:
         Relative standard uncertainty of ``m_per_px`` (a systematic shared by every impact).
     fps_err : float
         Relative standard uncertainty of ``fps`` (a systematic shared by every impact).
+    exposure_s : float
+        Exposure time of a frame (s); 0 where not known (a frame taken as an instant). A frame
+        whose exposure may reach into the contact is not a frame before it (the tip's fit).
 
     No field has a default: the defaults are the config schema's alone.
     """
@@ -56,6 +59,7 @@ class Camera:
     mirror: bool
     m_per_px_err: float
     fps_err: float
+    exposure_s: float
 
     @property
     def sign(self) -> float:
@@ -365,11 +369,19 @@ def to_dense(
     return out
 
 
+#: A render block's cameras sample the motion at instants: no exposure (its clips' is read from them).
+RENDERED_EXPOSURE_US = 0.0
+
+
 def camera_block(cfg: dict) -> dict:
     """``cameras`` and ``rig`` of a ``tracks`` or ``render`` block, with only the reduction's settings."""
-    keep = ("fps", "m_per_px", "mirror", "m_per_px_err", "fps_err")
+    keep = ("fps", "m_per_px", "mirror", "m_per_px_err", "fps_err", "exposure_us")
+    cams = {n: {k: v for k, v in c.items() if k in keep} for n, c in cfg["cameras"].items()}
+    for c in cams.values():
+        if "exposure_us" not in c:  # a render block's camera (a tracks block's has the schema's)
+            c["exposure_us"] = RENDERED_EXPOSURE_US
     return {
-        "cameras": {n: {k: v for k, v in c.items() if k in keep} for n, c in cfg["cameras"].items()},
+        "cameras": cams,
         "rig": dict(cfg["rig"]),
         **({"min_frames": cfg["min_frames"]} if "min_frames" in cfg else {}),
     }
@@ -398,7 +410,7 @@ def with_found_settings(block: dict, found: dict) -> dict:
     """Return the reduce rule's settings block with the frame rates and pixel scales found in the files."""
     out = {**block, "cameras": {c: dict(v) for c, v in block["cameras"].items()}}
     for cam, vals in found["cameras"].items():
-        for key in ("fps", "m_per_px"):
+        for key in ("fps", "m_per_px", "exposure_us"):
             if key in vals:
                 out["cameras"].setdefault(cam, {})[key] = vals[key]
     return out

@@ -103,6 +103,7 @@ def cameras_from_config(cfg: dict, where: str = "tracks") -> tuple[dict[str, Cam
             mirror=bool(c["mirror"]),
             m_per_px_err=float(c["m_per_px_err"]),
             fps_err=float(c["fps_err"]),
+            exposure_s=float(c["exposure_us"]) * 1e-6,
         )
         for name, c in cfg["cameras"].items()
     }

@@ -335,6 +335,7 @@ def contact_shifts(part: Reduction, lik: ContactLikelihood, shifted: tuple) -> d
             part.rig.pivot_to_tip,
             contact.t_start,
             contact.t_start_err,
+            part.cameras["swing"].exposure_s,
         )
         values = _measured_values(part.flight["swing"], swing, part.spin, contact, part.cameras, part.rig)
         with np.errstate(invalid="ignore"):
@@ -469,6 +470,7 @@ def _fit_bat_and_spin(
         rig.pivot_to_tip,
         contact.t_start,
         contact.t_start_err,
+        cameras["swing"].exposure_s,
     )
     if _same_camera(like, cameras, "spin"):
         for p in ("dot_a", "dot_b"):

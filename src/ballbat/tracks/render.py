@@ -170,6 +170,7 @@ def settings_from_config(cfg: dict) -> RenderSettings:
                 mirror=bool(c["mirror"]),
                 m_per_px_err=float(c["m_per_px_err"]),
                 fps_err=float(c["fps_err"]),
+                exposure_s=0.0,  # the tracks sample the motion at instants
             ),
             width_px=int(c["width_px"]),
             height_px=int(c["height_px"]),

@@ -24,7 +24,7 @@ TRACK_COLUMNS = ("impact_id", "camera", "point", "frame", "x_px", "y_px")
 #: Columns of an impacts file.
 IMPACT_COLUMNS = ("impact_id", "bat", "ball")
 #: Keys of a camera's settings and of the rig.
-CAMERA_KEYS = {"fps", "m_per_px", "mirror", "m_per_px_err", "fps_err"}
+CAMERA_KEYS = {"fps", "m_per_px", "mirror", "m_per_px_err", "fps_err", "exposure_us"}
 CAMERA_REQUIRED = ("fps", "m_per_px", "mirror")
 RIG_KEYS = ("pivot_to_tip_in", "pivot_to_impact_in")
 #: Optional standard uncertainties of the rig's lengths (in; systematics, docs/tracks.md).
@@ -220,7 +220,22 @@ def _camera_problems(c: dict, at: str) -> list[str]:
         )
     if "mirror" in c and not isinstance(c["mirror"], bool):
         problems.append(f"{at}.mirror: {c['mirror']!r} must be true or false")
-    return problems
+    return problems + _exposure_problems(c, at)
+
+
+def _exposure_problems(c: dict, at: str) -> list[str]:
+    """Problems of a camera's exposure time (us): a number >= 0, shorter than the time between frames."""
+    if "exposure_us" not in c:
+        return []
+    e = c["exposure_us"]
+    if not (_is_number(e) and e >= 0):
+        return [f"{at}.exposure_us: {e!r} must be a number >= 0 (microseconds; 0: not known)"]
+    if _is_number(c.get("fps")) and c["fps"] > 0 and e > 1e6 / c["fps"] * (1 + 1e-9):
+        return [
+            f"{at}.exposure_us: {e:g} us is longer than the {1e6 / c['fps']:.4g} us between frames at "
+            f"{c['fps']:g} fps: a frame cannot be exposed for longer (microseconds: 1/20000 s is 50)"
+        ]
+    return []
 
 
 def _rig_problems(rig: dict, where: str) -> list[str]:

@@ -74,7 +74,8 @@ def clip_found(path: Path, camera: str, m_per_px: float, ball_radius_m: float, v
             np.array(rows[k], dtype=t)[sel] for k, t in (("frame", np.int64), ("x_px", float), ("y_px", float))
         )
     info = clip.info
-    return FileTracks(str(path), tracks, fps=info.fps, source={"fps": info.source.get("fps", "the clip")}), found
+    source = {"fps": info.source.get("fps", "the clip"), "exposure_s": info.source.get("exposure_s", "the clip")}
+    return FileTracks(str(path), tracks, fps=info.fps, source=source, exposure_s=info.exposure_s or None), found
 
 
 def _track(job: tuple) -> tuple[FileTracks, dict] | FormatError:

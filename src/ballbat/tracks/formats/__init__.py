@@ -93,8 +93,9 @@ class FileTracks:
     """The tracks of one file, in ballbat's pixel convention, and the settings the file holds.
 
     ``tracks`` maps the tool's track name to ``(frame, x_px, y_px)`` arrays (frames whole,
-    coordinates finite). ``fps`` and ``m_per_px`` are None when the file does not hold them;
-    ``source`` says where each setting came from (for the import report).
+    coordinates finite). ``fps``, ``m_per_px`` and ``exposure_s`` (a frame's exposure time, s: a
+    clip's) are None when the file does not hold them; ``source`` says where each setting came
+    from (for the import report).
     """
 
     path: str
@@ -102,6 +103,7 @@ class FileTracks:
     fps: float | None = None
     m_per_px: float | None = None
     source: dict[str, str] = field(default_factory=dict)
+    exposure_s: float | None = None
 
 
 def whole_frames(values: np.ndarray, what: str, labels: list[str], tol: float = 0.05) -> tuple[np.ndarray, list[str]]:

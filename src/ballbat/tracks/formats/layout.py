@@ -344,7 +344,36 @@ def _camera_settings(cam: str, files: list[FileTracks], config: dict, where: str
                 f"{where}.{key}: missing: the {cam} camera's files do not hold it ({files[0].path}); "
                 "give it in the config"
             )
-    return out, problems
+    exposure, more = _exposure_setting(cam, files, config, where)
+    return {**out, **exposure}, problems + more
+
+
+def _exposure_setting(cam: str, files: list[FileTracks], config: dict, where: str) -> tuple[dict, list[str]]:
+    """Return one camera's exposure time (us) from its files (clips), checked against the config's.
+
+    The config's 0 (its default) is "not known": the files' value is taken. A value the config
+    gives that a file contradicts (by more than 1 %, or 1 us) is a problem naming both. Files of
+    one camera exposed differently: the longest is taken (the tip's fit keeps clear of the
+    contact by a frame's exposure) and the spread is reported.
+    """
+    vals = [(ft.path, ft.exposure_s * 1e6) for ft in files if ft.exposure_s]
+    given = float(config.get("exposure_us") or 0.0)
+    if given > 0:
+        bad = [(p, v) for p, v in vals if abs(v - given) > max(0.01 * given, 1.0)]
+        problems = [
+            f"{where}.exposure_us: the config says {given:g} us but {p} says {v:.4g} us "
+            f"({_src(files, p, 'exposure_s')})"
+            for p, v in bad[:5]
+        ]
+        agrees = f", agrees with {len(vals)} file(s)" if vals else ""
+        return {"exposure_us": given, "exposure_us_from": "config" + agrees}, problems
+    if not vals:
+        return {}, []
+    longest, shortest = max(v for _, v in vals), min(v for _, v in vals)
+    out = {"exposure_us": longest, "exposure_us_from": f"{len(vals)} file(s): {_src(files, vals[0][0], 'exposure_s')}"}
+    if shortest != longest:
+        out["exposure_us_range"] = [shortest, longest]
+    return out, []
 
 
 def _src(files: list[FileTracks], path: str, key: str) -> str:
