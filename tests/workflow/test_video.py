@@ -32,6 +32,7 @@ def test_a_folder_of_clips_is_tracked_and_reduced_to_its_impacts(tmp_path, lab_c
     snakemake(wd, "-c2", "--", "results/vid/reduce.nc")
     found = yaml.safe_load((wd / "results" / "vid" / "imported_cameras.yaml").read_text())
     assert found["files"] == 6 and found["cameras"]["swing"]["fps"] == 3000.0  # the frame rate from the clips
+    assert found["cameras"]["swing"]["exposure_us"] == pytest.approx(50.0)  # and the exposure
     assert (wd / "results" / "vid" / "imported_quality.nc").is_file()  # import_clips: the tracker's quality kept
     red = xr.open_dataset(wd / "results" / "vid" / "reduce.nc")
     assert list(red["impact_id"].values) == ["W1", "W2", "W3"]
@@ -90,6 +91,7 @@ def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_pa
         assert entity and "File" in entity[0]["@type"]
         batch = xr.open_dataset(res / "clip_tracks" / name)
         assert batch.attrs["provenance_rule"] == "track_clips" and batch["clip_fps"].attrs["units"] == "Hz"
+        assert batch["clip_exposure"].attrs["units"] == "s" and np.allclose(batch["clip_exposure"].values, 50e-6)
     assert [xr.open_dataset(res / "clip_tracks" / n).sizes["clip"] for n in batches] == [4, 4]
     _same_as_one_job(wd, res)
     names = sorted(p.name for p in (res / "clips").iterdir())
@@ -98,6 +100,7 @@ def test_a_filmed_experiment_is_drawn_tracked_and_reduced_from_its_pixels(tmp_pa
     truth = xr.open_dataset(res / "simulate.nc")
     red = xr.open_dataset(res / "reduce.nc")
     assert list(red["impact_id"].values) == [str(i) for i in truth["impact"].values]
+    assert red.attrs["swing_exposure_s"] == pytest.approx(50e-6)  # the tip's fit kept clear of the contact by it
     for name in ("v_bat", "v_ball", "theta", "omega"):
         got, err, true = red[name].values, red[f"{name}_err"].values, truth[f"truth_{name}"].values
         assert np.all(np.abs(got - true) < 4 * err), (name, got, true, err)
