@@ -37,7 +37,7 @@ def _cameras(red: xr.Dataset) -> dict[str, Camera]:
             bool(red.attrs[f"{c}_mirror"]),
             float(red.attrs[f"{c}_m_per_px_rel_err"]),
             0.0,  # fps_err: the figures draw the tracks, not the systematics
-            float(red.attrs.get(f"{c}_exposure_s", 0.0)),
+            0.0,  # exposure_s: only the tip's fit uses it, and the figures draw the fits reduce.nc holds
         )
         for c in ("swing", "spin")
     }

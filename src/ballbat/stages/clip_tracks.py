@@ -125,11 +125,14 @@ def batch_clips(ds: xr.Dataset) -> dict[str, tuple[FileTracks, dict[str, np.ndar
         for p in POINTS[cam]:
             sel = mine & found & (q["point"] == p)
             tracks[p] = (q["frame"][sel].astype(np.int64), q["x_px"][sel].astype(float), q["y_px"][sel].astype(float))
-        source = {"fps": str(ds["clip_fps_source"].values[k])}
-        source["exposure_s"] = str(ds["clip_exposure_source"].values[k])
+        source = {"fps": str(ds["clip_fps_source"].values[k]), "exposure_s": str(ds["clip_exposure_source"].values[k])}
         exposure = float(ds["clip_exposure"].values[k])
         ft = FileTracks(
-            path, tracks, None if np.isnan(fps) else fps, None, source, None if np.isnan(exposure) else exposure
+            path,
+            tracks,
+            fps=None if np.isnan(fps) else fps,
+            source=source,
+            exposure_s=None if np.isnan(exposure) else exposure,
         )
         out[path] = (ft, {c: v[mine] for c, v in q.items()})
     return out

@@ -29,7 +29,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from ..units import DEGREE, INCH, G
-from .data import POINTS, Camera, CameraTracks, Rig, Tracks
+from .data import POINTS, RENDERED_EXPOSURE_US, Camera, CameraTracks, Rig, Tracks
 
 #: Side of the square of dots drawn around the spin axis (Sec. II): 1.5 in.
 DOT_SQUARE = 1.5 * INCH
@@ -170,7 +170,7 @@ def settings_from_config(cfg: dict) -> RenderSettings:
                 mirror=bool(c["mirror"]),
                 m_per_px_err=float(c["m_per_px_err"]),
                 fps_err=float(c["fps_err"]),
-                exposure_s=0.0,  # the tracks sample the motion at instants
+                exposure_s=RENDERED_EXPOSURE_US * 1e-6,  # the tracks sample the motion at instants
             ),
             width_px=int(c["width_px"]),
             height_px=int(c["height_px"]),

@@ -344,11 +344,11 @@ def _camera_settings(cam: str, files: list[FileTracks], config: dict, where: str
                 f"{where}.{key}: missing: the {cam} camera's files do not hold it ({files[0].path}); "
                 "give it in the config"
             )
-    exposure, more = _exposure_setting(cam, files, config, where)
+    exposure, more = _exposure_setting(files, config, where)
     return {**out, **exposure}, problems + more
 
 
-def _exposure_setting(cam: str, files: list[FileTracks], config: dict, where: str) -> tuple[dict, list[str]]:
+def _exposure_setting(files: list[FileTracks], config: dict, where: str) -> tuple[dict, list[str]]:
     """Return one camera's exposure time (us) from its files (clips), checked against the config's.
 
     The config's 0 (its default) is "not known": the files' value is taken. A value the config
